@@ -1,0 +1,409 @@
+//! Generates `modelDescription.xml` and `documentation/index.html` from a model's declarations.
+//!
+//! XML is written with quick-xml. (fmi-schema's FMI 2 types were the first choice, but their `<Real>`
+//! has no `unit` attribute and an empty `dependencies=""` list, which says "no direct feed-through",
+//! cannot be written; masters such as OMSimulator would then see algebraic loops that do not exist.)
+//! The GUID is a name-based UUID (v5) of the description written with an empty GUID, so it changes
+//! exactly when the interface changes.
+
+use std::collections::HashMap;
+use std::io::Cursor;
+use std::sync::OnceLock;
+
+use quick_xml::events::{BytesDecl, BytesEnd, BytesStart, BytesText, Event};
+use quick_xml::Writer;
+
+use crate::model::{Causality, Feedthrough, Initial, ModelEntry, Start, VarDecl, VarKind, Variability};
+use crate::units;
+
+/// Log categories declared in every modelDescription and accepted by `fmi2SetDebugLogging`.
+pub const LOG_CATEGORIES: &[(&str, &str)] = &[
+    ("logStatusWarning", "Warnings (always forwarded to the logger)"),
+    ("logStatusError", "Errors (always forwarded to the logger)"),
+    ("logStatusFatal", "Fatal errors (always forwarded to the logger)"),
+    ("logCalls", "Every FMI function call with its arguments (debug logging)"),
+    ("logAll", "All of the above"),
+];
+
+pub const GENERATION_TOOL: &str = concat!("spacecraft_fmus ", env!("CARGO_PKG_VERSION"));
+
+fn causality_str(c: Causality) -> &'static str {
+    match c {
+        Causality::Parameter => "parameter",
+        Causality::CalculatedParameter => "calculatedParameter",
+        Causality::Input => "input",
+        Causality::Output => "output",
+        Causality::Local => "local",
+    }
+}
+
+fn variability_str(v: Variability) -> &'static str {
+    match v {
+        Variability::Constant => "constant",
+        Variability::Fixed => "fixed",
+        Variability::Tunable => "tunable",
+        Variability::Discrete => "discrete",
+        Variability::Continuous => "continuous",
+    }
+}
+
+fn initial_str(i: Initial) -> &'static str {
+    match i {
+        Initial::Exact => "exact",
+        Initial::Approx => "approx",
+        Initial::Calculated => "calculated",
+    }
+}
+
+/// xs:double text of a finite value ("1e30", "0.01", "1.0").
+pub fn fmt_real(v: f64) -> String {
+    assert!(v.is_finite(), "non-finite value cannot go into modelDescription");
+    format!("{v:?}")
+}
+
+fn start_str(s: Start) -> String {
+    match s {
+        Start::Real(v) => fmt_real(v),
+        Start::Integer(v) => v.to_string(),
+        Start::Boolean(v) => v.to_string(),
+    }
+}
+
+/// 1-based indices (position in ModelVariables) of the inputs the output `out` depends on directly.
+fn output_dependencies(entry: &ModelEntry, out: &VarDecl) -> Vec<usize> {
+    let index_of = |name: &str| {
+        entry
+            .decls
+            .iter()
+            .position(|d| d.name == name)
+            .unwrap_or_else(|| panic!("{}: feedthrough names unknown variable {name}", entry.info.name))
+            + 1
+    };
+    let inputs = || entry.decls.iter().enumerate().filter(|(_, d)| d.causality == Causality::Input).map(|(i, _)| i + 1);
+    match entry.info.feedthrough {
+        Feedthrough::None => vec![],
+        Feedthrough::AllInputs => inputs().collect(),
+        Feedthrough::Some(list) => list
+            .iter()
+            .filter(|(o, _)| *o == out.name)
+            .flat_map(|(_, ins)| ins.iter().map(|n| index_of(n)))
+            .collect(),
+    }
+}
+
+fn join(ix: &[usize]) -> String {
+    ix.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(" ")
+}
+
+/// Checks of a declaration table that the type system cannot make: unique names and value
+/// references, known units, feed-through names that are outputs and inputs.
+pub fn check_declarations(entry: &ModelEntry) -> Result<(), String> {
+    let name = entry.info.name;
+    for (i, a) in entry.decls.iter().enumerate() {
+        for b in &entry.decls[i + 1..] {
+            if a.name == b.name {
+                return Err(format!("{name}: duplicate variable name {}", a.name));
+            }
+            // Unique across kinds too: the generated slot/value dispatch matches on the number only.
+            if a.vr == b.vr {
+                return Err(format!("{name}: {} and {} share value reference {}", a.name, b.name, a.vr));
+            }
+        }
+        if !a.unit.is_empty() && units::lookup(a.unit).is_none() {
+            return Err(format!("{name}: variable {} uses undefined unit {}", a.name, a.unit));
+        }
+        if !a.unit.is_empty() && a.kind != VarKind::Real {
+            return Err(format!("{name}: only Real variables carry units ({})", a.name));
+        }
+        if a.description.is_empty() {
+            return Err(format!("{name}: variable {} has no description", a.name));
+        }
+        if let Start::Real(v) = a.start {
+            if !v.is_finite() {
+                return Err(format!("{name}: start of {} is not finite", a.name));
+            }
+        }
+    }
+    if let Feedthrough::Some(list) = entry.info.feedthrough {
+        for (o, ins) in list {
+            match entry.decl(o) {
+                Some(d) if d.causality == Causality::Output => {}
+                _ => return Err(format!("{name}: feedthrough output {o} is not an output")),
+            }
+            for i in *ins {
+                match entry.decl(i) {
+                    Some(d) if d.causality == Causality::Input => {}
+                    _ => return Err(format!("{name}: feedthrough input {i} is not an input")),
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+fn elem<'a>(name: &'a str, attrs: &[(&'a str, String)]) -> BytesStart<'a> {
+    let mut e = BytesStart::new(name);
+    for (k, v) in attrs {
+        e.push_attribute((*k, v.as_str()));
+    }
+    e
+}
+
+/// Writes the complete model description with the given GUID.
+fn write_xml(entry: &ModelEntry, guid: &str) -> String {
+    let info = entry.info;
+    let mut w = Writer::new_with_indent(Cursor::new(Vec::new()), b' ', 2);
+    let empty = |w: &mut Writer<Cursor<Vec<u8>>>, name: &str, attrs: &[(&str, String)]| {
+        w.write_event(Event::Empty(elem(name, attrs))).unwrap();
+    };
+    let start = |w: &mut Writer<Cursor<Vec<u8>>>, name: &str, attrs: &[(&str, String)]| {
+        w.write_event(Event::Start(elem(name, attrs))).unwrap();
+    };
+    let end = |w: &mut Writer<Cursor<Vec<u8>>>, name: &str| {
+        w.write_event(Event::End(BytesEnd::new(name))).unwrap();
+    };
+
+    w.write_event(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None))).unwrap();
+    start(
+        &mut w,
+        "fmiModelDescription",
+        &[
+            ("fmiVersion", "2.0".into()),
+            ("modelName", info.name.into()),
+            ("guid", guid.into()),
+            ("description", info.description.into()),
+            ("author", "spacecraft_fmus contributors".into()),
+            ("version", env!("CARGO_PKG_VERSION").into()),
+            ("license", "BSD-2-Clause".into()),
+            ("generationTool", GENERATION_TOOL.into()),
+            ("variableNamingConvention", "flat".into()),
+            ("numberOfEventIndicators", "0".into()),
+        ],
+    );
+    empty(
+        &mut w,
+        "CoSimulation",
+        &[
+            ("modelIdentifier", info.name.into()),
+            ("needsExecutionTool", "false".into()),
+            ("canHandleVariableCommunicationStepSize", info.variable_step.to_string()),
+            ("canInterpolateInputs", "false".into()),
+            ("maxOutputDerivativeOrder", "0".into()),
+            ("canRunAsynchronuously", "false".into()),
+            ("canBeInstantiatedOnlyOncePerProcess", "false".into()),
+            ("canNotUseMemoryManagementFunctions", "true".into()),
+            ("canGetAndSetFMUstate", "true".into()),
+            ("canSerializeFMUstate", "true".into()),
+            ("providesDirectionalDerivative", "true".into()),
+        ],
+    );
+
+    // Units actually used, in table order (deterministic).
+    let used: Vec<_> = units::UNITS.iter().filter(|(n, _, _)| entry.decls.iter().any(|d| d.unit == *n)).collect();
+    if !used.is_empty() {
+        start(&mut w, "UnitDefinitions", &[]);
+        for (name, b, display) in used {
+            start(&mut w, "Unit", &[("name", (*name).into())]);
+            let mut attrs: Vec<(&str, String)> = vec![];
+            for (k, v) in [("kg", b.kg), ("m", b.m), ("s", b.s), ("A", b.a), ("rad", b.rad)] {
+                if v != 0 {
+                    attrs.push((k, v.to_string()));
+                }
+            }
+            if b.factor != 1.0 {
+                attrs.push(("factor", fmt_real(b.factor)));
+            }
+            empty(&mut w, "BaseUnit", &attrs);
+            for (dn, f) in display.iter() {
+                empty(&mut w, "DisplayUnit", &[("name", (*dn).into()), ("factor", fmt_real(*f))]);
+            }
+            end(&mut w, "Unit");
+        }
+        end(&mut w, "UnitDefinitions");
+    }
+
+    start(&mut w, "LogCategories", &[]);
+    for (name, desc) in LOG_CATEGORIES {
+        empty(&mut w, "Category", &[("name", (*name).into()), ("description", (*desc).into())]);
+    }
+    end(&mut w, "LogCategories");
+
+    empty(
+        &mut w,
+        "DefaultExperiment",
+        &[
+            ("startTime", "0.0".into()),
+            ("stopTime", fmt_real(info.default_stop_time)),
+            ("tolerance", "1e-8".into()),
+            ("stepSize", fmt_real(info.default_step)),
+        ],
+    );
+
+    start(&mut w, "ModelVariables", &[]);
+    for (i, d) in entry.decls.iter().enumerate() {
+        w.write_event(Event::Comment(BytesText::new(&format!(" index {} ", i + 1)))).unwrap();
+        let mut attrs: Vec<(&str, String)> = vec![
+            ("name", d.name.into()),
+            ("valueReference", d.vr.to_string()),
+            ("description", d.description.into()),
+            ("causality", causality_str(d.causality).into()),
+            ("variability", variability_str(d.variability).into()),
+        ];
+        if let Some(init) = d.initial() {
+            attrs.push(("initial", initial_str(init).into()));
+        }
+        start(&mut w, "ScalarVariable", &attrs);
+        let mut t: Vec<(&str, String)> = vec![];
+        if !d.unit.is_empty() {
+            t.push(("unit", d.unit.into()));
+        }
+        if d.has_start() {
+            t.push(("start", start_str(d.start)));
+        }
+        let tag = match d.kind {
+            VarKind::Real => "Real",
+            VarKind::Integer => "Integer",
+            VarKind::Boolean => "Boolean",
+        };
+        empty(&mut w, tag, &t);
+        end(&mut w, "ScalarVariable");
+    }
+    end(&mut w, "ModelVariables");
+
+    start(&mut w, "ModelStructure", &[]);
+    let outputs: Vec<(usize, &VarDecl)> =
+        entry.decls.iter().enumerate().filter(|(_, d)| d.causality == Causality::Output).map(|(i, d)| (i + 1, d)).collect();
+    if !outputs.is_empty() {
+        start(&mut w, "Outputs", &[]);
+        for (ix, d) in &outputs {
+            // An empty list is meaningful: "depends on no input" (state or time only).
+            empty(&mut w, "Unknown", &[("index", ix.to_string()), ("dependencies", join(&output_dependencies(entry, d)))]);
+        }
+        end(&mut w, "Outputs");
+    }
+    let initial_unknowns: Vec<usize> = entry
+        .decls
+        .iter()
+        .enumerate()
+        .filter(|(_, d)| {
+            (d.causality == Causality::Output && d.initial() != Some(Initial::Exact)) || d.causality == Causality::CalculatedParameter
+        })
+        .map(|(i, _)| i + 1)
+        .collect();
+    if !initial_unknowns.is_empty() {
+        start(&mut w, "InitialUnknowns", &[]);
+        for ix in initial_unknowns {
+            // No dependencies attribute: may depend on every parameter and input (FMI 2.0 default).
+            empty(&mut w, "Unknown", &[("index", ix.to_string())]);
+        }
+        end(&mut w, "InitialUnknowns");
+    }
+    end(&mut w, "ModelStructure");
+    end(&mut w, "fmiModelDescription");
+
+    let mut s = String::from_utf8(w.into_inner().into_inner()).expect("quick-xml writes UTF-8");
+    s.push('\n');
+    s
+}
+
+/// Namespace of the project's name-based GUIDs (a fixed random UUID).
+const GUID_NAMESPACE: uuid::Uuid = uuid::Uuid::from_u128(0x6f1d_2b7e_3c4a_4e55_9a61_0d2f_8c3b_71a4);
+
+fn compute_guid(entry: &ModelEntry) -> String {
+    let unsigned = write_xml(entry, "");
+    format!("{{{}}}", uuid::Uuid::new_v5(&GUID_NAMESPACE, unsigned.as_bytes()))
+}
+
+/// GUID of a registered model, computed once per process.
+pub fn guid(entry: &ModelEntry) -> &'static str {
+    static CACHE: OnceLock<HashMap<&'static str, String>> = OnceLock::new();
+    let cache = CACHE.get_or_init(|| crate::registry::all().iter().map(|e| (e.info.name, compute_guid(e))).collect());
+    cache.get(entry.info.name).map(String::as_str).expect("model is registered")
+}
+
+/// The complete modelDescription.xml of a registered model.
+pub fn model_description(entry: &ModelEntry) -> String {
+    write_xml(entry, guid(entry))
+}
+
+fn html_escape(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+}
+
+/// documentation/index.html: purpose, source, equations, variable tables.
+pub fn documentation_html(entry: &ModelEntry) -> String {
+    let info = entry.info;
+    let mut h = String::new();
+    h.push_str("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n");
+    h.push_str(&format!("<title>{}</title>\n", info.name));
+    h.push_str("<style>body{font-family:sans-serif;max-width:60em;margin:2em auto;line-height:1.4}table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:2px 6px;text-align:left;vertical-align:top}pre{background:#f4f4f4;padding:0.5em;overflow-x:auto}code{background:#f4f4f4}</style>\n</head>\n<body>\n");
+    h.push_str(&format!("<h1>{}</h1>\n<p>{}</p>\n", info.name, html_escape(info.description)));
+    h.push_str(&format!("<p><b>Source:</b> {}</p>\n", html_escape(info.source)));
+    h.push_str(&format!("<p><b>GUID:</b> <code>{}</code> &middot; <b>Generated by:</b> {}</p>\n", guid(entry), GENERATION_TOOL));
+    h.push_str("<h2>Equations</h2>\n");
+    h.push_str(info.equations_html);
+    h.push_str("\n<h2>Conventions</h2>\n<ul><li>SI units on every port; degrees only where the name ends in <code>_deg</code>.</li>");
+    h.push_str("<li>Quaternions are scalar-first Hamilton quaternions (q_w, q_x, q_y, q_z) of the body frame relative to the reference frame; A(q) maps reference components into body components.</li>");
+    h.push_str("<li>Parameters are read at fmi2ExitInitializationMode; invalid values give fmi2Error with a log message.</li>");
+    h.push_str("<li>\"No limit\" is encoded as 1e30.</li></ul>\n");
+    for (title, caus) in [
+        ("Parameters", Causality::Parameter),
+        ("Inputs", Causality::Input),
+        ("Outputs", Causality::Output),
+        ("Calculated parameters", Causality::CalculatedParameter),
+        ("Local variables", Causality::Local),
+    ] {
+        let rows: Vec<&VarDecl> = entry.decls.iter().filter(|d| d.causality == caus).collect();
+        if rows.is_empty() {
+            continue;
+        }
+        h.push_str(&format!("<h2>{title}</h2>\n<table>\n<tr><th>name</th><th>vr</th><th>type</th><th>variability</th><th>start</th><th>unit</th><th>meaning</th></tr>\n"));
+        for d in rows {
+            let start = if d.has_start() { start_str(d.start) } else { String::new() };
+            h.push_str(&format!(
+                "<tr><td><code>{}</code></td><td>{}</td><td>{:?}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
+                d.name,
+                d.vr,
+                d.kind,
+                variability_str(d.variability),
+                start,
+                html_escape(d.unit),
+                html_escape(d.description)
+            ));
+        }
+        h.push_str("</table>\n");
+    }
+    h.push_str("</body>\n</html>\n");
+    h
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_registered_model_has_consistent_declarations() {
+        for e in crate::registry::all() {
+            check_declarations(e).unwrap();
+        }
+    }
+
+    #[test]
+    fn guids_are_distinct_and_stable() {
+        let all = crate::registry::all();
+        for (i, a) in all.iter().enumerate() {
+            assert_eq!(guid(a), compute_guid(a));
+            for b in &all[i + 1..] {
+                assert_ne!(guid(a), guid(b));
+            }
+        }
+    }
+
+    #[test]
+    fn real_formatting_is_xs_double() {
+        assert_eq!(fmt_real(1e30), "1e30");
+        assert_eq!(fmt_real(0.01), "0.01");
+        assert_eq!(fmt_real(1.0), "1.0");
+        assert_eq!(fmt_real(-2000.0), "-2000.0");
+    }
+}

@@ -1,0 +1,584 @@
+//! The exported FMI 2.0 Co-Simulation C functions. Each one: checks pointers, finds the instance
+//! among the live ones, checks the state machine, runs the call inside `catch_unwind`, and turns
+//! every failure into a status plus a logger message naming the function and the reason.
+#![allow(non_snake_case, clippy::missing_safety_doc, clippy::not_unsafe_ptr_arg_deref)]
+
+use std::cell::{Cell, RefCell};
+use std::collections::HashSet;
+use std::ffi::{c_char, c_int, c_void, CStr, CString};
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::{Mutex, MutexGuard, Once};
+
+use super::instance::{CallResult, Fail, Instance};
+use super::state::Snapshot;
+use super::{mask, status_kind, CallbackFunctions, FsmState, Status};
+use crate::description;
+use crate::model::{ModelEntry, Value, VarKind};
+use crate::registry;
+
+type Component = *mut c_void;
+
+const TYPES_PLATFORM: &CStr = c"default";
+const VERSION: &CStr = c"2.0";
+
+// ----- live instances ----------------------------------------------------------------------------
+
+fn live_instances() -> MutexGuard<'static, HashSet<usize>> {
+    static LIVE: std::sync::LazyLock<Mutex<HashSet<usize>>> = std::sync::LazyLock::new(|| Mutex::new(HashSet::new()));
+    LIVE.lock().unwrap_or_else(|p| p.into_inner())
+}
+
+/// The instance behind a component pointer, if it is one of ours and not freed. A null, foreign or
+/// freed pointer gives None (and the call returns fmi2Error: there is no logger to tell).
+fn instance<'a>(c: Component) -> Option<&'a mut Instance> {
+    if c.is_null() || !live_instances().contains(&(c as usize)) {
+        return None;
+    }
+    // SAFETY: the address is registered by fmi2Instantiate and removed by fmi2FreeInstance.
+    Some(unsafe { &mut *(c as *mut Instance) })
+}
+
+// ----- panics ------------------------------------------------------------------------------------
+
+thread_local! {
+    static IN_FFI: Cell<bool> = const { Cell::new(false) };
+    static PANIC_MESSAGE: RefCell<Option<String>> = const { RefCell::new(None) };
+}
+
+/// Panics inside an FMI call are reported through the logger, not printed: the hook records the
+/// message and location; outside FMI calls (Rust tests) the previous hook runs as usual.
+fn install_panic_hook() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if IN_FFI.with(Cell::get) {
+                let loc = info.location().map(|l| format!(" at {}:{}", l.file(), l.line())).unwrap_or_default();
+                let msg = info
+                    .payload()
+                    .downcast_ref::<&str>()
+                    .map(|s| s.to_string())
+                    .or_else(|| info.payload().downcast_ref::<String>().cloned())
+                    .unwrap_or_else(|| "unknown panic".into());
+                PANIC_MESSAGE.with(|m| *m.borrow_mut() = Some(format!("{msg}{loc}")));
+            } else {
+                previous(info);
+            }
+        }));
+    });
+}
+
+fn guarded<T>(f: impl FnOnce() -> T) -> Result<T, String> {
+    install_panic_hook();
+    let was = IN_FFI.with(|x| x.replace(true));
+    let r = catch_unwind(AssertUnwindSafe(f));
+    IN_FFI.with(|x| x.set(was));
+    r.map_err(|_| PANIC_MESSAGE.with(|m| m.borrow_mut().take()).unwrap_or_else(|| "unknown panic".into()))
+}
+
+/// Runs an instance call: state check, panic guard, logging of failures.
+fn call(c: Component, func: &str, allowed: u16, f: impl FnOnce(&mut Instance) -> CallResult) -> c_int {
+    let Some(inst) = instance(c) else {
+        return Status::Error as c_int;
+    };
+    if allowed & inst.state.bit() == 0 {
+        let status = if inst.state == FsmState::Fatal { Status::Fatal } else { Status::Error };
+        inst.log_fail(func, &Fail { status, reason: format!("not allowed in state {:?} (illegal call sequence)", inst.state) });
+        return status as c_int;
+    }
+    match guarded(|| f(&mut *inst)) {
+        Ok(Ok(())) => Status::Ok as c_int,
+        Ok(Err(fail)) => {
+            inst.log_fail(func, &fail);
+            fail.status as c_int
+        }
+        Err(panic) => {
+            inst.state = FsmState::Fatal;
+            inst.log_fail(func, &Fail { status: Status::Fatal, reason: format!("internal error (panic): {panic}") });
+            Status::Fatal as c_int
+        }
+    }
+}
+
+// ----- pointer helpers ---------------------------------------------------------------------------
+
+/// Borrows a C array; `n == 0` needs no pointer. Null with n > 0 is an error naming the argument.
+unsafe fn slice<'a, T>(p: *const T, n: usize, what: &str) -> CallResult<&'a [T]> {
+    if n == 0 {
+        return Ok(&[]);
+    }
+    if p.is_null() {
+        return Err(Fail::error(format!("{what} is NULL but its length is {n}")));
+    }
+    if n > (isize::MAX as usize) / std::mem::size_of::<T>().max(1) {
+        return Err(Fail::error(format!("length {n} of {what} is impossible")));
+    }
+    // SAFETY: non-null, length checked against the address space; the master owns n elements.
+    Ok(unsafe { std::slice::from_raw_parts(p, n) })
+}
+
+unsafe fn slice_mut<'a, T>(p: *mut T, n: usize, what: &str) -> CallResult<&'a mut [T]> {
+    if n == 0 {
+        return Ok(&mut []);
+    }
+    if p.is_null() {
+        return Err(Fail::error(format!("{what} is NULL but its length is {n}")));
+    }
+    if n > (isize::MAX as usize) / std::mem::size_of::<T>().max(1) {
+        return Err(Fail::error(format!("length {n} of {what} is impossible")));
+    }
+    // SAFETY: as in `slice`.
+    Ok(unsafe { std::slice::from_raw_parts_mut(p, n) })
+}
+
+fn out_ptr<'a, T>(p: *mut T, what: &str) -> CallResult<&'a mut T> {
+    if p.is_null() {
+        return Err(Fail::error(format!("{what} is NULL")));
+    }
+    // SAFETY: non-null pointer to storage the master provides for the result.
+    Ok(unsafe { &mut *p })
+}
+
+// ----- model lookup for fmi2Instantiate ------------------------------------------------------------
+
+/// File stem of the shared library this code lives in (`AttitudePlant` for
+/// `binaries/linux64/AttitudePlant.so`), so a GUID error can name the expected model.
+fn own_library_stem() -> Option<String> {
+    let mut info: libc::Dl_info = unsafe { std::mem::zeroed() };
+    // SAFETY: dladdr only reads the address; info is valid storage.
+    let ok = unsafe { libc::dladdr(fmi2Instantiate as *const c_void, &mut info) };
+    if ok == 0 || info.dli_fname.is_null() {
+        return None;
+    }
+    // SAFETY: dladdr returns a NUL-terminated path.
+    let path = unsafe { CStr::from_ptr(info.dli_fname) }.to_string_lossy().into_owned();
+    std::path::Path::new(&path).file_stem().map(|s| s.to_string_lossy().into_owned())
+}
+
+fn find_model(guid: &str) -> Result<&'static ModelEntry, String> {
+    let all = registry::all();
+    if let Some(expected) = own_library_stem().and_then(|stem| all.iter().find(|e| e.info.name == stem)) {
+        let want = description::guid(expected);
+        return if guid == want {
+            Ok(expected)
+        } else {
+            Err(format!("fmuGUID {guid} does not match {}'s GUID {want} (modelDescription.xml and binary are from different builds)", expected.info.name))
+        };
+    }
+    all.iter()
+        .find(|e| description::guid(e) == guid)
+        .ok_or_else(|| format!("fmuGUID {guid} matches no model in this binary"))
+}
+
+fn log_without_instance(functions: &CallbackFunctions, name: &CStr, message: &str) {
+    if let Some(logger) = functions.logger {
+        let text = CString::new(format!("fmi2Instantiate: {message}").replace('%', "%%").replace('\0', "")).unwrap_or_default();
+        // SAFETY: master-provided callback with valid NUL-terminated strings.
+        unsafe { logger(functions.component_environment, name.as_ptr(), Status::Error as c_int, c"logStatusError".as_ptr(), text.as_ptr()) };
+    }
+}
+
+// ----- platform ------------------------------------------------------------------------------------
+
+#[no_mangle]
+pub extern "C" fn fmi2GetTypesPlatform() -> *const c_char {
+    TYPES_PLATFORM.as_ptr()
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2GetVersion() -> *const c_char {
+    VERSION.as_ptr()
+}
+
+// ----- life cycle ----------------------------------------------------------------------------------
+
+#[no_mangle]
+pub extern "C" fn fmi2Instantiate(
+    instance_name: *const c_char,
+    fmu_type: c_int,
+    fmu_guid: *const c_char,
+    _resource_location: *const c_char,
+    functions: *const CallbackFunctions,
+    _visible: c_int,
+    logging_on: c_int,
+) -> Component {
+    if functions.is_null() {
+        return std::ptr::null_mut();
+    }
+    // SAFETY: non-null pointer to the master's callback struct.
+    let functions = unsafe { &*functions };
+    let result = guarded(|| -> Result<Component, String> {
+        if instance_name.is_null() {
+            return Err("instanceName is NULL".into());
+        }
+        // SAFETY: non-null C string from the master.
+        let name = unsafe { CStr::from_ptr(instance_name) };
+        if name.to_bytes().is_empty() {
+            return Err("instanceName is empty".into());
+        }
+        if fmu_type != 1 {
+            return Err(format!("fmuType {fmu_type} requested, but this FMU supports only Co-Simulation (fmi2CoSimulation = 1)"));
+        }
+        if fmu_guid.is_null() {
+            return Err("fmuGUID is NULL".into());
+        }
+        // SAFETY: non-null C string from the master.
+        let guid = unsafe { CStr::from_ptr(fmu_guid) }.to_string_lossy();
+        let entry = find_model(&guid)?;
+        let inst = Box::new(Instance::new(name.to_owned(), entry, functions.logger, functions.component_environment, logging_on != 0));
+        inst.trace(|| format!("fmi2Instantiate: {} instance of {}", inst.name.to_string_lossy(), entry.info.name));
+        let p = Box::into_raw(inst) as Component;
+        live_instances().insert(p as usize);
+        Ok(p)
+    });
+    let name = if instance_name.is_null() { c"?" } else { unsafe { CStr::from_ptr(instance_name) } };
+    match result {
+        Ok(Ok(p)) => p,
+        Ok(Err(msg)) => {
+            log_without_instance(functions, name, &msg);
+            std::ptr::null_mut()
+        }
+        Err(panic) => {
+            log_without_instance(functions, name, &format!("internal error (panic): {panic}"));
+            std::ptr::null_mut()
+        }
+    }
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2FreeInstance(c: Component) {
+    if c.is_null() || !live_instances().remove(&(c as usize)) {
+        return; // null or not ours: nothing to free, nothing to log to
+    }
+    let _ = guarded(|| {
+        Snapshot::free_all_of(c as usize);
+        // SAFETY: it was registered (so it is a leaked Box<Instance>) and is now unregistered.
+        drop(unsafe { Box::from_raw(c as *mut Instance) });
+    });
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2SetDebugLogging(c: Component, logging_on: c_int, n: usize, categories: *const *const c_char) -> c_int {
+    call(c, "fmi2SetDebugLogging", mask::SET_DEBUG_LOGGING, |inst| {
+        let ptrs = unsafe { slice(categories, n, "categories[]")? };
+        let mut names = Vec::with_capacity(n);
+        for (i, p) in ptrs.iter().enumerate() {
+            if p.is_null() {
+                return Err(Fail::error(format!("categories[{i}] is NULL")));
+            }
+            // SAFETY: non-null C string from the master.
+            names.push(unsafe { CStr::from_ptr(*p) }.to_string_lossy().into_owned());
+        }
+        inst.set_debug_logging(logging_on != 0, &names)
+    })
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2SetupExperiment(c: Component, tol_defined: c_int, tol: f64, start: f64, stop_defined: c_int, stop: f64) -> c_int {
+    call(c, "fmi2SetupExperiment", mask::SETUP_EXPERIMENT, |inst| {
+        inst.trace(|| format!("fmi2SetupExperiment(toleranceDefined={tol_defined}, tolerance={tol}, startTime={start}, stopTimeDefined={stop_defined}, stopTime={stop})"));
+        inst.setup_experiment((tol_defined != 0).then_some(tol), start, (stop_defined != 0).then_some(stop))
+    })
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2EnterInitializationMode(c: Component) -> c_int {
+    call(c, "fmi2EnterInitializationMode", mask::ENTER_INITIALIZATION_MODE, |inst| inst.enter_initialization_mode())
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2ExitInitializationMode(c: Component) -> c_int {
+    call(c, "fmi2ExitInitializationMode", mask::EXIT_INITIALIZATION_MODE, |inst| inst.exit_initialization_mode())
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2Terminate(c: Component) -> c_int {
+    call(c, "fmi2Terminate", mask::TERMINATE, |inst| {
+        inst.state = FsmState::Terminated;
+        Ok(())
+    })
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2Reset(c: Component) -> c_int {
+    call(c, "fmi2Reset", mask::RESET, |inst| {
+        inst.reset();
+        Ok(())
+    })
+}
+
+// ----- get / set -----------------------------------------------------------------------------------
+
+fn get_typed<T: Copy>(
+    c: Component,
+    func: &str,
+    kind: VarKind,
+    vr: *const u32,
+    n: usize,
+    value: *mut T,
+    conv: impl Fn(Value) -> T,
+) -> c_int {
+    call(c, func, mask::GET, |inst| {
+        let vrs = unsafe { slice(vr, n, "vr[]")? };
+        let out = unsafe { slice_mut(value, n, "value[]")? };
+        let mut vals = Vec::with_capacity(n);
+        inst.get_values(kind, vrs, &mut vals)?;
+        for (o, v) in out.iter_mut().zip(vals) {
+            *o = conv(v);
+        }
+        Ok(())
+    })
+}
+
+fn set_typed<T: Copy>(c: Component, func: &str, kind: VarKind, vr: *const u32, n: usize, value: *const T, conv: impl Fn(T) -> Value) -> c_int {
+    call(c, func, mask::SET, |inst| {
+        let vrs = unsafe { slice(vr, n, "vr[]")? };
+        let vals: Vec<Value> = unsafe { slice(value, n, "value[]")? }.iter().map(|v| conv(*v)).collect();
+        inst.set_values(kind, vrs, &vals)
+    })
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2GetReal(c: Component, vr: *const u32, n: usize, value: *mut f64) -> c_int {
+    get_typed(c, "fmi2GetReal", VarKind::Real, vr, n, value, |v| if let Value::Real(x) = v { x } else { f64::NAN })
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2GetInteger(c: Component, vr: *const u32, n: usize, value: *mut c_int) -> c_int {
+    get_typed(c, "fmi2GetInteger", VarKind::Integer, vr, n, value, |v| if let Value::Integer(x) = v { x } else { 0 })
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2GetBoolean(c: Component, vr: *const u32, n: usize, value: *mut c_int) -> c_int {
+    get_typed(c, "fmi2GetBoolean", VarKind::Boolean, vr, n, value, |v| matches!(v, Value::Boolean(true)) as c_int)
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2GetString(c: Component, vr: *const u32, n: usize, value: *mut *const c_char) -> c_int {
+    call(c, "fmi2GetString", mask::GET, |_inst| {
+        let vrs = unsafe { slice(vr, n, "vr[]")? };
+        unsafe { slice_mut(value, n, "value[]")? };
+        match vrs.first() {
+            None => Ok(()),
+            Some(v) => Err(Fail::error(format!("unknown String value reference {v} (this FMU has no String variables)"))),
+        }
+    })
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2SetReal(c: Component, vr: *const u32, n: usize, value: *const f64) -> c_int {
+    set_typed(c, "fmi2SetReal", VarKind::Real, vr, n, value, Value::Real)
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2SetInteger(c: Component, vr: *const u32, n: usize, value: *const c_int) -> c_int {
+    set_typed(c, "fmi2SetInteger", VarKind::Integer, vr, n, value, Value::Integer)
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2SetBoolean(c: Component, vr: *const u32, n: usize, value: *const c_int) -> c_int {
+    set_typed(c, "fmi2SetBoolean", VarKind::Boolean, vr, n, value, |b| Value::Boolean(b != 0))
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2SetString(c: Component, vr: *const u32, n: usize, value: *const *const c_char) -> c_int {
+    call(c, "fmi2SetString", mask::SET, |_inst| {
+        let vrs = unsafe { slice(vr, n, "vr[]")? };
+        unsafe { slice(value, n, "value[]")? };
+        match vrs.first() {
+            None => Ok(()),
+            Some(v) => Err(Fail::error(format!("unknown String value reference {v} (this FMU has no String variables)"))),
+        }
+    })
+}
+
+// ----- FMU state -----------------------------------------------------------------------------------
+
+#[no_mangle]
+pub extern "C" fn fmi2GetFMUstate(c: Component, state: *mut *mut c_void) -> c_int {
+    call(c, "fmi2GetFMUstate", mask::FMU_STATE, |inst| {
+        let slot = out_ptr(state, "FMUstate")?;
+        let snap = Snapshot::capture(inst, c as usize);
+        if slot.is_null() {
+            *slot = snap.into_handle() as *mut c_void;
+        } else {
+            // Reuse of a state we handed out earlier (allowed by the standard).
+            *unsafe { Snapshot::from_handle(*slot as *mut Snapshot)? } = snap;
+        }
+        Ok(())
+    })
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2SetFMUstate(c: Component, state: *mut c_void) -> c_int {
+    call(c, "fmi2SetFMUstate", mask::FMU_STATE, |inst| {
+        let snap = unsafe { Snapshot::from_handle(state as *mut Snapshot)? };
+        snap.restore_into(inst)
+    })
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2FreeFMUstate(c: Component, state: *mut *mut c_void) -> c_int {
+    call(c, "fmi2FreeFMUstate", mask::FMU_STATE, |_inst| {
+        let slot = out_ptr(state, "FMUstate")?;
+        if slot.is_null() {
+            return Ok(()); // freeing NULL is a no-op
+        }
+        Snapshot::free_handle(*slot as *mut Snapshot)?;
+        *slot = std::ptr::null_mut();
+        Ok(())
+    })
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2SerializedFMUstateSize(c: Component, state: *mut c_void, size: *mut usize) -> c_int {
+    call(c, "fmi2SerializedFMUstateSize", mask::FMU_STATE, |inst| {
+        let out = out_ptr(size, "size")?;
+        let snap = unsafe { Snapshot::from_handle(state as *mut Snapshot)? };
+        let bytes = snap.to_bytes(description::guid(inst.entry))?;
+        *out = bytes.len();
+        snap.serialized = Some(bytes);
+        Ok(())
+    })
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2SerializeFMUstate(c: Component, state: *mut c_void, buffer: *mut c_char, size: usize) -> c_int {
+    call(c, "fmi2SerializeFMUstate", mask::FMU_STATE, |inst| {
+        let snap = unsafe { Snapshot::from_handle(state as *mut Snapshot)? };
+        let bytes = match snap.serialized.take() {
+            Some(b) => b,
+            None => snap.to_bytes(description::guid(inst.entry))?,
+        };
+        if size != bytes.len() {
+            return Err(Fail::error(format!("size {size} differs from fmi2SerializedFMUstateSize = {}", bytes.len())));
+        }
+        let out = unsafe { slice_mut(buffer as *mut u8, size, "serializedState[]")? };
+        out.copy_from_slice(&bytes);
+        Ok(())
+    })
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2DeSerializeFMUstate(c: Component, buffer: *const c_char, size: usize, state: *mut *mut c_void) -> c_int {
+    call(c, "fmi2DeSerializeFMUstate", mask::FMU_STATE, |inst| {
+        let slot = out_ptr(state, "FMUstate")?;
+        let bytes = unsafe { slice(buffer as *const u8, size, "serializedState[]")? };
+        let snap = Snapshot::from_bytes(bytes, inst, c as usize, description::guid(inst.entry))?;
+        if slot.is_null() {
+            *slot = snap.into_handle() as *mut c_void;
+        } else {
+            *unsafe { Snapshot::from_handle(*slot as *mut Snapshot)? } = snap;
+        }
+        Ok(())
+    })
+}
+
+// ----- derivatives ---------------------------------------------------------------------------------
+
+#[no_mangle]
+pub extern "C" fn fmi2GetDirectionalDerivative(
+    c: Component,
+    v_unknown: *const u32,
+    n_unknown: usize,
+    v_known: *const u32,
+    n_known: usize,
+    dv_known: *const f64,
+    dv_unknown: *mut f64,
+) -> c_int {
+    call(c, "fmi2GetDirectionalDerivative", mask::DIRECTIONAL_DERIVATIVE, |inst| {
+        let unknowns = unsafe { slice(v_unknown, n_unknown, "vUnknown_ref[]")? };
+        let knowns = unsafe { slice(v_known, n_known, "vKnown_ref[]")? };
+        let seed = unsafe { slice(dv_known, n_known, "dvKnown[]")? };
+        let out = unsafe { slice_mut(dv_unknown, n_unknown, "dvUnknown[]")? };
+        let d = inst.directional_derivative(unknowns, knowns, seed)?;
+        out.copy_from_slice(&d);
+        Ok(())
+    })
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2SetRealInputDerivatives(c: Component, _vr: *const u32, _n: usize, _order: *const c_int, _value: *const f64) -> c_int {
+    call(c, "fmi2SetRealInputDerivatives", mask::SET_INPUT_DERIVATIVES, |_| {
+        Err(Fail::error("not supported: canInterpolateInputs = false, inputs are held constant over a step"))
+    })
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2GetRealOutputDerivatives(c: Component, _vr: *const u32, _n: usize, _order: *const c_int, _value: *mut f64) -> c_int {
+    call(c, "fmi2GetRealOutputDerivatives", mask::GET_OUTPUT_DERIVATIVES, |_| {
+        Err(Fail::error("not supported: maxOutputDerivativeOrder = 0"))
+    })
+}
+
+// ----- stepping ------------------------------------------------------------------------------------
+
+#[no_mangle]
+pub extern "C" fn fmi2DoStep(c: Component, t: f64, h: f64, _no_set_prior: c_int) -> c_int {
+    call(c, "fmi2DoStep", mask::DO_STEP, |inst| {
+        inst.trace(|| format!("fmi2DoStep(currentCommunicationPoint={t}, communicationStepSize={h})"));
+        inst.do_step(t, h)
+    })
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2CancelStep(c: Component) -> c_int {
+    // Never allowed: fmi2DoStep is synchronous and never returns fmi2Pending.
+    call(c, "fmi2CancelStep", mask::CANCEL_STEP, |_| Ok(()))
+}
+
+fn status_query(c: Component, func: &str, f: impl FnOnce(&mut Instance) -> CallResult) -> c_int {
+    call(c, func, mask::GET_STATUS, f)
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2GetStatus(c: Component, kind: c_int, value: *mut c_int) -> c_int {
+    status_query(c, "fmi2GetStatus", |_| {
+        out_ptr(value, "value")?;
+        Err(Fail::discard(format!("status kind {kind} is not available: no asynchronous step is ever pending")))
+    })
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2GetRealStatus(c: Component, kind: c_int, value: *mut f64) -> c_int {
+    status_query(c, "fmi2GetRealStatus", |inst| {
+        let out = out_ptr(value, "value")?;
+        if kind == status_kind::LAST_SUCCESSFUL_TIME {
+            *out = inst.time;
+            Ok(())
+        } else {
+            Err(Fail::discard(format!("status kind {kind} has no Real value (only fmi2LastSuccessfulTime)")))
+        }
+    })
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2GetIntegerStatus(c: Component, kind: c_int, value: *mut c_int) -> c_int {
+    status_query(c, "fmi2GetIntegerStatus", |_| {
+        out_ptr(value, "value")?;
+        Err(Fail::discard(format!("status kind {kind} has no Integer value")))
+    })
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2GetBooleanStatus(c: Component, kind: c_int, value: *mut c_int) -> c_int {
+    status_query(c, "fmi2GetBooleanStatus", |inst| {
+        let out = out_ptr(value, "value")?;
+        if kind == status_kind::TERMINATED {
+            *out = (inst.state == FsmState::Terminated) as c_int;
+            Ok(())
+        } else {
+            Err(Fail::discard(format!("status kind {kind} has no Boolean value (only fmi2Terminated)")))
+        }
+    })
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2GetStringStatus(c: Component, kind: c_int, value: *mut *const c_char) -> c_int {
+    status_query(c, "fmi2GetStringStatus", |_| {
+        out_ptr(value, "value")?;
+        let _ = status_kind::PENDING_STATUS;
+        let _ = status_kind::DO_STEP_STATUS;
+        Err(Fail::discard(format!("status kind {kind} is not available: no asynchronous step is ever pending")))
+    })
+}

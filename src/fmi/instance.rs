@@ -1,0 +1,396 @@
+//! One FMU instance: state machine, logging, value access with the causality/variability rules,
+//! initialization and stepping. Called only from `abi`, after null/state checks.
+
+use std::collections::HashSet;
+use std::ffi::{c_int, c_void, CString};
+
+use super::{FsmState, LoggerFn, Status};
+use crate::description::LOG_CATEGORIES;
+use crate::model::{Causality, DynModel, Experiment, ModelEntry, SlotMut, Value, VarDecl, VarKind, Variability};
+
+/// Failure of an FMI call: the status to return and the reason to log.
+#[derive(Debug)]
+pub struct Fail {
+    pub status: Status,
+    pub reason: String,
+}
+
+impl Fail {
+    pub fn error(reason: impl Into<String>) -> Self {
+        Fail { status: Status::Error, reason: reason.into() }
+    }
+    pub fn discard(reason: impl Into<String>) -> Self {
+        Fail { status: Status::Discard, reason: reason.into() }
+    }
+}
+
+pub type CallResult<T = ()> = Result<T, Fail>;
+
+/// Index of declarations by (kind, value reference): value references are small integers, so a
+/// vector per kind is the fastest lookup for the per-step get/set calls.
+#[derive(Default)]
+struct VrIndex {
+    real: Vec<Option<u16>>,
+    integer: Vec<Option<u16>>,
+    boolean: Vec<Option<u16>>,
+}
+
+impl VrIndex {
+    fn new(decls: &[VarDecl]) -> Self {
+        let mut ix = VrIndex::default();
+        for (i, d) in decls.iter().enumerate() {
+            let v = match d.kind {
+                VarKind::Real => &mut ix.real,
+                VarKind::Integer => &mut ix.integer,
+                VarKind::Boolean => &mut ix.boolean,
+            };
+            let vr = d.vr as usize;
+            if v.len() <= vr {
+                v.resize(vr + 1, None);
+            }
+            v[vr] = Some(i as u16);
+        }
+        ix
+    }
+    fn get(&self, kind: VarKind, vr: u32) -> Option<usize> {
+        let v = match kind {
+            VarKind::Real => &self.real,
+            VarKind::Integer => &self.integer,
+            VarKind::Boolean => &self.boolean,
+        };
+        v.get(vr as usize).copied().flatten().map(usize::from)
+    }
+}
+
+pub struct Instance {
+    pub name: CString,
+    pub entry: &'static ModelEntry,
+    logger: Option<LoggerFn>,
+    env: *mut c_void,
+    debug_logging: bool,
+    categories: HashSet<&'static str>,
+    pub state: FsmState,
+    pub model: Box<dyn DynModel>,
+    pub exp: Experiment,
+    pub time: f64,
+    /// Outputs must be recomputed before the next get (an input, parameter or the state changed).
+    pub outputs_dirty: bool,
+    /// Parameters changed during initialization: derived quantities must be recomputed.
+    pub params_dirty: bool,
+    index: VrIndex,
+}
+
+fn kind_name(k: VarKind) -> &'static str {
+    match k {
+        VarKind::Real => "Real",
+        VarKind::Integer => "Integer",
+        VarKind::Boolean => "Boolean",
+    }
+}
+
+impl Instance {
+    pub fn new(name: CString, entry: &'static ModelEntry, logger: Option<LoggerFn>, env: *mut c_void, logging_on: bool) -> Self {
+        Instance {
+            name,
+            entry,
+            logger,
+            env,
+            debug_logging: logging_on,
+            categories: LOG_CATEGORIES.iter().map(|(n, _)| *n).collect(),
+            state: FsmState::Instantiated,
+            model: (entry.create)(),
+            exp: Experiment::default(),
+            time: 0.0,
+            outputs_dirty: true,
+            params_dirty: true,
+            index: VrIndex::new(entry.decls),
+        }
+    }
+
+    // ----- logging -----------------------------------------------------------------------------
+
+    /// Sends a message to the logger callback. Warnings and errors always go out; other messages
+    /// only with debug logging on and their category enabled.
+    pub fn log(&self, status: Status, category: &str, message: &str) {
+        let Some(logger) = self.logger else { return };
+        if status < Status::Warning && !(self.debug_logging && (self.categories.contains(category) || self.categories.contains("logAll"))) {
+            return;
+        }
+        // The message is a printf format for C loggers: escape '%'; interior NULs cannot pass.
+        let text = CString::new(message.replace('%', "%%").replace('\0', "")).unwrap_or_default();
+        let cat = CString::new(category).unwrap_or_default();
+        // SAFETY: the logger is the master's callback with the fmi2CallbackLogger signature; all
+        // strings are valid NUL-terminated for the duration of the call.
+        unsafe { logger(self.env, self.name.as_ptr(), status as c_int, cat.as_ptr(), text.as_ptr()) };
+    }
+
+    pub fn log_fail(&self, func: &str, fail: &Fail) {
+        let category = match fail.status {
+            Status::Fatal => "logStatusFatal",
+            Status::Error => "logStatusError",
+            _ => "logStatusWarning",
+        };
+        self.log(fail.status, category, &format!("{func}: {}", fail.reason));
+    }
+
+    pub fn trace(&self, message: impl FnOnce() -> String) {
+        if self.debug_logging && (self.categories.contains("logCalls") || self.categories.contains("logAll")) {
+            self.log(Status::Ok, "logCalls", &message());
+        }
+    }
+
+    pub fn set_debug_logging(&mut self, on: bool, categories: &[String]) -> CallResult {
+        let known: Vec<&'static str> = LOG_CATEGORIES.iter().map(|(n, _)| *n).collect();
+        if let Some(bad) = categories.iter().find(|c| !known.contains(&c.as_str())) {
+            return Err(Fail::error(format!("unknown log category '{bad}' (declared: {})", known.join(", "))));
+        }
+        self.debug_logging = on;
+        if categories.is_empty() {
+            self.categories = known.into_iter().collect();
+        } else {
+            for c in categories {
+                let c = known.iter().find(|k| **k == c.as_str()).copied().expect("checked above");
+                if on {
+                    self.categories.insert(c);
+                } else {
+                    self.categories.remove(c);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    // ----- variable access ----------------------------------------------------------------------
+
+    fn decl(&self, kind: VarKind, vr: u32) -> CallResult<&'static VarDecl> {
+        if let Some(i) = self.index.get(kind, vr) {
+            return Ok(&self.entry.decls[i]);
+        }
+        let other = [VarKind::Real, VarKind::Integer, VarKind::Boolean]
+            .into_iter()
+            .filter(|k| *k != kind)
+            .find_map(|k| self.index.get(k, vr).map(|i| &self.entry.decls[i]));
+        Err(match other {
+            Some(d) => Fail::error(format!(
+                "value reference {vr} is not a {} variable ({} is {})",
+                kind_name(kind),
+                d.name,
+                kind_name(d.kind)
+            )),
+            None => Fail::error(format!("unknown {} value reference {vr}", kind_name(kind))),
+        })
+    }
+
+    /// Whether a variable may be set in the current state (FMI 2.0 section 4.2.4 rules).
+    fn check_settable(&self, d: &VarDecl) -> CallResult {
+        let init = matches!(self.state, FsmState::Instantiated | FsmState::InitializationMode);
+        let ok = match (d.causality, d.variability) {
+            (_, Variability::Constant) => false,
+            (Causality::Input, _) => true,
+            (Causality::Parameter, Variability::Fixed) => init,
+            (Causality::Parameter, Variability::Tunable) => true,
+            (Causality::Parameter, _) => init,
+            _ => false,
+        };
+        if ok {
+            return Ok(());
+        }
+        Err(Fail::error(match d.causality {
+            Causality::Parameter => format!("parameter {} is fixed and cannot be set after initialization (state {:?})", d.name, self.state),
+            Causality::Output => format!("{} is an output and cannot be set", d.name),
+            Causality::CalculatedParameter => format!("{} is a calculated parameter and cannot be set", d.name),
+            _ => format!("{} ({:?}, {:?}) cannot be set", d.name, d.causality, d.variability),
+        }))
+    }
+
+    /// Sets values of one kind atomically: every entry is checked before any is written, so a
+    /// refused call leaves the instance unchanged.
+    pub fn set_values(&mut self, kind: VarKind, vrs: &[u32], values: &[Value]) -> CallResult {
+        let mut decls = Vec::with_capacity(vrs.len());
+        for (vr, v) in vrs.iter().zip(values) {
+            let d = self.decl(kind, *vr)?;
+            self.check_settable(d)?;
+            if let Value::Real(x) = v {
+                if !x.is_finite() {
+                    return Err(Fail::error(format!("value {x} for {} is not finite (use 1e30 for \"no limit\")", d.name)));
+                }
+            }
+            decls.push(d);
+        }
+        for (d, v) in decls.iter().zip(values) {
+            match (self.model.slot(d.vr), v) {
+                (Some(SlotMut::Real(s)), Value::Real(x)) => *s = *x,
+                (Some(SlotMut::Integer(s)), Value::Integer(x)) => *s = *x,
+                (Some(SlotMut::Boolean(s)), Value::Boolean(x)) => *s = *x,
+                _ => return Err(Fail::error(format!("internal: storage of {} does not match its declaration", d.name))),
+            }
+            if d.causality == Causality::Parameter {
+                self.params_dirty = true;
+            }
+        }
+        self.outputs_dirty = true;
+        Ok(())
+    }
+
+    /// Brings outputs up to date with the inputs most recently set. During initialization the
+    /// parameters are (re)applied first so that initial outputs reflect them.
+    pub fn ensure_outputs(&mut self) -> CallResult {
+        if self.state == FsmState::InitializationMode && self.params_dirty {
+            self.model.initialize(&self.exp).map_err(Fail::error)?;
+            self.params_dirty = false;
+            self.outputs_dirty = true;
+        }
+        if self.outputs_dirty && self.state != FsmState::Instantiated {
+            self.model.update_outputs(self.time).map_err(Fail::error)?;
+            for d in self.entry.decls.iter().filter(|d| d.causality == Causality::Output) {
+                if let Some(Value::Real(x)) = self.model.value(d.vr) {
+                    if !x.is_finite() {
+                        return Err(Fail::error(format!("output {} became {x} at t = {}", d.name, self.time)));
+                    }
+                }
+            }
+            self.outputs_dirty = false;
+        }
+        Ok(())
+    }
+
+    pub fn get_values(&mut self, kind: VarKind, vrs: &[u32], out: &mut Vec<Value>) -> CallResult {
+        self.ensure_outputs()?;
+        out.clear();
+        for vr in vrs {
+            let d = self.decl(kind, *vr)?;
+            out.push(self.model.value(d.vr).ok_or_else(|| Fail::error(format!("internal: no storage for {}", d.name)))?);
+        }
+        Ok(())
+    }
+
+    // ----- life cycle ---------------------------------------------------------------------------
+
+    pub fn setup_experiment(&mut self, tolerance: Option<f64>, start: f64, stop: Option<f64>) -> CallResult {
+        if !start.is_finite() {
+            return Err(Fail::error(format!("startTime {start} is not finite")));
+        }
+        if let Some(tol) = tolerance {
+            if !(tol.is_finite() && tol > 0.0) {
+                return Err(Fail::error(format!("tolerance {tol} must be finite and > 0")));
+            }
+        }
+        if let Some(stop) = stop {
+            if !(stop.is_finite() && stop >= start) {
+                return Err(Fail::error(format!("stopTime {stop} must be finite and >= startTime {start}")));
+            }
+        }
+        self.exp = Experiment { start_time: start, tolerance, stop_time: stop };
+        self.time = start;
+        Ok(())
+    }
+
+    pub fn enter_initialization_mode(&mut self) -> CallResult {
+        self.state = FsmState::InitializationMode;
+        self.params_dirty = true;
+        self.outputs_dirty = true;
+        Ok(())
+    }
+
+    /// Applies the parameters. On invalid parameters the instance stays in initialization mode, so
+    /// the master may correct them and call again.
+    pub fn exit_initialization_mode(&mut self) -> CallResult {
+        self.model.initialize(&self.exp).map_err(Fail::error)?;
+        self.params_dirty = false;
+        self.outputs_dirty = true;
+        self.ensure_outputs()?;
+        self.state = FsmState::StepComplete;
+        Ok(())
+    }
+
+    pub fn do_step(&mut self, t: f64, h: f64) -> CallResult {
+        if !(h.is_finite() && h > 0.0) {
+            return Err(Fail::error(format!("communicationStepSize {h} must be finite and > 0")));
+        }
+        let tol = 1e-9 * self.time.abs().max(1.0);
+        if !t.is_finite() || (t - self.time).abs() > tol {
+            return Err(Fail::error(format!("currentCommunicationPoint {t} does not match the FMU time {}", self.time)));
+        }
+        if let Some(stop) = self.exp.stop_time {
+            if t + h > stop + 1e-9 * stop.abs().max(1.0) {
+                return Err(Fail::error(format!("step to {} goes beyond stopTime {stop} set in fmi2SetupExperiment", t + h)));
+            }
+        }
+        if let Err(reason) = self.model.do_step(t, h, &self.exp) {
+            self.state = FsmState::Error;
+            return Err(Fail::error(format!("step from t = {t} failed: {reason}")));
+        }
+        // Continue on the master's grid: no accumulation of round-off in the FMU time.
+        self.time = t + h;
+        self.outputs_dirty = true;
+        if let Err(f) = self.ensure_outputs() {
+            self.state = FsmState::Error;
+            return Err(f);
+        }
+        Ok(())
+    }
+
+    pub fn reset(&mut self) {
+        self.model = (self.entry.create)();
+        self.exp = Experiment::default();
+        self.time = 0.0;
+        self.state = FsmState::Instantiated;
+        self.outputs_dirty = true;
+        self.params_dirty = true;
+    }
+
+    /// Directional derivative of Real outputs with respect to Real inputs, by central differences
+    /// on a copy of the model (the instance itself is not touched).
+    pub fn directional_derivative(&mut self, unknowns: &[u32], knowns: &[u32], dv_known: &[f64]) -> CallResult<Vec<f64>> {
+        self.ensure_outputs()?;
+        let mut known_decls = Vec::with_capacity(knowns.len());
+        for vr in knowns {
+            let d = self.decl(VarKind::Real, *vr)?;
+            if d.causality != Causality::Input {
+                return Err(Fail::error(format!("known {} is not an input", d.name)));
+            }
+            known_decls.push(d);
+        }
+        let mut unknown_decls = Vec::with_capacity(unknowns.len());
+        for vr in unknowns {
+            let d = self.decl(VarKind::Real, *vr)?;
+            if d.causality != Causality::Output {
+                return Err(Fail::error(format!("unknown {} is not an output", d.name)));
+            }
+            unknown_decls.push(d);
+        }
+        if let Some(x) = dv_known.iter().find(|x| !x.is_finite()) {
+            return Err(Fail::error(format!("seed value {x} is not finite")));
+        }
+        let dmax = dv_known.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        if dmax == 0.0 {
+            return Ok(vec![0.0; unknowns.len()]);
+        }
+        let xmax = known_decls.iter().fold(0.0f64, |a, d| match self.model.value(d.vr) {
+            Some(Value::Real(x)) => a.max(x.abs()),
+            _ => a,
+        });
+        let eps = 1e-6 * (1.0 + xmax) / dmax;
+        let eval = |sign: f64| -> CallResult<Vec<f64>> {
+            let mut m = self.model.clone_box();
+            for (d, dv) in known_decls.iter().zip(dv_known) {
+                if let Some(SlotMut::Real(s)) = m.slot(d.vr) {
+                    *s += sign * eps * dv;
+                }
+            }
+            m.update_outputs(self.time).map_err(Fail::error)?;
+            Ok(unknown_decls.iter().map(|d| if let Some(Value::Real(x)) = m.value(d.vr) { x } else { f64::NAN }).collect())
+        };
+        let plus = eval(1.0)?;
+        let minus = eval(-1.0)?;
+        Ok(plus.iter().zip(&minus).map(|(p, m)| (p - m) / (2.0 * eps)).collect())
+    }
+
+    pub fn new_model_like(&self) -> Box<dyn DynModel> {
+        self.model.clone_box()
+    }
+
+    pub fn entry(&self) -> &'static ModelEntry {
+        self.entry
+    }
+}

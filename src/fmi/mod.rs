@@ -1,0 +1,93 @@
+//! The FMI 2.0 Co-Simulation layer, written once for every model: C types, the exported C ABI
+//! (`abi`), the per-instance state machine, logging and value access (`instance`), and FMU state
+//! snapshots and their byte format (`state`). Models never see anything in here.
+
+pub mod abi;
+pub mod instance;
+pub mod state;
+
+use std::ffi::{c_char, c_int, c_void};
+
+/// `fmi2Status`.
+#[repr(i32)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Status {
+    Ok = 0,
+    Warning = 1,
+    Discard = 2,
+    Error = 3,
+    Fatal = 4,
+    Pending = 5,
+}
+
+/// `fmi2CallbackLogger`: a C-variadic function; we always pass a fully formatted message.
+pub type LoggerFn =
+    unsafe extern "C" fn(env: *mut c_void, instance_name: *const c_char, status: c_int, category: *const c_char, message: *const c_char, ...);
+
+/// `fmi2CallbackFunctions`.
+#[repr(C)]
+pub struct CallbackFunctions {
+    pub logger: Option<LoggerFn>,
+    pub allocate_memory: Option<unsafe extern "C" fn(usize, usize) -> *mut c_void>,
+    pub free_memory: Option<unsafe extern "C" fn(*mut c_void)>,
+    pub step_finished: Option<unsafe extern "C" fn(*mut c_void, c_int)>,
+    pub component_environment: *mut c_void,
+}
+
+/// States of the FMI 2.0 Co-Simulation state machine (section 4.2.4). `StepInProgress` and
+/// `StepCanceled` cannot be reached: `fmi2DoStep` never returns `fmi2Pending`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum FsmState {
+    Instantiated,
+    InitializationMode,
+    StepComplete,
+    StepFailed,
+    StepCanceled,
+    Terminated,
+    Error,
+    Fatal,
+}
+
+impl FsmState {
+    pub const fn bit(self) -> u16 {
+        1 << (self as u16)
+    }
+}
+
+/// Sets of states in which a function may be called (FMI 2.0.4, CS state table).
+pub mod mask {
+    use super::FsmState::*;
+    const fn m(states: &[super::FsmState]) -> u16 {
+        let mut bits = 0;
+        let mut i = 0;
+        while i < states.len() {
+            bits |= states[i].bit();
+            i += 1;
+        }
+        bits
+    }
+    pub const SET_DEBUG_LOGGING: u16 = m(&[Instantiated, InitializationMode, StepComplete, StepFailed, StepCanceled, Terminated, Error]);
+    pub const FREE_INSTANCE: u16 = SET_DEBUG_LOGGING;
+    pub const SETUP_EXPERIMENT: u16 = m(&[Instantiated]);
+    pub const ENTER_INITIALIZATION_MODE: u16 = m(&[Instantiated]);
+    pub const EXIT_INITIALIZATION_MODE: u16 = m(&[InitializationMode]);
+    pub const TERMINATE: u16 = m(&[StepComplete, StepFailed]);
+    pub const RESET: u16 = FREE_INSTANCE;
+    pub const GET: u16 = m(&[InitializationMode, StepComplete, StepFailed, StepCanceled, Terminated, Error]);
+    pub const SET: u16 = m(&[Instantiated, InitializationMode, StepComplete]);
+    pub const FMU_STATE: u16 = FREE_INSTANCE;
+    pub const DIRECTIONAL_DERIVATIVE: u16 = GET;
+    pub const SET_INPUT_DERIVATIVES: u16 = m(&[Instantiated, InitializationMode, StepComplete]);
+    pub const GET_OUTPUT_DERIVATIVES: u16 = m(&[StepComplete, StepFailed, StepCanceled, Terminated, Error]);
+    pub const DO_STEP: u16 = m(&[StepComplete]);
+    pub const CANCEL_STEP: u16 = 0; // StepInProgress only, which this FMU never enters
+    pub const GET_STATUS: u16 = m(&[StepComplete, StepFailed, Terminated]);
+}
+
+/// `fmi2StatusKind`.
+pub mod status_kind {
+    pub const DO_STEP_STATUS: i32 = 0;
+    pub const PENDING_STATUS: i32 = 1;
+    pub const LAST_SUCCESSFUL_TIME: i32 = 2;
+    pub const TERMINATED: i32 = 3;
+}

@@ -1,0 +1,17 @@
+//! Spacecraft guidance and control units as FMI 2.0 Co-Simulation FMUs.
+//!
+//! - `fmi`: the FMI 2.0 CS C ABI, state machine, logging and FMU state, written once.
+//! - `model`: what a model is (declared variables + init/step code) and the declaration macro.
+//! - `models`: one file per FMU; `registry` lists them.
+//! - `description`: modelDescription.xml and documentation generated from the declarations.
+//! - `math`: shared math (attitude conventions, integrators, ...), unit-tested on its own.
+//! - `package`: writes `fmus/<Model>.fmu` and `modelDescription/<Model>.xml`.
+
+pub mod description;
+pub mod fmi;
+pub mod math;
+pub mod model;
+pub mod models;
+pub mod package;
+pub mod registry;
+pub mod units;

@@ -1,0 +1,8 @@
+//! One file per FMU model. Each declares its variables, its init/step code and its documentation;
+//! `crate::registry` lists them.
+
+pub mod attitude_command;
+pub mod attitude_controller;
+pub mod attitude_metrics;
+pub mod attitude_plant;
+pub mod pd_controller;

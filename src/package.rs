@@ -1,0 +1,72 @@
+//! Packaging: `modelDescription/<Model>.xml` and `fmus/<Model>.fmu` for every registered model.
+//! One cdylib build serves every FMU: it is copied into each archive as
+//! `binaries/linux64/<Model>.so`, and `fmi2Instantiate` picks the model by file name and GUID.
+
+use std::fs;
+use std::io::Write;
+use std::path::Path;
+
+use zip::write::SimpleFileOptions;
+use zip::{CompressionMethod, DateTime, ZipWriter};
+
+use crate::description::{documentation_html, model_description};
+use crate::model::ModelEntry;
+use crate::registry;
+
+/// Platform folder of the binary inside the FMU.
+pub const PLATFORM: &str = if cfg!(all(target_os = "linux", target_pointer_width = "64")) {
+    "linux64"
+} else if cfg!(all(target_os = "windows", target_pointer_width = "64")) {
+    "win64"
+} else if cfg!(target_os = "macos") {
+    "darwin64"
+} else {
+    "unknown"
+};
+
+/// Shared-library file extension of the platform.
+pub const LIB_EXT: &str = if cfg!(target_os = "windows") {
+    "dll"
+} else if cfg!(target_os = "macos") {
+    "dylib"
+} else {
+    "so"
+};
+
+/// Writes `modelDescription/<Model>.xml` for every model; returns the paths written.
+pub fn write_model_descriptions(dir: &Path) -> std::io::Result<Vec<String>> {
+    fs::create_dir_all(dir)?;
+    let mut written = vec![];
+    for e in registry::all() {
+        let p = dir.join(format!("{}.xml", e.info.name));
+        fs::write(&p, model_description(e))?;
+        written.push(p.display().to_string());
+    }
+    Ok(written)
+}
+
+/// Names of the models whose committed `modelDescription/<Model>.xml` differs from the generated one.
+pub fn stale_model_descriptions(dir: &Path) -> Vec<String> {
+    registry::all()
+        .iter()
+        .filter(|e| fs::read_to_string(dir.join(format!("{}.xml", e.info.name))).ok().as_deref() != Some(model_description(e).as_str()))
+        .map(|e| e.info.name.to_string())
+        .collect()
+}
+
+/// Writes one `.fmu` archive (deterministic: fixed timestamps, fixed order).
+pub fn write_fmu(entry: &ModelEntry, library: &[u8], out_dir: &Path) -> std::io::Result<std::path::PathBuf> {
+    fs::create_dir_all(out_dir)?;
+    let path = out_dir.join(format!("{}.fmu", entry.info.name));
+    let mut zip = ZipWriter::new(fs::File::create(&path)?);
+    let opts = SimpleFileOptions::default().compression_method(CompressionMethod::Deflated).last_modified_time(DateTime::default());
+    let add = |zip: &mut ZipWriter<fs::File>, name: &str, data: &[u8], mode: u32| -> std::io::Result<()> {
+        zip.start_file(name, opts.unix_permissions(mode)).map_err(std::io::Error::other)?;
+        zip.write_all(data)
+    };
+    add(&mut zip, "modelDescription.xml", model_description(entry).as_bytes(), 0o644)?;
+    add(&mut zip, &format!("binaries/{PLATFORM}/{}.{LIB_EXT}", entry.info.name), library, 0o755)?;
+    add(&mut zip, "documentation/index.html", documentation_html(entry).as_bytes(), 0o644)?;
+    zip.finish().map_err(std::io::Error::other)?;
+    Ok(path)
+}
