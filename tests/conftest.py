@@ -1,0 +1,7 @@
+"""pytest configuration: the FMU tests drive the built FMUs in fmus/ through fmpy."""
+
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "scripts"))
