@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 from fmpy import extract, read_model_description
-from fmpy.fmi2 import FMU2Slave
+from fmpy.fmi2 import FMU2Slave, defaultCallbacks, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
 
 ROOT = Path(__file__).resolve().parents[2]
 FMU_DIR = Path(os.environ.get("SCFMU_FMU_DIR", ROOT / "fmus"))
@@ -32,31 +32,46 @@ def fmu_path(model: str) -> Path:
     return p
 
 
+def recording_callbacks(messages: list) -> fmi2CallbackFunctions:
+    """fmi2CallbackFunctions whose logger appends (status, category, message) to `messages`."""
+
+    def log(_env, _name, status, category, message):
+        messages.append((int(status), (category or b"").decode(), (message or b"").decode().replace("%%", "%")))
+
+    cb = fmi2CallbackFunctions()
+    cb.logger = fmi2CallbackLoggerTYPE(log)
+    cb.allocateMemory = defaultCallbacks.allocateMemory
+    cb.freeMemory = defaultCallbacks.freeMemory
+    cb._keep = cb.logger  # keep the ctypes thunk alive as long as the struct
+    return cb
+
+
 class Fmu:
-    """One instantiated, initialized co-simulation FMU with name-based access."""
+    """One instantiated co-simulation FMU with name-based access. With `initialize=True` (default) it
+    is set up, given `params` in initialization mode, and ready to step at `start_time`. Every
+    logger message is kept in `messages` as (status, category, text)."""
 
     def __init__(self, model: str, params: dict | None = None, name: str | None = None,
                  start_time: float = 0.0, stop_time: float | None = None, tolerance: float | None = None,
-                 logger=None, path: Path | None = None):
+                 path: Path | None = None, initialize: bool = True, logging_on: bool = False):
         self.model = model
         self.path = Path(path) if path else fmu_path(model)
         self.md = read_model_description(str(self.path))
         self.vars = {v.name: v for v in self.md.modelVariables}
         self.unzipdir = extract(str(self.path))
-        self.messages: list[tuple[int, str]] = []
-        kwargs = {}
-        if logger is not None:
-            kwargs["logger"] = logger
+        self.messages: list[tuple[int, str, str]] = []
+        self.callbacks = recording_callbacks(self.messages)
         self.slave = FMU2Slave(guid=self.md.guid, unzipDirectory=self.unzipdir,
                                modelIdentifier=self.md.coSimulation.modelIdentifier,
-                               instanceName=name or model, **kwargs)
-        self.slave.instantiate()
-        self.slave.setupExperiment(tolerance=tolerance, startTime=start_time, stopTime=stop_time)
-        self.slave.enterInitializationMode()
-        for k, v in (params or {}).items():
-            self.set(k, v)
-        self.slave.exitInitializationMode()
+                               instanceName=name or model)
+        self.slave.instantiate(callbacks=self.callbacks, loggingOn=logging_on)
         self.time = start_time
+        if initialize:
+            self.slave.setupExperiment(tolerance=tolerance, startTime=start_time, stopTime=stop_time)
+            self.slave.enterInitializationMode()
+            for k, v in (params or {}).items():
+                self.set(k, v)
+            self.slave.exitInitializationMode()
 
     # ----- name-based access -------------------------------------------------------------
     def var(self, name: str):

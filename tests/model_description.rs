@@ -1,0 +1,44 @@
+//! The committed modelDescription/ files are exactly what the declarations generate, and every
+//! generated description passes fmi-rs's FMI 2.0 validation and parses with fmi-schema.
+
+use std::path::Path;
+use std::str::FromStr;
+
+use spacecraft_fmus::description::model_description;
+use spacecraft_fmus::package::stale_model_descriptions;
+use spacecraft_fmus::registry;
+
+#[test]
+fn committed_model_descriptions_are_not_stale() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("modelDescription");
+    let stale = stale_model_descriptions(&dir);
+    assert!(stale.is_empty(), "stale modelDescription/ for {stale:?}: run scripts/build_fmus.sh and commit");
+}
+
+#[test]
+fn fmi_rs_validation_finds_no_problem() {
+    for e in registry::all() {
+        let xml = model_description(e);
+        let md = fmi_rs::model_description::fmi2::ModelDescription::from_string(&xml)
+            .unwrap_or_else(|err| panic!("{}: fmi-rs cannot read the description: {err}", e.info.name));
+        let problems: Vec<String> = md.validate().into_iter().map(|p| p.message).collect();
+        assert!(problems.is_empty(), "{}: {problems:?}", e.info.name);
+    }
+}
+
+#[test]
+fn fmi_schema_reads_every_variable_back() {
+    for e in registry::all() {
+        let xml = model_description(e);
+        let md = fmi_schema::fmi2::Fmi2ModelDescription::from_str(&xml).unwrap_or_else(|err| panic!("{}: {err}", e.info.name));
+        assert_eq!(md.model_name, e.info.name);
+        assert_eq!(md.num_variables(), e.decls.len());
+        let cs = md.co_simulation.as_ref().expect("CoSimulation element");
+        assert_eq!(cs.model_identifier, e.info.name);
+        assert_eq!(cs.can_get_and_set_fmu_state, Some(true));
+        assert_eq!(cs.can_serialize_fmu_state, Some(true));
+        for (sv, d) in md.model_variables.variables.iter().zip(e.decls) {
+            assert_eq!((sv.name.as_str(), sv.value_reference), (d.name, d.vr));
+        }
+    }
+}
