@@ -171,12 +171,7 @@ impl Instance {
             .filter(|k| *k != kind)
             .find_map(|k| self.index.get(k, vr).map(|i| &self.entry.decls[i]));
         Err(match other {
-            Some(d) => Fail::error(format!(
-                "value reference {vr} is not a {} variable ({} is {})",
-                kind_name(kind),
-                d.name,
-                kind_name(d.kind)
-            )),
+            Some(d) => Fail::error(format!("value reference {vr} is {} ({}), not {}", d.name, kind_name(d.kind), kind_name(kind))),
             None => Fail::error(format!("unknown {} value reference {vr}", kind_name(kind))),
         })
     }
