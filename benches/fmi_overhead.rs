@@ -1,1 +1,126 @@
-fn main() {}
+//! Cost of one FMI co-simulation cycle through the C ABI (fmi2SetReal of the inputs, fmi2DoStep,
+//! fmi2GetReal of the outputs) against the same model work called directly in Rust
+//! (field writes, `Model::do_step`, `Model::update_outputs`, field reads).
+//!
+//! Run: `cargo bench --bench fmi_overhead` (prints a Markdown table for docs/benchmarks.md).
+
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+use std::hint::black_box;
+use std::time::Instant;
+
+use common::TestFmu;
+use spacecraft_fmus::fmi::abi::{fmi2DoStep, fmi2GetReal, fmi2SetReal};
+use spacecraft_fmus::model::{Experiment, Model};
+use spacecraft_fmus::models::attitude_plant::AttitudePlant;
+use spacecraft_fmus::models::pd_controller::PdController;
+
+const H: f64 = 0.01;
+
+/// Median over `reps` repetitions of the mean time per iteration of `n` iterations, in ns.
+fn time_ns(reps: usize, n: usize, mut f: impl FnMut(usize)) -> f64 {
+    let mut samples: Vec<f64> = (0..reps)
+        .map(|r| {
+            let t = Instant::now();
+            for k in 0..n {
+                f(r * n + k);
+            }
+            t.elapsed().as_nanos() as f64 / n as f64
+        })
+        .collect();
+    samples.sort_by(f64::total_cmp);
+    samples[reps / 2]
+}
+
+struct Case {
+    name: &'static str,
+    inputs: &'static [&'static str],
+    outputs: &'static [&'static str],
+}
+
+const PD: Case = Case {
+    name: "PdController",
+    inputs: &["q_w", "q_x", "q_y", "q_z", "w_x", "w_y", "w_z", "q_ref_w", "q_ref_x", "q_ref_y"],
+    outputs: &["torque_cmd_x", "torque_cmd_y", "torque_cmd_z", "k_x", "k_y", "k_z", "k_d_x", "k_d_y", "k_d_z", "torque_cmd_x"],
+};
+
+const PLANT: Case = Case {
+    name: "AttitudePlant",
+    inputs: &["torque_cmd_x", "torque_cmd_y", "torque_cmd_z", "torque_dist_x", "torque_dist_y", "torque_dist_z", "torque_cmd_x", "torque_cmd_y", "torque_cmd_z", "torque_dist_x"],
+    outputs: &["q_w", "q_x", "q_y", "q_z", "w_x", "w_y", "w_z", "roll", "pitch", "yaw"],
+};
+
+fn input_values(case: &Case, k: usize) -> Vec<f64> {
+    let s = 1e-3 * (k % 1000) as f64;
+    if case.name == "PdController" {
+        let q = [(1.0f64 - s * s).sqrt(), s, 0.0, 0.0];
+        vec![q[0], q[1], q[2], q[3], 0.01, -0.02, 0.03, 1.0, 0.0, 0.0]
+    } else {
+        vec![s, -s, 0.5 * s, 0.0, 0.0, 0.0, s, -s, 0.5 * s, 0.0]
+    }
+}
+
+fn abi_cycle(case: &Case, reps: usize, n: usize) -> f64 {
+    let mut f = TestFmu::new(case.name);
+    f.init(&[], &[]);
+    let vin: Vec<u32> = case.inputs.iter().map(|x| f.vr(x)).collect();
+    let vout: Vec<u32> = case.outputs.iter().map(|x| f.vr(x)).collect();
+    let mut out = vec![0.0; vout.len()];
+    let mut t = 0.0;
+    time_ns(reps, n, |k| {
+        let u = input_values(case, k);
+        assert_eq!(fmi2SetReal(f.c, vin.as_ptr(), vin.len(), u.as_ptr()), 0);
+        assert_eq!(fmi2DoStep(f.c, t, H, 1), 0);
+        t += H;
+        assert_eq!(fmi2GetReal(f.c, vout.as_ptr(), vout.len(), out.as_mut_ptr()), 0);
+        black_box(&out);
+    })
+}
+
+fn direct_plant(reps: usize, n: usize) -> f64 {
+    let mut m = AttitudePlant::default();
+    let exp = Experiment::default();
+    m.initialize(&exp).unwrap();
+    let mut t = 0.0;
+    time_ns(reps, n, |k| {
+        let u = input_values(&PLANT, k);
+        let v = m.vars_mut();
+        (v.torque_cmd_x, v.torque_cmd_y, v.torque_cmd_z, v.torque_dist_x, v.torque_dist_y, v.torque_dist_z) = (u[6], u[7], u[8], u[9], u[4], u[5]);
+        m.do_step(t, H, &exp).unwrap();
+        t += H;
+        m.update_outputs(t).unwrap();
+        let v = m.vars();
+        black_box([v.q_w, v.q_x, v.q_y, v.q_z, v.w_x, v.w_y, v.w_z, v.roll, v.pitch, v.yaw]);
+    })
+}
+
+fn direct_pd(reps: usize, n: usize) -> f64 {
+    let mut m = PdController::default();
+    let exp = Experiment::default();
+    m.initialize(&exp).unwrap();
+    let mut t = 0.0;
+    time_ns(reps, n, |k| {
+        let u = input_values(&PD, k);
+        let v = m.vars_mut();
+        (v.q_w, v.q_x, v.q_y, v.q_z, v.w_x, v.w_y, v.w_z, v.q_ref_w, v.q_ref_x, v.q_ref_y) = (u[0], u[1], u[2], u[3], u[4], u[5], u[6], u[7], u[8], u[9]);
+        m.do_step(t, H, &exp).unwrap();
+        t += H;
+        m.update_outputs(t).unwrap();
+        let v = m.vars();
+        black_box([v.torque_cmd_x, v.torque_cmd_y, v.torque_cmd_z, v.k_x, v.k_y, v.k_z, v.k_d_x, v.k_d_y, v.k_d_z]);
+    })
+}
+
+fn main() {
+    // `cargo test --benches` runs this with --bench absent: keep that quick.
+    let quick = !std::env::args().any(|a| a == "--bench");
+    let (reps, n) = if quick { (3, 1_000) } else { (15, 100_000) };
+    println!("| cycle (10 inputs set, doStep {H} s, 10 outputs read) | C ABI [ns] | direct Rust [ns] | ratio |");
+    println!("|---|---|---|---|");
+    for (case, direct) in [(&PD, direct_pd as fn(usize, usize) -> f64), (&PLANT, direct_plant)] {
+        let a = abi_cycle(case, reps, n);
+        let d = direct(reps, n);
+        println!("| {} | {a:.0} | {d:.0} | {:.2} |", case.name, a / d);
+    }
+}

@@ -321,20 +321,15 @@ fn get_typed<T: Copy>(
     call(c, func, mask::GET, |inst| {
         let vrs = unsafe { slice(vr, n, "vr[]")? };
         let out = unsafe { slice_mut(value, n, "value[]")? };
-        let mut vals = Vec::with_capacity(n);
-        inst.get_values(kind, vrs, &mut vals)?;
-        for (o, v) in out.iter_mut().zip(vals) {
-            *o = conv(v);
-        }
-        Ok(())
+        inst.get_values(kind, vrs, |i, v| out[i] = conv(v))
     })
 }
 
 fn set_typed<T: Copy>(c: Component, func: &str, kind: VarKind, vr: *const u32, n: usize, value: *const T, conv: impl Fn(T) -> Value) -> c_int {
     call(c, func, mask::SET, |inst| {
         let vrs = unsafe { slice(vr, n, "vr[]")? };
-        let vals: Vec<Value> = unsafe { slice(value, n, "value[]")? }.iter().map(|v| conv(*v)).collect();
-        inst.set_values(kind, vrs, &vals)
+        let vals = unsafe { slice(value, n, "value[]")? };
+        inst.set_values(kind, vrs, |i| conv(vals[i]))
     })
 }
 

@@ -78,6 +78,8 @@ pub struct Instance {
     /// Parameters changed during initialization: derived quantities must be recomputed.
     pub params_dirty: bool,
     index: VrIndex,
+    /// Declaration indices of the Real outputs (checked for finiteness after every update).
+    real_outputs: Vec<usize>,
 }
 
 fn kind_name(k: VarKind) -> &'static str {
@@ -104,6 +106,7 @@ impl Instance {
             outputs_dirty: true,
             params_dirty: true,
             index: VrIndex::new(entry.decls),
+            real_outputs: entry.decls.iter().enumerate().filter(|(_, d)| d.causality == Causality::Output && d.kind == VarKind::Real).map(|(i, _)| i).collect(),
         }
     }
 
@@ -199,24 +202,23 @@ impl Instance {
     }
 
     /// Sets values of one kind atomically: every entry is checked before any is written, so a
-    /// refused call leaves the instance unchanged.
-    pub fn set_values(&mut self, kind: VarKind, vrs: &[u32], values: &[Value]) -> CallResult {
-        let mut decls = Vec::with_capacity(vrs.len());
-        for (vr, v) in vrs.iter().zip(values) {
+    /// refused call leaves the instance unchanged. `value(i)` is the value for `vrs[i]`.
+    pub fn set_values(&mut self, kind: VarKind, vrs: &[u32], value: impl Fn(usize) -> Value) -> CallResult {
+        for (i, vr) in vrs.iter().enumerate() {
             let d = self.decl(kind, *vr)?;
             self.check_settable(d)?;
-            if let Value::Real(x) = v {
+            if let Value::Real(x) = value(i) {
                 if !x.is_finite() {
                     return Err(Fail::error(format!("value {x} for {} is not finite (use 1e30 for \"no limit\")", d.name)));
                 }
             }
-            decls.push(d);
         }
-        for (d, v) in decls.iter().zip(values) {
-            match (self.model.slot(d.vr), v) {
-                (Some(SlotMut::Real(s)), Value::Real(x)) => *s = *x,
-                (Some(SlotMut::Integer(s)), Value::Integer(x)) => *s = *x,
-                (Some(SlotMut::Boolean(s)), Value::Boolean(x)) => *s = *x,
+        for (i, vr) in vrs.iter().enumerate() {
+            let d = self.decl(kind, *vr)?;
+            match (self.model.slot(d.vr), value(i)) {
+                (Some(SlotMut::Real(s)), Value::Real(x)) => *s = x,
+                (Some(SlotMut::Integer(s)), Value::Integer(x)) => *s = x,
+                (Some(SlotMut::Boolean(s)), Value::Boolean(x)) => *s = x,
                 _ => return Err(Fail::error(format!("internal: storage of {} does not match its declaration", d.name))),
             }
             if d.causality == Causality::Parameter {
@@ -237,7 +239,8 @@ impl Instance {
         }
         if self.outputs_dirty && self.state != FsmState::Instantiated {
             self.model.update_outputs(self.time).map_err(Fail::error)?;
-            for d in self.entry.decls.iter().filter(|d| d.causality == Causality::Output) {
+            for &i in &self.real_outputs {
+                let d = &self.entry.decls[i];
                 if let Some(Value::Real(x)) = self.model.value(d.vr) {
                     if !x.is_finite() {
                         return Err(Fail::error(format!("output {} became {x} at t = {}", d.name, self.time)));
@@ -249,12 +252,12 @@ impl Instance {
         Ok(())
     }
 
-    pub fn get_values(&mut self, kind: VarKind, vrs: &[u32], out: &mut Vec<Value>) -> CallResult {
+    /// Reads values of one kind; `write(i, v)` receives the value of `vrs[i]`.
+    pub fn get_values(&mut self, kind: VarKind, vrs: &[u32], mut write: impl FnMut(usize, Value)) -> CallResult {
         self.ensure_outputs()?;
-        out.clear();
-        for vr in vrs {
+        for (i, vr) in vrs.iter().enumerate() {
             let d = self.decl(kind, *vr)?;
-            out.push(self.model.value(d.vr).ok_or_else(|| Fail::error(format!("internal: no storage for {}", d.name)))?);
+            write(i, self.model.value(d.vr).ok_or_else(|| Fail::error(format!("internal: no storage for {}", d.name)))?);
         }
         Ok(())
     }
