@@ -67,7 +67,7 @@ pub mod mask {
         bits
     }
     pub const SET_DEBUG_LOGGING: u16 = m(&[Instantiated, InitializationMode, StepComplete, StepFailed, StepCanceled, Terminated, Error]);
-    pub const FREE_INSTANCE: u16 = SET_DEBUG_LOGGING;
+    pub const FREE_INSTANCE: u16 = SET_DEBUG_LOGGING; // fmi2FreeInstance itself is always honoured (also after fmi2Fatal)
     pub const SETUP_EXPERIMENT: u16 = m(&[Instantiated]);
     pub const ENTER_INITIALIZATION_MODE: u16 = m(&[Instantiated]);
     pub const EXIT_INITIALIZATION_MODE: u16 = m(&[InitializationMode]);
