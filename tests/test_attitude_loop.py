@@ -187,3 +187,23 @@ def test_controller_torque_is_the_paper_law(dt):
         assert np.allclose(got, expected, rtol=1e-14, atol=1e-12)
     finally:
         sim.close()
+
+
+def test_directional_derivatives_match_the_closed_form():
+    """fmi2GetDirectionalDerivative: ∂T/∂w = k_d (diagonal) for the PD law; the plant's state outputs
+    do not depend on its inputs, its applied torque does with slope 1 below the limit, 0 above it."""
+    ctrl = Fmu("PdController")
+    plant = Fmu("AttitudePlant", {"u_max_y": 1.0})
+    try:
+        vr = lambda f, n: f.var(n).valueReference  # noqa: E731
+        d = ctrl.slave.getDirectionalDerivative([vr(ctrl, "torque_cmd_x"), vr(ctrl, "torque_cmd_y"), vr(ctrl, "torque_cmd_z")],
+                                                [vr(ctrl, "w_y")], [1.0])
+        assert np.allclose(d, [0.0, -1000.0, 0.0], rtol=1e-8, atol=1e-6)
+        plant.set("torque_cmd_x", 0.5)
+        plant.set("torque_cmd_y", 3.0)  # saturated at 1
+        unknowns = [vr(plant, n) for n in ["q_x", "w_x", "torque_applied_x", "torque_applied_y"]]
+        d = plant.slave.getDirectionalDerivative(unknowns, [vr(plant, "torque_cmd_x"), vr(plant, "torque_cmd_y")], [1.0, 1.0])
+        assert np.allclose(d, [0.0, 0.0, 1.0, 0.0], atol=1e-9)
+    finally:
+        ctrl.close()
+        plant.close()
