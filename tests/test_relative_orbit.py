@@ -345,3 +345,27 @@ def test_eccentric_leader_feed_forward():
     assert diffs[0] < 1e-5
     assert 1.8 < diffs[0] / diffs[1] < 2.2
     assert mismatch > 20 * diffs[0]
+
+
+def test_step_response_matches_linear_closed_loop():
+    """Case a, structure 0, nonlinear plant, Δ = RK4 step = 0.005 s, 40 s: the position error follows
+    ë + (K2 + c)ė + (K1 + cK2)e + cK1 E = 0 (E = ∫e, e(0) = ref, ė(0) = 0), solved independently with DOP853;
+    max deviation <= 2e-3 * |ref| (O(Δ): force held over a step, E by the rectangle rule); the 2 % settling
+    time (13.43 s for this reference) is reproduced to 0.05 s."""
+    t2, c = 5.0, 5.0
+    k1, k2 = 10.0 / (3.0 * t2**2), 2.5 / t2
+    out = closed_loop(t2, c, 40.0, 0.005)
+    t = out["time"]
+
+    def f(_t, x):
+        return [x[1], -(k2 + c) * x[1] - (k1 + c * k2) * x[0] - c * k1 * x[2], x[0]]
+
+    sol = solve_ivp(f, (0.0, t[-1]), [1.0, 0.0, 0.0], t_eval=t, method="DOP853", rtol=1e-11, atol=1e-13)
+    e_lin = sol.y[0]
+    ts_lin = t[np.nonzero(np.abs(e_lin) > 0.02)[0][-1] + 1]
+    for a, r in zip(AX, REF):
+        dev = np.max(np.abs((r - out[f"pos_{a}"]) - r * e_lin))
+        ts = settling_time(t, out[f"pos_{a}"], r)
+        print(f"axis {a}: max |e - e_linear| = {dev:.3e} m, settling {ts:.3f} s (linear reference {ts_lin:.3f} s)")
+        assert dev <= 2e-3 * r
+        assert abs(ts - ts_lin) <= 0.05
