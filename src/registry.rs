@@ -4,7 +4,11 @@
 use std::sync::OnceLock;
 
 use crate::model::ModelEntry;
-use crate::models::{attitude_command::AttitudeCommand, attitude_metrics::AttitudeMetrics, attitude_plant::AttitudePlant, pd_controller::PdController};
+use crate::models::{
+    attitude_command::AttitudeCommand, attitude_metrics::AttitudeMetrics, attitude_plant::AttitudePlant, pd_controller::PdController,
+    predictive_pid_controller::PredictivePidController, relative_orbit_plant::RelativeOrbitPlant,
+    relative_position_command::RelativePositionCommand,
+};
 
 pub fn all() -> &'static [ModelEntry] {
     static ALL: OnceLock<Vec<ModelEntry>> = OnceLock::new();
@@ -14,6 +18,9 @@ pub fn all() -> &'static [ModelEntry] {
             ModelEntry::of::<AttitudeCommand>(),
             ModelEntry::of::<PdController>(),
             ModelEntry::of::<AttitudeMetrics>(),
+            ModelEntry::of::<RelativeOrbitPlant>(),
+            ModelEntry::of::<RelativePositionCommand>(),
+            ModelEntry::of::<PredictivePidController>(),
         ]
     })
 }

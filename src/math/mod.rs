@@ -1,7 +1,10 @@
-//! Shared math used by the models: attitude representations and conversions, integrators.
+//! Shared math used by the models: attitude representations and conversions, integrators,
+//! relative orbital motion, predictive-control gains.
 //! Each module carries its own unit tests against closed-form results.
 
 pub mod attitude;
 pub mod integrate;
+pub mod predictive_control;
+pub mod relative_orbit;
 
 pub use nalgebra::{Matrix3, Quaternion, Vector3};

@@ -6,3 +6,6 @@ pub mod attitude_controller;
 pub mod attitude_metrics;
 pub mod attitude_plant;
 pub mod pd_controller;
+pub mod predictive_pid_controller;
+pub mod relative_orbit_plant;
+pub mod relative_position_command;
