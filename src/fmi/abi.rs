@@ -7,11 +7,11 @@ use std::cell::{Cell, RefCell};
 use std::collections::HashSet;
 use std::ffi::{c_char, c_int, c_void, CStr, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::sync::{Mutex, MutexGuard, Once};
+use std::sync::{MutexGuard, Once};
 
 use super::instance::{CallResult, Fail, Instance};
 use super::state::Snapshot;
-use super::{mask, status_kind, CallbackFunctions, FsmState, Status};
+use super::{mask, status_kind, BuildAddrHasher, CallbackFunctions, FsmState, LiveSet, Status};
 use crate::description;
 use crate::model::{ModelEntry, Value, VarKind};
 use crate::registry;
@@ -23,9 +23,9 @@ const VERSION: &CStr = c"2.0";
 
 // ----- live instances ----------------------------------------------------------------------------
 
-fn live_instances() -> MutexGuard<'static, HashSet<usize>> {
-    static LIVE: std::sync::LazyLock<Mutex<HashSet<usize>>> = std::sync::LazyLock::new(|| Mutex::new(HashSet::new()));
-    LIVE.lock().unwrap_or_else(|p| p.into_inner())
+fn live_instances() -> MutexGuard<'static, HashSet<usize, BuildAddrHasher>> {
+    static LIVE: LiveSet = LiveSet::new();
+    LIVE.lock()
 }
 
 /// The instance behind a component pointer, if it is one of ours and not freed. A null, foreign or

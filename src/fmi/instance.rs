@@ -52,6 +52,7 @@ impl VrIndex {
         }
         ix
     }
+    #[inline]
     fn get(&self, kind: VarKind, vr: u32) -> Option<usize> {
         let v = match kind {
             VarKind::Real => &self.real,
@@ -165,10 +166,16 @@ impl Instance {
 
     // ----- variable access ----------------------------------------------------------------------
 
+    #[inline]
     fn decl(&self, kind: VarKind, vr: u32) -> CallResult<&'static VarDecl> {
         if let Some(i) = self.index.get(kind, vr) {
             return Ok(&self.entry.decls[i]);
         }
+        self.unknown_vr(kind, vr)
+    }
+
+    #[cold]
+    fn unknown_vr(&self, kind: VarKind, vr: u32) -> CallResult<&'static VarDecl> {
         let other = [VarKind::Real, VarKind::Integer, VarKind::Boolean]
             .into_iter()
             .filter(|k| *k != kind)
@@ -204,6 +211,7 @@ impl Instance {
     /// Sets values of one kind atomically: every entry is checked before any is written, so a
     /// refused call leaves the instance unchanged. `value(i)` is the value for `vrs[i]`.
     pub fn set_values(&mut self, kind: VarKind, vrs: &[u32], value: impl Fn(usize) -> Value) -> CallResult {
+        let mut sets_parameter = false;
         for (i, vr) in vrs.iter().enumerate() {
             let d = self.decl(kind, *vr)?;
             self.check_settable(d)?;
@@ -212,19 +220,18 @@ impl Instance {
                     return Err(Fail::error(format!("value {x} for {} is not finite (use 1e30 for \"no limit\")", d.name)));
                 }
             }
+            sets_parameter |= d.causality == Causality::Parameter;
         }
+        // All checked: write (the value references are known to exist with this kind).
         for (i, vr) in vrs.iter().enumerate() {
-            let d = self.decl(kind, *vr)?;
-            match (self.model.slot(d.vr), value(i)) {
+            match (self.model.slot(*vr), value(i)) {
                 (Some(SlotMut::Real(s)), Value::Real(x)) => *s = x,
                 (Some(SlotMut::Integer(s)), Value::Integer(x)) => *s = x,
                 (Some(SlotMut::Boolean(s)), Value::Boolean(x)) => *s = x,
-                _ => return Err(Fail::error(format!("internal: storage of {} does not match its declaration", d.name))),
-            }
-            if d.causality == Causality::Parameter {
-                self.params_dirty = true;
+                _ => return Err(Fail::error(format!("internal: storage of value reference {vr} does not match its declaration"))),
             }
         }
+        self.params_dirty |= sets_parameter;
         self.outputs_dirty = true;
         Ok(())
     }

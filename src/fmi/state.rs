@@ -7,12 +7,12 @@
 //! payload (postcard), CRC-32 of everything before it (u32).
 
 use std::collections::HashSet;
-use std::sync::{Mutex, MutexGuard};
+use std::sync::MutexGuard;
 
 use serde::{Deserialize, Serialize};
 
 use super::instance::{CallResult, Fail, Instance};
-use super::FsmState;
+use super::{BuildAddrHasher, FsmState, LiveSet};
 use crate::model::{DynModel, Experiment};
 
 const MAGIC: &[u8; 8] = b"SCFMUST\0";
@@ -46,9 +46,9 @@ struct Payload {
     model: Vec<u8>,
 }
 
-fn live() -> MutexGuard<'static, HashSet<usize>> {
-    static LIVE: std::sync::LazyLock<Mutex<HashSet<usize>>> = std::sync::LazyLock::new(|| Mutex::new(HashSet::new()));
-    LIVE.lock().unwrap_or_else(|p| p.into_inner())
+fn live() -> MutexGuard<'static, HashSet<usize, BuildAddrHasher>> {
+    static LIVE: LiveSet = LiveSet::new();
+    LIVE.lock()
 }
 
 impl Snapshot {
