@@ -4,7 +4,7 @@
 use std::sync::OnceLock;
 
 use crate::model::ModelEntry;
-use crate::models::{attitude_command::AttitudeCommand, attitude_metrics::AttitudeMetrics, attitude_plant::AttitudePlant, pd_controller::PdController};
+use crate::models::{attitude_command::AttitudeCommand, attitude_metrics::AttitudeMetrics, attitude_plant::AttitudePlant, pd_controller::PdController, single_axis_plant::SingleAxisPlant};
 
 pub fn all() -> &'static [ModelEntry] {
     static ALL: OnceLock<Vec<ModelEntry>> = OnceLock::new();
@@ -14,6 +14,7 @@ pub fn all() -> &'static [ModelEntry] {
             ModelEntry::of::<AttitudeCommand>(),
             ModelEntry::of::<PdController>(),
             ModelEntry::of::<AttitudeMetrics>(),
+            ModelEntry::of::<SingleAxisPlant>(),
         ]
     })
 }

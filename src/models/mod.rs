@@ -6,3 +6,4 @@ pub mod attitude_controller;
 pub mod attitude_metrics;
 pub mod attitude_plant;
 pub mod pd_controller;
+pub mod single_axis_plant;
