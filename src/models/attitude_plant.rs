@@ -475,9 +475,10 @@ impl Model for AttitudePlant {
         source: "shared/spec attitude-plant.md §1 (papers 000, 002, 003, 004)",
         equations_html: EQUATIONS_HTML,
         feedthrough: Feedthrough::Some(&[
-            ("torque_applied_x", &["torque_cmd_x", "torque_cmd_y", "torque_cmd_z"]),
-            ("torque_applied_y", &["torque_cmd_x", "torque_cmd_y", "torque_cmd_z"]),
-            ("torque_applied_z", &["torque_cmd_x", "torque_cmd_y", "torque_cmd_z"]),
+            // per axis also in wheel mode: τ_applied,i = sat(K_w (u_i − τ_mtq,i)) + τ_mtq,i with τ_mtq from the state
+            ("torque_applied_x", &["torque_cmd_x"]),
+            ("torque_applied_y", &["torque_cmd_y"]),
+            ("torque_applied_z", &["torque_cmd_z"]),
             ("torque_ext_x", &["torque_dist_x"]),
             ("torque_ext_y", &["torque_dist_y"]),
             ("torque_ext_z", &["torque_dist_z"]),
