@@ -758,7 +758,8 @@ N(seed, k, i) = sqrt(-2 ln U_2i) cos(2 pi U_2i+1)              (Box-Muller)</pre
 integrator 2: adaptive Dormand-Prince 5(4) with rtol = atol = the tolerance of fmi2SetupExperiment (default 1e-8), \
 error norm RMS(e_i / (atol + rtol max(|x_i|, |x_new,i|))), step size free (max_internal_step is not used), \
 A communication step is cut into pieces at fault_time and at the noise-hold boundaries k T_n; the fault state and the noise \
-are constant within a piece. Inputs are held over the step. The quaternion is renormalised after every internal step \
+are constant within a piece (with noise on, internal steps are therefore never longer than dist_noise_hold). \
+Inputs are held over the step. The quaternion is renormalised after every internal step \
 (RK4/Euler) or piece (Dormand-Prince).</p>";
 #[cfg(test)]
 mod tests {
