@@ -7,7 +7,7 @@ use crate::model::ModelEntry;
 use crate::models::{
     attitude_command::AttitudeCommand, attitude_metrics::AttitudeMetrics, attitude_plant::AttitudePlant, pd_controller::PdController,
     predictive_pid_controller::PredictivePidController, relative_orbit_plant::RelativeOrbitPlant,
-    relative_position_command::RelativePositionCommand,
+    relative_position_command::RelativePositionCommand, single_axis_plant::SingleAxisPlant,
 };
 
 pub fn all() -> &'static [ModelEntry] {
@@ -18,6 +18,7 @@ pub fn all() -> &'static [ModelEntry] {
             ModelEntry::of::<AttitudeCommand>(),
             ModelEntry::of::<PdController>(),
             ModelEntry::of::<AttitudeMetrics>(),
+            ModelEntry::of::<SingleAxisPlant>(),
             ModelEntry::of::<RelativeOrbitPlant>(),
             ModelEntry::of::<RelativePositionCommand>(),
             ModelEntry::of::<PredictivePidController>(),

@@ -1,5 +1,6 @@
-//! Fixed-step integrators over nalgebra vectors, and the splitting of a communication step into
-//! internal steps (equal steps between breakpoints such as a fault onset).
+//! Fixed-step integrators over nalgebra vectors, the adaptive Dormand–Prince 5(4) integrator, and the
+//! splitting of a communication step into internal steps (equal steps between breakpoints such as a
+//! fault onset).
 
 use nalgebra::SVector;
 
@@ -15,6 +16,125 @@ pub fn rk4<const N: usize>(f: &mut impl FnMut(f64, &SVector<f64, N>) -> SVector<
 /// One explicit Euler step.
 pub fn euler<const N: usize>(f: &mut impl FnMut(f64, &SVector<f64, N>) -> SVector<f64, N>, t: f64, x: &SVector<f64, N>, h: f64) -> SVector<f64, N> {
     x + f(t, x) * h
+}
+
+/// Result of an adaptive integration over one interval.
+#[derive(Clone, Copy, Debug)]
+pub struct AdaptiveOutcome<const N: usize> {
+    pub x: SVector<f64, N>,
+    /// Step size to try first on the next interval (the controller's last proposal).
+    pub h_next: f64,
+    pub accepted: usize,
+    pub rejected: usize,
+}
+
+// Dormand & Prince (1980) RK5(4)7M coefficients.
+const DP_C: [f64; 7] = [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0, 1.0];
+const DP_A: [[f64; 6]; 7] = [
+    [0.0; 6],
+    [1.0 / 5.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
+    [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0],
+    [19372.0 / 6561.0, -25360.0 / 2187.0, 64448.0 / 6561.0, -212.0 / 729.0, 0.0, 0.0],
+    [9017.0 / 3168.0, -355.0 / 33.0, 46732.0 / 5247.0, 49.0 / 176.0, -5103.0 / 18656.0, 0.0],
+    [35.0 / 384.0, 0.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0],
+];
+/// 5th-order weights minus 4th-order weights (error estimate).
+const DP_E: [f64; 7] = [
+    71.0 / 57600.0,
+    0.0,
+    -71.0 / 16695.0,
+    71.0 / 1920.0,
+    -17253.0 / 339200.0,
+    22.0 / 525.0,
+    -1.0 / 40.0,
+];
+
+/// Adaptive Dormand–Prince 5(4) (local extrapolation, FSAL) from t0 to exactly t1.
+/// Error norm: RMS over components of e_i / (atol + rtol · max(|x_i|, |x_new,i|)); a step is
+/// accepted when the norm is ≤ 1; the next step is h · clamp(0.9 · norm^(−1/5), 0.2, 5).
+/// `h0` is the first trial step (≤ 0: h = 0.01·(t1 − t0)); steps never exceed `h_max`.
+pub fn dopri5<const N: usize>(
+    f: &mut impl FnMut(f64, &SVector<f64, N>) -> SVector<f64, N>,
+    t0: f64,
+    x0: &SVector<f64, N>,
+    t1: f64,
+    rtol: f64,
+    atol: f64,
+    h0: f64,
+    h_max: f64,
+) -> Result<AdaptiveOutcome<N>, String> {
+    let span = t1 - t0;
+    let mut out = AdaptiveOutcome { x: *x0, h_next: h0, accepted: 0, rejected: 0 };
+    if span <= 0.0 {
+        return Ok(out);
+    }
+    let h_max = if h_max > 0.0 { h_max.min(span) } else { span };
+    let mut h = if h0 > 0.0 { h0.min(h_max) } else { 0.01 * span };
+    let mut t = t0;
+    let mut x = *x0;
+    let mut k1 = f(t, &x);
+    let mut h_prop = h;
+    while t < t1 {
+        let last = t + h >= t1 - 1e-12 * span.max(t1.abs());
+        let step = if last { t1 - t } else { h };
+        let mut k = [SVector::<f64, N>::zeros(); 7];
+        k[0] = k1;
+        for s in 1..7 {
+            let mut xs = x;
+            for (j, kj) in k.iter().enumerate().take(s) {
+                let a = DP_A[s][j];
+                if a != 0.0 {
+                    xs += kj * (a * step);
+                }
+            }
+            if s == 6 {
+                // the 7th stage is evaluated at the 5th-order solution (FSAL)
+                k[6] = f(t + step, &xs);
+                // error estimate
+                let mut errv = SVector::<f64, N>::zeros();
+                for (j, kj) in k.iter().enumerate() {
+                    if DP_E[j] != 0.0 {
+                        errv += kj * (DP_E[j] * step);
+                    }
+                }
+                let mut sum = 0.0;
+                for i in 0..N {
+                    let sc = atol + rtol * x[i].abs().max(xs[i].abs());
+                    let r = errv[i] / sc;
+                    sum += r * r;
+                }
+                let norm = (sum / N as f64).sqrt();
+                if !norm.is_finite() {
+                    return Err(format!("adaptive integrator: non-finite error estimate at t = {t}"));
+                }
+                let fac = if norm == 0.0 { 5.0 } else { (0.9 * norm.powf(-0.2)).clamp(0.2, 5.0) };
+                if norm <= 1.0 {
+                    t = if last { t1 } else { t + step };
+                    x = xs;
+                    k1 = k[6];
+                    out.accepted += 1;
+                    // a short final step does not shrink the proposal for the next interval
+                    h_prop = if last && step < h { h } else { (step * fac).min(h_max) };
+                    h = (step * fac).min(h_max);
+                } else {
+                    out.rejected += 1;
+                    h = step * fac.min(1.0);
+                    if h < 1e-14 * t.abs().max(1.0) {
+                        return Err(format!("adaptive integrator: step size underflow at t = {t}"));
+                    }
+                }
+                if out.accepted + out.rejected > 10_000_000 {
+                    return Err(format!("adaptive integrator: more than 1e7 steps at t = {t}"));
+                }
+            } else {
+                k[s] = f(t + DP_C[s] * step, &xs);
+            }
+        }
+    }
+    out.x = x;
+    out.h_next = h_prop;
+    Ok(out)
 }
 
 /// Fixed-step methods.
@@ -86,5 +206,36 @@ mod tests {
         assert!((total - 0.1).abs() < 1e-15);
         // breakpoints on the edges do not add steps
         assert_eq!(internal_steps(1.0, 0.01, 0.01, &[1.0, 1.01]).len(), 1);
+    }
+    #[test]
+    fn dopri5_meets_tolerance_on_oscillator() {
+        // ẍ = −x over 20 s: the global error follows the tolerance
+        let mut f = |_t: f64, x: &Vector2<f64>| Vector2::new(x[1], -x[0]);
+        for &tol in &[1e-6, 1e-9, 1e-12] {
+            let r = dopri5(&mut f, 0.0, &Vector2::new(1.0, 0.0), 20.0, tol, tol, 0.0, 0.0).unwrap();
+            let err = (r.x[0] - 20f64.cos()).abs().max((r.x[1] + 20f64.sin()).abs());
+            println!("dopri5 tol {tol:e}: error {err:.2e}, {} accepted, {} rejected", r.accepted, r.rejected);
+            assert!(err < 200.0 * tol, "tol {tol}: error {err}");
+        }
+    }
+
+    #[test]
+    fn dopri5_is_fifth_order_and_hits_the_end_exactly() {
+        // With a fixed step forced through h_max and a loose tolerance, halving h divides the
+        // error by ~32 (5th order with local extrapolation).
+        let f = |t: f64, x: &SVector<f64, 1>| SVector::<f64, 1>::new(x[0] * t.cos());
+        let exact = 2f64.sin().exp();
+        let err = |h: f64| {
+            let mut f2 = |t: f64, x: &SVector<f64, 1>| f(t, x);
+            let r = dopri5(&mut f2, 0.0, &SVector::<f64, 1>::new(1.0), 2.0, 1.0, 1.0, h, h).unwrap();
+            (r.x[0] - exact).abs()
+        };
+        let ratio = err(0.2) / err(0.1);
+        assert!((25.0..40.0).contains(&ratio), "ratio {ratio}");
+        // stiff-ish decay with a rejected first step still ends at t1
+        let mut g = |_t: f64, x: &SVector<f64, 1>| SVector::<f64, 1>::new(-50.0 * x[0]);
+        let r = dopri5(&mut g, 1.0, &SVector::<f64, 1>::new(1.0), 1.3, 1e-10, 1e-12, 1.0, 0.0).unwrap();
+        assert!(r.rejected > 0);
+        assert!((r.x[0] - (-15f64).exp()).abs() < 1e-10);
     }
 }

@@ -9,3 +9,4 @@ pub mod pd_controller;
 pub mod predictive_pid_controller;
 pub mod relative_orbit_plant;
 pub mod relative_position_command;
+pub mod single_axis_plant;

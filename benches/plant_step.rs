@@ -1,0 +1,196 @@
+//! Benchmark (issue 3, item 4): cost of one `fmi2DoStep` of `AttitudePlant` with reaction wheels,
+//! magnetorquers and the full disturbance generator at a 0.1 s communication step (default internal
+//! RK4 step 0.01 s → 10 internal steps), through the exported C ABI, versus the direct Rust
+//! `Model::do_step` of the same configuration. Plain `std::time::Instant` loops, no harness.
+//!
+//! Run: `cargo bench --bench plant_step` (release profile). Results go to docs/benchmarks.md by hand.
+
+use std::ffi::{c_int, CString};
+use std::hint::black_box;
+use std::time::Instant;
+
+use spacecraft_fmus::description::guid;
+use spacecraft_fmus::fmi::abi::*;
+use spacecraft_fmus::fmi::CallbackFunctions;
+use spacecraft_fmus::model::{Experiment, Model, SlotMut, Variables};
+use spacecraft_fmus::models::attitude_plant::AttitudePlant;
+use spacecraft_fmus::registry;
+
+const DT: f64 = 0.1;
+
+/// Paper 003 configuration: full inertia, wheels with lag, magnetorquers, gravity gradient,
+/// constant + sinusoidal + white-noise disturbance torques.
+const REALS: &[(&str, f64)] = &[
+    ("inertia_xx", 4.0),
+    ("inertia_yy", 5.0),
+    ("inertia_zz", 3.5),
+    ("inertia_xy", 0.05),
+    ("inertia_xz", -0.03),
+    ("inertia_yz", 0.02),
+    ("init_w_x", 0.01),
+    ("init_w_y", -0.005),
+    ("wheel_time_constant", 0.1),
+    ("dist_const_x", 5e-4),
+    ("dist_sin_amp_x", 5e-4),
+    ("dist_sin_amp_y", 5e-4),
+    ("dist_sin_amp_z", 5e-4),
+    ("dist_sin_freq", 0.1),
+    ("dist_noise_std_x", 5e-4),
+    ("dist_noise_std_y", 5e-4),
+    ("dist_noise_std_z", 5e-4),
+];
+const INTS: &[(&str, i32)] = &[("actuator_mode", 1), ("mtq_enable", 1), ("gg_enable", 1)];
+
+fn vr(name: &str) -> u32 {
+    registry::find("AttitudePlant").unwrap().decl(name).unwrap_or_else(|| panic!("no variable {name}")).vr
+}
+
+fn cmd(k: usize) -> [f64; 3] {
+    let t = k as f64 * DT;
+    [0.03 * (0.3 * t).sin(), 0.03 * (0.2 * t).cos(), -0.02]
+}
+
+/// Mean time per call of `f` over `n` calls after a warm-up; the step index keeps counting (an FMU
+/// checks that time advances consistently).
+fn time_block(start: &mut usize, n: usize, f: &mut impl FnMut(usize)) -> f64 {
+    let t0 = Instant::now();
+    for k in *start..*start + n {
+        f(k);
+    }
+    *start += n;
+    t0.elapsed().as_secs_f64() / n as f64
+}
+
+/// Interleaves the measurements (ROUNDS rounds of BLOCK calls each) and reports the minimum and the
+/// median of the per-round means: the machine is shared, so the minimum is the least disturbed value.
+const ROUNDS: usize = 15;
+const BLOCK: usize = 4000;
+
+fn direct_model() -> AttitudePlant {
+    let mut m = AttitudePlant::default();
+    for (n, v) in REALS {
+        if let Some(SlotMut::Real(x)) = m.vars_mut().slot(vr(n)) {
+            *x = *v;
+        }
+    }
+    for (n, v) in INTS {
+        if let Some(SlotMut::Integer(x)) = m.vars_mut().slot(vr(n)) {
+            *x = *v;
+        }
+    }
+    m.initialize(&Experiment::default()).unwrap();
+    m
+}
+
+fn abi_instance() -> *mut std::ffi::c_void {
+    let entry = registry::find("AttitudePlant").unwrap();
+    let g = CString::new(guid(entry)).unwrap();
+    let name = CString::new("bench").unwrap();
+    // The logger is never called on the success path; NULL avoids defining a C-variadic function,
+    // which stable Rust cannot do.
+    let cb = Box::leak(Box::new(CallbackFunctions {
+        logger: None,
+        allocate_memory: None,
+        free_memory: None,
+        step_finished: None,
+        component_environment: std::ptr::null_mut(),
+    }));
+    let c = fmi2Instantiate(name.as_ptr(), 1, g.as_ptr(), std::ptr::null(), cb, 0, 0);
+    assert!(!c.is_null());
+    assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), 0);
+    assert_eq!(fmi2EnterInitializationMode(c), 0);
+    let (rv, rx): (Vec<u32>, Vec<f64>) = REALS.iter().map(|(n, v)| (vr(n), *v)).unzip();
+    assert_eq!(fmi2SetReal(c, rv.as_ptr(), rv.len(), rx.as_ptr()), 0);
+    let (iv, ix): (Vec<u32>, Vec<c_int>) = INTS.iter().map(|(n, v)| (vr(n), *v)).unzip();
+    assert_eq!(fmi2SetInteger(c, iv.as_ptr(), iv.len(), ix.as_ptr()), 0);
+    assert_eq!(fmi2ExitInitializationMode(c), 0);
+    c
+}
+
+fn main() {
+    println!("AttitudePlant, wheels + magnetorquers + gravity gradient + const/sin/noise disturbances,");
+    println!("communication step {DT} s, RK4 internal step 0.01 s (10 internal steps); {ROUNDS} interleaved rounds of {BLOCK} steps\n");
+    let exp = Experiment::default();
+    let in_vr = [vr("torque_cmd_x"), vr("torque_cmd_y"), vr("torque_cmd_z")];
+    let out_names = ["q_w", "q_x", "q_y", "q_z", "w_x", "w_y", "w_z", "torque_applied_x", "torque_applied_y", "torque_applied_z", "h_wheel_x", "h_wheel_y", "h_wheel_z"];
+    let out_vr: Vec<u32> = out_names.iter().map(|n| vr(n)).collect();
+    let mut buf = vec![0.0; out_vr.len()];
+    let mut buf2 = vec![0.0; out_vr.len()];
+
+    // 1. direct Rust: inputs written into the variable block, Model::do_step
+    let mut m = direct_model();
+    let mut direct = |k: usize| {
+        let c = cmd(k);
+        for (i, x) in c.iter().enumerate() {
+            if let Some(SlotMut::Real(s)) = m.vars_mut().slot(i as u32) {
+                *s = *x;
+            }
+        }
+        m.do_step(k as f64 * DT, DT, &exp).unwrap();
+    };
+    // 2. through the C ABI: fmi2SetReal(3 inputs) + fmi2DoStep
+    let c = abi_instance();
+    let mut abi = |k: usize| {
+        let u = cmd(k);
+        assert_eq!(fmi2SetReal(c, in_vr.as_ptr(), 3, u.as_ptr()), 0);
+        assert_eq!(fmi2DoStep(c, k as f64 * DT, DT, 1), 0);
+    };
+    // 3. a master's full cycle: set inputs, step, read 13 outputs
+    let mut m2 = direct_model();
+    let mut direct_cycle = |k: usize| {
+        let u = cmd(k);
+        for (i, x) in u.iter().enumerate() {
+            if let Some(SlotMut::Real(s)) = m2.vars_mut().slot(i as u32) {
+                *s = *x;
+            }
+        }
+        m2.do_step(k as f64 * DT, DT, &exp).unwrap();
+        m2.update_outputs((k + 1) as f64 * DT).unwrap();
+        for (b, v) in buf.iter_mut().zip(&out_vr) {
+            if let Some(spacecraft_fmus::model::Value::Real(x)) = m2.vars().value(*v) {
+                *b = x;
+            }
+        }
+        black_box(&buf);
+    };
+    let c2 = abi_instance();
+    let mut abi_cycle = |k: usize| {
+        let u = cmd(k);
+        assert_eq!(fmi2SetReal(c2, in_vr.as_ptr(), 3, u.as_ptr()), 0);
+        assert_eq!(fmi2DoStep(c2, k as f64 * DT, DT, 1), 0);
+        assert_eq!(fmi2GetReal(c2, out_vr.as_ptr(), out_vr.len(), buf2.as_mut_ptr()), 0);
+        black_box(&buf2);
+    };
+
+    let mut idx = [0usize; 4];
+    let mut res: [Vec<f64>; 4] = Default::default();
+    // warm-up round, not recorded
+    time_block(&mut idx[0], BLOCK / 4, &mut direct);
+    time_block(&mut idx[1], BLOCK / 4, &mut abi);
+    time_block(&mut idx[2], BLOCK / 4, &mut direct_cycle);
+    time_block(&mut idx[3], BLOCK / 4, &mut abi_cycle);
+    for _ in 0..ROUNDS {
+        res[0].push(time_block(&mut idx[0], BLOCK, &mut direct));
+        res[1].push(time_block(&mut idx[1], BLOCK, &mut abi));
+        res[2].push(time_block(&mut idx[2], BLOCK, &mut direct_cycle));
+        res[3].push(time_block(&mut idx[3], BLOCK, &mut abi_cycle));
+    }
+    let labels = [
+        "direct Rust Model::do_step (+ 3 inputs written)",
+        "C ABI fmi2SetReal(3) + fmi2DoStep",
+        "direct Rust cycle: 3 inputs + do_step + update_outputs + 13 reads",
+        "C ABI cycle: fmi2SetReal(3) + fmi2DoStep + fmi2GetReal(13)",
+    ];
+    let mut mins = [0.0; 4];
+    println!("{:<68} {:>10} {:>10}", "", "min µs", "median µs");
+    for (i, r) in res.iter_mut().enumerate() {
+        r.sort_by(f64::total_cmp);
+        mins[i] = r[0];
+        println!("{:<68} {:>10.3} {:>10.3}", labels[i], r[0] * 1e6, r[r.len() / 2] * 1e6);
+    }
+    println!("\nratio C ABI / direct (min), step only:  {:.3}", mins[1] / mins[0]);
+    println!("ratio C ABI / direct (min), full cycle: {:.3}", mins[3] / mins[2]);
+    println!("C ABI overhead per step (min): {:.3} µs (step only), {:.3} µs (cycle)", (mins[1] - mins[0]) * 1e6, (mins[3] - mins[2]) * 1e6);
+    fmi2FreeInstance(c);
+    fmi2FreeInstance(c2);
+}
