@@ -1,6 +1,5 @@
-//! Fixed-step integrators over nalgebra vectors, the adaptive Dormand–Prince 5(4) integrator, and the
-//! splitting of a communication step into internal steps (equal steps between breakpoints such as a
-//! fault onset).
+//! Fixed-step integrators over nalgebra vectors, the adaptive Dormand–Prince 5(4) integrator, the
+//! splitting of a communication step into pieces at events, and the `Stepper` every plant uses.
 
 use nalgebra::SVector;
 
@@ -137,32 +136,85 @@ pub fn dopri5<const N: usize>(
     Ok(out)
 }
 
-/// Fixed-step methods.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub enum FixedMethod {
+/// Integrator option shared by the plants (`integrator` parameter): 0 = classical RK4,
+/// 1 = explicit Euler, 2 = adaptive Dormand–Prince 5(4).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum Method {
+    #[default]
     Rk4,
     Euler,
+    DormandPrince,
 }
 
-/// Internal steps covering [t0, t0 + h]: the interval is cut at every breakpoint strictly inside it,
-/// and each piece is divided into ⌈length / max_step⌉ equal steps. Returns (start, length) pairs.
-pub fn internal_steps(t0: f64, h: f64, max_step: f64, breakpoints: &[f64]) -> Vec<(f64, f64)> {
+impl Method {
+    pub fn from_param(v: i32) -> Result<Self, String> {
+        Ok(match crate::model::check::choice("integrator", v, &[0, 1, 2])? {
+            0 => Method::Rk4,
+            1 => Method::Euler,
+            _ => Method::DormandPrince,
+        })
+    }
+}
+
+/// Pieces of [t0, t0 + h] between the breakpoints strictly inside it (events such as a fault onset
+/// must fall on a piece boundary, not inside an integration step). Returns (start, length) pairs.
+pub fn pieces(t0: f64, h: f64, breakpoints: &[f64]) -> Vec<(f64, f64)> {
     let t1 = t0 + h;
-    let mut cuts: Vec<f64> = breakpoints.iter().copied().filter(|b| *b > t0 + 1e-12 * h && *b < t1 - 1e-12 * h).collect();
-    cuts.sort_by(f64::total_cmp);
     let mut edges = vec![t0];
-    edges.extend(cuts);
+    edges.extend(breakpoints.iter().copied().filter(|b| *b > t0 + 1e-12 * h && *b < t1 - 1e-12 * h));
+    edges[1..].sort_by(f64::total_cmp);
     edges.push(t1);
-    let mut steps = Vec::new();
-    for pair in edges.windows(2) {
-        let len = pair[1] - pair[0];
-        let n = (len / max_step - 1e-9).ceil().max(1.0) as usize;
-        let dt = len / n as f64;
-        for k in 0..n {
-            steps.push((pair[0] + k as f64 * dt, dt));
+    edges.windows(2).map(|p| (p[0], p[1] - p[0])).collect()
+}
+
+/// A plant's integrator: method, fixed internal step, adaptive tolerance and the adaptive step
+/// proposal carried from one communication step to the next (part of the FMU state).
+#[derive(Clone, Copy, Debug, Default, serde::Serialize, serde::Deserialize)]
+pub struct Stepper {
+    pub method: Method,
+    /// Largest internal step of the fixed-step methods.
+    pub max_step: f64,
+    /// rtol = atol of Dormand–Prince.
+    pub tol: f64,
+    /// Dormand–Prince's proposal for its next step (0 = none yet).
+    pub h_adapt: f64,
+}
+
+impl Stepper {
+    pub fn new(method: Method, max_step: f64, tol: f64) -> Self {
+        Stepper { method, max_step, tol, h_adapt: 0.0 }
+    }
+
+    /// Integrates ẋ = f(t, x) over one piece [ts, ts + len] that contains no event. Fixed-step
+    /// methods take ⌈len / max_step⌉ equal steps and call `after_step(x, t)` after each (e.g. to
+    /// renormalise a quaternion); Dormand–Prince adapts its steps and calls it once at the end.
+    pub fn piece<const N: usize>(
+        &mut self,
+        f: &mut impl FnMut(f64, &SVector<f64, N>) -> SVector<f64, N>,
+        ts: f64,
+        len: f64,
+        x: &mut SVector<f64, N>,
+        mut after_step: impl FnMut(&mut SVector<f64, N>, f64) -> Result<(), String>,
+    ) -> Result<(), String> {
+        match self.method {
+            Method::DormandPrince => {
+                let r = dopri5(f, ts, x, ts + len, self.tol, self.tol, self.h_adapt, 0.0)?;
+                *x = r.x;
+                self.h_adapt = r.h_next;
+                after_step(x, ts + len)
+            }
+            fixed => {
+                let n = (len / self.max_step - 1e-9).ceil().max(1.0) as usize;
+                let dt = len / n as f64;
+                for k in 0..n {
+                    let tk = ts + k as f64 * dt;
+                    *x = if fixed == Method::Euler { euler(f, tk, x, dt) } else { rk4(f, tk, x, dt) };
+                    after_step(x, tk + dt)?;
+                }
+                Ok(())
+            }
         }
     }
-    steps
 }
 
 #[cfg(test)]
@@ -195,18 +247,29 @@ mod tests {
     }
 
     #[test]
-    fn internal_steps_split_at_breakpoints() {
-        let s = internal_steps(0.0, 0.1, 0.01, &[]);
-        assert_eq!(s.len(), 10);
-        let s = internal_steps(0.0, 0.1, 0.04, &[0.05]);
-        // [0, 0.05] in 2 steps, [0.05, 0.1] in 2 steps
-        assert_eq!(s.len(), 4);
-        assert!((s[2].0 - 0.05).abs() < 1e-15);
-        let total: f64 = s.iter().map(|x| x.1).sum();
+    fn pieces_split_at_breakpoints_and_stepper_takes_equal_steps() {
+        assert_eq!(pieces(0.0, 0.1, &[]), vec![(0.0, 0.1)]);
+        let p = pieces(0.0, 0.1, &[0.07, 0.05, 0.2]);
+        assert_eq!(p.len(), 3);
+        assert!((p[1].0 - 0.05).abs() < 1e-15 && (p[2].0 - 0.07).abs() < 1e-15);
+        let total: f64 = p.iter().map(|x| x.1).sum();
         assert!((total - 0.1).abs() < 1e-15);
-        // breakpoints on the edges do not add steps
-        assert_eq!(internal_steps(1.0, 0.01, 0.01, &[1.0, 1.01]).len(), 1);
+        // breakpoints on the edges do not add pieces
+        assert_eq!(pieces(1.0, 0.01, &[1.0, 1.01]).len(), 1);
+        // [0, 0.05] with max step 0.04 → 2 equal Euler steps of 0.025
+        let mut times = vec![];
+        let mut f = |_t: f64, _x: &SVector<f64, 1>| SVector::<f64, 1>::new(1.0);
+        let mut x = SVector::<f64, 1>::new(0.0);
+        Stepper::new(Method::Euler, 0.04, 0.0)
+            .piece(&mut f, 0.0, 0.05, &mut x, |_, t| {
+                times.push(t);
+                Ok(())
+            })
+            .unwrap();
+        assert_eq!(times, vec![0.025, 0.05]);
+        assert!((x[0] - 0.05).abs() < 1e-15);
     }
+
     #[test]
     fn dopri5_meets_tolerance_on_oscillator() {
         // ẍ = −x over 20 s: the global error follows the tolerance

@@ -12,7 +12,7 @@ use crate::math::attitude::{
     quat_from_dcm, quat_from_euler321, skew, wxyz,
 };
 use crate::math::environment::{gravity_gradient, CircularOrbit};
-use crate::math::integrate::{dopri5, euler, internal_steps, rk4};
+use crate::math::integrate::{pieces, Method, Stepper};
 use crate::math::random::{hold_index, normal};
 use crate::model::{check, Experiment, Feedthrough, Model, ModelInfo, ModelResult};
 
@@ -155,14 +155,6 @@ pub enum Kinematics {
     LinearSmallAngle,
 }
 
-/// Integrator option (`integrator` parameter).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Method {
-    Rk4,
-    Euler,
-    DormandPrince,
-}
-
 /// Length of the state vector. Layout (unused entries stay 0):
 /// - `ATT..ATT+9`: attitude — quaternion (w, x, y, z) in mode 0, the DCM A column-major in mode 1,
 ///   the angles (φ, θ, ψ) in modes 2 and 3;
@@ -211,15 +203,13 @@ pub struct AttitudePlant {
     x: State,
     inertia: Matrix3<f64>,
     inertia_inv: Matrix3<f64>,
-    /// Integrator chosen at initialization (None before).
-    method: Option<Method>,
+    /// Integrator chosen at initialization (None before), with its adaptive step proposal.
+    stepper: Option<Stepper>,
     kin: Option<Kinematics>,
     d: Derived,
     /// Quaternion output of the DCM mode: Shepperd's quaternion of A with the sign continuous with the
     /// previous output (updated after every internal step).
     q_dcm: [f64; 4],
-    /// Step size proposed by the adaptive integrator for the next communication step (0 = none yet).
-    h_adapt: f64,
 }
 
 fn v3(x: &State, i: usize) -> Vector3<f64> {
@@ -419,11 +409,11 @@ impl AttitudePlant {
 
     /// Projection after every internal step: quaternion renormalisation (mode 0), optional DCM
     /// re-orthonormalisation (mode 1); also updates the sign-continuous DCM quaternion.
-    fn post_step(&mut self, x: &mut State, t: f64) -> ModelResult {
+    fn post_step(kin: Kinematics, orthonormalize_dcm: bool, q_dcm: &mut [f64; 4], x: &mut State, t: f64) -> ModelResult {
         if !x.iter().all(|c| c.is_finite()) {
             return Err(format!("state became non-finite at t = {t}"));
         }
-        match self.kin() {
+        match kin {
             Kinematics::Quaternion => {
                 let n = x.fixed_rows::<4>(ATT).norm();
                 if !(n > 0.0) {
@@ -433,14 +423,14 @@ impl AttitudePlant {
             }
             Kinematics::Dcm => {
                 let mut a = Matrix3::from_column_slice(&x.as_slice()[ATT..ATT + 9]);
-                if self.v.dcm_orthonormalize == 1 {
+                if orthonormalize_dcm {
                     a = orthonormalize(&a);
                     x.as_mut_slice()[ATT..ATT + 9].copy_from_slice(a.as_slice());
                 }
-                let prev = quat(self.q_dcm[0], self.q_dcm[1], self.q_dcm[2], self.q_dcm[3]);
+                let prev = quat(q_dcm[0], q_dcm[1], q_dcm[2], q_dcm[3]);
                 // A drifts off SO(3) without re-orthonormalisation; report a unit quaternion
                 let q = align_sign(quat_from_dcm(&a), &prev).normalize();
-                self.q_dcm = wxyz(&q);
+                *q_dcm = wxyz(&q);
             }
             Kinematics::Euler213Rates => {
                 if x[ATT].cos().abs() < 1e-9 {
@@ -495,13 +485,9 @@ impl Model for AttitudePlant {
         &mut self.v
     }
 
-    fn initialize(&mut self, _exp: &Experiment) -> ModelResult {
+    fn initialize(&mut self, exp: &Experiment) -> ModelResult {
         let v = &self.v;
-        let method = match check::choice("integrator", v.integrator, &[0, 1, 2])? {
-            0 => Method::Rk4,
-            1 => Method::Euler,
-            _ => Method::DormandPrince,
-        };
+        let method = Method::from_param(v.integrator)?;
         let kin = match check::choice("kinematics", v.kinematics, &[0, 1, 2, 3])? {
             0 => Kinematics::Quaternion,
             1 => Kinematics::Dcm,
@@ -631,11 +617,11 @@ impl Model for AttitudePlant {
         }
         self.inertia = inertia;
         self.inertia_inv = chol.inverse();
-        self.method = Some(method);
+        // adaptive tolerance from fmi2SetupExperiment (default 1e-8)
+        self.stepper = Some(Stepper::new(method, v.max_internal_step, exp.tolerance.filter(|x| *x > 0.0).unwrap_or(1e-8)));
         self.kin = Some(kin);
         self.d = d;
         self.q_dcm = wxyz(&q0);
-        self.h_adapt = 0.0;
         self.x = x;
         let v = &mut self.v;
         v.wheel_torque_max = d.wheel_torque_max;
@@ -677,39 +663,22 @@ impl Model for AttitudePlant {
         Ok(())
     }
 
-    fn do_step(&mut self, t: f64, h: f64, exp: &Experiment) -> ModelResult {
-        let method = self.method.ok_or("plant was not initialized")?;
+    fn do_step(&mut self, t: f64, h: f64, _exp: &Experiment) -> ModelResult {
+        let mut stepper = self.stepper.ok_or("plant was not initialized")?;
+        let (kin, ortho) = (self.kin(), self.v.dcm_orthonormalize == 1);
+        let mut q_dcm = self.q_dcm;
         let mut x = self.x;
-        let bps = self.breakpoints(t, h)?;
         let tn = self.v.dist_noise_hold;
-        let segment = |s: &Self, ts: f64, dt: f64| {
-            let mid = ts + 0.5 * dt;
-            Segment { faulted: mid >= s.v.fault_time, noise: s.noise((mid / tn).floor() as i64) }
-        };
-        if method == Method::DormandPrince {
-            // adaptive steps between breakpoints; tolerance from fmi2SetupExperiment (default 1e-8)
-            let tol = exp.tolerance.filter(|x| *x > 0.0).unwrap_or(1e-8);
-            for (ts, dt) in internal_steps(t, h, f64::INFINITY, &bps) {
-                let seg = segment(self, ts, dt);
-                let mut f = |tt: f64, xx: &State| self.derivative(tt, xx, &seg);
-                let r = dopri5(&mut f, ts, &x, ts + dt, tol, tol, self.h_adapt, 0.0)?;
-                x = r.x;
-                self.h_adapt = r.h_next;
-                self.post_step(&mut x, ts + dt)?;
-            }
-        } else {
-            for (ts, dt) in internal_steps(t, h, self.v.max_internal_step, &bps) {
-                // fault state and noise are constant over an internal step (steps are cut at the events)
-                let seg = segment(self, ts, dt);
-                let mut f = |tt: f64, xx: &State| self.derivative(tt, xx, &seg);
-                x = match method {
-                    Method::Euler => euler(&mut f, ts, &x, dt),
-                    _ => rk4(&mut f, ts, &x, dt),
-                };
-                self.post_step(&mut x, ts + dt)?;
-            }
+        // fault state and noise are constant over a piece: pieces are cut at the events
+        for (ts, len) in pieces(t, h, &self.breakpoints(t, h)?) {
+            let mid = ts + 0.5 * len;
+            let seg = Segment { faulted: mid >= self.v.fault_time, noise: self.noise((mid / tn).floor() as i64) };
+            let mut f = |tt: f64, xx: &State| self.derivative(tt, xx, &seg);
+            stepper.piece(&mut f, ts, len, &mut x, |xx, tt| Self::post_step(kin, ortho, &mut q_dcm, xx, tt))?;
         }
         self.x = x;
+        self.q_dcm = q_dcm;
+        self.stepper = Some(stepper);
         Ok(())
     }
 }
@@ -999,7 +968,9 @@ mod tests {
             tumbling(v);
             v.integrator = 2;
         });
+        // the tolerance of fmi2SetupExperiment reaches the plant at initialization
         let exp = Experiment { tolerance: Some(1e-12), ..Default::default() };
+        p.initialize(&exp).unwrap();
         let (dh, de) = free_run(&mut p, 5926.0, 1.0, &exp);
         println!("torque-free Dormand-Prince tol 1e-12, 5926 s: momentum drift {dh:.3e}, energy drift {de:.3e}");
         assert!(dh <= 1e-10 && de <= 1e-10);

@@ -6,7 +6,7 @@ use nalgebra::{SVector, Vector3};
 use serde::{Deserialize, Serialize};
 
 use crate::declare_variables;
-use crate::math::integrate::{euler, internal_steps, rk4, FixedMethod};
+use crate::math::integrate::{Method, Stepper};
 use crate::math::relative_orbit::LeaderOrbit;
 use crate::model::{check, Experiment, Feedthrough, Model, ModelInfo, ModelResult};
 
@@ -41,7 +41,7 @@ declare_variables! {
         109 => init_vel_y: Real = 0.0, Parameter, Fixed, "m/s", "Initial relative velocity y";
         110 => init_vel_z: Real = 0.0, Parameter, Fixed, "m/s", "Initial relative velocity z";
         111 => max_internal_step: Real = 0.001, Parameter, Fixed, "s", "Largest internal integration step";
-        140 => integrator: Integer = 0, Parameter, Fixed, "", "Internal integrator: 0 = classical RK4, 1 = explicit Euler";
+        140 => integrator: Integer = 0, Parameter, Fixed, "", "Internal integrator: 0 = classical RK4, 1 = explicit Euler, 2 = adaptive Dormand-Prince 5(4) (tolerance from fmi2SetupExperiment, default 1e-8)";
     }
 }
 
@@ -54,7 +54,7 @@ pub struct RelativeOrbitPlant {
     x: State,
     orbit: LeaderOrbit,
     /// Integrator chosen at initialization (None before).
-    method: Option<FixedMethod>,
+    stepper: Option<Stepper>,
 }
 
 impl RelativeOrbitPlant {
@@ -90,7 +90,7 @@ y'' = -2 th' x' - th'' x + th'^2 y - mu y/rho_f^3 + (F_y + dist_y)/m\n\
 z'' =                             - mu z/rho_f^3 + (F_z + dist_z)/m</pre>\n\
 <p>LVLH: x radial outward, y along-track, z along the leader's angular momentum. mu/R^2 - mu (R + x)/rho_f^3 is \
 evaluated without cancellation. Fixed-step RK4 (or explicit Euler) with ceil(step / max_internal_step) equal \
-internal steps per communication step; inputs are held over the step; nu is not wrapped.</p>",
+internal steps per communication step, or adaptive Dormand-Prince 5(4) with rtol = atol = the tolerance of fmi2SetupExperiment; inputs are held over the step; nu is not wrapped.</p>",
         feedthrough: Feedthrough::None,
         default_stop_time: 300.0,
         default_step: 0.001,
@@ -104,13 +104,9 @@ internal steps per communication step; inputs are held over the step; nu is not 
         &mut self.v
     }
 
-    fn initialize(&mut self, _exp: &Experiment) -> ModelResult {
+    fn initialize(&mut self, exp: &Experiment) -> ModelResult {
         let v = &self.v;
-        // integrator 2 (adaptive Dormand–Prince) follows when the shared integrator provides it
-        let method = match check::choice("integrator", v.integrator, &[0, 1])? {
-            0 => FixedMethod::Rk4,
-            _ => FixedMethod::Euler,
-        };
+        let method = Method::from_param(v.integrator)?;
         check::positive("max_internal_step", v.max_internal_step)?;
         check::positive("mass", v.mass)?;
         let orbit = LeaderOrbit::new(v.mu, v.semi_major_axis, v.eccentricity)?;
@@ -128,7 +124,8 @@ internal steps per communication step; inputs are held over the step; nu is not 
         let rho0 = Vector3::new(v.init_pos_x, v.init_pos_y, v.init_pos_z);
         orbit.differential_gravity(v.nu0, &rho0).map_err(|e| format!("initial state: {e}"))?;
         self.orbit = orbit;
-        self.method = Some(method);
+        // adaptive tolerance from fmi2SetupExperiment (default 1e-8)
+        self.stepper = Some(Stepper::new(method, self.v.max_internal_step, exp.tolerance.filter(|x| *x > 0.0).unwrap_or(1e-8)));
         self.x = State::from_column_slice(&[v.init_pos_x, v.init_pos_y, v.init_pos_z, v.init_vel_x, v.init_vel_y, v.init_vel_z, v.nu0]);
         Ok(())
     }
@@ -145,7 +142,7 @@ internal steps per communication step; inputs are held over the step; nu is not 
     }
 
     fn do_step(&mut self, t: f64, h: f64, _exp: &Experiment) -> ModelResult {
-        let method = self.method.ok_or("plant was not initialized")?;
+        let mut stepper = self.stepper.ok_or("plant was not initialized")?;
         let orbit = self.orbit;
         let a_ext = self.ext_accel();
         if !a_ext.iter().all(|c| c.is_finite()) {
@@ -153,26 +150,22 @@ internal steps per communication step; inputs are held over the step; nu is not 
         }
         let mut x = self.x;
         let mut err: Option<String> = None;
-        for (ts, dt) in internal_steps(t, h, self.v.max_internal_step, &[]) {
-            let mut f = |_tt: f64, xx: &State| match Self::derivative(&orbit, &a_ext, xx) {
-                Ok(d) => d,
-                Err(e) => {
-                    err.get_or_insert(e);
-                    State::from_element(f64::NAN)
-                }
-            };
-            x = match method {
-                FixedMethod::Rk4 => rk4(&mut f, ts, &x, dt),
-                FixedMethod::Euler => euler(&mut f, ts, &x, dt),
-            };
-            if let Some(e) = err.take() {
-                return Err(format!("at t = {ts}: {e}"));
+        let mut f = |_tt: f64, xx: &State| match Self::derivative(&orbit, &a_ext, xx) {
+            Ok(d) => d,
+            Err(e) => {
+                err.get_or_insert(e);
+                State::from_element(f64::NAN)
             }
-            if !x.iter().all(|c| c.is_finite()) {
-                return Err(format!("state became non-finite at t = {ts}"));
-            }
+        };
+        let r = stepper.piece(&mut f, t, h, &mut x, |xx, tt| {
+            if xx.iter().all(|c| c.is_finite()) { Ok(()) } else { Err(format!("state became non-finite at t = {tt}")) }
+        });
+        if let Some(e) = err {
+            return Err(format!("in the step from t = {t}: {e}"));
         }
+        r?;
         self.x = x;
+        self.stepper = Some(stepper);
         Ok(())
     }
 }
@@ -286,6 +279,27 @@ mod tests {
     }
 
     #[test]
+    fn adaptive_integrator_agrees_with_fine_rk4() {
+        // 1 km radial offset, eccentric leader, 600 s: Dormand–Prince (tol 1e-12) vs RK4 0.01 s
+        let run = |integrator: i32, step: f64| {
+            let mut p = RelativeOrbitPlant::default();
+            p.v.eccentricity = 0.1;
+            p.v.init_pos_x = 1000.0;
+            p.v.init_vel_y = -1.0;
+            p.v.integrator = integrator;
+            p.v.max_internal_step = step;
+            let exp = Experiment { tolerance: Some(1e-12), ..Default::default() };
+            p.initialize(&exp).unwrap();
+            for k in 0..60 {
+                p.do_step(k as f64 * 10.0, 10.0, &exp).unwrap();
+            }
+            p.x
+        };
+        let d = (run(2, 1.0) - run(0, 0.01)).fixed_rows::<3>(0).norm();
+        assert!(d < 1e-6, "difference {d} m");
+    }
+
+    #[test]
     fn bad_parameters_are_rejected() {
         let mut p = RelativeOrbitPlant::default();
         p.v.eccentricity = 1.0;
@@ -294,7 +308,7 @@ mod tests {
         p.v.mass = 0.0;
         assert!(p.initialize(&Experiment::default()).unwrap_err().contains("mass"));
         let mut p = RelativeOrbitPlant::default();
-        p.v.integrator = 2;
+        p.v.integrator = 3;
         assert!(p.initialize(&Experiment::default()).unwrap_err().contains("integrator"));
         let mut p = RelativeOrbitPlant::default();
         p.v.init_pos_x = -6.0e6;

@@ -5,7 +5,7 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 use crate::declare_variables;
-use crate::math::integrate::{euler, internal_steps, rk4, FixedMethod};
+use crate::math::integrate::{Method, Stepper};
 use crate::model::{check, Experiment, Feedthrough, Model, ModelInfo, ModelResult};
 
 declare_variables! {
@@ -28,7 +28,7 @@ declare_variables! {
         108 => max_internal_step: Real = 0.001, Parameter, Fixed, "s", "Internal step h (paper 002 Euler step; 0.001 is a project choice)";
         109 => init_theta: Real = 0.0, Parameter, Fixed, "rad", "Initial angle theta(0)";
         110 => init_omega: Real = 0.0, Parameter, Fixed, "rad/s", "Initial rate omega(0)";
-        120 => integrator: Integer = 1, Parameter, Fixed, "", "Internal integrator: 1 = explicit Euler (paper 002, default), 0 = classical RK4";
+        120 => integrator: Integer = 1, Parameter, Fixed, "", "Internal integrator: 1 = explicit Euler (paper 002, default), 0 = classical RK4, 2 = adaptive Dormand-Prince 5(4)";
     }
 }
 
@@ -40,7 +40,8 @@ pub struct SingleAxisPlant {
     v: SingleAxisPlantVars,
     x: State,
     j_true: f64,
-    method: Option<FixedMethod>,
+    /// Integrator chosen at initialization (None before).
+    stepper: Option<Stepper>,
 }
 
 impl SingleAxisPlant {
@@ -66,7 +67,7 @@ d(omega)/dt = (M_c + M_d) / J_true,      J_true = inertia_scale J\n\
 d(T_c)/dt   = (K u - T_c) / T              (paper 002 Eq. 7)\n\
 M_c         = clamp(T_c, -T_sat, T_sat)    (paper 002 Eq. 4; saturation after the lag)\n\
 M_d         = torque_dist + md_amp sin(md_freq t) + md_const</pre>\n\
-<p>Integration: explicit Euler (integrator = 1, default, paper 002) or classical RK4 (integrator = 0) with \
+<p>Integration: explicit Euler (integrator = 1, default, paper 002), classical RK4 (integrator = 0) or adaptive Dormand-Prince 5(4) (integrator = 2, tolerance from fmi2SetupExperiment) with \
 ceil(step / max_internal_step) equal internal steps per communication step; Euler evaluates every right-hand side at t_n. \
 Inputs are held over the communication step. theta(0) = init_theta, omega(0) = init_omega, T_c(0) = 0.</p>",
         feedthrough: Feedthrough::None,
@@ -82,12 +83,9 @@ Inputs are held over the communication step. theta(0) = init_theta, omega(0) = i
         &mut self.v
     }
 
-    fn initialize(&mut self, _exp: &Experiment) -> ModelResult {
+    fn initialize(&mut self, exp: &Experiment) -> ModelResult {
         let v = &self.v;
-        let method = match check::choice("integrator", v.integrator, &[0, 1])? {
-            0 => FixedMethod::Rk4,
-            _ => FixedMethod::Euler,
-        };
+        let method = Method::from_param(v.integrator)?;
         let j = check::positive("inertia", v.inertia)? * check::positive("inertia_scale", v.inertia_scale)?;
         check::finite("wheel_gain", v.wheel_gain)?;
         check::positive("wheel_time_constant", v.wheel_time_constant)?;
@@ -97,7 +95,8 @@ Inputs are held over the communication step. theta(0) = init_theta, omega(0) = i
         }
         check::positive("max_internal_step", v.max_internal_step)?;
         self.j_true = j;
-        self.method = Some(method);
+        // adaptive tolerance from fmi2SetupExperiment (default 1e-8)
+        self.stepper = Some(Stepper::new(method, self.v.max_internal_step, exp.tolerance.filter(|x| *x > 0.0).unwrap_or(1e-8)));
         self.x = Vector3::new(v.init_theta, v.init_omega, 0.0);
         Ok(())
     }
@@ -111,19 +110,14 @@ Inputs are held over the communication step. theta(0) = init_theta, omega(0) = i
     }
 
     fn do_step(&mut self, t: f64, h: f64, _exp: &Experiment) -> ModelResult {
-        let method = self.method.ok_or("plant was not initialized")?;
+        let mut stepper = self.stepper.ok_or("plant was not initialized")?;
         let mut x = self.x;
-        for (ts, dt) in internal_steps(t, h, self.v.max_internal_step, &[]) {
-            let mut f = |tt: f64, xx: &State| self.derivative(tt, xx);
-            x = match method {
-                FixedMethod::Rk4 => rk4(&mut f, ts, &x, dt),
-                FixedMethod::Euler => euler(&mut f, ts, &x, dt),
-            };
-            if !x.iter().all(|c| c.is_finite()) {
-                return Err(format!("state became non-finite at t = {ts}"));
-            }
-        }
+        let mut f = |tt: f64, xx: &State| self.derivative(tt, xx);
+        stepper.piece(&mut f, t, h, &mut x, |xx, tt| {
+            if xx.iter().all(|c| c.is_finite()) { Ok(()) } else { Err(format!("state became non-finite at t = {tt}")) }
+        })?;
         self.x = x;
+        self.stepper = Some(stepper);
         Ok(())
     }
 }
