@@ -54,7 +54,7 @@ mod tests {
     fn rk4_harmonic_oscillator_is_fourth_order() {
         // ẍ = −x, x(0) = 1: x(t) = cos t. Halving h divides the error by about 16.
         let mut f = |_t: f64, x: &Vector2<f64>| Vector2::new(x[1], -x[0]);
-        let err = |h: f64| {
+        let mut err = |h: f64| {
             let n = (1.0 / h).round() as usize;
             let mut x = Vector2::new(1.0, 0.0);
             for k in 0..n {
