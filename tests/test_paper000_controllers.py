@@ -315,10 +315,11 @@ def test_mrac_exact_inertia_follows_reference_model():
 
 def test_mrac_converges_and_estimate_moves_to_truth_under_excitation():
     """Plant inertia scaled by 1.3 (controller nominal), sinusoidal command on all axes (persistent
-    excitation). Manual Gauss–Seidel loop: q_ref(t) is set by the test."""
+    excitation), γ = 1e5 (the default 1000 adapts too slowly to show convergence in 120 s). Manual
+    Gauss–Seidel loop: q_ref(t) is set by the test."""
     scale = 1.3
     dt, t_end = 0.01, 120.0
-    ctrl = Fmu("MracController", {"gamma": 2000.0})
+    ctrl = Fmu("MracController", {"gamma": 1e5})
     plant = Fmu("AttitudePlant", {"inertia_scale_x": scale, "inertia_scale_y": scale, "inertia_scale_z": scale})
     amp = np.radians([25.0, 20.0, 30.0])
     om = np.array([0.31, 0.43, 0.23])
@@ -350,7 +351,7 @@ def test_mrac_converges_and_estimate_moves_to_truth_under_excitation():
     print(f"MRAC excitation: max|x−x_m| first 20 s {first}, last 20 s {last}; "
           f"|Î−I_true| start {err0} -> end {err_end}; Î(end) = {ihat[-1]}")
     assert np.all(last <= 0.25 * first), (first, last)
-    assert np.all(err_end <= 0.5 * err0), (ihat[-1], true_i)
+    assert np.all(err_end <= 0.1 * err0), (ihat[-1], true_i)
 
 
 # ----- adaptive fuzzy ----------------------------------------------------------------------------------
