@@ -157,3 +157,31 @@ requirement checked at initialization: lambda1_min^2 >= 4 lambda2_max (real nega
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reference_root_condition_is_checked() {
+        let mut m = AdaptiveFuzzyController::default();
+        assert!(m.initialize(&Experiment::default()).is_ok(), "defaults: (2 sqrt 2)^2 = 8 = 4 * 2");
+        m.v.lambda2_max = 2.1;
+        let e = m.initialize(&Experiment::default()).unwrap_err();
+        assert!(e.contains("lambda1_min"), "{e}");
+    }
+
+    #[test]
+    fn lambdas_stay_in_range() {
+        let mut m = AdaptiveFuzzyController::default();
+        m.initialize(&Experiment::default()).unwrap();
+        let core = m.core.unwrap();
+        for i in 0..=40 {
+            for j in 0..=40 {
+                let (l1, l2) = core.gains.axis(-2.0 + 0.1 * i as f64, -2.0 + 0.1 * j as f64);
+                assert!((2.0 * 2f64.sqrt() - 1e-12..=4.0 + 1e-12).contains(&l1) && (0.5 - 1e-12..=2.0 + 1e-12).contains(&l2));
+                assert!(l1 * l1 >= 4.0 * l2 - 1e-12, "real roots");
+            }
+        }
+    }
+}

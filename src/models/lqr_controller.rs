@@ -114,3 +114,19 @@ Defaults give K_i = [I_i, 2 I_i] (closed loop s^2 + 2 s + 1). w_ref is not used.
         Ok(()) // static law
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_give_paper_gains_and_bad_q_is_rejected() {
+        let mut m = LqrController::default();
+        m.initialize(&Experiment::default()).unwrap();
+        for (k1, k2, i) in [(m.v.k1_x, m.v.k2_x, 1000.0), (m.v.k1_y, m.v.k2_y, 500.0), (m.v.k1_z, m.v.k2_z, 700.0)] {
+            assert!((k1 - i).abs() < 1e-12 * i && (k2 - 2.0 * i).abs() < 1e-12 * i);
+        }
+        m.v.q12 = 5.0; // q11 q22 − q12² < 0
+        assert!(m.initialize(&Experiment::default()).is_err());
+    }
+}
