@@ -190,7 +190,7 @@ def plot_comparison(path: Path, title: str, items: list[tuple[str, dict]]) -> No
     plt.close(fig)
 
 
-COLUMNS = [("run", "{:<15s}", 15), ("label", "{:<10s}", 10), ("kin", "{:>3d}", 3), ("cmd", "{:<3s}", 3),
+COLUMNS = [("run", "{:<20s}", 20), ("label", "{:<10s}", 10), ("kin", "{:>3d}", 3), ("cmd", "{:<3s}", 3),
            ("EULERINT", "{:>9.2f}", 9), ("eff_abs", "{:>9.1f}", 9), ("eff_sq", "{:>10.4g}", 10),
            ("ts_r", "{:>6.2f}", 6), ("ts_p", "{:>6.2f}", 6), ("ts_y", "{:>6.2f}", 6),
            ("OS_r%", "{:>6.2f}", 6), ("OS_p%", "{:>6.2f}", 6), ("OS_y%", "{:>6.2f}", 6)]
@@ -250,6 +250,19 @@ def main() -> int:
         print(table_line(row))
     for s in skipped:
         print(f"skipped: {s}")
+    # L2 = (40, 40, 60) deg is the mirror image of L = (40, -40, -60) deg under the 180 deg rotation
+    # about x (q -> (q_w, q_x, -q_y, -q_z)), a symmetry of the diagonal-inertia plant and of every law
+    # here; without a disturbance the metrics of L and L2 must agree (R1's +10 N m breaks the symmetry).
+    by_id = {row["run"]: row for row in rows}
+    diffs = []
+    for rid, row in by_id.items():
+        if row["command"] == "L" and not rid.startswith("R1"):
+            twin = by_id.get(rid[:-1] + "L2") if rid.endswith("L") else None
+            if twin:
+                diffs.append(abs(row["eulerint_deg_s"] - twin["eulerint_deg_s"]) / row["eulerint_deg_s"])
+    if diffs:
+        print(f"L vs L2 (no disturbance, {len(diffs)} pairs): max relative EULERINT difference {max(diffs):.2e} "
+              f"(mirror symmetry)")
     print(f"({len(rows)} runs in {time.time() - t0:.1f} s)")
 
     with open(out / "summary.csv", "w", newline="") as f:

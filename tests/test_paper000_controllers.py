@@ -293,23 +293,30 @@ def test_fuzzy_pd_matches_skfuzzy_on_grid(defuzz):
 
 
 # ----- MRAC ------------------------------------------------------------------------------------------
-def test_mrac_exact_inertia_follows_reference_model():
-    """With Î = I, x follows the ωn = 1, ξ = 1 reference model: x_m(t) = r − (r − x0)(1 + t)e^{−t}."""
-    r = closed_loop("MracController", {}, {}, LARGE, t_end=20.0, dt=0.01,
-                    extra_log=[f"{p}_{a}" for p in ("xm", "track_err", "ihat", "x") for a in AX])
+@pytest.mark.parametrize("coordinates,kinematics,command", [(0, 0, LARGE), (1, 3, SMALL)], ids=["quat-L", "linear-S"])
+def test_mrac_exact_inertia_follows_reference_model(coordinates, kinematics, command):
+    """With Î = I, x follows the ωn = 1, ξ = 1 reference model: x_m(t) = r − (r − x0)(1 + t)e^{−t}
+    (coordinates 0: x = 2 q̄_v, r = 2 q̄_ref,v; coordinates 1: 321 angles on the linear plant)."""
+    if not plant_has_kinematics(kinematics):
+        pytest.skip(f"AttitudePlant kinematics {kinematics} not available")
+    r = closed_loop("MracController", {"coordinates": coordinates}, {"kinematics": kinematics}, command,
+                    t_end=20.0, dt=0.01, extra_log=[f"{p}_{a}" for p in ("xm", "track_err", "ihat", "x") for a in AX])
     t = r["time"]
-    qr = q321(*LARGE)
-    rr = 2 * np.sign(qr[0]) * qr[1:]
+    if coordinates == 0:
+        qr = q321(*command)
+        rr = 2 * np.sign(qr[0]) * qr[1:]
+    else:
+        rr = np.array(command)
     worst_m = worst_track = worst_i = 0.0
     for i, a in enumerate(AX):
         xm_ref = rr[i] - rr[i] * (1 + t) * np.exp(-t)
         worst_m = max(worst_m, np.max(np.abs(r[f"xm_{a}"] - xm_ref)))
         worst_track = max(worst_track, np.max(np.abs(r[f"track_err_{a}"])))
         worst_i = max(worst_i, np.max(np.abs(r[f"ihat_{a}"] - INERTIA[i])) / INERTIA[i])
-    print(f"MRAC exact Î: max |x_m − closed form| = {worst_m:.3e}, max |x − x_m| = {worst_track:.3e}, "
-          f"max |Î − I|/I = {worst_i:.3e}")
+    print(f"MRAC exact Î (coordinates {coordinates}, kinematics {kinematics}): max |x_m − closed form| = {worst_m:.3e}, "
+          f"max |x − x_m| = {worst_track:.3e}, max |Î − I|/I = {worst_i:.3e}")
     assert worst_m <= 1e-8
-    assert worst_track <= 5e-3      # O(Δ): the torque is held over each 0.01 s step
+    assert worst_track <= 5e-3 * np.max(np.abs(rr))   # O(Δ): the torque is held over each 0.01 s step
     assert worst_i <= 0.05
 
 
@@ -419,3 +426,33 @@ def test_linear_plant_pd_double_pole_closed_form():
           f"max |θ − closed form| (Δ = 0.01, 0.005) = {worst_cont}; "
           f"Richardson 2θ_(Δ/2) − θ_Δ: {worst_rich:.3e} rad")
     assert worst_rich <= 1e-6
+
+
+# ----- robustness of the FMU interface ---------------------------------------------------------------
+@pytest.mark.parametrize("model", NEW)
+def test_bad_parameters_are_errors(model):
+    with pytest.raises(Exception):
+        Fmu(model, {"inertia_xx": -1.0})
+
+
+@pytest.mark.parametrize("model", ["MracController", "AdaptiveFuzzyController"])
+def test_fmu_state_restore_reproduces_adaptive_run(model):
+    """getFMUstate after 5 s, run 5 s more, setFMUstate on every FMU, rerun: bit-identical."""
+    cmd = Fmu("AttitudeCommand", {"ref_euler321_roll": LARGE[0], "ref_euler321_pitch": LARGE[1],
+                                  "ref_euler321_yaw": LARGE[2]})
+    ctrl = Fmu(model, {"gamma": 1e4})
+    plant = Fmu("AttitudePlant", {"inertia_scale_x": 1.2})
+    sim = CoSimulation([cmd, ctrl, plant])
+    log = {n: (ctrl, n) for n in ["torque_cmd_x", "torque_cmd_y", "torque_cmd_z", "ihat_x", "xm_y"]}
+    try:
+        sim.run(5.0, 0.01)
+        states = [(f, f.slave.getFMUstate()) for f in (cmd, ctrl, plant)]
+        a = sim.run(10.0, 0.01, log, t0=5.0)
+        for f, s in states:
+            f.slave.setFMUstate(s)
+        b = sim.run(10.0, 0.01, log, t0=5.0)
+        for k in log:
+            assert np.array_equal(a[k], b[k]), k
+        assert np.max(np.abs(a["ihat_x"] - 1000.0)) > 1.0   # the adaptation did move
+    finally:
+        sim.close()
