@@ -5,20 +5,29 @@ use std::sync::OnceLock;
 
 use crate::model::ModelEntry;
 use crate::models::{
-    attitude_command::AttitudeCommand, attitude_metrics::AttitudeMetrics, attitude_plant::AttitudePlant, pd_controller::PdController,
-    predictive_pid_controller::PredictivePidController, relative_orbit_plant::RelativeOrbitPlant,
-    relative_position_command::RelativePositionCommand, single_axis_plant::SingleAxisPlant,
+    adaptive_fuzzy_controller::AdaptiveFuzzyController, attitude_command::AttitudeCommand, attitude_metrics::AttitudeMetrics,
+    attitude_plant::AttitudePlant, fuzzy_pd_controller::FuzzyPdController, lqr_controller::LqrController, mrac_controller::MracController,
+    pd_controller::PdController, pole_placement_controller::PolePlacementController, predictive_pid_controller::PredictivePidController,
+    relative_orbit_plant::RelativeOrbitPlant, relative_position_command::RelativePositionCommand, single_axis_plant::SingleAxisPlant,
 };
 
 pub fn all() -> &'static [ModelEntry] {
     static ALL: OnceLock<Vec<ModelEntry>> = OnceLock::new();
     ALL.get_or_init(|| {
         vec![
+            // three-axis attitude: plant, reference, metrics, controllers (papers 000, 003, 004)
             ModelEntry::of::<AttitudePlant>(),
             ModelEntry::of::<AttitudeCommand>(),
-            ModelEntry::of::<PdController>(),
             ModelEntry::of::<AttitudeMetrics>(),
+            ModelEntry::of::<PdController>(),
+            ModelEntry::of::<LqrController>(),
+            ModelEntry::of::<PolePlacementController>(),
+            ModelEntry::of::<MracController>(),
+            ModelEntry::of::<FuzzyPdController>(),
+            ModelEntry::of::<AdaptiveFuzzyController>(),
+            // single axis (paper 002)
             ModelEntry::of::<SingleAxisPlant>(),
+            // relative orbit (paper 001)
             ModelEntry::of::<RelativeOrbitPlant>(),
             ModelEntry::of::<RelativePositionCommand>(),
             ModelEntry::of::<PredictivePidController>(),

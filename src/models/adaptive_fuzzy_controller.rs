@@ -1,0 +1,187 @@
+//! `AdaptiveFuzzyController`: paper 000's adaptive-fuzzy attitude law (spec controllers.md §1.7): the
+//! MRAC law of `mrac_controller` whose reference model has per-axis λ1, λ2 set by the fuzzy system of
+//! `FuzzyPdController` from the model's own error to the command.
+
+use serde::{Deserialize, Serialize};
+
+use crate::declare_attitude_controller_variables;
+use crate::math::fuzzy::PdFuzzySystem;
+use crate::model::{check, Experiment, Feedthrough, Model, ModelInfo, ModelResult};
+use crate::models::attitude_controller::check_unit_quaternions;
+use crate::models::fuzzy_pd_controller::defuzz_from_param;
+use crate::models::mrac_controller::{initial_inertia, mrac_outputs, MracCoordinates, MracCore, MracState, ReferenceGains};
+
+declare_attitude_controller_variables! {
+    pub struct AdaptiveFuzzyControllerVars {
+        30 => xm_x: Real = 0.0, Output, Continuous, "", "Reference-model state x_m, x (coordinates 0: 2 q_v units; 1: rad)";
+        31 => xm_y: Real = 0.0, Output, Continuous, "", "Reference-model state x_m, y";
+        32 => xm_z: Real = 0.0, Output, Continuous, "", "Reference-model state x_m, z";
+        33 => track_err_x: Real = 0.0, Output, Continuous, "", "Tracking error x - x_m, x";
+        34 => track_err_y: Real = 0.0, Output, Continuous, "", "Tracking error x - x_m, y";
+        35 => track_err_z: Real = 0.0, Output, Continuous, "", "Tracking error x - x_m, z";
+        36 => ihat_x: Real = 0.0, Output, Continuous, "kg.m2", "Inertia estimate I^_x";
+        37 => ihat_y: Real = 0.0, Output, Continuous, "kg.m2", "Inertia estimate I^_y";
+        38 => ihat_z: Real = 0.0, Output, Continuous, "kg.m2", "Inertia estimate I^_z";
+        39 => s_x: Real = 0.0, Output, Continuous, "1/s", "Sliding variable s = x~' + lambda x~, x";
+        40 => s_y: Real = 0.0, Output, Continuous, "1/s", "Sliding variable, y";
+        41 => s_z: Real = 0.0, Output, Continuous, "1/s", "Sliding variable, z";
+        42 => x_x: Real = 0.0, Output, Continuous, "", "Controlled coordinate x (coordinates 0: 2 q_v; 1: 321 angle), x";
+        43 => x_y: Real = 0.0, Output, Continuous, "", "Controlled coordinate x, y";
+        44 => x_z: Real = 0.0, Output, Continuous, "", "Controlled coordinate x, z";
+        45 => lambda1_x: Real = 0.0, Output, Continuous, "1/s", "Current reference-model damping lambda1, x";
+        46 => lambda1_y: Real = 0.0, Output, Continuous, "1/s", "Current reference-model damping lambda1, y";
+        47 => lambda1_z: Real = 0.0, Output, Continuous, "1/s", "Current reference-model damping lambda1, z";
+        48 => lambda2_x: Real = 0.0, Output, Continuous, "1/s2", "Current reference-model stiffness lambda2, x";
+        49 => lambda2_y: Real = 0.0, Output, Continuous, "1/s2", "Current reference-model stiffness lambda2, y";
+        50 => lambda2_z: Real = 0.0, Output, Continuous, "1/s2", "Current reference-model stiffness lambda2, z";
+        100 => inertia_xx: Real = 1000.0, Parameter, Fixed, "kg.m2", "Controller's nominal inertia I_x";
+        101 => inertia_yy: Real = 500.0, Parameter, Fixed, "kg.m2", "Controller's nominal inertia I_y";
+        102 => inertia_zz: Real = 700.0, Parameter, Fixed, "kg.m2", "Controller's nominal inertia I_z";
+        103 => ihat0_x: Real = 0.0, Parameter, Fixed, "kg.m2", "Initial estimate I^_x(0); 0 = nominal inertia_xx";
+        104 => ihat0_y: Real = 0.0, Parameter, Fixed, "kg.m2", "Initial estimate I^_y(0); 0 = nominal inertia_yy";
+        105 => ihat0_z: Real = 0.0, Parameter, Fixed, "kg.m2", "Initial estimate I^_z(0); 0 = nominal inertia_zz";
+        106 => ihat_min_ratio: Real = 0.1, Parameter, Fixed, "", "Lower bound of the estimate: I^_min = ihat_min_ratio * I^(0)";
+        109 => lambda: Real = 2.0, Parameter, Fixed, "1/s", "Sliding-surface bandwidth lambda (paper 000 Eqs. 38-39)";
+        110 => gamma: Real = 1000.0, Parameter, Fixed, "kg.m2.s2", "Adaptation gain gamma (project choice)";
+        111 => lambda1_min: Real = 2.8284271247461903, Parameter, Fixed, "1/s", "Lower end of lambda1 (damping), 2 sqrt(2) (project choice)";
+        112 => lambda1_max: Real = 4.0, Parameter, Fixed, "1/s", "Upper end of lambda1 (project choice)";
+        113 => lambda2_min: Real = 0.5, Parameter, Fixed, "1/s2", "Lower end of lambda2 (stiffness) (project choice)";
+        114 => lambda2_max: Real = 2.0, Parameter, Fixed, "1/s2", "Upper end of lambda2 (project choice); lambda1_min^2 >= 4 lambda2_max is required";
+        115 => e_scale: Real = 1.0, Parameter, Fixed, "", "Fuzzy input normalisation of e_m = r - x_m";
+        116 => edot_scale: Real = 0.5, Parameter, Fixed, "1/s", "Fuzzy input normalisation of edot_m = -x_m'";
+        117 => sigma: Real = 0.25, Parameter, Fixed, "", "Width of the Gaussian output sets Small and Big";
+        118 => mf_half_width: Real = 0.3333333333333333, Parameter, Fixed, "", "Half-width of the seven triangular input sets (>= 1/3)";
+        120 => coordinates: Integer = 0, Parameter, Fixed, "", "0 = quaternion feedback linearisation; 1 = linear (321 angles, T = I^ v)";
+        121 => defuzz: Integer = 0, Parameter, Fixed, "", "Defuzzification: 0 = c(S) = 0, c(B) = 1; 1 = truncated-centroid representatives";
+        200 => ihat_init_x: Real = 0.0, CalculatedParameter, Fixed, "kg.m2", "I^_x(0) in use";
+        201 => ihat_init_y: Real = 0.0, CalculatedParameter, Fixed, "kg.m2", "I^_y(0) in use";
+        202 => ihat_init_z: Real = 0.0, CalculatedParameter, Fixed, "kg.m2", "I^_z(0) in use";
+        203 => ihat_min_x: Real = 0.0, CalculatedParameter, Fixed, "kg.m2", "Lower bound I^_min,x";
+        204 => ihat_min_y: Real = 0.0, CalculatedParameter, Fixed, "kg.m2", "Lower bound I^_min,y";
+        205 => ihat_min_z: Real = 0.0, CalculatedParameter, Fixed, "kg.m2", "Lower bound I^_min,z";
+        206 => c_small: Real = 0.0, CalculatedParameter, Fixed, "", "Representative value c(S) of the output set Small";
+        207 => c_big: Real = 0.0, CalculatedParameter, Fixed, "", "Representative value c(B) of the output set Big";
+    }
+}
+
+#[derive(Clone, Default, Serialize, Deserialize)]
+pub struct AdaptiveFuzzyController {
+    v: AdaptiveFuzzyControllerVars,
+    core: Option<MracCore>,
+    st: MracState,
+}
+
+impl Model for AdaptiveFuzzyController {
+    type Vars = AdaptiveFuzzyControllerVars;
+    const INFO: ModelInfo = ModelInfo {
+        name: "AdaptiveFuzzyController",
+        description: "Paper 000 adaptive-fuzzy attitude controller: MRAC whose reference-model lambda1, lambda2 are fuzzy-scheduled",
+        source: "paper 000 §7, Eqs. 48, 54-57; shared/spec controllers.md §1.5-1.7",
+        equations_html: "<pre>MracController with, per axis and at every instant,\n\
+e_m = r - x_m,  edot_m = -x_m'          (fuzzy inputs, scaled by e_scale, edot_scale; sets and tables of FuzzyPdController)\n\
+lambda2 = lambda2_min + (lambda2_max - lambda2_min) k'_p      (stiffness from the k_p table)\n\
+lambda1 = lambda1_min + (lambda1_max - lambda1_min) k'_d      (damping from the k_d table)\n\
+x_m'' = lambda2 (r - x_m) - lambda1 x_m'\n\
+requirement checked at initialization: lambda1_min^2 >= 4 lambda2_max (real negative model roots)</pre>",
+        feedthrough: Feedthrough::AllInputs,
+        default_stop_time: 30.0,
+        default_step: 0.01,
+        variable_step: true,
+    };
+
+    fn vars(&self) -> &AdaptiveFuzzyControllerVars {
+        &self.v
+    }
+    fn vars_mut(&mut self) -> &mut AdaptiveFuzzyControllerVars {
+        &mut self.v
+    }
+
+    fn initialize(&mut self, _exp: &Experiment) -> ModelResult {
+        let v = &mut self.v;
+        let coordinates = MracCoordinates::from_param(v.coordinates)?;
+        let defuzz = defuzz_from_param(v.defuzz)?;
+        let (i0, imin) = initial_inertia(
+            [("inertia_xx", v.inertia_xx), ("inertia_yy", v.inertia_yy), ("inertia_zz", v.inertia_zz)],
+            [("ihat0_x", v.ihat0_x), ("ihat0_y", v.ihat0_y), ("ihat0_z", v.ihat0_z)],
+            v.ihat_min_ratio,
+        )?;
+        let l1min = check::positive("lambda1_min", v.lambda1_min)?;
+        let l1max = check::positive("lambda1_max", v.lambda1_max)?;
+        let l2min = check::positive("lambda2_min", v.lambda2_min)?;
+        let l2max = check::positive("lambda2_max", v.lambda2_max)?;
+        if l1max < l1min || l2max < l2min {
+            return Err(format!("need lambda1_min <= lambda1_max and lambda2_min <= lambda2_max, got [{l1min}, {l1max}] and [{l2min}, {l2max}]"));
+        }
+        if l1min * l1min < 4.0 * l2max * (1.0 - 1e-12) {
+            return Err(format!(
+                "lambda1_min^2 = {} < 4 lambda2_max = {}: the reference model could get complex roots (paper 000 requires two real negative roots)",
+                l1min * l1min,
+                4.0 * l2max
+            ));
+        }
+        let e_scale = check::positive("e_scale", v.e_scale)?;
+        let edot_scale = check::positive("edot_scale", v.edot_scale)?;
+        let fuzzy = PdFuzzySystem::new(v.mf_half_width, v.sigma, defuzz).map_err(|e| format!("parameters mf_half_width / sigma: {e}"))?;
+        let gains = ReferenceGains::Fuzzy { fuzzy, lambda1_min: l1min, lambda1_max: l1max, lambda2_min: l2min, lambda2_max: l2max, e_scale, edot_scale };
+        let core = MracCore { coordinates, lambda: check::positive("lambda", v.lambda)?, gamma: check::non_negative("gamma", v.gamma)?, ihat_min: imin, gains };
+        [v.ihat_init_x, v.ihat_init_y, v.ihat_init_z] = i0;
+        [v.ihat_min_x, v.ihat_min_y, v.ihat_min_z] = imin;
+        (v.c_small, v.c_big) = (fuzzy.c_small, fuzzy.c_big);
+        self.core = Some(core);
+        self.st = MracState { xm: [0.0; 3], xm_dot: [0.0; 3], ihat: i0, started: false };
+        Ok(())
+    }
+
+    fn update_outputs(&mut self, _t: f64) -> ModelResult {
+        let core = self.core.ok_or("controller was not initialized")?;
+        let inp = self.v.inputs();
+        let o = mrac_outputs(&core, &self.st, &inp)?;
+        let v = &mut self.v;
+        v.set_torque(&o.torque);
+        [v.xm_x, v.xm_y, v.xm_z] = o.state.xm;
+        (v.track_err_x, v.track_err_y, v.track_err_z) = (o.sig.xt.x, o.sig.xt.y, o.sig.xt.z);
+        [v.ihat_x, v.ihat_y, v.ihat_z] = o.state.ihat;
+        (v.s_x, v.s_y, v.s_z) = (o.sig.s.x, o.sig.s.y, o.sig.s.z);
+        (v.x_x, v.x_y, v.x_z) = (o.x.x, o.x.y, o.x.z);
+        (v.lambda1_x, v.lambda1_y, v.lambda1_z) = (o.sig.lambda1.x, o.sig.lambda1.y, o.sig.lambda1.z);
+        (v.lambda2_x, v.lambda2_y, v.lambda2_z) = (o.sig.lambda2.x, o.sig.lambda2.y, o.sig.lambda2.z);
+        Ok(())
+    }
+
+    fn do_step(&mut self, _t: f64, h: f64, _exp: &Experiment) -> ModelResult {
+        let core = self.core.ok_or("controller was not initialized")?;
+        let inp = self.v.inputs();
+        check_unit_quaternions(&inp)?;
+        let m = core.measure(&inp);
+        self.st = core.step(&self.st, &m, h)?;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reference_root_condition_is_checked() {
+        let mut m = AdaptiveFuzzyController::default();
+        assert!(m.initialize(&Experiment::default()).is_ok(), "defaults: (2 sqrt 2)^2 = 8 = 4 * 2");
+        m.v.lambda2_max = 2.1;
+        let e = m.initialize(&Experiment::default()).unwrap_err();
+        assert!(e.contains("lambda1_min"), "{e}");
+    }
+
+    #[test]
+    fn lambdas_stay_in_range() {
+        let mut m = AdaptiveFuzzyController::default();
+        m.initialize(&Experiment::default()).unwrap();
+        let core = m.core.unwrap();
+        for i in 0..=40 {
+            for j in 0..=40 {
+                let (l1, l2) = core.gains.axis(-2.0 + 0.1 * i as f64, -2.0 + 0.1 * j as f64);
+                assert!((2.0 * 2f64.sqrt() - 1e-12..=4.0 + 1e-12).contains(&l1) && (0.5 - 1e-12..=2.0 + 1e-12).contains(&l2));
+                assert!(l1 * l1 >= 4.0 * l2 - 1e-12, "real roots");
+            }
+        }
+    }
+}
