@@ -402,3 +402,16 @@ def test_null_and_freed_component_pointers():
     finally:
         g.close()
         f.close()
+
+
+def test_non_finite_output_is_an_error_not_a_value():
+    f = Fmu("PdController", {"gain_mode": 1, "kd_x": -1e308})
+    try:
+        f.set("w_x", 10.0)  # torque = -1e309: overflows to -inf
+        r = vr(f, "torque_cmd_x")
+        assert status(f.slave.fmi2GetReal, f.slave.component, vrs(r), 1, reals(0.0)) == ERROR
+        assert "torque_cmd_x is -inf" in last(f)
+        assert status(f.slave.fmi2DoStep, f.slave.component, 0.0, 0.01, 1) == ERROR, "error state: no stepping"
+        f.slave.reset()  # recovers
+    finally:
+        f.close()

@@ -79,8 +79,6 @@ pub struct Instance {
     /// Parameters changed during initialization: derived quantities must be recomputed.
     pub params_dirty: bool,
     index: VrIndex,
-    /// Declaration indices of the Real outputs (checked for finiteness after every update).
-    real_outputs: Vec<usize>,
 }
 
 fn kind_name(k: VarKind) -> &'static str {
@@ -107,7 +105,6 @@ impl Instance {
             outputs_dirty: true,
             params_dirty: true,
             index: VrIndex::new(entry.decls),
-            real_outputs: entry.decls.iter().enumerate().filter(|(_, d)| d.causality == Causality::Output && d.kind == VarKind::Real).map(|(i, _)| i).collect(),
         }
     }
 
@@ -246,25 +243,25 @@ impl Instance {
         }
         if self.outputs_dirty && self.state != FsmState::Instantiated {
             self.model.update_outputs(self.time).map_err(Fail::error)?;
-            for &i in &self.real_outputs {
-                let d = &self.entry.decls[i];
-                if let Some(Value::Real(x)) = self.model.value(d.vr) {
-                    if !x.is_finite() {
-                        return Err(Fail::error(format!("output {} became {x} at t = {}", d.name, self.time)));
-                    }
-                }
-            }
             self.outputs_dirty = false;
         }
         Ok(())
     }
 
-    /// Reads values of one kind; `write(i, v)` receives the value of `vrs[i]`.
+    /// Reads values of one kind; `write(i, v)` receives the value of `vrs[i]`. Outputs are computed
+    /// lazily here; a non-finite output puts the instance into the error state.
     pub fn get_values(&mut self, kind: VarKind, vrs: &[u32], mut write: impl FnMut(usize, Value)) -> CallResult {
         self.ensure_outputs()?;
         for (i, vr) in vrs.iter().enumerate() {
             let d = self.decl(kind, *vr)?;
-            write(i, self.model.value(d.vr).ok_or_else(|| Fail::error(format!("internal: no storage for {}", d.name)))?);
+            let v = self.model.value(d.vr).ok_or_else(|| Fail::error(format!("internal: no storage for {}", d.name)))?;
+            if let Value::Real(x) = v {
+                if !x.is_finite() && d.causality == Causality::Output {
+                    self.state = FsmState::Error;
+                    return Err(Fail::error(format!("output {} is {x} at t = {}", d.name, self.time)));
+                }
+            }
+            write(i, v);
         }
         Ok(())
     }
@@ -327,11 +324,7 @@ impl Instance {
         }
         // Continue on the master's grid: no accumulation of round-off in the FMU time.
         self.time = t + h;
-        self.outputs_dirty = true;
-        if let Err(f) = self.ensure_outputs() {
-            self.state = FsmState::Error;
-            return Err(f);
-        }
+        self.outputs_dirty = true; // computed when read
         Ok(())
     }
 
