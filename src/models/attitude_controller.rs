@@ -3,6 +3,10 @@
 //! own parameters and extra ports after these with `declare_attitude_controller_variables!`.
 
 use nalgebra::{Quaternion, Vector3};
+use serde::{Deserialize, Serialize};
+
+use crate::math::attitude::{attitude_matrix, error_quaternion, euler321_from_quat, wrap_pi};
+use crate::model::check;
 
 /// Measured and commanded attitude as read from the common inputs.
 #[derive(Clone, Copy, Debug)]
@@ -71,4 +75,51 @@ pub fn check_unit_quaternions(inp: &AttitudeInputs) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// Error signal of paper 000 (controllers.md §1.1), ≈ commanded minus actual angle per axis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ErrorLaw {
+    Quaternion,
+    Dcm,
+    Euler,
+}
+
+impl ErrorLaw {
+    pub fn from_param(v: i32) -> Result<Self, String> {
+        Ok(match check::choice("error_law", v, &[0, 1, 2])? {
+            0 => ErrorLaw::Quaternion,
+            1 => ErrorLaw::Dcm,
+            _ => ErrorLaw::Euler,
+        })
+    }
+
+    pub fn error(self, inp: &AttitudeInputs) -> Vector3<f64> {
+        match self {
+            // e^Q = 2 q_E,w q_E,v with q_E = q* ⊗ q_ref (paper 000 Eq. 35)
+            ErrorLaw::Quaternion => {
+                let e = error_quaternion(&inp.q, &inp.q_ref);
+                e.vector() * (2.0 * e.w)
+            }
+            // A_E = A(q) A(q_ref)ᵀ, e^D = (A_E[3,2], A_E[1,3], A_E[2,1]) (paper 000 Eq. 13)
+            ErrorLaw::Dcm => {
+                let a = attitude_matrix(&inp.q) * attitude_matrix(&inp.q_ref).transpose();
+                Vector3::new(a[(2, 1)], a[(0, 2)], a[(1, 0)])
+            }
+            // e^E = wrap(euler321(q_ref) − euler321(q)) (paper 000 Eqs. 2, 11)
+            ErrorLaw::Euler => {
+                let r = euler321_from_quat(&inp.q_ref);
+                let m = euler321_from_quat(&inp.q);
+                Vector3::new(wrap_pi(r[0] - m[0]), wrap_pi(r[1] - m[1]), wrap_pi(r[2] - m[2]))
+            }
+        }
+    }
+}
+
+/// The per-axis linear law of paper 000's PD, LQR and pole-placement controllers:
+/// T = k_e ⊙ e + k_w ⊙ ω, with e from `law` (≈ commanded minus actual angle). In the paper's
+/// convention the rate gain k_w is negative (it adds +k_d·rate with k_d < 0).
+pub fn linear_law(law: ErrorLaw, inp: &AttitudeInputs, k_e: &Vector3<f64>, k_w: &Vector3<f64>) -> Result<Vector3<f64>, String> {
+    check_unit_quaternions(inp)?;
+    Ok(k_e.component_mul(&law.error(inp)) + k_w.component_mul(&inp.w))
 }

@@ -7,8 +7,7 @@ use serde::{Deserialize, Serialize};
 use crate::declare_attitude_controller_variables;
 use crate::math::fuzzy::{Defuzz, PdFuzzySystem};
 use crate::model::{check, Experiment, Feedthrough, Model, ModelInfo, ModelResult};
-use crate::models::attitude_controller::check_unit_quaternions;
-use crate::models::pd_controller::ErrorLaw;
+use crate::models::attitude_controller::{check_unit_quaternions, ErrorLaw};
 
 declare_attitude_controller_variables! {
     pub struct FuzzyPdControllerVars {

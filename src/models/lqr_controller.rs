@@ -7,8 +7,7 @@ use serde::{Deserialize, Serialize};
 use crate::declare_attitude_controller_variables;
 use crate::math::riccati::lqr;
 use crate::model::{check, Experiment, Feedthrough, Model, ModelInfo, ModelResult};
-use crate::models::attitude_controller::check_unit_quaternions;
-use crate::models::pd_controller::ErrorLaw;
+use crate::models::attitude_controller::{linear_law, ErrorLaw};
 
 declare_attitude_controller_variables! {
     pub struct LqrControllerVars {
@@ -99,13 +98,9 @@ Defaults give K_i = [I_i, 2 I_i] (closed loop s^2 + 2 s + 1). w_ref is not used.
 
     fn update_outputs(&mut self, _t: f64) -> ModelResult {
         let law = self.law.ok_or("controller was not initialized")?;
-        let inp = self.v.inputs();
-        check_unit_quaternions(&inp)?;
         let v = &self.v;
-        let e = law.error(&inp);
-        let k1 = Vector3::new(v.k1_x, v.k1_y, v.k1_z);
-        let k2 = Vector3::new(v.k2_x, v.k2_y, v.k2_z);
-        let torque = k1.component_mul(&e) - k2.component_mul(&inp.w);
+        // T = K1 e − K2 ω
+        let torque = linear_law(law, &v.inputs(), &Vector3::new(v.k1_x, v.k1_y, v.k1_z), &-Vector3::new(v.k2_x, v.k2_y, v.k2_z))?;
         self.v.set_torque(&torque);
         Ok(())
     }

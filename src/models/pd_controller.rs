@@ -5,9 +5,8 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 use crate::declare_attitude_controller_variables;
-use crate::math::attitude::{attitude_matrix, error_quaternion, euler321_from_quat, wrap_pi};
 use crate::model::{check, Experiment, Feedthrough, Model, ModelInfo, ModelResult};
-use crate::models::attitude_controller::{check_unit_quaternions, AttitudeInputs};
+use crate::models::attitude_controller::{linear_law, ErrorLaw};
 
 declare_attitude_controller_variables! {
     pub struct PdControllerVars {
@@ -30,45 +29,6 @@ declare_attitude_controller_variables! {
         203 => k_d_x: Real = 0.0, CalculatedParameter, Fixed, "N.m.s/rad", "Rate gain in use (negative), x";
         204 => k_d_y: Real = 0.0, CalculatedParameter, Fixed, "N.m.s/rad", "Rate gain in use (negative), y";
         205 => k_d_z: Real = 0.0, CalculatedParameter, Fixed, "N.m.s/rad", "Rate gain in use (negative), z";
-    }
-}
-
-/// Error signal of paper 000 (controllers.md §1.1), ≈ commanded minus actual angle per axis.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub enum ErrorLaw {
-    Quaternion,
-    Dcm,
-    Euler,
-}
-
-impl ErrorLaw {
-    pub fn from_param(v: i32) -> Result<Self, String> {
-        Ok(match check::choice("error_law", v, &[0, 1, 2])? {
-            0 => ErrorLaw::Quaternion,
-            1 => ErrorLaw::Dcm,
-            _ => ErrorLaw::Euler,
-        })
-    }
-
-    pub fn error(self, inp: &AttitudeInputs) -> Vector3<f64> {
-        match self {
-            // e^Q = 2 q_E,w q_E,v with q_E = q* ⊗ q_ref (paper 000 Eq. 35)
-            ErrorLaw::Quaternion => {
-                let e = error_quaternion(&inp.q, &inp.q_ref);
-                e.vector() * (2.0 * e.w)
-            }
-            // A_E = A(q) A(q_ref)ᵀ, e^D = (A_E[3,2], A_E[1,3], A_E[2,1]) (paper 000 Eq. 13)
-            ErrorLaw::Dcm => {
-                let a = attitude_matrix(&inp.q) * attitude_matrix(&inp.q_ref).transpose();
-                Vector3::new(a[(2, 1)], a[(0, 2)], a[(1, 0)])
-            }
-            // e^E = wrap(euler321(q_ref) − euler321(q)) (paper 000 Eqs. 2, 11)
-            ErrorLaw::Euler => {
-                let r = euler321_from_quat(&inp.q_ref);
-                let m = euler321_from_quat(&inp.q);
-                Vector3::new(wrap_pi(r[0] - m[0]), wrap_pi(r[1] - m[1]), wrap_pi(r[2] - m[2]))
-            }
-        }
     }
 }
 
@@ -131,13 +91,8 @@ w_ref is not used (paper 000 commands are constant).</p>",
 
     fn update_outputs(&mut self, _t: f64) -> ModelResult {
         let law = self.law.ok_or("controller was not initialized")?;
-        let inp = self.v.inputs();
-        check_unit_quaternions(&inp)?;
         let v = &self.v;
-        let e = law.error(&inp);
-        let k = Vector3::new(v.k_x, v.k_y, v.k_z);
-        let kd = Vector3::new(v.k_d_x, v.k_d_y, v.k_d_z);
-        let torque = k.component_mul(&e) + kd.component_mul(&inp.w);
+        let torque = linear_law(law, &v.inputs(), &Vector3::new(v.k_x, v.k_y, v.k_z), &Vector3::new(v.k_d_x, v.k_d_y, v.k_d_z))?;
         self.v.set_torque(&torque);
         Ok(())
     }
