@@ -32,7 +32,6 @@ from scfmu.master import CoSimulation, Fmu  # noqa: E402
 from scfmu.metrics import overshoot_percent, settling_time, steady_state_error  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
-OUT = ROOT / "out" / "paper001"
 AX = "xyz"
 CASES = {"a": (5.0, 5.0), "b": (25.0, 5.0), "c": (25.0, 25.0), "d": (25.0, 150.0)}
 REF = (50.0, 40.0, 60.0)
@@ -157,9 +156,11 @@ def main() -> None:
     ap.add_argument("--cases", default="a,b,c,d")
     ap.add_argument("--csv-every", type=int, default=100, help="write every n-th sample to the per-run CSV")
     ap.add_argument("--no-plots", action="store_true")
+    ap.add_argument("--out", type=Path, default=ROOT / "out" / "paper001", help="output folder")
     args = ap.parse_args()
 
-    OUT.mkdir(parents=True, exist_ok=True)
+    out_dir = args.out
+    out_dir.mkdir(parents=True, exist_ok=True)
     dists = [0.0, 0.01] + ([1.0] if args.alt else [])
     cases = [c.strip() for c in args.cases.split(",") if c.strip()]
     print(f"Paper 001 formation runs: Δ = RK4 step = {args.dt} s, t_end = {args.t_end} s; RelativeOrbitPlant "
@@ -188,17 +189,17 @@ def main() -> None:
             print(f"  int sum|F_i| dt = {m['int_sum_abs_F']:.6g} N s, int |F|^2 dt = {m['int_F2']:.6g} N^2 s")
             rows.append({"run": tag, "T1": 0.0, "T2": t2, "c": c, "dt": args.dt, "t_end": args.t_end,
                          **{k: g[k] for k in ("K1", "K2", "P_x", "D_x", "I_g_x")}, **m, "wall_s": wall})
-            write_csv(OUT / f"{tag}.csv", out, args.csv_every)
+            write_csv(out_dir / f"{tag}.csv", out, args.csv_every)
             if not args.no_plots:
-                plot_run(OUT / f"{tag}.png", f"{tag}: T2 = {t2:g} s, c = {c:g} 1/s, Δ = {args.dt} s", out, dist)
+                plot_run(out_dir / f"{tag}.png", f"{tag}: T2 = {t2:g} s, c = {c:g} 1/s, Δ = {args.dt} s", out, dist)
             runs[name] = out
         if not args.no_plots:
-            plot_compare(OUT / f"compare_dist{dist:g}N.png", runs, dist)
-    with (OUT / "summary.csv").open("w", newline="") as fh:
+            plot_compare(out_dir / f"compare_dist{dist:g}N.png", runs, dist)
+    with (out_dir / "summary.csv").open("w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=list(rows[0].keys()))
         w.writeheader()
         w.writerows(rows)
-    print(f"\nwrote {OUT}/summary.csv, per-run CSV (every {args.csv_every}th sample) and PNGs")
+    print(f"\nwrote {out_dir}/summary.csv, per-run CSV (every {args.csv_every}th sample) and PNGs")
 
 
 if __name__ == "__main__":
