@@ -4,45 +4,21 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::declare_attitude_controller_variables;
+use crate::declare_mrac_controller_variables;
 use crate::math::fuzzy::PdFuzzySystem;
 use crate::model::{check, Experiment, Feedthrough, Model, ModelInfo, ModelResult};
 use crate::models::attitude_controller::check_unit_quaternions;
 use crate::models::fuzzy_pd_controller::defuzz_from_param;
 use crate::models::mrac_controller::{initial_inertia, mrac_outputs, MracCoordinates, MracCore, MracState, ReferenceGains};
 
-declare_attitude_controller_variables! {
+declare_mrac_controller_variables! {
     pub struct AdaptiveFuzzyControllerVars {
-        30 => xm_x: Real = 0.0, Output, Continuous, "", "Reference-model state x_m, x (coordinates 0: 2 q_v units; 1: rad)";
-        31 => xm_y: Real = 0.0, Output, Continuous, "", "Reference-model state x_m, y";
-        32 => xm_z: Real = 0.0, Output, Continuous, "", "Reference-model state x_m, z";
-        33 => track_err_x: Real = 0.0, Output, Continuous, "", "Tracking error x - x_m, x";
-        34 => track_err_y: Real = 0.0, Output, Continuous, "", "Tracking error x - x_m, y";
-        35 => track_err_z: Real = 0.0, Output, Continuous, "", "Tracking error x - x_m, z";
-        36 => ihat_x: Real = 0.0, Output, Continuous, "kg.m2", "Inertia estimate I^_x";
-        37 => ihat_y: Real = 0.0, Output, Continuous, "kg.m2", "Inertia estimate I^_y";
-        38 => ihat_z: Real = 0.0, Output, Continuous, "kg.m2", "Inertia estimate I^_z";
-        39 => s_x: Real = 0.0, Output, Continuous, "1/s", "Sliding variable s = x~' + lambda x~, x";
-        40 => s_y: Real = 0.0, Output, Continuous, "1/s", "Sliding variable, y";
-        41 => s_z: Real = 0.0, Output, Continuous, "1/s", "Sliding variable, z";
-        42 => x_x: Real = 0.0, Output, Continuous, "", "Controlled coordinate x (coordinates 0: 2 q_v; 1: 321 angle), x";
-        43 => x_y: Real = 0.0, Output, Continuous, "", "Controlled coordinate x, y";
-        44 => x_z: Real = 0.0, Output, Continuous, "", "Controlled coordinate x, z";
         45 => lambda1_x: Real = 0.0, Output, Continuous, "1/s", "Current reference-model damping lambda1, x";
         46 => lambda1_y: Real = 0.0, Output, Continuous, "1/s", "Current reference-model damping lambda1, y";
         47 => lambda1_z: Real = 0.0, Output, Continuous, "1/s", "Current reference-model damping lambda1, z";
         48 => lambda2_x: Real = 0.0, Output, Continuous, "1/s2", "Current reference-model stiffness lambda2, x";
         49 => lambda2_y: Real = 0.0, Output, Continuous, "1/s2", "Current reference-model stiffness lambda2, y";
         50 => lambda2_z: Real = 0.0, Output, Continuous, "1/s2", "Current reference-model stiffness lambda2, z";
-        100 => inertia_xx: Real = 1000.0, Parameter, Fixed, "kg.m2", "Controller's nominal inertia I_x";
-        101 => inertia_yy: Real = 500.0, Parameter, Fixed, "kg.m2", "Controller's nominal inertia I_y";
-        102 => inertia_zz: Real = 700.0, Parameter, Fixed, "kg.m2", "Controller's nominal inertia I_z";
-        103 => ihat0_x: Real = 0.0, Parameter, Fixed, "kg.m2", "Initial estimate I^_x(0); 0 = nominal inertia_xx";
-        104 => ihat0_y: Real = 0.0, Parameter, Fixed, "kg.m2", "Initial estimate I^_y(0); 0 = nominal inertia_yy";
-        105 => ihat0_z: Real = 0.0, Parameter, Fixed, "kg.m2", "Initial estimate I^_z(0); 0 = nominal inertia_zz";
-        106 => ihat_min_ratio: Real = 0.1, Parameter, Fixed, "", "Lower bound of the estimate: I^_min = ihat_min_ratio * I^(0)";
-        109 => lambda: Real = 2.0, Parameter, Fixed, "1/s", "Sliding-surface bandwidth lambda (paper 000 Eqs. 38-39)";
-        110 => gamma: Real = 1000.0, Parameter, Fixed, "kg.m2.s2", "Adaptation gain gamma (project choice)";
         111 => lambda1_min: Real = 2.8284271247461903, Parameter, Fixed, "1/s", "Lower end of lambda1 (damping), 2 sqrt(2) (project choice)";
         112 => lambda1_max: Real = 4.0, Parameter, Fixed, "1/s", "Upper end of lambda1 (project choice)";
         113 => lambda2_min: Real = 0.5, Parameter, Fixed, "1/s2", "Lower end of lambda2 (stiffness) (project choice)";
@@ -51,14 +27,7 @@ declare_attitude_controller_variables! {
         116 => edot_scale: Real = 0.5, Parameter, Fixed, "1/s", "Fuzzy input normalisation of edot_m = -x_m'";
         117 => sigma: Real = 0.25, Parameter, Fixed, "", "Width of the Gaussian output sets Small and Big";
         118 => mf_half_width: Real = 0.3333333333333333, Parameter, Fixed, "", "Half-width of the seven triangular input sets (>= 1/3)";
-        120 => coordinates: Integer = 0, Parameter, Fixed, "", "0 = quaternion feedback linearisation; 1 = linear (321 angles, T = I^ v)";
         121 => defuzz: Integer = 0, Parameter, Fixed, "", "Defuzzification: 0 = c(S) = 0, c(B) = 1; 1 = truncated-centroid representatives";
-        200 => ihat_init_x: Real = 0.0, CalculatedParameter, Fixed, "kg.m2", "I^_x(0) in use";
-        201 => ihat_init_y: Real = 0.0, CalculatedParameter, Fixed, "kg.m2", "I^_y(0) in use";
-        202 => ihat_init_z: Real = 0.0, CalculatedParameter, Fixed, "kg.m2", "I^_z(0) in use";
-        203 => ihat_min_x: Real = 0.0, CalculatedParameter, Fixed, "kg.m2", "Lower bound I^_min,x";
-        204 => ihat_min_y: Real = 0.0, CalculatedParameter, Fixed, "kg.m2", "Lower bound I^_min,y";
-        205 => ihat_min_z: Real = 0.0, CalculatedParameter, Fixed, "kg.m2", "Lower bound I^_min,z";
         206 => c_small: Real = 0.0, CalculatedParameter, Fixed, "", "Representative value c(S) of the output set Small";
         207 => c_big: Real = 0.0, CalculatedParameter, Fixed, "", "Representative value c(B) of the output set Big";
     }

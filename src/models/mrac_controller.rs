@@ -5,7 +5,6 @@
 use nalgebra::{Matrix3, Quaternion, SVector, Vector3};
 use serde::{Deserialize, Serialize};
 
-use crate::declare_attitude_controller_variables;
 use crate::math::attitude::{euler321_from_quat, skew};
 use crate::math::fuzzy::PdFuzzySystem;
 use crate::math::integrate::rk4;
@@ -231,41 +230,56 @@ pub fn initial_inertia(nominal: [(&str, f64); 3], ihat0: [(&str, f64); 3], ratio
     Ok((i0, i0.map(|v| v * ratio)))
 }
 
-declare_attitude_controller_variables! {
+/// `declare_attitude_controller_variables!` plus the ports and parameters every MRAC-type controller
+/// has (reference-model state, tracking error, inertia estimate, sliding variable; nominal inertia,
+/// initial estimate and its bound, λ, γ, coordinates), so `MracController` and
+/// `AdaptiveFuzzyController` declare only what differs.
+#[macro_export]
+macro_rules! declare_mrac_controller_variables {
+    (pub struct $Name:ident { $($rest:tt)* }) => {
+        $crate::declare_attitude_controller_variables! {
+            pub struct $Name {
+                30 => xm_x: Real = 0.0, Output, Continuous, "", "Reference-model state x_m, x (coordinates 0: 2 q_v units; 1: rad)";
+                31 => xm_y: Real = 0.0, Output, Continuous, "", "Reference-model state x_m, y";
+                32 => xm_z: Real = 0.0, Output, Continuous, "", "Reference-model state x_m, z";
+                33 => track_err_x: Real = 0.0, Output, Continuous, "", "Tracking error x - x_m, x";
+                34 => track_err_y: Real = 0.0, Output, Continuous, "", "Tracking error x - x_m, y";
+                35 => track_err_z: Real = 0.0, Output, Continuous, "", "Tracking error x - x_m, z";
+                36 => ihat_x: Real = 0.0, Output, Continuous, "kg.m2", "Inertia estimate I^_x";
+                37 => ihat_y: Real = 0.0, Output, Continuous, "kg.m2", "Inertia estimate I^_y";
+                38 => ihat_z: Real = 0.0, Output, Continuous, "kg.m2", "Inertia estimate I^_z";
+                39 => s_x: Real = 0.0, Output, Continuous, "1/s", "Sliding variable s = x~' + lambda x~, x";
+                40 => s_y: Real = 0.0, Output, Continuous, "1/s", "Sliding variable, y";
+                41 => s_z: Real = 0.0, Output, Continuous, "1/s", "Sliding variable, z";
+                42 => x_x: Real = 0.0, Output, Continuous, "", "Controlled coordinate x (coordinates 0: 2 q_v; 1: 321 angle), x";
+                43 => x_y: Real = 0.0, Output, Continuous, "", "Controlled coordinate x, y";
+                44 => x_z: Real = 0.0, Output, Continuous, "", "Controlled coordinate x, z";
+                100 => inertia_xx: Real = 1000.0, Parameter, Fixed, "kg.m2", "Controller's nominal inertia I_x";
+                101 => inertia_yy: Real = 500.0, Parameter, Fixed, "kg.m2", "Controller's nominal inertia I_y";
+                102 => inertia_zz: Real = 700.0, Parameter, Fixed, "kg.m2", "Controller's nominal inertia I_z";
+                103 => ihat0_x: Real = 0.0, Parameter, Fixed, "kg.m2", "Initial estimate I^_x(0); 0 = nominal inertia_xx";
+                104 => ihat0_y: Real = 0.0, Parameter, Fixed, "kg.m2", "Initial estimate I^_y(0); 0 = nominal inertia_yy";
+                105 => ihat0_z: Real = 0.0, Parameter, Fixed, "kg.m2", "Initial estimate I^_z(0); 0 = nominal inertia_zz";
+                106 => ihat_min_ratio: Real = 0.1, Parameter, Fixed, "", "Lower bound of the estimate: I^_min = ihat_min_ratio * I^(0)";
+                109 => lambda: Real = 2.0, Parameter, Fixed, "1/s", "Sliding-surface bandwidth lambda (paper 000 Eqs. 38-39)";
+                110 => gamma: Real = 1000.0, Parameter, Fixed, "kg.m2.s2", "Adaptation gain gamma (project choice)";
+                120 => coordinates: Integer = 0, Parameter, Fixed, "", "0 = quaternion feedback linearisation; 1 = linear (321 angles, T = I^ v)";
+                200 => ihat_init_x: Real = 0.0, CalculatedParameter, Fixed, "kg.m2", "I^_x(0) in use";
+                201 => ihat_init_y: Real = 0.0, CalculatedParameter, Fixed, "kg.m2", "I^_y(0) in use";
+                202 => ihat_init_z: Real = 0.0, CalculatedParameter, Fixed, "kg.m2", "I^_z(0) in use";
+                203 => ihat_min_x: Real = 0.0, CalculatedParameter, Fixed, "kg.m2", "Lower bound I^_min,x";
+                204 => ihat_min_y: Real = 0.0, CalculatedParameter, Fixed, "kg.m2", "Lower bound I^_min,y";
+                205 => ihat_min_z: Real = 0.0, CalculatedParameter, Fixed, "kg.m2", "Lower bound I^_min,z";
+                $($rest)*
+            }
+        }
+    };
+}
+
+declare_mrac_controller_variables! {
     pub struct MracControllerVars {
-        30 => xm_x: Real = 0.0, Output, Continuous, "", "Reference-model state x_m, x (coordinates 0: 2 q_v units; 1: rad)";
-        31 => xm_y: Real = 0.0, Output, Continuous, "", "Reference-model state x_m, y";
-        32 => xm_z: Real = 0.0, Output, Continuous, "", "Reference-model state x_m, z";
-        33 => track_err_x: Real = 0.0, Output, Continuous, "", "Tracking error x - x_m, x";
-        34 => track_err_y: Real = 0.0, Output, Continuous, "", "Tracking error x - x_m, y";
-        35 => track_err_z: Real = 0.0, Output, Continuous, "", "Tracking error x - x_m, z";
-        36 => ihat_x: Real = 0.0, Output, Continuous, "kg.m2", "Inertia estimate I^_x";
-        37 => ihat_y: Real = 0.0, Output, Continuous, "kg.m2", "Inertia estimate I^_y";
-        38 => ihat_z: Real = 0.0, Output, Continuous, "kg.m2", "Inertia estimate I^_z";
-        39 => s_x: Real = 0.0, Output, Continuous, "1/s", "Sliding variable s = x~' + lambda x~, x";
-        40 => s_y: Real = 0.0, Output, Continuous, "1/s", "Sliding variable, y";
-        41 => s_z: Real = 0.0, Output, Continuous, "1/s", "Sliding variable, z";
-        42 => x_x: Real = 0.0, Output, Continuous, "", "Controlled coordinate x (coordinates 0: 2 q_v; 1: 321 angle), x";
-        43 => x_y: Real = 0.0, Output, Continuous, "", "Controlled coordinate x, y";
-        44 => x_z: Real = 0.0, Output, Continuous, "", "Controlled coordinate x, z";
-        100 => inertia_xx: Real = 1000.0, Parameter, Fixed, "kg.m2", "Controller's nominal inertia I_x";
-        101 => inertia_yy: Real = 500.0, Parameter, Fixed, "kg.m2", "Controller's nominal inertia I_y";
-        102 => inertia_zz: Real = 700.0, Parameter, Fixed, "kg.m2", "Controller's nominal inertia I_z";
-        103 => ihat0_x: Real = 0.0, Parameter, Fixed, "kg.m2", "Initial estimate I^_x(0); 0 = nominal inertia_xx";
-        104 => ihat0_y: Real = 0.0, Parameter, Fixed, "kg.m2", "Initial estimate I^_y(0); 0 = nominal inertia_yy";
-        105 => ihat0_z: Real = 0.0, Parameter, Fixed, "kg.m2", "Initial estimate I^_z(0); 0 = nominal inertia_zz";
-        106 => ihat_min_ratio: Real = 0.1, Parameter, Fixed, "", "Lower bound of the estimate: I^_min = ihat_min_ratio * I^(0)";
         107 => lambda1: Real = 2.0, Parameter, Fixed, "1/s", "Reference-model damping coefficient lambda1 (paper 000 Eq. 37)";
         108 => lambda2: Real = 1.0, Parameter, Fixed, "1/s2", "Reference-model stiffness lambda2 (paper 000 Eq. 37)";
-        109 => lambda: Real = 2.0, Parameter, Fixed, "1/s", "Sliding-surface bandwidth lambda (paper 000 Eqs. 38-39)";
-        110 => gamma: Real = 1000.0, Parameter, Fixed, "kg.m2.s2", "Adaptation gain gamma (project choice)";
-        120 => coordinates: Integer = 0, Parameter, Fixed, "", "0 = quaternion feedback linearisation; 1 = linear (321 angles, T = I^ v)";
-        200 => ihat_init_x: Real = 0.0, CalculatedParameter, Fixed, "kg.m2", "I^_x(0) in use";
-        201 => ihat_init_y: Real = 0.0, CalculatedParameter, Fixed, "kg.m2", "I^_y(0) in use";
-        202 => ihat_init_z: Real = 0.0, CalculatedParameter, Fixed, "kg.m2", "I^_z(0) in use";
-        203 => ihat_min_x: Real = 0.0, CalculatedParameter, Fixed, "kg.m2", "Lower bound I^_min,x";
-        204 => ihat_min_y: Real = 0.0, CalculatedParameter, Fixed, "kg.m2", "Lower bound I^_min,y";
-        205 => ihat_min_z: Real = 0.0, CalculatedParameter, Fixed, "kg.m2", "Lower bound I^_min,z";
     }
 }
 
