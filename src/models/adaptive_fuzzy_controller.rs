@@ -7,7 +7,6 @@ use serde::{Deserialize, Serialize};
 use crate::declare_mrac_controller_variables;
 use crate::math::fuzzy::PdFuzzySystem;
 use crate::model::{check, Experiment, Feedthrough, Model, ModelInfo, ModelResult};
-use crate::models::attitude_controller::check_unit_quaternions;
 use crate::models::fuzzy_pd_controller::defuzz_from_param;
 use crate::models::mrac_controller::{initial_inertia, mrac_outputs, MracCoordinates, MracCore, MracState, ReferenceGains};
 
@@ -105,13 +104,8 @@ requirement checked at initialization: lambda1_min^2 >= 4 lambda2_max (real nega
         let core = self.core.ok_or("controller was not initialized")?;
         let inp = self.v.inputs();
         let o = mrac_outputs(&core, &self.st, &inp)?;
+        self.v.set_mrac_outputs(&o);
         let v = &mut self.v;
-        v.set_torque(&o.torque);
-        [v.xm_x, v.xm_y, v.xm_z] = o.state.xm;
-        (v.track_err_x, v.track_err_y, v.track_err_z) = (o.sig.xt.x, o.sig.xt.y, o.sig.xt.z);
-        [v.ihat_x, v.ihat_y, v.ihat_z] = o.state.ihat;
-        (v.s_x, v.s_y, v.s_z) = (o.sig.s.x, o.sig.s.y, o.sig.s.z);
-        (v.x_x, v.x_y, v.x_z) = (o.x.x, o.x.y, o.x.z);
         (v.lambda1_x, v.lambda1_y, v.lambda1_z) = (o.sig.lambda1.x, o.sig.lambda1.y, o.sig.lambda1.z);
         (v.lambda2_x, v.lambda2_y, v.lambda2_z) = (o.sig.lambda2.x, o.sig.lambda2.y, o.sig.lambda2.z);
         Ok(())
@@ -119,10 +113,7 @@ requirement checked at initialization: lambda1_min^2 >= 4 lambda2_max (real nega
 
     fn do_step(&mut self, _t: f64, h: f64, _exp: &Experiment) -> ModelResult {
         let core = self.core.ok_or("controller was not initialized")?;
-        let inp = self.v.inputs();
-        check_unit_quaternions(&inp)?;
-        let m = core.measure(&inp);
-        self.st = core.step(&self.st, &m, h)?;
+        self.st = core.advance(&self.st, &self.v.inputs(), h)?;
         Ok(())
     }
 }

@@ -178,6 +178,12 @@ impl MracCore {
 
     /// Advances the state over h with the inputs held: RK4 in ⌈h / MAX_STEP⌉ equal steps, Î clamped
     /// at Î_min after each.
+    /// Advances the controller state over one communication step with the inputs held.
+    pub fn advance(&self, st: &MracState, inp: &AttitudeInputs, h: f64) -> Result<MracState, String> {
+        check_unit_quaternions(inp)?;
+        self.step(st, &self.measure(inp), h)
+    }
+
     pub fn step(&self, st: &MracState, m: &Measured, h: f64) -> Result<MracState, String> {
         let e = self.effective(st, m);
         let mut y = SVector::<f64, 9>::from_iterator(e.xm.iter().chain(e.xm_dot.iter()).chain(e.ihat.iter()).copied());
@@ -273,6 +279,18 @@ macro_rules! declare_mrac_controller_variables {
                 $($rest)*
             }
         }
+
+        impl $Name {
+            /// Writes the torque and the common MRAC outputs.
+            pub fn set_mrac_outputs(&mut self, o: &$crate::models::mrac_controller::MracOutputs) {
+                self.set_torque(&o.torque);
+                [self.xm_x, self.xm_y, self.xm_z] = o.state.xm;
+                (self.track_err_x, self.track_err_y, self.track_err_z) = (o.sig.xt.x, o.sig.xt.y, o.sig.xt.z);
+                [self.ihat_x, self.ihat_y, self.ihat_z] = o.state.ihat;
+                (self.s_x, self.s_y, self.s_z) = (o.sig.s.x, o.sig.s.y, o.sig.s.z);
+                (self.x_x, self.x_y, self.x_z) = (o.x.x, o.x.y, o.x.z);
+            }
+        }
     };
 }
 
@@ -305,13 +323,7 @@ impl MracController {
         let core = self.core.ok_or("controller was not initialized")?;
         let inp = self.v.inputs();
         let o = mrac_outputs(&core, &self.st, &inp)?;
-        let v = &mut self.v;
-        v.set_torque(&o.torque);
-        [v.xm_x, v.xm_y, v.xm_z] = o.state.xm;
-        (v.track_err_x, v.track_err_y, v.track_err_z) = (o.sig.xt.x, o.sig.xt.y, o.sig.xt.z);
-        [v.ihat_x, v.ihat_y, v.ihat_z] = o.state.ihat;
-        (v.s_x, v.s_y, v.s_z) = (o.sig.s.x, o.sig.s.y, o.sig.s.z);
-        (v.x_x, v.x_y, v.x_z) = (o.x.x, o.x.y, o.x.z);
+        self.v.set_mrac_outputs(&o);
         Ok(())
     }
 }
@@ -359,10 +371,7 @@ impl Model for MracController {
 
     fn do_step(&mut self, _t: f64, h: f64, _exp: &Experiment) -> ModelResult {
         let core = self.core.ok_or("controller was not initialized")?;
-        let inp = self.v.inputs();
-        check_unit_quaternions(&inp)?;
-        let m = core.measure(&inp);
-        self.st = core.step(&self.st, &m, h)?;
+        self.st = core.advance(&self.st, &self.v.inputs(), h)?;
         Ok(())
     }
 }
