@@ -31,6 +31,7 @@ import numpy as np  # noqa: E402
 
 from scfmu import CoSimulation, Fmu  # noqa: E402
 from scfmu.metrics import overshoot_percent, settling_time  # noqa: E402
+from scfmu.results import write_csv  # noqa: E402
 
 D = math.radians
 COMMANDS = {
@@ -136,14 +137,6 @@ def summarize(run: Run, r: dict) -> dict:
         row[f"ts_{ang}_s"] = settling_time(t, r[ang], cmd[i])
         row[f"os_{ang}_pct"] = overshoot_percent(r[ang], cmd[i])
     return row
-
-
-def write_csv(path: Path, r: dict) -> None:
-    keys = list(r.keys())
-    with open(path, "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(keys)
-        w.writerows(np.column_stack([r[k] for k in keys]).tolist())
 
 
 def plot_run(path: Path, run: Run, r: dict, row: dict) -> None:

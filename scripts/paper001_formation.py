@@ -30,6 +30,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from scfmu.master import CoSimulation, Fmu  # noqa: E402
 from scfmu.metrics import overshoot_percent, settling_time, steady_state_error  # noqa: E402
+from scfmu.results import write_csv  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 AX = "xyz"
@@ -76,16 +77,9 @@ def metrics(out: dict, dist: float, dt: float) -> dict:
     return m
 
 
-def write_csv(path: Path, out: dict, every: int) -> None:
+def write_run_csv(path: Path, out: dict, every: int) -> None:
     keys = ["time"] + [f"{k}_{a}" for k in ("pos", "pos_ref", "vel", "force", "dist_est") for a in AX]
-    with path.open("w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(keys)
-        idx = np.arange(0, len(out["time"]), every)
-        if idx[-1] != len(out["time"]) - 1:
-            idx = np.append(idx, len(out["time"]) - 1)
-        for k in idx:
-            w.writerow([f"{out[key][k]:.10g}" for key in keys])
+    write_csv(path, out, keys, every, ".10g")
 
 
 def plot_run(path: Path, title: str, out: dict, dist: float) -> None:
@@ -189,7 +183,7 @@ def main() -> None:
             print(f"  int sum|F_i| dt = {m['int_sum_abs_F']:.6g} N s, int |F|^2 dt = {m['int_F2']:.6g} N^2 s")
             rows.append({"run": tag, "T1": 0.0, "T2": t2, "c": c, "dt": args.dt, "t_end": args.t_end,
                          **{k: g[k] for k in ("K1", "K2", "P_x", "D_x", "I_g_x")}, **m, "wall_s": wall})
-            write_csv(out_dir / f"{tag}.csv", out, args.csv_every)
+            write_run_csv(out_dir / f"{tag}.csv", out, args.csv_every)
             if not args.no_plots:
                 plot_run(out_dir / f"{tag}.png", f"{tag}: T2 = {t2:g} s, c = {c:g} 1/s, Δ = {args.dt} s", out, dist)
             runs[name] = out

@@ -10,7 +10,6 @@ RK4 0.01 s, communication step 0.01 s, t_end = 30 s.
 from __future__ import annotations
 
 import argparse
-import csv
 import math
 import sys
 from pathlib import Path
@@ -21,6 +20,7 @@ import numpy as np  # noqa: E402
 
 from scfmu import CoSimulation, Fmu  # noqa: E402
 from scfmu.metrics import overshoot_percent, settling_time  # noqa: E402
+from scfmu.results import write_csv  # noqa: E402
 
 LARGE = (math.radians(40.0), math.radians(-40.0), math.radians(-60.0))
 
@@ -68,11 +68,7 @@ def main() -> int:
     print(f"Paper 000 run 000-6: quaternion PD, large command (40, -40, -60) deg, dt = {args.dt} s, t_end = {args.t_end} s")
     for k, v in s.items():
         print(f"  {k:22s} {v:12.6g}")
-    keys = list(r.keys())
-    with open(out / "default_run.csv", "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(keys)
-        w.writerows(np.column_stack([r[k] for k in keys]).tolist())
+    write_csv(out / "default_run.csv", r)
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

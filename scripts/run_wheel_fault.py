@@ -16,7 +16,6 @@ Writes out/wheel_fault/wheel_fault.csv and .png; prints the saturation and fault
 from __future__ import annotations
 
 import argparse
-import csv
 import math
 import sys
 from pathlib import Path
@@ -26,6 +25,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import numpy as np  # noqa: E402
 
 from scfmu import CoSimulation, Fmu  # noqa: E402
+from scfmu.results import write_csv  # noqa: E402
 
 COMMAND = (math.radians(30.0), math.radians(-20.0), math.radians(45.0))
 I003 = {"inertia_xx": 4.0, "inertia_yy": 5.0, "inertia_zz": 3.5, "inertia_xy": 0.05, "inertia_xz": -0.03, "inertia_yz": 0.02}
@@ -72,11 +72,7 @@ def main() -> int:
     post = t >= args.fault_time
     print(f"  after the fault: max |torque_applied_x| = {np.max(np.abs(r['torque_applied_x'][post])):.4f} N m "
           f"(limit a_x k_t i_max = {args.effectiveness_x * tmax:.4f} plus |m x B| <= 1 A m2 * |B|)")
-    keys = list(r.keys())
-    with open(out / "wheel_fault.csv", "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(keys)
-        w.writerows(np.column_stack([r[k] for k in keys]).tolist())
+    write_csv(out / "wheel_fault.csv", r)
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
