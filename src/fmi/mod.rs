@@ -135,7 +135,8 @@ pub mod mask {
     pub const GET_STATUS: u16 = m(&[StepComplete, StepFailed, Terminated]);
 }
 
-/// `fmi2StatusKind`.
+/// `fmi2StatusKind` (all four listed; only the last two have values here).
+#[allow(dead_code)]
 pub mod status_kind {
     pub const DO_STEP_STATUS: i32 = 0;
     pub const PENDING_STATUS: i32 = 1;
