@@ -7,7 +7,7 @@ use std::cell::{Cell, RefCell};
 use std::collections::HashSet;
 use std::ffi::{c_char, c_int, c_void, CStr, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::sync::{MutexGuard, Once};
+use std::sync::MutexGuard;
 
 use super::instance::{CallResult, Fail, Instance};
 use super::state::Snapshot;
@@ -46,30 +46,28 @@ thread_local! {
 }
 
 /// Panics inside an FMI call are reported through the logger, not printed: the hook records the
-/// message and location; outside FMI calls (Rust tests) the previous hook runs as usual.
+/// message and location; outside FMI calls (Rust tests) the default report is printed as usual. The
+/// hook is installed while at least one instance lives (changed only under the live-instance lock)
+/// and removed with the last one, so an unloaded library leaves no hook behind.
 fn install_panic_hook() {
-    static ONCE: Once = Once::new();
-    ONCE.call_once(|| {
-        let previous = std::panic::take_hook();
-        std::panic::set_hook(Box::new(move |info| {
-            if IN_FFI.with(Cell::get) {
-                let loc = info.location().map(|l| format!(" at {}:{}", l.file(), l.line())).unwrap_or_default();
-                let msg = info
-                    .payload()
-                    .downcast_ref::<&str>()
-                    .map(|s| s.to_string())
-                    .or_else(|| info.payload().downcast_ref::<String>().cloned())
-                    .unwrap_or_else(|| "unknown panic".into());
-                PANIC_MESSAGE.with(|m| *m.borrow_mut() = Some(format!("{msg}{loc}")));
-            } else {
-                previous(info);
-            }
-        }));
-    });
+    std::panic::set_hook(Box::new(|info| {
+        if IN_FFI.with(Cell::get) {
+            let loc = info.location().map(|l| format!(" at {}:{}", l.file(), l.line())).unwrap_or_default();
+            let msg = info
+                .payload()
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| info.payload().downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown panic".into());
+            PANIC_MESSAGE.with(|m| *m.borrow_mut() = Some(format!("{msg}{loc}")));
+        } else {
+            let msg = info.payload().downcast_ref::<&str>().copied().or_else(|| info.payload().downcast_ref::<String>().map(String::as_str));
+            eprintln!("panic: {}{}", msg.unwrap_or("unknown panic"), info.location().map(|l| format!(" at {l}")).unwrap_or_default());
+        }
+    }));
 }
 
 fn guarded<T>(f: impl FnOnce() -> T) -> Result<T, String> {
-    install_panic_hook();
     let was = IN_FFI.with(|x| x.replace(true));
     let r = catch_unwind(AssertUnwindSafe(f));
     IN_FFI.with(|x| x.set(was));
@@ -226,7 +224,11 @@ pub extern "C" fn fmi2Instantiate(
         let inst = Box::new(Instance::new(name.to_owned(), entry, functions.logger, functions.component_environment, logging_on != 0));
         inst.trace(|| format!("fmi2Instantiate: {} instance of {}", inst.name.to_string_lossy(), entry.info.name));
         let p = Box::into_raw(inst) as Component;
-        live_instances().insert(p as usize);
+        let mut live = live_instances();
+        if live.is_empty() {
+            install_panic_hook();
+        }
+        live.insert(p as usize);
         Ok(p)
     });
     let name = if instance_name.is_null() { c"?" } else { unsafe { CStr::from_ptr(instance_name) } };
@@ -253,6 +255,12 @@ pub extern "C" fn fmi2FreeInstance(c: Component) {
         // SAFETY: it was registered (so it is a leaked Box<Instance>) and is now unregistered.
         drop(unsafe { Box::from_raw(c as *mut Instance) });
     });
+    let mut live = live_instances();
+    if live.is_empty() {
+        // the last instance: give the set's memory back and remove the panic hook
+        live.shrink_to_fit();
+        drop(std::panic::take_hook());
+    }
 }
 
 #[no_mangle]
@@ -391,22 +399,24 @@ pub extern "C" fn fmi2SetString(c: Component, vr: *const u32, n: usize, value: *
 pub extern "C" fn fmi2GetFMUstate(c: Component, state: *mut *mut c_void) -> c_int {
     call(c, "fmi2GetFMUstate", mask::FMU_STATE, |inst| {
         let slot = out_ptr(state, "FMUstate")?;
-        let snap = Snapshot::capture(inst, c as usize);
+        let snap = Snapshot::capture(inst);
         if slot.is_null() {
-            *slot = snap.into_handle() as *mut c_void;
+            *slot = snap.into_handle(c as usize) as *mut c_void;
+            Ok(())
         } else {
             // Reuse of a state we handed out earlier (allowed by the standard).
-            *unsafe { Snapshot::from_handle(*slot as *mut Snapshot)? } = snap;
+            Snapshot::with_handle(*slot as *mut Snapshot, |s| {
+                *s = snap;
+                Ok(())
+            })
         }
-        Ok(())
     })
 }
 
 #[no_mangle]
 pub extern "C" fn fmi2SetFMUstate(c: Component, state: *mut c_void) -> c_int {
     call(c, "fmi2SetFMUstate", mask::FMU_STATE, |inst| {
-        let snap = unsafe { Snapshot::from_handle(state as *mut Snapshot)? };
-        snap.restore_into(inst)
+        Snapshot::with_handle(state as *mut Snapshot, |snap| snap.restore_into(inst))
     })
 }
 
@@ -427,28 +437,30 @@ pub extern "C" fn fmi2FreeFMUstate(c: Component, state: *mut *mut c_void) -> c_i
 pub extern "C" fn fmi2SerializedFMUstateSize(c: Component, state: *mut c_void, size: *mut usize) -> c_int {
     call(c, "fmi2SerializedFMUstateSize", mask::FMU_STATE, |inst| {
         let out = out_ptr(size, "size")?;
-        let snap = unsafe { Snapshot::from_handle(state as *mut Snapshot)? };
-        let bytes = snap.to_bytes(guid(inst.entry))?;
-        *out = bytes.len();
-        snap.serialized = Some(bytes);
-        Ok(())
+        Snapshot::with_handle(state as *mut Snapshot, |snap| {
+            let bytes = snap.to_bytes(guid(inst.entry))?;
+            *out = bytes.len();
+            snap.serialized = Some(bytes);
+            Ok(())
+        })
     })
 }
 
 #[no_mangle]
 pub extern "C" fn fmi2SerializeFMUstate(c: Component, state: *mut c_void, buffer: *mut c_char, size: usize) -> c_int {
     call(c, "fmi2SerializeFMUstate", mask::FMU_STATE, |inst| {
-        let snap = unsafe { Snapshot::from_handle(state as *mut Snapshot)? };
-        let bytes = match snap.serialized.take() {
-            Some(b) => b,
-            None => snap.to_bytes(guid(inst.entry))?,
-        };
-        if size != bytes.len() {
-            return Err(Fail::error(format!("size {size} differs from fmi2SerializedFMUstateSize = {}", bytes.len())));
-        }
-        let out = unsafe { slice_mut(buffer as *mut u8, size, "serializedState[]")? };
-        out.copy_from_slice(&bytes);
-        Ok(())
+        Snapshot::with_handle(state as *mut Snapshot, |snap| {
+            let bytes = match snap.serialized.take() {
+                Some(b) => b,
+                None => snap.to_bytes(guid(inst.entry))?,
+            };
+            if size != bytes.len() {
+                return Err(Fail::error(format!("size {size} differs from fmi2SerializedFMUstateSize = {}", bytes.len())));
+            }
+            let out = unsafe { slice_mut(buffer as *mut u8, size, "serializedState[]")? };
+            out.copy_from_slice(&bytes);
+            Ok(())
+        })
     })
 }
 
@@ -457,13 +469,16 @@ pub extern "C" fn fmi2DeSerializeFMUstate(c: Component, buffer: *const c_char, s
     call(c, "fmi2DeSerializeFMUstate", mask::FMU_STATE, |inst| {
         let slot = out_ptr(state, "FMUstate")?;
         let bytes = unsafe { slice(buffer as *const u8, size, "serializedState[]")? };
-        let snap = Snapshot::from_bytes(bytes, inst, c as usize, guid(inst.entry))?;
+        let snap = Snapshot::from_bytes(bytes, inst, guid(inst.entry))?;
         if slot.is_null() {
-            *slot = snap.into_handle() as *mut c_void;
+            *slot = snap.into_handle(c as usize) as *mut c_void;
+            Ok(())
         } else {
-            *unsafe { Snapshot::from_handle(*slot as *mut Snapshot)? } = snap;
+            Snapshot::with_handle(*slot as *mut Snapshot, |s| {
+                *s = snap;
+                Ok(())
+            })
         }
-        Ok(())
     })
 }
 

@@ -79,6 +79,21 @@ pub struct Run {
 }
 
 impl Run {
+    /// Consistency of a decoded run state: finite time, a sane experiment, a reachable state.
+    pub fn validate(&self) -> Result<(), String> {
+        if !self.time.is_finite() {
+            return Err(format!("time {} is not finite", self.time));
+        }
+        let e = &self.exp;
+        if !e.start_time.is_finite() || e.tolerance.is_some_and(|t| !(t.is_finite() && t > 0.0)) || e.stop_time.is_some_and(|s| !(s.is_finite() && s >= e.start_time)) {
+            return Err(format!("experiment {e:?} is not valid"));
+        }
+        if matches!(self.fsm, FsmState::Fatal | FsmState::StepCanceled) {
+            return Err(format!("state machine state {:?} cannot be restored", self.fsm));
+        }
+        Ok(())
+    }
+
     pub const INSTANTIATED: Run =
         Run { fsm: FsmState::Instantiated, time: 0.0, exp: Experiment { start_time: 0.0, tolerance: None, stop_time: None }, outputs_dirty: true, params_dirty: true };
 }

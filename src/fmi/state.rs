@@ -1,18 +1,21 @@
 //! FMU state snapshots (`fmi2GetFMUstate` & co.) and their byte format.
 //!
-//! Every snapshot handed to the master is recorded in a process-wide set, so a foreign, freed or
-//! corrupted `fmi2FMUstate` pointer is refused with an error instead of being dereferenced.
+//! Every snapshot handed to the master is recorded in a process-wide table (address → owning
+//! instance), so a foreign, freed or corrupted `fmi2FMUstate` pointer is refused with an error instead
+//! of being dereferenced. Every read or write of a snapshot happens while that table's lock is held,
+//! so instances on different threads never touch a snapshot at the same time (FMI allows independent
+//! instances on independent threads).
 //!
 //! Byte format (little endian): magic `SCFMUST\0` (8 bytes), format version u32, payload length u32,
 //! payload (postcard), CRC-32 of everything before it (u32).
 
-use std::collections::HashSet;
-use std::sync::MutexGuard;
+use std::collections::HashMap;
+use std::sync::{Mutex, MutexGuard};
 
 use serde::{Deserialize, Serialize};
 
 use super::instance::{CallResult, Fail, Instance, Run};
-use super::{BuildAddrHasher, LiveSet};
+use super::BuildAddrHasher;
 use crate::model::DynModel;
 
 const MAGIC: &[u8; 8] = b"SCFMUST\0";
@@ -21,8 +24,6 @@ const HEADER: usize = 16;
 const TRAILER: usize = 4;
 
 pub struct Snapshot {
-    /// Address of the instance that created it (freed with that instance).
-    pub owner: usize,
     pub model_name: &'static str,
     pub run: Run,
     pub model: Box<dyn DynModel>,
@@ -38,15 +39,24 @@ struct Payload {
     model: Vec<u8>,
 }
 
-fn live() -> MutexGuard<'static, HashSet<usize, BuildAddrHasher>> {
-    static LIVE: LiveSet = LiveSet::new();
-    LIVE.lock()
+/// Live snapshots: address → address of the instance that created it (freed with that instance).
+type Table = HashMap<usize, usize, BuildAddrHasher>;
+
+fn live() -> MutexGuard<'static, Table> {
+    static LIVE: Mutex<Table> = Mutex::new(HashMap::with_hasher(BuildAddrHasher));
+    LIVE.lock().unwrap_or_else(|p| p.into_inner())
+}
+
+/// Gives the table's memory back once it is empty, so an unloaded library leaves nothing behind.
+fn release_if_empty(table: &mut Table) {
+    if table.is_empty() {
+        table.shrink_to_fit();
+    }
 }
 
 impl Snapshot {
-    pub fn capture(inst: &Instance, owner: usize) -> Snapshot {
+    pub fn capture(inst: &Instance) -> Snapshot {
         Snapshot {
-            owner,
             model_name: inst.entry.info.name,
             run: inst.run,
             model: inst.model.clone_box(),
@@ -63,52 +73,52 @@ impl Snapshot {
         Ok(())
     }
 
-    /// Hands a snapshot to the master as an opaque pointer.
-    pub fn into_handle(self) -> *mut Snapshot {
+    /// Hands a snapshot of instance `owner` to the master as an opaque pointer.
+    pub fn into_handle(self, owner: usize) -> *mut Snapshot {
         let p = Box::into_raw(Box::new(self));
-        live().insert(p as usize);
+        live().insert(p as usize, owner);
         p
     }
 
-    /// The snapshot behind a handle, if the handle is one we issued and have not freed.
-    ///
-    /// # Safety
-    /// The caller must not keep the reference across a call that frees the handle.
-    pub unsafe fn from_handle<'a>(p: *mut Snapshot) -> CallResult<&'a mut Snapshot> {
+    /// Runs `f` on the snapshot behind a handle, if the handle is one we issued and have not freed,
+    /// with the table locked for the whole access.
+    pub fn with_handle<T>(p: *mut Snapshot, f: impl FnOnce(&mut Snapshot) -> CallResult<T>) -> CallResult<T> {
         if p.is_null() {
             return Err(Fail::error("FMUstate is NULL"));
         }
-        if !live().contains(&(p as usize)) {
+        let table = live();
+        if !table.contains_key(&(p as usize)) {
             return Err(Fail::error(format!("FMUstate {p:p} was not created by this FMU or was already freed")));
         }
-        // SAFETY: the address is in the live set, so it came from Box::into_raw and is not freed.
-        Ok(unsafe { &mut *p })
+        // SAFETY: the address is in the table, so it came from Box::into_raw and is not freed; the
+        // lock held until the end of this function keeps every other thread away from it.
+        let r = f(unsafe { &mut *p });
+        drop(table);
+        r
     }
 
     /// Frees a handle we issued; unknown handles are refused.
     pub fn free_handle(p: *mut Snapshot) -> CallResult {
-        if !live().remove(&(p as usize)) {
+        let mut table = live();
+        if table.remove(&(p as usize)).is_none() {
             return Err(Fail::error(format!("FMUstate {p:p} was not created by this FMU or was already freed")));
         }
-        // SAFETY: it was in the live set, so it is a Box we leaked and nobody else frees it.
+        release_if_empty(&mut table);
+        // SAFETY: it was in the table, so it is a Box we leaked and nobody else frees it.
         drop(unsafe { Box::from_raw(p) });
         Ok(())
     }
 
     /// Frees every snapshot created by the given instance (called by fmi2FreeInstance).
     pub fn free_all_of(owner: usize) {
-        let mut set = live();
-        let mine: Vec<usize> = set
-            .iter()
-            .copied()
-            // SAFETY: every address in the set is a live Snapshot box.
-            .filter(|p| unsafe { (*(*p as *const Snapshot)).owner } == owner)
-            .collect();
+        let mut table = live();
+        let mine: Vec<usize> = table.iter().filter(|(_, o)| **o == owner).map(|(p, _)| *p).collect();
         for p in mine {
-            set.remove(&p);
-            // SAFETY: removed from the set just now; it was a leaked Box.
+            table.remove(&p);
+            // SAFETY: removed from the table just now; it was a leaked Box.
             drop(unsafe { Box::from_raw(p as *mut Snapshot) });
         }
+        release_if_empty(&mut table);
     }
 
     pub fn to_bytes(&self, guid: &str) -> CallResult<Vec<u8>> {
@@ -129,8 +139,9 @@ impl Snapshot {
         Ok(out)
     }
 
-    /// Decodes bytes written by `to_bytes` for the instance's model; anything else is refused.
-    pub fn from_bytes(bytes: &[u8], inst: &Instance, owner: usize, guid: &str) -> CallResult<Snapshot> {
+    /// Decodes bytes written by `to_bytes` for the instance's model; anything else is refused, and the
+    /// decoded state is validated like parameters at initialization (see `Fmu::validate`).
+    pub fn from_bytes(bytes: &[u8], inst: &Instance, guid: &str) -> CallResult<Snapshot> {
         if bytes.len() < HEADER + TRAILER {
             return Err(Fail::error(format!("serialized state has {} bytes, too short to be one of ours", bytes.len())));
         }
@@ -158,6 +169,8 @@ impl Snapshot {
         }
         let mut model = inst.model.clone_box();
         model.load_bytes(&p.model).map_err(Fail::error)?;
-        Ok(Snapshot { owner, model_name: inst.entry.info.name, run: p.run, model, serialized: None })
+        p.run.validate().map_err(|e| Fail::error(format!("serialized state is invalid: {e}")))?;
+        model.validate(&p.run.exp).map_err(|e| Fail::error(format!("serialized state is invalid: {e}")))?;
+        Ok(Snapshot { model_name: inst.entry.info.name, run: p.run, model, serialized: None })
     }
 }

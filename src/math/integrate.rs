@@ -5,6 +5,24 @@ use nalgebra::SVector;
 
 use crate::model::{Experiment, ParamEnum};
 
+/// Most internal integration steps one call may take (one `fmi2DoStep` of a plant, one adaptive
+/// integration): a step that would need more is refused before any work is done, so every call
+/// returns in bounded time.
+pub const MAX_INTERNAL_STEPS: usize = 1_000_000;
+
+/// Refuses a fixed-step integration of `span` seconds in steps of at most `max_step` when it would
+/// take more than [`MAX_INTERNAL_STEPS`] steps.
+pub fn check_step_count(span: f64, max_step: f64) -> Result<(), String> {
+    let n = span / max_step;
+    if !(n <= MAX_INTERNAL_STEPS as f64) {
+        return Err(format!(
+            "a step of {span} s needs {n:.3e} internal steps of at most {max_step} s, more than the limit of {MAX_INTERNAL_STEPS} per call \
+             (use shorter communication steps or a larger internal step)"
+        ));
+    }
+    Ok(())
+}
+
 /// One classical Runge–Kutta 4 step of ẋ = f(t, x).
 pub fn rk4<const N: usize>(f: &mut impl FnMut(f64, &SVector<f64, N>) -> SVector<f64, N>, t: f64, x: &SVector<f64, N>, h: f64) -> SVector<f64, N> {
     let k1 = f(t, x);
@@ -125,8 +143,8 @@ pub fn dopri5<const N: usize>(
                         return Err(format!("adaptive integrator: step size underflow at t = {t}"));
                     }
                 }
-                if out.accepted + out.rejected > 10_000_000 {
-                    return Err(format!("adaptive integrator: more than 1e7 steps at t = {t}"));
+                if out.accepted + out.rejected >= MAX_INTERNAL_STEPS {
+                    return Err(format!("adaptive integrator: more than {MAX_INTERNAL_STEPS} steps in one call at t = {t} (tolerance too tight for this step?)"));
                 }
             } else {
                 k[s] = f(t + DP_C[s] * step, &xs);
@@ -181,6 +199,21 @@ impl Stepper {
         Stepper { method, max_step, tol, h_adapt: 0.0 }
     }
 
+    /// Checks a restored stepper against `fresh`, the one the parameters give: same method, step and
+    /// tolerance, and a usable adaptive step proposal.
+    pub fn check_against(&self, fresh: &Stepper) -> Result<(), String> {
+        if (self.method, self.max_step, self.tol) != (fresh.method, fresh.max_step, fresh.tol) {
+            return Err(format!(
+                "integrator state ({:?}, step {}, tolerance {}) does not match the parameters ({:?}, step {}, tolerance {})",
+                self.method, self.max_step, self.tol, fresh.method, fresh.max_step, fresh.tol
+            ));
+        }
+        if !(self.h_adapt.is_finite() && self.h_adapt >= 0.0) {
+            return Err(format!("adaptive step proposal {} is not a finite non-negative number", self.h_adapt));
+        }
+        Ok(())
+    }
+
     /// The stepper a plant's `integrator` and `max_internal_step` parameters select; the adaptive
     /// tolerance comes from `fmi2SetupExperiment` (default 1e-8).
     pub fn for_plant(integrator: i32, max_internal_step: f64, exp: &Experiment) -> Result<Self, String> {
@@ -203,6 +236,9 @@ impl Stepper {
     where
         F: FnMut(f64, &SVector<f64, N>) -> SVector<f64, N>,
     {
+        if self.method != Method::DormandPrince {
+            check_step_count(h, self.max_step)?;
+        }
         for (ts, len) in pieces(t, h, breakpoints) {
             let mut f = rhs(ts, len);
             self.piece(&mut f, ts, len, x, |xx, tt| {

@@ -45,6 +45,21 @@ impl<M: Model> Fmu<M> {
         state.step(&self.v, t, h)
     }
 
+    /// Checks a state restored from bytes as strictly as parameters at initialization: declared
+    /// bounds, finite variables, parameter relations (a trial `initialize`), finite calculated
+    /// parameters, and the model's own invariants.
+    pub fn validate(&self, exp: &Experiment) -> ModelResult {
+        self.v.check_bounds()?;
+        self.v.check_finite()?;
+        if let Some(state) = &self.state {
+            let mut v = self.v.clone();
+            let fresh = M::initialize(&mut v, exp)?;
+            v.check_calculated()?;
+            state.validate(&fresh)?;
+        }
+        Ok(())
+    }
+
     /// The internal state (for tests); panics before initialization.
     pub fn model(&self) -> &M {
         self.state.as_ref().expect("model is initialized")
@@ -71,6 +86,7 @@ pub trait DynModel: Send {
     fn to_bytes(&self) -> Result<Vec<u8>, String>;
     /// Replaces `self` by the decoded state; `self` is unchanged on error.
     fn load_bytes(&mut self, bytes: &[u8]) -> ModelResult;
+    fn validate(&self, exp: &Experiment) -> ModelResult;
 }
 
 impl<M: Model> DynModel for Fmu<M> {
@@ -105,5 +121,8 @@ impl<M: Model> DynModel for Fmu<M> {
         let decoded: Fmu<M> = postcard::from_bytes(bytes).map_err(|e| format!("model state does not decode: {e}"))?;
         *self = decoded;
         Ok(())
+    }
+    fn validate(&self, exp: &Experiment) -> ModelResult {
+        Fmu::validate(self, exp)
     }
 }

@@ -229,6 +229,18 @@ pub trait Variables: Clone + Default + Serialize + DeserializeOwned + Send + 'st
         Ok(())
     }
 
+    /// Every Real variable is finite (a restored state must not smuggle in NaN or infinity).
+    fn check_finite(&self) -> Result<(), String> {
+        for (i, d) in Self::DECLS.iter().enumerate() {
+            if let Some(Value::Real(x)) = self.value(i) {
+                if !x.is_finite() {
+                    return Err(format!("variable {} = {x} is not finite", d.name));
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Calculated parameters must be finite: a derived value that overflowed is an initialization error.
     fn check_calculated(&self) -> Result<(), String> {
         for (i, d) in Self::DECLS.iter().enumerate() {
@@ -298,14 +310,25 @@ pub struct Experiment {
 }
 
 impl Experiment {
-    /// Relative tolerance for adaptive integrators: the master's, or 1e-8.
+    /// Relative tolerance for adaptive integrators: the master's, clamped into [1e-14, 0.1] (a tighter
+    /// value cannot be met in double precision, a looser one is meaningless), or 1e-8.
     pub fn tolerance_or_default(&self) -> f64 {
-        self.tolerance.filter(|x| *x > 0.0).unwrap_or(1e-8)
+        self.tolerance.filter(|x| *x > 0.0).map_or(1e-8, |x| x.clamp(1e-14, 0.1))
     }
 }
 
 /// Error from model code; the FMI layer logs it with the calling function's name.
 pub type ModelResult = Result<(), String>;
+
+/// For [`Model::validate`]: the named parts of a restored state must be finite.
+pub fn check_finite_state<'a>(what: &str, values: impl IntoIterator<Item = &'a f64>) -> ModelResult {
+    if values.into_iter().all(|x| x.is_finite()) { Ok(()) } else { Err(format!("restored state: {what} is not finite")) }
+}
+
+/// For [`Model::validate`]: a part derived from the parameters must equal the freshly derived one.
+pub fn check_derived<T: PartialEq>(what: &str, restored: &T, fresh: &T) -> ModelResult {
+    if restored == fresh { Ok(()) } else { Err(format!("restored state: {what} does not match the parameters")) }
+}
 
 /// A model: a variable block plus an internal state built from the parameters.
 ///
@@ -322,6 +345,13 @@ pub trait Model: Clone + Serialize + DeserializeOwned + Send + 'static {
     fn initialize(v: &mut Self::Vars, exp: &Experiment) -> Result<Self, String>;
     fn outputs(&self, v: &mut Self::Vars, t: f64) -> ModelResult;
     fn step(&mut self, _v: &Self::Vars, _t: f64, _h: f64) -> ModelResult {
+        Ok(())
+    }
+    /// Invariants of a state restored from bytes (fmi2DeSerializeFMUstate), beyond what the layer
+    /// checks itself (declared bounds, finite variables, parameter relations through `initialize`):
+    /// `fresh` is the state `initialize` builds from the same parameters, so the parts derived from
+    /// parameters must equal it and the evolving parts must be finite. Default: none.
+    fn validate(&self, _fresh: &Self) -> ModelResult {
         Ok(())
     }
 }

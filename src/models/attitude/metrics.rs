@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::declare_variables;
 use crate::math::attitude::{euler321_from_quat, euler_axis_angle, wrap_pi};
-use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult};
+use crate::model::{check_finite_state, Experiment, Feedthrough, Model, ModelInfo, ModelResult};
 
 declare_variables! {
     pub struct AttitudeMetricsVars {
@@ -73,5 +73,9 @@ effort_abs = integral of sum_i |tau_applied,i| dt</pre>\n\
             *acc += x * h;
         }
         Ok(())
+    }
+
+    fn validate(&self, _fresh: &Self) -> ModelResult {
+        check_finite_state("integrals", &self.integrals)
     }
 }

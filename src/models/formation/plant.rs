@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 use crate::declare_variables;
 use crate::math::integrate::{Method, Stepper};
 use crate::math::relative_orbit::LeaderOrbit;
-use crate::model::{Experiment, Model, ModelInfo, ModelResult, ParamEnum};
+use crate::model::{check_derived, check_finite_state, Experiment, Model, ModelInfo, ModelResult, ParamEnum};
 
 declare_variables! {
     pub struct RelativeOrbitPlantVars {
@@ -29,7 +29,7 @@ declare_variables! {
         104 => mass: Real = 100.0, Parameter, "kg", "Follower mass m (paper 001)", Positive;
         105 => init_pos: Vec3 = [0.0; 3], Parameter, "m", "Initial relative position";
         108 => init_vel: Vec3 = [0.0; 3], Parameter, "m/s", "Initial relative velocity";
-        111 => max_internal_step: Real = 0.001, Parameter, "s", "Largest internal integration step", Positive;
+        111 => max_internal_step: Real = 0.001, Parameter, "s", "Largest internal integration step; at most 1e6 internal steps per doStep", Range(1e-6, 1000.0);
         140 => integrator: Integer = 0, Parameter, "", "Internal integrator: 0 = classical RK4, 1 = explicit Euler, 2 = adaptive Dormand-Prince 5(4) (tolerance from fmi2SetupExperiment, default 1e-8)", Choice(Method::CODES);
     }
 }
@@ -117,6 +117,12 @@ impl Model for RelativeOrbitPlant {
         r?;
         (self.stepper, self.x) = (stepper, x);
         Ok(())
+    }
+
+    fn validate(&self, fresh: &Self) -> ModelResult {
+        self.stepper.check_against(&fresh.stepper)?;
+        check_derived("leader orbit", &self.orbit, &fresh.orbit)?;
+        check_finite_state("state vector", self.x.iter())
     }
 }
 

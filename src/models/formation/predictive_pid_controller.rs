@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 use crate::declare_variables;
 use crate::math::predictive_control::predictive_gains;
 use crate::math::relative_orbit::LeaderOrbit;
-use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult, ParamEnum};
+use crate::model::{check_derived, check_finite_state, Experiment, Feedthrough, Model, ModelInfo, ModelResult, ParamEnum};
 
 declare_variables! {
     #[allow(non_snake_case)]
@@ -156,6 +156,11 @@ impl Model for PredictivePidController {
             }
         }
         Ok(())
+    }
+
+    fn validate(&self, fresh: &Self) -> ModelResult {
+        check_derived("structure, observer gains and leader orbit", &(self.structure, self.c, self.orbit), &(fresh.structure, fresh.c, fresh.orbit))?;
+        check_finite_state("integral and observer states", self.int_e.iter().chain(self.z.iter().flatten()))
     }
 }
 

@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::declare_variables;
 use crate::math::integrate::{Method, Stepper};
-use crate::model::{Experiment, Model, ModelInfo, ModelResult, ParamEnum};
+use crate::model::{check_derived, check_finite_state, Experiment, Model, ModelInfo, ModelResult, ParamEnum};
 
 declare_variables! {
     pub struct SingleAxisPlantVars {
@@ -25,7 +25,7 @@ declare_variables! {
         105 => md_amp: Real = 0.01, Parameter, "N.m", "Disturbance amplitude: M_d = md_amp sin(md_freq t) + md_const (paper 002 form)";
         106 => md_freq: Real = 0.1, Parameter, "rad/s", "Disturbance frequency";
         107 => md_const: Real = 0.0001, Parameter, "N.m", "Constant disturbance";
-        108 => max_internal_step: Real = 0.001, Parameter, "s", "Internal step h (paper 002 Euler step; 0.001 is a project choice)", Positive;
+        108 => max_internal_step: Real = 0.001, Parameter, "s", "Internal step h (paper 002 Euler step; 0.001 is a project choice); at most 1e6 internal steps per doStep", Range(1e-6, 1000.0);
         109 => init_theta: Real = 0.0, Parameter, "rad", "Initial angle theta(0)";
         110 => init_omega: Real = 0.0, Parameter, "rad/s", "Initial rate omega(0)";
         120 => integrator: Integer = 1, Parameter, "", "Internal integrator: 1 = explicit Euler (paper 002, default), 0 = classical RK4, 2 = adaptive Dormand-Prince 5(4)", Choice(Method::CODES);
@@ -82,6 +82,12 @@ impl Model for SingleAxisPlant {
         stepper.advance(t, h, &[], &mut x, |_, _| move |tt: f64, xx: &State| this.derivative(v, tt, xx), |_, _| Ok(()))?;
         (self.stepper, self.x) = (stepper, x);
         Ok(())
+    }
+
+    fn validate(&self, fresh: &Self) -> ModelResult {
+        self.stepper.check_against(&fresh.stepper)?;
+        check_derived("inertia", &self.j_true, &fresh.j_true)?;
+        check_finite_state("state vector", self.x.iter())
     }
 }
 

@@ -8,7 +8,7 @@ use super::shared::mrac::{mrac_outputs, MracCore, MracState, MracVariables, Refe
 use super::shared::AttitudeControllerPorts;
 use crate::declare_variables;
 use crate::math::fuzzy::{Defuzz, PdFuzzySystem};
-use crate::model::{check, Experiment, Feedthrough, Model, ModelInfo, ModelResult, ParamEnum};
+use crate::model::{check_derived, check, Experiment, Feedthrough, Model, ModelInfo, ModelResult, ParamEnum};
 
 declare_variables! {
     pub struct AdaptiveFuzzyControllerVars {
@@ -90,6 +90,11 @@ requirement checked at initialization: lambda1_min^2 >= 4 lambda2_max (real nega
     fn step(&mut self, v: &AdaptiveFuzzyControllerVars, _t: f64, h: f64) -> ModelResult {
         self.st = self.core.advance(&self.st, &v.ports, h)?;
         Ok(())
+    }
+
+    fn validate(&self, fresh: &Self) -> ModelResult {
+        check_derived("adaptive law", &self.core, &fresh.core)?;
+        self.st.validate(&self.core)
     }
 }
 

@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use super::shared::{check_unit_quaternions, AttitudeControllerPorts, ErrorLaw};
 use crate::declare_variables;
 use crate::math::fuzzy::{Defuzz, PdFuzzySystem};
-use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult, ParamEnum};
+use crate::model::{check_derived, Experiment, Feedthrough, Model, ModelInfo, ModelResult, ParamEnum};
 
 declare_variables! {
     pub struct FuzzyPdControllerVars {
@@ -88,5 +88,10 @@ T_i = k_p e - k_d w_i</pre>\n\
         v.ports.torque_cmd = kp.component_mul(&e) - kd.component_mul(&w);
         (v.kp, v.kd) = (kp, kd);
         Ok(())
+    }
+
+    fn validate(&self, fresh: &Self) -> ModelResult {
+        check_derived("error law", &self.law, &fresh.law)?;
+        check_derived("fuzzy system", &self.fuzzy, &fresh.fuzzy)
     }
 }

@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use super::shared::{linear_law, AttitudeControllerPorts, ErrorLaw};
 use crate::declare_variables;
 use crate::math::riccati::lqr;
-use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult, ParamEnum};
+use crate::model::{check_derived, Experiment, Feedthrough, Model, ModelInfo, ModelResult, ParamEnum};
 
 declare_variables! {
     pub struct LqrControllerVars {
@@ -68,6 +68,10 @@ Defaults give K_i = [I_i, 2 I_i] (closed loop s^2 + 2 s + 1). w_ref is not used.
         // T = K1 e − K2 ω
         v.ports.torque_cmd = linear_law(self.law, &v.ports, &v.k1, &-v.k2)?;
         Ok(())
+    }
+
+    fn validate(&self, fresh: &Self) -> ModelResult {
+        check_derived("error law", &self.law, &fresh.law)
     }
 }
 

@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use super::shared::mrac::{mrac_outputs, MracCore, MracState, MracVariables, ReferenceGains, EQUATIONS_HTML};
 use super::shared::AttitudeControllerPorts;
 use crate::declare_variables;
-use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult};
+use crate::model::{check_derived, Experiment, Feedthrough, Model, ModelInfo, ModelResult};
 
 declare_variables! {
     pub struct MracControllerVars {
@@ -50,6 +50,11 @@ impl Model for MracController {
     fn step(&mut self, v: &MracControllerVars, _t: f64, h: f64) -> ModelResult {
         self.st = self.core.advance(&self.st, &v.ports, h)?;
         Ok(())
+    }
+
+    fn validate(&self, fresh: &Self) -> ModelResult {
+        check_derived("adaptive law", &self.core, &fresh.core)?;
+        self.st.validate(&self.core)
     }
 }
 

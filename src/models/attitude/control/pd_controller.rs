@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use super::shared::{linear_law, AttitudeControllerPorts, ErrorLaw};
 use crate::declare_variables;
-use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult, ParamEnum};
+use crate::model::{check_derived, Experiment, Feedthrough, Model, ModelInfo, ModelResult, ParamEnum};
 
 declare_variables! {
     pub struct PdControllerVars {
@@ -56,6 +56,10 @@ w_ref is not used (paper 000 commands are constant).</p>",
     fn outputs(&self, v: &mut PdControllerVars, _t: f64) -> ModelResult {
         v.ports.torque_cmd = linear_law(self.law, &v.ports, &v.k, &v.k_d)?;
         Ok(())
+    }
+
+    fn validate(&self, fresh: &Self) -> ModelResult {
+        check_derived("error law", &self.law, &fresh.law)
     }
 }
 

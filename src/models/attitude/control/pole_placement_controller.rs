@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use super::shared::{linear_law, AttitudeControllerPorts, ErrorLaw};
 use crate::declare_variables;
 use crate::math::pole_placement::{ackermann, poly_from_roots, quadratic_roots, second_order_poly};
-use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult, ParamEnum};
+use crate::model::{check_derived, Experiment, Feedthrough, Model, ModelInfo, ModelResult, ParamEnum};
 
 declare_variables! {
     pub struct PolePlacementControllerVars {
@@ -78,5 +78,9 @@ factor 2 on k2/I (typo). w_ref is not used.</p>",
         // T = K1 e − K2 ω
         v.ports.torque_cmd = linear_law(self.law, &v.ports, &v.k1, &-v.k2)?;
         Ok(())
+    }
+
+    fn validate(&self, fresh: &Self) -> ModelResult {
+        check_derived("error law", &self.law, &fresh.law)
     }
 }

@@ -25,10 +25,10 @@ use self::kinematics::{attitude_rates, initial_attitude, post_step, v3, State, A
 use crate::math::attitude::{euler321_from_dcm, euler321_from_quat, wxyz};
 use crate::math::environment::CircularOrbit;
 use crate::math::integrate::Stepper;
-use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult, ParamEnum};
+use crate::model::{check_derived, check_finite_state, Experiment, Feedthrough, Model, ModelInfo, ModelResult, ParamEnum};
 
 /// Parameters derived at initialization.
-#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 struct Derived {
     orbit: CircularOrbit,
     n2: f64,
@@ -174,6 +174,18 @@ impl Model for AttitudePlant {
             |xx, tt| post_step(kin, ortho, &mut q_dcm, xx, tt),
         )?;
         (self.stepper, self.x, self.q_dcm) = (stepper, x, q_dcm);
+        Ok(())
+    }
+
+    fn validate(&self, fresh: &Self) -> ModelResult {
+        self.stepper.check_against(&fresh.stepper)?;
+        check_derived("kinematics", &self.kin, &fresh.kin)?;
+        check_derived("inertia", &(self.inertia, self.inertia_inv), &(fresh.inertia, fresh.inertia_inv))?;
+        check_derived("derived limits and orbit", &self.d, &fresh.d)?;
+        check_finite_state("state vector", self.x.iter().chain(&self.q_dcm))?;
+        if self.kin == Kinematics::Quaternion && (self.x.fixed_rows::<4>(ATT).norm() - 1.0).abs() > 1e-6 {
+            return Err("restored state: attitude quaternion is not of unit norm".into());
+        }
         Ok(())
     }
 }

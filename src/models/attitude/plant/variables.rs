@@ -42,7 +42,7 @@ declare_variables! {
         123 => effectiveness: Vec3 = [1.0; 3], Parameter, "", "Effectiveness a in [0, 1] after fault_time: limit a u_max (mode 0) or a k_t i_max (mode 1) (paper 004)", Range(0.0, 1.0);
         126 => fault_time: Real = 0.0, Parameter, "s", "Onset time of all actuator faults (effectiveness, bias, stuck)";
         127 => fault_bias: Vec3 = [0.0; 3], Parameter, "N.m", "Bias fault: added to the torque command after fault_time (before the limits)";
-        130 => max_internal_step: Real = 0.01, Parameter, "s", "Internal step of RK4/Euler (integrator 2 ignores it: adaptive steps)", Positive;
+        130 => max_internal_step: Real = 0.01, Parameter, "s", "Internal step of RK4/Euler (integrator 2 ignores it: adaptive steps); at most 1e6 internal steps per doStep", Range(1e-6, 1000.0);
         131 => fault_stuck_value: Vec3 = [0.0; 3], Parameter, "N.m", "Stuck fault: the torque command is replaced by this value after fault_time where fault_stuck_* = 1";
         // Integer parameters
         140 => integrator: Integer = 0, Parameter, "", "Internal integrator: 0 = classical RK4, 1 = explicit Euler, 2 = adaptive Dormand-Prince 5(4) (tolerance from fmi2SetupExperiment, default 1e-8)", Choice(Method::CODES);

@@ -34,6 +34,17 @@ declare_variables! {
     }
 }
 
+impl MracState {
+    /// Invariants of a restored state: finite, estimate not below its bound.
+    pub fn validate(&self, core: &MracCore) -> Result<(), String> {
+        crate::model::check_finite_state("reference model and inertia estimate", self.xm.iter().chain(&self.xm_dot).chain(&self.ihat))?;
+        if self.ihat.iter().zip(&core.ihat_min).any(|(i, m)| i < m) {
+            return Err(format!("restored state: inertia estimate {:?} is below its bound {:?}", self.ihat, core.ihat_min));
+        }
+        Ok(())
+    }
+}
+
 impl MracVariables {
     /// The adaptive core for the given reference-model gains, and its initial state; writes the
     /// calculated parameters.
@@ -226,6 +237,7 @@ impl MracCore {
         let e = self.effective(st, m);
         let mut y = SVector::<f64, 9>::from_iterator(e.xm.iter().chain(e.xm_dot.iter()).chain(e.ihat.iter()).copied());
         let mut f = |_t: f64, y: &SVector<f64, 9>| self.derivative(m, y);
+        crate::math::integrate::check_step_count(h, Self::MAX_STEP)?;
         let n = (h / Self::MAX_STEP - 1e-9).ceil().max(1.0) as usize;
         let dt = h / n as f64;
         for k in 0..n {
