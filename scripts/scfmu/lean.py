@@ -22,7 +22,7 @@ from ctypes import c_double, c_int, c_size_t, c_uint, c_void_p
 
 import numpy as np
 
-from .master import Fmu
+from .master import Fmu, fmu_path, unpacked
 from .scenario import Scenario
 
 _STATUS = {0: "OK", 1: "Warning", 2: "Discard", 3: "Error", 4: "Fatal", 5: "Pending"}
@@ -44,14 +44,16 @@ def _raw(slave, name: str, argtypes, restype=c_int):
     return f
 
 
-def build_fmus(scenario: Scenario, path_of=None) -> dict[str, Fmu]:
+def build_fmus(scenario: Scenario, path_of=None, reuse: bool = False) -> dict[str, Fmu]:
     """Instantiates and initializes every instance of the scenario (parameters in initialization mode),
-    then writes the fixed ``inputs``. Returns {instance name: Fmu} in Gauss–Seidel order."""
+    then writes the fixed ``inputs``. Returns {instance name: Fmu} in Gauss–Seidel order. With ``reuse``
+    the FMUs are unpacked once per process (``master.unpacked``)."""
     fmus: dict[str, Fmu] = {}
     try:
         for c in scenario.components:
-            fmus[c.name] = Fmu(c.model, c.params, name=c.name, start_time=scenario.start_time,
-                               path=path_of(c.model) if path_of else None)
+            p = path_of(c.model) if path_of else fmu_path(c.model)
+            fmus[c.name] = Fmu(c.model, c.params, name=c.name, start_time=scenario.start_time, path=p,
+                               unpacked=unpacked(p) if reuse else None)
         for q, value in scenario.inputs.items():
             inst, _, var = q.partition(".")
             fmus[inst].set(var, value)
@@ -69,9 +71,9 @@ def ports_of(fmus: dict[str, Fmu]) -> dict[str, tuple[list[str], list[str]]]:
 class LeanMaster:
     """Runs a Scenario (see module docstring). Use as a context manager or call ``close()``."""
 
-    def __init__(self, scenario: Scenario, path_of=None):
+    def __init__(self, scenario: Scenario, path_of=None, reuse: bool = True):
         self.scenario = scenario
-        self.fmus = build_fmus(scenario, path_of)
+        self.fmus = build_fmus(scenario, path_of, reuse)
         try:
             self._prepare()
         except Exception:
