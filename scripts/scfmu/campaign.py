@@ -168,7 +168,7 @@ def fmu_versions(scenario: Scenario) -> dict:
     for c in scenario.components:
         p = master.fmu_path(c.model)
         md = master.unpacked(p)[0]
-        out[c.model] = {"guid": md.guid, "sha256": hashlib.sha256(p.read_bytes()).hexdigest()}
+        out[c.model] = {"guid": md.guid, "sha256": master.fmu_digest(p)}
     return out
 
 

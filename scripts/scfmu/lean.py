@@ -52,8 +52,20 @@ def build_fmus(scenario: Scenario, path_of=None, reuse: bool = False) -> dict[st
     try:
         for c in scenario.components:
             p = path_of(c.model) if path_of else fmu_path(c.model)
-            fmus[c.name] = Fmu(c.model, c.params, name=c.name, start_time=scenario.start_time, path=p,
-                               unpacked=unpacked(p) if reuse else None)
+            # the same calls as Fmu(initialize=True), keeping the instance to report its log messages
+            f = Fmu(c.model, name=c.name, start_time=scenario.start_time, path=p, initialize=False,
+                    unpacked=unpacked(p) if reuse else None)
+            fmus[c.name] = f
+            f.slave.setupExperiment(tolerance=None, startTime=scenario.start_time, stopTime=None)
+            f.slave.enterInitializationMode()
+            for k, v in c.params.items():
+                f.set(k, v)
+            try:
+                f.slave.exitInitializationMode()
+            except Exception:
+                msgs = "; ".join(m[2] for m in f.messages if m[0] >= 2)
+                raise SimulationError("fmu_error", f"{c.name} ({c.model}): fmi2ExitInitializationMode failed"
+                                      + (f": {msgs}" if msgs else "")) from None
         for q, value in scenario.inputs.items():
             inst, _, var = q.partition(".")
             fmus[inst].set(var, value)

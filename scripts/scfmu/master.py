@@ -49,6 +49,20 @@ def unpacked(path: Path) -> tuple:
     return hit
 
 
+_DIGESTS: dict = {}
+
+
+def fmu_digest(path: Path) -> str:
+    """SHA-256 of an FMU file (cached per process by path, modification time and size)."""
+    import hashlib
+    path = Path(path).resolve()
+    st = path.stat()
+    key = (str(path), st.st_mtime_ns, st.st_size)
+    if key not in _DIGESTS:
+        _DIGESTS[key] = hashlib.sha256(path.read_bytes()).hexdigest()
+    return _DIGESTS[key]
+
+
 def recording_callbacks(messages: list) -> fmi2CallbackFunctions:
     """fmi2CallbackFunctions whose logger appends (status, category, message) to `messages`."""
 

@@ -23,7 +23,8 @@ Logging. ``log_every = m`` (default 1) reads the logged variables with one conta
 every m communication steps (one ``fmi2DoStep(t, mΔ)`` in between); ``log_every = 0`` runs the whole
 interval in one ``fmi2DoStep`` call and returns only the initial and final samples.
 
-Containers are cached on disk by a hash of their configuration (FMU GUIDs, wiring, step), in
+Containers are cached on disk by a hash of their configuration (FMU GUIDs and file SHA-256, wiring,
+step), in
 ``$SCFMU_CONTAINER_DIR`` or ``~/.cache/scfmu/containers``.
 """
 
@@ -42,7 +43,7 @@ from pathlib import Path
 import numpy as np
 
 from .lean import SimulationError
-from .master import Fmu, fmu_path, unpacked
+from .master import Fmu, fmu_digest, fmu_path, unpacked
 from .scenario import Scenario
 
 CACHE = Path(os.environ.get("SCFMU_CONTAINER_DIR", Path.home() / ".cache" / "scfmu" / "containers"))
@@ -59,7 +60,8 @@ def container_key(scenario: Scenario) -> tuple[str, dict]:
                       [v.name for v in mds[c.model].modelVariables if v.causality == "output"])
              for c in scenario.components}
     links = scenario.wiring(ports)
-    key = {"components": [(c.name, c.model, mds[c.model].guid) for c in scenario.components],
+    key = {"components": [(c.name, c.model, mds[c.model].guid, fmu_digest(fmu_path(c.model)))
+                          for c in scenario.components],
            "links": links, "step": repr(scenario.step)}
     h = hashlib.sha256(json.dumps(key, sort_keys=True).encode()).hexdigest()[:20]
     return h, {"mds": mds, "links": links}
