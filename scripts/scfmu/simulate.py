@@ -20,21 +20,27 @@ from .scenario import Scenario
 ENGINES = ("reference", "lean", "native")
 
 
-def run_reference(scenario: Scenario) -> dict[str, np.ndarray]:
+def reference_master(scenario: Scenario) -> tuple[CoSimulation, dict, dict]:
+    """(CoSimulation, {instance: Fmu}, log spec) for the scenario; the caller runs and closes it."""
     fmus = build_fmus(scenario)
-    sim = CoSimulation(list(fmus.values()), unconnected=set())
+    # the scenario's wiring (explicit exceptions included) replaces the master's own name matching
+    sim = CoSimulation(list(fmus.values()), unconnected={n for f in fmus.values() for n in f.inputs()})
+    sim.links = []
+    groups: dict[tuple[str, str], _Link] = {}
+    for d, di, s, so in scenario.wiring(ports_of(fmus)):
+        link = groups.get((d, s))
+        if link is None:
+            link = groups[(d, s)] = _Link(fmus[d], [], fmus[s], [])
+            sim.links.append(link)
+        link.dst_names.append(di)
+        link.src_names.append(so)
+    log = {key: (fmus[inst], var) for key, inst, var in scenario.log_items()}
+    return sim, fmus, log
+
+
+def run_reference(scenario: Scenario) -> dict[str, np.ndarray]:
+    sim, fmus, log = reference_master(scenario)
     try:
-        # the scenario's wiring (explicit exceptions included) replaces the master's own name matching
-        sim.links = []
-        groups: dict[tuple[str, str], _Link] = {}
-        for d, di, s, so in scenario.wiring(ports_of(fmus)):
-            link = groups.get((d, s))
-            if link is None:
-                link = groups[(d, s)] = _Link(fmus[d], [], fmus[s], [])
-                sim.links.append(link)
-            link.dst_names.append(di)
-            link.src_names.append(so)
-        log = {key: (fmus[inst], var) for key, inst, var in scenario.log_items()}
         try:
             return sim.run(scenario.stop_time, scenario.step, log, t0=scenario.start_time)
         except Exception as e:
