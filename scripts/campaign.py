@@ -91,7 +91,7 @@ def build(args) -> campaign.Campaign:
     if args.timeseries is not None:
         ts = [x for x in args.timeseries.split(",") if x]
     return campaign.Campaign(sc, sets, parse_seeds(args.seeds), engine=args.engine, timeseries=ts,
-                             ts_every=args.ts_every)
+                             ts_every=args.ts_every, log_every=args.log_every)
 
 
 def main(argv=None) -> int:
@@ -110,6 +110,8 @@ def main(argv=None) -> int:
     ap.add_argument("--timeseries", nargs="?", const="", default=None, metavar="KEYS",
                     help="keep time series per run (comma-separated logged keys; all when empty)")
     ap.add_argument("--ts-every", type=int, default=10, help="keep every n-th sample of the time series")
+    ap.add_argument("--log-every", type=int, default=1,
+                    help="native engine: sample the logged signals every n-th step (faster; metrics on that grid)")
     ap.add_argument("--workers", type=int, default=None, help="LocalCluster workers (default: CPU count)")
     ap.add_argument("--scheduler", help="address of an existing Dask scheduler (tcp://host:port)")
     ap.add_argument("--chunk", type=int, default=None, help="runs per Dask task (default: automatic)")

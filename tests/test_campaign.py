@@ -201,3 +201,20 @@ def test_cli_grid_and_plots(tmp_path):
     for f in ("results.parquet", "manifest.json", "hist_eulerint_deg_s.png", "eulerint_deg_s_vs_controller_wn.png",
               "envelope_alpha_deg.png"):
         assert (tmp_path / f).stat().st_size > 0, f
+
+
+def test_native_instance_reuse_after_reset_gives_fresh_results():
+    """A container instance reset after a run (also after a failed one) gives the fresh-instance results."""
+    from scfmu import native
+    from scfmu.lean import SimulationError
+    a = short(t=2.0).with_overrides({"controller.wn": 1.7, "plant.dist_noise_std_x": 0.5}).with_seed(7)
+    b = short(t=2.0).with_overrides({"controller.wn": 0.6}).with_seed(1)
+    fresh_a = simulate(a, "native", reuse=False)
+    fresh_b = simulate(b, "native", reuse=False)
+    native._POOL.clear()
+    for sc, ref in ((a, fresh_a), (b, fresh_b), (a, fresh_a)):
+        r = simulate(sc, "native")
+        assert all(np.array_equal(r[k], ref[k]) for k in ref)
+        with pytest.raises(SimulationError):
+            simulate(short(t=2.0).with_overrides({"controller.wn": -1.0}), "native")
+    assert sum(len(v) for v in native._POOL.values()) >= 1

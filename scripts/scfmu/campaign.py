@@ -86,6 +86,7 @@ class Campaign:
     engine: str = "native"  # "native", "lean" or "reference"
     timeseries: list | None = None  # log keys to keep per run (None: metrics only; [] : all logged keys)
     ts_every: int = 1
+    log_every: int = 1  # native engine: read the logged signals every n-th step (metrics see that grid)
 
     def runs(self) -> list[dict]:
         sc = self.scenario.to_dict()
@@ -94,13 +95,13 @@ class Campaign:
             for j, seed in enumerate(self.seeds):
                 out.append({"run": i * len(self.seeds) + j, "override_index": i, "overrides": dict(ov),
                             "seed": seed, "scenario": sc, "engine": self.engine, "timeseries": self.timeseries,
-                            "ts_every": self.ts_every})
+                            "ts_every": self.ts_every, "log_every": self.log_every})
         return out
 
     def describe(self) -> dict:
         return {"scenario": self.scenario.to_dict(), "overrides": [dict(o) for o in self.overrides],
                 "seeds": list(self.seeds), "engine": self.engine, "timeseries": self.timeseries,
-                "ts_every": self.ts_every}
+                "ts_every": self.ts_every, **({"log_every": self.log_every} if self.log_every != 1 else {})}
 
     def campaign_id(self) -> str:
         return hashlib.sha256(json.dumps(self.describe(), sort_keys=True, default=str).encode()).hexdigest()[:16]
@@ -123,7 +124,7 @@ def run_one(spec: dict, fmu_dir: str | None = None) -> tuple[dict, dict | None]:
     metric_cols = run_metrics.columns(base.metrics)
     try:
         sc = base.with_overrides(spec["overrides"]).with_seed(spec["seed"])
-        kw = {"log_every": 1} if spec["engine"] == "native" else {}
+        kw = {"log_every": max(1, int(spec.get("log_every", 1)))} if spec["engine"] == "native" else {}
         r = simulate(sc, spec["engine"], **kw)
         m = run_metrics.compute(sc.metrics, r)
         for k in metric_cols:
