@@ -12,7 +12,9 @@ AttitudeMetrics), Δ = 0.01 s, 3,000 communication steps. Per loop, µs per comm
 * native: scfmu.native.NativeLoop, the loop inside fmpy's container FMU, logging every step (one
   fmi2DoStep + one fmi2GetReal from Python per step) and with no Python call per step (log_every=0);
 * C floor: the lean master's exact call list run by a small C function (benches/cosim_floor.c,
-  compiled here with cc): the cost of the FMUs themselves plus the FMI call overhead.
+  compiled here with cc): the cost of the FMUs themselves plus the FMI call overhead;
+* libcosim: the same scenario on libcosim's fixed-step algorithm (simulate_until, last-value
+  observer), for comparison (a Jacobi scheme: not the same results).
 
 Only the stepping loop is timed (instantiation and initialization excluded); each figure is the
 minimum over --repeat interleaved repetitions. With --campaign, also campaign throughput (runs/s of
@@ -42,6 +44,7 @@ from scfmu.lean import LeanMaster  # noqa: E402
 from scfmu.master import Fmu  # noqa: E402
 from scfmu.native import NativeLoop  # noqa: E402
 from scfmu.scenario import Component, Scenario, log_of  # noqa: E402
+from scfmu.libcosim_run import run_libcosim  # noqa: E402
 from scfmu.simulate import reference_master  # noqa: E402
 
 
@@ -143,7 +146,8 @@ METHODS = [("reference master (fmpy, CoSimulation)", t_reference), ("lean master
            ("lean master, no logging", lambda sc: t_lean(sc, False)), ("minimal ctypes loop (unrolled)", t_minimal),
            ("native container, logging every step", lambda sc: t_native(sc, 1)),
            ("native container, no Python per step", lambda sc: t_native(sc, 0)),
-           ("C floor (same FMI calls from C)", t_floor)]
+           ("C floor (same FMI calls from C)", t_floor),
+           ("libcosim (libcosimpy; Jacobi coupling)", lambda sc: run_libcosim(sc)["wall_s"])]
 
 
 def loops(repeat: int):
