@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import argparse
 import ctypes
+import logging
 import os
 import platform
 import subprocess
@@ -184,7 +185,7 @@ def campaign_throughput(n_runs: int):
     os.environ["PYTHONPATH"] = str(ROOT / "scripts")
     for nw in (1, 2):
         with LocalCluster(n_workers=nw, threads_per_worker=1, processes=True, dashboard_address=None,
-                          host="127.0.0.1") as cl, Client(cl) as client:
+                          host="127.0.0.1", silence_logs=logging.CRITICAL) as cl, Client(cl) as client:
             warm = campaign.Campaign(sc, [{}] * (2 * nw), seeds=[None])
             with tempfile.TemporaryDirectory() as d:
                 campaign.run(warm, Path(d) / "w", client=client, progress=False, chunk=1)

@@ -28,6 +28,7 @@ from __future__ import annotations
 import hashlib
 import itertools
 import json
+import logging
 import math
 import os
 import platform
@@ -267,7 +268,8 @@ def _client(scheduler: str | None, n_workers: int | None):
     if scripts not in pp.split(os.pathsep):  # worker processes import scfmu from here
         os.environ["PYTHONPATH"] = scripts + (os.pathsep + pp if pp else "")
     cluster = LocalCluster(n_workers=n_workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
-                           dashboard_address=None, host="127.0.0.1")
+                           dashboard_address=None, host="127.0.0.1",
+                           silence_logs=logging.CRITICAL)
     return Client(cluster), cluster
 
 
