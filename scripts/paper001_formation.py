@@ -29,7 +29,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from scfmu import scenarios  # noqa: E402
-from scfmu.lean import LeanMaster  # noqa: E402
+from scfmu.native import NativeLoop  # noqa: E402
 from scfmu.metrics import overshoot_percent, settling_time, steady_state_error  # noqa: E402
 from scfmu.results import write_csv  # noqa: E402
 
@@ -40,12 +40,12 @@ REF = scenarios.PAPER001_REF
 
 
 def run_case(t2: float, c: float, dist: float, dt: float, t_end: float) -> dict[str, np.ndarray]:
-    """The set-up is scenarios.paper001 (one declaration for every script and campaign), run on the lean
-    master; (T2, c) may differ from the four named cases."""
+    """The set-up is scenarios.paper001 (one declaration for every script and campaign), run on the native
+    path (the loop inside fmpy's container FMU; bit-identical to the reference master, about 3x faster
+    than the lean master for 300,000 steps); (T2, c) may differ from the four named cases."""
     sc = scenarios.paper001("a", dist, t_end, dt).with_overrides({"controller.T2": t2, "controller.c": c})
-    with LeanMaster(sc) as m:
-        ctl = m.fmus["controller"]
-        gains = {k: ctl.get(k) for k in ("K1", "K2", "P_x", "D_x", "I_g_x")}
+    with NativeLoop(sc) as m:
+        gains = {k: m.get(f"controller.{k}") for k in ("K1", "K2", "P_x", "D_x", "I_g_x")}
         out = m.run()
     out["gains"] = gains
     return out

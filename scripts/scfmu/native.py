@@ -4,7 +4,7 @@ loop shipped with fmpy), so a run needs no Python call per communication step.
 How. ``build_container(scenario)`` packs the scenario's FMUs into one FMI 2.0 co-simulation FMU
 (``fmpy.container_fmu``): its configuration lists the instances, the scenario's connections (value
 references resolved by port name), and one container variable ``"<instance>.<variable>"`` for every
-parameter, input and output of every instance. The container's ``fmi2DoStep(t, h)`` runs h/Δ fixed
+parameter, calculated parameter, input and output of every instance. The container's ``fmi2DoStep(t, h)`` runs h/Δ fixed
 steps of Δ = scenario.step in compiled code; each fixed step is: ``doStep`` of every instance from
 t_k to t_k + Δ, then, connection by connection in the listed order, ``fmi2GetReal`` of the source
 outputs and ``fmi2SetReal`` of the destination inputs.
@@ -47,7 +47,8 @@ from .master import Fmu, fmu_digest, fmu_path, unpacked
 from .scenario import Scenario
 
 CACHE = Path(os.environ.get("SCFMU_CONTAINER_DIR", Path.home() / ".cache" / "scfmu" / "containers"))
-_KINDS = ("parameter", "input", "output")
+_KINDS = ("parameter", "calculatedParameter", "input", "output")
+LAYOUT = 2  # version of the container layout below (part of the cache key)
 
 
 def _descriptions(scenario: Scenario):
@@ -62,7 +63,7 @@ def container_key(scenario: Scenario) -> tuple[str, dict]:
     links = scenario.wiring(ports)
     key = {"components": [(c.name, c.model, mds[c.model].guid, fmu_digest(fmu_path(c.model)))
                           for c in scenario.components],
-           "links": links, "step": repr(scenario.step)}
+           "links": links, "step": repr(scenario.step), "layout": LAYOUT}
     h = hashlib.sha256(json.dumps(key, sort_keys=True).encode()).hexdigest()[:20]
     return h, {"mds": mds, "links": links}
 
@@ -95,6 +96,9 @@ def build_container(scenario: Scenario) -> Path:
                 cv = ModelVariable(type=v.type, variability="tunable" if v.variability == "tunable" else "fixed",
                                    causality="parameter", name=f"{c.name}.{v.name}", start=v.start)
                 cv.initial = "exact"
+            elif v.causality == "calculatedParameter":
+                cv = ModelVariable(type=v.type, variability=v.variability, causality="calculatedParameter",
+                                   name=f"{c.name}.{v.name}")
             elif v.causality == "input":
                 cv = ModelVariable(type=v.type, variability=v.variability, causality="input",
                                    name=f"{c.name}.{v.name}", start=v.start)
@@ -234,6 +238,10 @@ class NativeLoop:
                 raise KeyError(f"log {key!r}: no variable {inst}.{var}")
         self._log_vrs = (c_uint * len(items))(*[vr[f"{i}.{v}"] for _, i, v in items])
         self._log_keys = [k for k, _, _ in items]
+
+    def get(self, name: str):
+        """Current value of ``"instance.variable"`` (a parameter, calculated parameter, input or output)."""
+        return self.fmu.get(name)
 
     def run(self) -> dict[str, np.ndarray]:
         sc = self.scenario
