@@ -232,3 +232,13 @@ def test_second_master_libcosim_agrees_within_the_coupling_delay():
     assert e_lc != e_ref  # a different coupling scheme, not the same computation
     assert abs(e_lc - e_ref) / e_ref < 0.01
     assert lc["alpha_deg"] < 1e-3 and lc["wall_s"] > 0
+
+
+def test_a_worker_that_dies_gives_a_worker_error_row(tmp_path, monkeypatch):
+    import dask
+    monkeypatch.setenv("SCFMU_CRASH_TEST_RUN", "2")  # inherited by the LocalCluster's worker processes
+    c = campaign.Campaign(short(t=1.0), campaign.grid({"controller.wn": [0.5, 1.0, 2.0, 3.0]}), seeds=[None])
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+        rows = rows_of(campaign.run(c, tmp_path, n_workers=1, chunk=2, progress=False))
+    assert [r["status"] for r in rows] == ["ok", "ok", "worker_error", "ok"]
+    assert rows[2]["p:controller.wn"] == 2.0 and np.isnan(rows[2]["eulerint_deg_s"])

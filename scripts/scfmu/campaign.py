@@ -21,6 +21,10 @@ Output folder:
   holding a different campaign is refused unless ``overwrite=True``);
 * ``results.parquet``: all rows sorted by ``run`` (written at the end);
 * ``timeseries/run-<run>.parquet`` when ``timeseries`` is set (logged keys, every ``ts_every``-th sample).
+
+A worker process that dies during a task (e.g. a crash inside an FMU's native code) makes Dask retry the
+task; if it keeps failing, its runs (and those of tasks lost with it) are retried one at a time after
+the others, and a run that still kills its worker gets a row with status ``worker_error``.
 """
 
 from __future__ import annotations
@@ -114,6 +118,8 @@ def run_one(spec: dict, fmu_dir: str | None = None) -> tuple[dict, dict | None]:
     from .lean import SimulationError
     from .simulate import simulate
 
+    if os.environ.get("SCFMU_CRASH_TEST_RUN") == str(spec["run"]):  # test hook: a worker that dies mid-run
+        os._exit(70)
     if fmu_dir:
         master.FMU_DIR = Path(fmu_dir)
     base = Scenario.from_dict(spec["scenario"])
@@ -147,6 +153,17 @@ def run_one(spec: dict, fmu_dir: str | None = None) -> tuple[dict, dict | None]:
     for k in metric_cols:
         row.setdefault(k, math.nan)
     return row, ts
+
+
+def _crash_row(spec: dict, c: "Campaign", e: Exception) -> dict:
+    row = {"run": spec["run"], "override_index": spec["override_index"],
+           "seed": -1 if spec["seed"] is None else int(spec["seed"]), "status": "worker_error",
+           "message": f"{type(e).__name__}: {e}"[:2000]}
+    for k, v in spec["overrides"].items():
+        row[f"p:{k}"] = v
+    for k in run_metrics.columns(c.scenario.metrics):
+        row[k] = math.nan
+    return row
 
 
 def run_chunk(specs: list[dict], fmu_dir: str | None = None) -> list[tuple[dict, dict | None]]:
@@ -337,15 +354,22 @@ def run(c: Campaign, out_dir: str | Path, scheduler: str | None = None, n_worker
             chunks = [todo[i:i + size] for i in range(0, len(todo), size)]
             fmu_dir = str(master.FMU_DIR.resolve())
             from dask.distributed import as_completed
-            futures = [client.submit(run_chunk, ch, fmu_dir, pure=False) for ch in chunks]
+            chunk_of = {}
+            futures = []
+            for ch in chunks:
+                f = client.submit(run_chunk, ch, fmu_dir, pure=False)
+                chunk_of[f.key] = ch
+                futures.append(f)
             bar = None
             if progress:
                 from tqdm import tqdm
                 bar = tqdm(total=len(specs), initial=len(specs) - len(todo), unit="run", desc=c.scenario.name,
                            file=sys.stderr, dynamic_ncols=True)
             try:
-                for fut in as_completed(futures):
-                    for row, ts in fut.result():
+                suspects = []
+
+                def take(results):
+                    for row, ts in results:
                         if ts is not None:
                             _write_ts(out_dir, row["run"], ts)
                         writer.add(row)
@@ -353,6 +377,21 @@ def run(c: Campaign, out_dir: str | Path, scheduler: str | None = None, n_worker
                             bar.update(1)
                             if row["status"] != "ok":
                                 bar.set_postfix_str(f"failed: {row['run']}", refresh=False)
+
+                for fut in as_completed(futures):
+                    try:
+                        results = fut.result()
+                    except Exception:  # the worker died (e.g. a crash inside an FMU) or was lost
+                        suspects.extend(chunk_of[fut.key])  # also innocent tasks queued on that worker
+                        continue
+                    take(results)
+                # runs of failed tasks again, one at a time, so that only a run that kills its worker fails
+                for spec in sorted(suspects, key=lambda s: s["run"]):
+                    try:
+                        results = client.submit(run_chunk, [spec], fmu_dir, pure=False).result()
+                    except Exception as e:
+                        results = [(_crash_row(spec, c, e), None)]
+                    take(results)
             finally:
                 writer.flush()
                 if bar is not None:
