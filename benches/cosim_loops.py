@@ -205,11 +205,13 @@ def main() -> int:
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--campaign", action="store_true")
     ap.add_argument("--runs", type=int, default=40)
+    ap.add_argument("--no-loops", action="store_true", help="only the campaign throughput")
     args = ap.parse_args()
     load = os.getloadavg()[0]
     print(f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, {os.cpu_count()} cores, load average {load:.1f}, "
           f"Python {platform.python_version()}")
-    loops(args.repeat)
+    if not args.no_loops:
+        loops(args.repeat)
     if args.campaign:
         campaign_throughput(args.runs)
     return 0
