@@ -171,13 +171,14 @@ def test_resume_runs_only_what_is_missing(reference_rows, tmp_path):
     assert len(parts) == 4
     # an interrupted campaign: the final table and half of the parts are gone, one time series too
     (tmp_path / "results.parquet").unlink()
-    for p in parts[2:]:
+    for p in parts[1:3]:  # parts lost in the middle: new parts must not overwrite the last one
         p.unlink()
+    parts = [parts[0], parts[3]]
     import pyarrow.parquet as pq
-    kept = sorted(r for p in parts[:2] for r in pq.read_table(p).column("run").to_pylist())
+    kept = sorted(r for p in parts for r in pq.read_table(p).column("run").to_pylist())
     lost_ts = kept[0]
     (tmp_path / "timeseries" / f"run-{lost_ts:06d}.parquet").unlink()
-    done_before = {p.name: p.stat().st_mtime_ns for p in parts[:2]}
+    done_before = {p.name: p.stat().st_mtime_ns for p in parts}
     resumed = rows_of(campaign.run(c, tmp_path, n_workers=1, flush_every=100, progress=False))
     same_rows(full, resumed)
     new_parts = sorted(set(p.name for p in (tmp_path / "parts").glob("rows-*.parquet")) - set(done_before))

@@ -257,7 +257,8 @@ class _Writer:
         self.columns = columns
         self.flush_every = flush_every
         self.buf: list[dict] = []
-        self.n = len(list(self.dir.glob("rows-*.parquet")))
+        existing = [int(p.stem.split("-")[1]) for p in self.dir.glob("rows-*.parquet")]
+        self.n = max(existing) + 1 if existing else 0  # never reuse the name of a part already written
 
     def add(self, row: dict) -> None:
         self.buf.append(row)
@@ -334,9 +335,12 @@ def run(c: Campaign, out_dir: str | Path, scheduler: str | None = None, n_worker
     (out_dir / "results.parquet").unlink(missing_ok=True)
 
     done_table = read_results(out_dir)
-    done = set(done_table.column("run").to_pylist()) if done_table is not None else set()
-    if c.timeseries is not None:  # a row without its time series is redone
-        done = {r for r in done if (out_dir / "timeseries" / f"run-{r:06d}.parquet").exists()}
+    done = set()
+    if done_table is not None:
+        for r, st in zip(done_table.column("run").to_pylist(), done_table.column("status").to_pylist()):
+            # a successful run whose time series file is missing is redone
+            if c.timeseries is None or st != "ok" or (out_dir / "timeseries" / f"run-{r:06d}.parquet").exists():
+                done.add(r)
     todo = [s for s in specs if s["run"] not in done]
     columns = _row_columns(c)
     writer = _Writer(out_dir, columns, flush_every)
