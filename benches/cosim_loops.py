@@ -159,7 +159,7 @@ def loops(repeat: int):
             for mn, f in METHODS:
                 best[(ln, mn)] = min(best[(ln, mn)], f(sc) / sc.n_steps * 1e6)
     calls = {ln: unrolled_calls(sc) for ln, sc in scs.items()}
-    print(f"\n| loop (µs per communication step; ratio to the minimal ctypes loop) | "
+    print("\n| loop (µs per communication step; ratio to the minimal ctypes loop) | "
           + " | ".join(f"{ln} ({calls[ln]} FMI calls/step)" for ln in scs) + " |")
     print("|---|" + "---:|" * len(scs))
     for mn, _ in METHODS:
