@@ -22,72 +22,27 @@ import csv
 import math
 import sys
 import time
-from dataclasses import dataclass, field
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import numpy as np  # noqa: E402
 
-from scfmu import CoSimulation, Fmu  # noqa: E402
+from scfmu import Fmu, scenarios  # noqa: E402
 from scfmu.metrics import overshoot_percent, settling_time  # noqa: E402
 from scfmu.results import write_csv  # noqa: E402
+from scfmu.simulate import simulate as run_scenario  # noqa: E402
 
-D = math.radians
-COMMANDS = {
-    "S": (D(4.0), D(-4.0), D(-6.0)),
-    "L": (D(40.0), D(-40.0), D(-60.0)),
-    "L2": (D(40.0), D(40.0), D(60.0)),
-}
-KIN_NAMES = {0: "quat", 1: "dcm", 2: "eul213", 3: "linear"}
+COMMANDS = scenarios.COMMANDS
+KIN_NAMES = scenarios.KIN_NAMES
 ANGLES = ["roll", "pitch", "yaw"]
-
-
-@dataclass
-class Run:
-    run_id: str
-    controller: str
-    command: str
-    kinematics: int = 0
-    ctrl_params: dict = field(default_factory=dict)
-    plant_params: dict = field(default_factory=dict)
-    label: str = ""
-
-    @property
-    def key(self) -> str:
-        return self.run_id
+Run = scenarios.Paper000Run
+CSV_KEYS = ["time", "roll", "pitch", "yaw", "w_x", "w_y", "w_z", "torque_applied_x", "torque_applied_y",
+            "torque_applied_z", "alpha_deg", "eulerint_deg_s", "effort_abs", "effort_sq"]
 
 
 def run_table() -> list[Run]:
-    runs = [
-        Run("000-1", "PdController", "S", 3, {"error_law": 2}, label="PD Euler"),
-        Run("000-2", "PdController", "L", 2, {"error_law": 2}, label="PD Euler"),
-        Run("000-3", "PdController", "S", 3, {"error_law": 1}, label="PD DCM"),
-        Run("000-4", "PdController", "L", 1, {"error_law": 1}, label="PD DCM"),
-        Run("000-5", "PdController", "S", 3, {"error_law": 0}, label="PD quat"),
-        Run("000-6", "PdController", "L", 0, {"error_law": 0}, label="PD quat"),
-        Run("000-7S", "LqrController", "S", 3, label="LQR"),
-        Run("000-7L", "LqrController", "L", 0, label="LQR"),
-        Run("000-8S", "PolePlacementController", "S", 3, label="PolePl"),
-        Run("000-8L", "PolePlacementController", "L", 0, label="PolePl"),
-        Run("000-9S", "MracController", "S", 3, {"coordinates": 1}, label="MRAC lin"),
-        Run("000-9L", "MracController", "L", 0, {"coordinates": 0}, label="MRAC quat"),
-        Run("000-10L", "FuzzyPdController", "L", 0, label="FuzzyPD"),
-        Run("000-10L2", "FuzzyPdController", "L2", 0, label="FuzzyPD"),
-        Run("000-11L", "AdaptiveFuzzyController", "L", 0, label="AdaptFuzzy"),
-        Run("000-11L2", "AdaptiveFuzzyController", "L2", 0, label="AdaptFuzzy"),
-    ]
-    robust = [("PdController", {"error_law": 0}, "PD quat"), ("MracController", {}, "MRAC quat"),
-              ("FuzzyPdController", {}, "FuzzyPD"), ("AdaptiveFuzzyController", {}, "AdaptFuzzy")]
-    for cmd in ("L", "L2"):
-        for name, cp, label in robust:
-            runs.append(Run(f"R1-{label.split()[0]}-{cmd}", name, cmd, 0, cp, {"dist_const": 10.0}, label=label))
-    for scale in (1.2, 0.8):
-        for cmd in ("L", "L2"):
-            for name, cp, label in robust:
-                pp = {f"inertia_scale_{a}": scale for a in "xyz"}
-                runs.append(Run(f"R2-{scale}-{label.split()[0]}-{cmd}", name, cmd, 0, cp, pp, label=label))
-    return runs
+    return scenarios.paper000_runs()
 
 
 def plant_supports(kinematics: int) -> bool:
@@ -99,32 +54,8 @@ def plant_supports(kinematics: int) -> bool:
 
 
 def simulate(run: Run, t_end: float, dt: float) -> dict:
-    command = COMMANDS[run.command]
-    cmd = Fmu("AttitudeCommand", {"ref_euler321_roll": command[0], "ref_euler321_pitch": command[1],
-                                  "ref_euler321_yaw": command[2]})
-    ctrl = Fmu(run.controller, run.ctrl_params)
-    plant_params = {"max_internal_step": 0.01, "kinematics": run.kinematics}
-    dist = run.plant_params.get("dist_const")
-    plant_params.update({k: v for k, v in run.plant_params.items() if k != "dist_const"})
-    plant = Fmu("AttitudePlant", {k: v for k, v in plant_params.items() if k != "kinematics" or v != 0})
-    if dist is not None:
-        # constant disturbance torque: the plant's generator parameter if present, else its input
-        if "dist_const_x" in plant.vars:
-            plant.close()
-            plant = Fmu("AttitudePlant", {**{k: v for k, v in plant_params.items() if k != "kinematics" or v != 0},
-                                          **{f"dist_const_{a}": dist for a in "xyz"}})
-        else:
-            plant.set_reals(["torque_dist_x", "torque_dist_y", "torque_dist_z"], [dist] * 3)
-    metrics = Fmu("AttitudeMetrics")
-    sim = CoSimulation([cmd, ctrl, plant, metrics])
-    log = {n: (plant, n) for n in ["roll", "pitch", "yaw", "w_x", "w_y", "w_z",
-                                    "torque_applied_x", "torque_applied_y", "torque_applied_z"]}
-    log.update({n: (metrics, n) for n in ["alpha_deg", "eulerint_deg_s", "effort_abs", "effort_sq"]})
-    try:
-        r = sim.run(t_end, dt, log)
-    finally:
-        sim.close()
-    return r
+    """The set-up is scenarios.paper000(run_id) (one declaration for every script and campaign)."""
+    return run_scenario(scenarios.paper000(run.run_id, t_end, dt), "lean")
 
 
 def summarize(run: Run, r: dict) -> dict:
@@ -227,7 +158,7 @@ def main() -> int:
         row = summarize(run, r)
         rows.append(row)
         results[run.run_id] = r
-        write_csv(out / f"{run.run_id}.csv", r)
+        write_csv(out / f"{run.run_id}.csv", r, CSV_KEYS)
         if not args.no_plots:
             plot_run(out / f"{run.run_id}.png", run, r, row)
 

@@ -3,7 +3,7 @@
 quaternion PD law (run 000-6): AttitudeCommand + PdController + AttitudePlant + AttitudeMetrics wired
 by port name in fmpy. Prints EULERINT, settling time and control effort; writes CSV and PNG.
 
-Setup (spec metrics-and-scenarios.md §2.1): inertia diag(1000, 500, 700) kg m², no torque limit,
+The set-up is declared once in scfmu.scenarios.default(): inertia diag(1000, 500, 700) kg m², no torque limit,
 RK4 0.01 s, communication step 0.01 s, t_end = 30 s.
 """
 
@@ -18,26 +18,22 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import numpy as np  # noqa: E402
 
-from scfmu import CoSimulation, Fmu  # noqa: E402
+from scfmu import scenarios  # noqa: E402
 from scfmu.metrics import overshoot_percent, settling_time  # noqa: E402
 from scfmu.results import write_csv  # noqa: E402
+from scfmu.simulate import simulate  # noqa: E402
 
-LARGE = (math.radians(40.0), math.radians(-40.0), math.radians(-60.0))
+LARGE = scenarios.COMMANDS["L"]
+CSV_KEYS = ["time", "q_w", "q_x", "q_y", "q_z", "w_x", "w_y", "w_z", "roll", "pitch", "yaw", "torque_applied_x",
+            "torque_applied_y", "torque_applied_z", "alpha_deg", "eulerint_deg_s", "effort_abs", "effort_sq"]
 
 
-def run(t_end: float = 30.0, dt: float = 0.01, command=LARGE, error_law: int = 0):
-    cmd = Fmu("AttitudeCommand", {"ref_euler321_roll": command[0], "ref_euler321_pitch": command[1], "ref_euler321_yaw": command[2]})
-    ctrl = Fmu("PdController", {"error_law": error_law})
-    plant = Fmu("AttitudePlant", {"max_internal_step": 0.01})
-    metrics = Fmu("AttitudeMetrics")
-    sim = CoSimulation([cmd, ctrl, plant, metrics])
-    log = {n: (plant, n) for n in ["q_w", "q_x", "q_y", "q_z", "w_x", "w_y", "w_z", "roll", "pitch", "yaw",
-                                    "torque_applied_x", "torque_applied_y", "torque_applied_z"]}
-    log.update({n: (metrics, n) for n in ["alpha_deg", "eulerint_deg_s", "effort_abs", "effort_sq"]})
-    try:
-        return sim.run(t_end, dt, log)
-    finally:
-        sim.close()
+def run(t_end: float = 30.0, dt: float = 0.01, command=LARGE, error_law: int = 0, engine: str = "lean"):
+    """The set-up is scenarios.default() (paper 000 run 000-6); `engine` picks the master (scfmu.simulate)."""
+    sc = scenarios.default(t_end, dt).with_overrides({
+        "command.ref_euler321_roll": command[0], "command.ref_euler321_pitch": command[1],
+        "command.ref_euler321_yaw": command[2], "controller.error_law": error_law})
+    return simulate(sc, engine)
 
 
 def summarize(r: dict, command=LARGE) -> dict:
@@ -60,15 +56,17 @@ def main() -> int:
     ap.add_argument("--out", default="out/default", help="output folder for CSV and PNG")
     ap.add_argument("--t-end", type=float, default=30.0)
     ap.add_argument("--dt", type=float, default=0.01)
+    ap.add_argument("--engine", default="lean", choices=["lean", "native", "reference"],
+                    help="co-simulation master (all give bit-identical results)")
     args = ap.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    r = run(args.t_end, args.dt)
+    r = run(args.t_end, args.dt, engine=args.engine)
     s = summarize(r)
     print(f"Paper 000 run 000-6: quaternion PD, large command (40, -40, -60) deg, dt = {args.dt} s, t_end = {args.t_end} s")
     for k, v in s.items():
         print(f"  {k:22s} {v:12.6g}")
-    write_csv(out / "default_run.csv", r)
+    write_csv(out / "default_run.csv", r, CSV_KEYS)
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

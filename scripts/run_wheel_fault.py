@@ -24,28 +24,18 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import numpy as np  # noqa: E402
 
-from scfmu import CoSimulation, Fmu  # noqa: E402
+from scfmu import scenarios  # noqa: E402
 from scfmu.results import write_csv  # noqa: E402
+from scfmu.simulate import simulate  # noqa: E402
 
-COMMAND = (math.radians(30.0), math.radians(-20.0), math.radians(45.0))
-I003 = {"inertia_xx": 4.0, "inertia_yy": 5.0, "inertia_zz": 3.5, "inertia_xy": 0.05, "inertia_xz": -0.03, "inertia_yz": 0.02}
+COMMAND = scenarios.WHEEL_FAULT_COMMAND
+CSV_KEYS = ["time", "roll", "pitch", "yaw"] + [f"{v}_{a}" for v in ["torque_applied", "h_wheel", "wheel_speed", "dipole", "w"]
+                                               for a in "xyz"] + [f"torque_cmd_{a}" for a in "xyz"]
 
 
-def run(t_end: float, dt: float, fault_time: float, effectiveness_x: float, bias_z: float):
-    cmd = Fmu("AttitudeCommand", {"ref_euler321_roll": COMMAND[0], "ref_euler321_pitch": COMMAND[1], "ref_euler321_yaw": COMMAND[2]})
-    ctrl = Fmu("PdController", {"wn": 0.3, "zeta": 0.9, "inertia_xx": 4.0, "inertia_yy": 5.0, "inertia_zz": 3.5})
-    plant = Fmu("AttitudePlant", dict(I003, actuator_mode=1, mtq_enable=1, gg_enable=1,
-                                      dist_const_x=5e-4, dist_const_y=5e-4, dist_const_z=5e-4,
-                                      effectiveness_x=effectiveness_x, fault_bias_z=bias_z, fault_time=fault_time))
-    sim = CoSimulation([cmd, ctrl, plant])
-    names = ["roll", "pitch", "yaw"] + [f"{v}_{a}" for v in ["torque_applied", "h_wheel", "wheel_speed", "dipole", "w"]
-                                        for a in "xyz"]
-    log = {n: (plant, n) for n in names}
-    log.update({f"torque_cmd_{a}": (ctrl, f"torque_cmd_{a}") for a in "xyz"})
-    try:
-        return sim.run(t_end, dt, log)
-    finally:
-        sim.close()
+def run(t_end: float, dt: float, fault_time: float, effectiveness_x: float, bias_z: float, engine: str = "lean"):
+    """The set-up is scenarios.wheel_fault(); `engine` picks the master (scfmu.simulate)."""
+    return simulate(scenarios.wheel_fault(t_end, dt, fault_time, effectiveness_x, bias_z), engine)
 
 
 def main() -> int:
@@ -72,7 +62,7 @@ def main() -> int:
     post = t >= args.fault_time
     print(f"  after the fault: max |torque_applied_x| = {np.max(np.abs(r['torque_applied_x'][post])):.4f} N m "
           f"(limit a_x k_t i_max = {args.effectiveness_x * tmax:.4f} plus |m x B| <= 1 A m2 * |B|)")
-    write_csv(out / "wheel_fault.csv", r)
+    write_csv(out / "wheel_fault.csv", r, CSV_KEYS)
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

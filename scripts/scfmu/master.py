@@ -31,6 +31,38 @@ def fmu_path(model: str) -> Path:
     return p
 
 
+_UNPACKED: dict = {}
+
+
+def unpacked(path: Path) -> tuple:
+    """(model description, unzip directory) of an FMU, extracted once per process and kept until exit
+    (for runs that instantiate the same FMUs many times, e.g. campaigns)."""
+    path = Path(path).resolve()
+    st = path.stat()
+    key = (str(path), st.st_mtime_ns, st.st_size)
+    hit = _UNPACKED.get(key)
+    if hit is None:
+        import atexit
+        hit = (read_model_description(str(path)), extract(str(path)))
+        atexit.register(shutil.rmtree, hit[1], True)
+        _UNPACKED[key] = hit
+    return hit
+
+
+_DIGESTS: dict = {}
+
+
+def fmu_digest(path: Path) -> str:
+    """SHA-256 of an FMU file (cached per process by path, modification time and size)."""
+    import hashlib
+    path = Path(path).resolve()
+    st = path.stat()
+    key = (str(path), st.st_mtime_ns, st.st_size)
+    if key not in _DIGESTS:
+        _DIGESTS[key] = hashlib.sha256(path.read_bytes()).hexdigest()
+    return _DIGESTS[key]
+
+
 def recording_callbacks(messages: list) -> fmi2CallbackFunctions:
     """fmi2CallbackFunctions whose logger appends (status, category, message) to `messages`."""
 
@@ -52,12 +84,18 @@ class Fmu:
 
     def __init__(self, model: str, params: dict | None = None, name: str | None = None,
                  start_time: float = 0.0, stop_time: float | None = None, tolerance: float | None = None,
-                 path: Path | None = None, initialize: bool = True, logging_on: bool = False):
+                 path: Path | None = None, initialize: bool = True, logging_on: bool = False,
+                 unpacked: tuple | None = None):
         self.model = model
         self.path = Path(path) if path else fmu_path(model)
-        self.md = read_model_description(str(self.path))
+        if unpacked is None:  # (model description, unzip directory) shared by instances; kept on close
+            self.md = read_model_description(str(self.path))
+            self.unzipdir = extract(str(self.path))
+            self._owns_dir = True
+        else:
+            self.md, self.unzipdir = unpacked
+            self._owns_dir = False
         self.vars = {v.name: v for v in self.md.modelVariables}
-        self.unzipdir = extract(str(self.path))
         self.messages: list[tuple[int, str, str]] = []
         self.callbacks = recording_callbacks(self.messages)
         self.slave = FMU2Slave(guid=self.md.guid, unzipDirectory=self.unzipdir,
@@ -124,7 +162,8 @@ class Fmu:
         try:
             self.slave.freeInstance()
         finally:
-            shutil.rmtree(self.unzipdir, ignore_errors=True)
+            if self._owns_dir:
+                shutil.rmtree(self.unzipdir, ignore_errors=True)
 
 
 @dataclass

@@ -1,0 +1,221 @@
+#!/usr/bin/env python3
+"""Co-simulation loop speed, measured side by side in one run (docs/benchmarks.md, issue 9).
+
+Loops: 2 FMUs (PdController + AttitudePlant, reference fixed at the paper 000 large command) and the
+4-FMU run 000-6 of scripts/run_default.py (AttitudeCommand + PdController + AttitudePlant +
+AttitudeMetrics), Δ = 0.01 s, 3,000 communication steps. Per loop, µs per communication step of:
+
+* reference: scfmu.master.CoSimulation (fmpy high-level calls, logging the scenario's signals);
+* lean: scfmu.lean.LeanMaster (logging), and without logging;
+* minimal ctypes: the same FMI calls as straight-line Python code (generated, unrolled, no logging,
+  no status checks): the floor of any master written in Python;
+* native: scfmu.native.NativeLoop, the loop inside fmpy's container FMU, logging every step (one
+  fmi2DoStep + one fmi2GetReal from Python per step) and with no Python call per step (log_every=0);
+* C floor: the lean master's exact call list run by a small C function (benches/cosim_floor.c,
+  compiled here with cc): the cost of the FMUs themselves plus the FMI call overhead;
+* libcosim: the same scenario on libcosim's fixed-step algorithm (simulate_until, last-value
+  observer), for comparison (a Jacobi scheme: not the same results).
+
+Only the stepping loop is timed (instantiation and initialization excluded); each figure is the
+minimum over --repeat interleaved repetitions. With --campaign, also campaign throughput (runs/s of
+the 30 s run 000-6 on the native path, warm workers) with 1 and 2 Dask workers.
+
+Usage: .venv/bin/python benches/cosim_loops.py [--repeat 5] [--campaign] [--runs 40]
+"""
+
+from __future__ import annotations
+
+import argparse
+import ctypes
+import logging
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+import time
+from ctypes import c_double, c_long, c_size_t, c_void_p
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "scripts"))
+
+from scfmu import scenarios  # noqa: E402
+from scfmu.lean import LeanMaster  # noqa: E402
+from scfmu.master import Fmu  # noqa: E402
+from scfmu.native import NativeLoop  # noqa: E402
+from scfmu.scenario import Component, Scenario, log_of  # noqa: E402
+from scfmu.libcosim_run import run_libcosim  # noqa: E402
+from scfmu.simulate import reference_master  # noqa: E402
+
+
+def two_fmu_scenario(stop_time=30.0) -> Scenario:
+    c = scenarios.COMMANDS["L"]
+    cmd = Fmu("AttitudeCommand", {"ref_euler321_roll": c[0], "ref_euler321_pitch": c[1], "ref_euler321_yaw": c[2]})
+    qref = {f"controller.q_ref_{a}": cmd.get(f"q_ref_{a}") for a in "wxyz"}
+    cmd.close()
+    return Scenario("pd+plant", [Component("controller", "PdController", {"error_law": 0}),
+                                 Component("plant", "AttitudePlant", {"max_internal_step": 0.01})],
+                    stop_time, 0.01, log=log_of("plant", ["q_w", "q_x", "q_y", "q_z", "w_x", "w_y", "w_z"]),
+                    inputs={**qref, **{f"controller.w_ref_{a}": 0.0 for a in "xyz"}})
+
+
+def t_reference(sc):
+    sim, fmus, log = reference_master(sc)
+    t = time.perf_counter()
+    sim.run(sc.stop_time, sc.step, log)
+    dt = time.perf_counter() - t
+    sim.close()
+    return dt
+
+
+def t_lean(sc, log=True):
+    if not log:
+        sc = sc.with_overrides(log={})
+    with LeanMaster(sc) as m:
+        t = time.perf_counter()
+        m.run()
+        return time.perf_counter() - t
+
+
+def unrolled(m: LeanMaster):
+    """Straight-line Python for one communication step of the lean master's call list."""
+    lines, env = [], {}
+    for i, (fn, comp, vrs, n, buf) in enumerate(m._ops):
+        env[f"f{i}"] = fn
+        lines.append(f"f{i}({comp}, {vrs}, {n}, {buf})")
+    for j, (fn, comp) in enumerate(m._steps):
+        env[f"s{j}"] = fn
+        lines.append(f"s{j}({comp}, t, dt, 1)")
+    src = "def loop(n, t0, dt):\n    for k in range(n):\n        t = t0 + k * dt\n" + "".join(
+        f"        {ln}\n" for ln in lines)
+    exec(src, env)
+    return env["loop"], len(lines)
+
+
+def t_minimal(sc):
+    with LeanMaster(sc.with_overrides(log={})) as m:
+        loop, calls = unrolled(m)
+        t = time.perf_counter()
+        loop(m.n, sc.start_time, sc.step)
+        return time.perf_counter() - t
+
+
+_FLOOR = None
+
+
+def floor_lib():
+    global _FLOOR
+    if _FLOOR is None:
+        d = Path(tempfile.mkdtemp(prefix="scfmu_floor_"))
+        so = d / "cosim_floor.so"
+        subprocess.run(["cc", "-O2", "-shared", "-fPIC", "-o", str(so), str(ROOT / "benches" / "cosim_floor.c")],
+                       check=True)
+        lib = ctypes.CDLL(str(so))
+        lib.run_loop.argtypes = [c_void_p, c_size_t, c_long, c_double, c_double]
+        lib.run_loop.restype = ctypes.c_int
+        _FLOOR = lib
+    return _FLOOR
+
+
+class Op(ctypes.Structure):
+    _fields_ = [("kind", ctypes.c_int), ("fn", c_void_p), ("component", c_void_p), ("vr", c_void_p),
+                ("n", c_size_t), ("buf", c_void_p)]
+
+
+def t_floor(sc):
+    lib = floor_lib()
+    with LeanMaster(sc.with_overrides(log={})) as m:
+        ops = [Op(0, ctypes.cast(fn, c_void_p).value, comp, vrs, n, buf) for fn, comp, vrs, n, buf in m._ops]
+        ops += [Op(2, ctypes.cast(fn, c_void_p).value, comp, None, 0, None) for fn, comp in m._steps]
+        arr = (Op * len(ops))(*ops)
+        t = time.perf_counter()
+        st = lib.run_loop(arr, len(ops), m.n, sc.start_time, sc.step)
+        dt = time.perf_counter() - t
+        assert st <= 1, st
+        return dt
+
+
+def t_native(sc, log_every):
+    with NativeLoop(sc, log_every=log_every) as m:
+        t = time.perf_counter()
+        m.run()
+        return time.perf_counter() - t
+
+
+METHODS = [("reference master (fmpy, CoSimulation)", t_reference), ("lean master, logging", t_lean),
+           ("lean master, no logging", lambda sc: t_lean(sc, False)), ("minimal ctypes loop (unrolled)", t_minimal),
+           ("native container, logging every step", lambda sc: t_native(sc, 1)),
+           ("native container, no Python per step", lambda sc: t_native(sc, 0)),
+           ("C floor (same FMI calls from C)", t_floor),
+           ("libcosim (libcosimpy; Jacobi coupling)", lambda sc: run_libcosim(sc)["wall_s"])]
+
+
+def loops(repeat: int):
+    scs = {"2 FMUs": two_fmu_scenario(), "4 FMUs (run 000-6)": scenarios.default()}
+    best = {(ln, mn): float("inf") for ln in scs for mn, _ in METHODS}
+    for _ in range(repeat):
+        for ln, sc in scs.items():
+            for mn, f in METHODS:
+                best[(ln, mn)] = min(best[(ln, mn)], f(sc) / sc.n_steps * 1e6)
+    calls = {ln: unrolled_calls(sc) for ln, sc in scs.items()}
+    print("\n| loop (µs per communication step; ratio to the minimal ctypes loop) | "
+          + " | ".join(f"{ln} ({calls[ln]} FMI calls/step)" for ln in scs) + " |")
+    print("|---|" + "---:|" * len(scs))
+    for mn, _ in METHODS:
+        cells = []
+        for ln in scs:
+            us = best[(ln, mn)]
+            cells.append(f"{us:.2f} µs ({us / best[(ln, 'minimal ctypes loop (unrolled)')]:.2f}×)")
+        print(f"| {mn} | " + " | ".join(cells) + " |")
+    return best
+
+
+def unrolled_calls(sc):
+    with LeanMaster(sc.with_overrides(log={})) as m:
+        return len(m._ops) + len(m._steps)
+
+
+def campaign_throughput(n_runs: int):
+    from dask.distributed import Client, LocalCluster
+    from scfmu import campaign
+    sc = scenarios.default()
+    sets = campaign.random_sample({"controller.wn": ("uniform", 0.5, 2.0)}, n_runs, 1)
+    res = {}
+    os.environ["PYTHONPATH"] = str(ROOT / "scripts")
+    for nw in (1, 2):
+        with LocalCluster(n_workers=nw, threads_per_worker=1, processes=True, dashboard_address=None,
+                          host="127.0.0.1", silence_logs=logging.CRITICAL) as cl, Client(cl) as client:
+            warm = campaign.Campaign(sc, [{}] * (2 * nw), seeds=[None])
+            with tempfile.TemporaryDirectory() as d:
+                campaign.run(warm, Path(d) / "w", client=client, progress=False, chunk=1)
+                c = campaign.Campaign(sc, sets, seeds=[None])
+                t = time.perf_counter()
+                campaign.run(c, Path(d) / "c", client=client, progress=False)
+                res[nw] = n_runs / (time.perf_counter() - t)
+    print(f"\n| campaign: {n_runs} runs of run 000-6 (30 s, 3,001 samples, native path, metrics) | runs/s |")
+    print("|---|---:|")
+    print(f"| 1 Dask worker | {res[1]:.2f} |")
+    print(f"| 2 Dask workers | {res[2]:.2f} ({res[2] / res[1]:.2f}× of 1 worker) |")
+    return res
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--campaign", action="store_true")
+    ap.add_argument("--runs", type=int, default=40)
+    ap.add_argument("--no-loops", action="store_true", help="only the campaign throughput")
+    args = ap.parse_args()
+    load = os.getloadavg()[0]
+    print(f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, {os.cpu_count()} cores, load average {load:.1f}, "
+          f"Python {platform.python_version()}")
+    if not args.no_loops:
+        loops(args.repeat)
+    if args.campaign:
+        campaign_throughput(args.runs)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
