@@ -5,6 +5,7 @@
 
 pub mod attitude;
 pub mod environment;
+pub mod feedback_linearization;
 pub mod fuzzy;
 pub mod integrate;
 pub mod pole_placement;
@@ -12,5 +13,6 @@ pub mod predictive_control;
 pub mod random;
 pub mod relative_orbit;
 pub mod riccati;
+pub mod spline;
 
 pub use nalgebra::{Matrix3, Quaternion, Vector3};
