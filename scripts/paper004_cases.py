@@ -133,7 +133,7 @@ def main() -> int:
     rows, all_runs = [], {}
     for prefix, init, nodes_json in sets:
         runs, info, opt, extra = run_set(prefix, init, nodes_json)
-        print(f"\n{prefix}: initial (yaw, pitch, roll) = ({init['yaw']}, {init['pitch']}, {init['roll']}) deg; "
+        print(f"\n{prefix.rstrip('-')}: initial (yaw, pitch, roll) = ({init['yaw']}, {init['pitch']}, {init['roll']}) deg; "
               f"optimiser {info['status']}, {info['evaluations']} evaluations, objective {info['objective']:.5g} N^2 m^2 s "
               f"({info['source']})")
         if opt is not None:
