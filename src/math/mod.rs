@@ -5,7 +5,6 @@
 
 pub mod attitude;
 pub mod environment;
-pub mod feedback_linearization;
 pub mod fuzzy;
 pub mod integrate;
 pub mod pole_placement;
