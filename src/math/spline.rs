@@ -44,7 +44,7 @@ impl NotAKnotSpline {
         if let Some(i) = t.iter().chain(y.iter()).position(|v| !v.is_finite()) {
             return Err(format!("spline: node {} is not finite", i % n));
         }
-        if let Some(i) = (1..n).find(|&i| !(t[i] > t[i - 1])) {
+        if let Some(i) = (1..n).find(|&i| t[i] <= t[i - 1]) {
             return Err(format!("spline: node times must increase strictly (t[{}] = {} ≤ t[{}] = {})", i, t[i], i - 1, t[i - 1]));
         }
         let m = match n {

@@ -74,7 +74,7 @@ pub fn chi(q: &Quaternion<f64>, w: &Vector3<f64>, inertia: &Vector3<f64>) -> Vec
 /// Solves M(q) x = b in closed form, M⁻¹ = (q_w² I + q_v q_vᵀ − q_w [q_v×]) / (q_w (q_w² + |q_v|²)).
 /// Refuses |q_w| < [`SINGULAR_QW`] with a message.
 pub fn solve_m(q: &Quaternion<f64>, b: &Vector3<f64>) -> Result<Vector3<f64>, String> {
-    if !(q.w.abs() >= SINGULAR_QW) {
+    if q.w.is_nan() || q.w.abs() < SINGULAR_QW {
         return Err(format!(
             "feedback linearisation is singular: |q_w| = {:e} < {SINGULAR_QW:e} (attitude near 180 degrees, det M(q) = q_w)",
             q.w.abs()
@@ -163,7 +163,7 @@ impl OpenLoopCopy {
     ) -> Result<Self, String> {
         let i = Matrix3::from_diagonal(inertia);
         let chol = nalgebra::Cholesky::new(i).ok_or_else(|| format!("inertia {:?} is not positive definite", inertia.as_slice()))?;
-        if !(max_step > 0.0) {
+        if max_step.is_nan() || max_step <= 0.0 {
             return Err(format!("max_internal_step = {max_step} must be positive"));
         }
         let mut x = CopyState::zeros();
@@ -227,7 +227,7 @@ impl OpenLoopCopy {
                 return Err(format!("reference corrector: open-loop state became non-finite at t = {}", tk + dt));
             }
             let nq = x.fixed_rows::<4>(0).norm();
-            if !(nq > 0.0) {
+            if nq <= 0.0 {
                 return Err(format!("reference corrector: quaternion norm became zero at t = {}", tk + dt));
             }
             x.fixed_rows_mut::<4>(0).unscale_mut(nq);
