@@ -70,7 +70,7 @@ def test_controller_matches_numpy_law_on_random_states():
             got = np.array(c.get_reals([f"torque_cmd_{a}" for a in "xyz"]))
             want = law_numpy(q, w, qr[1:], qd, qdd, inertia, kq, kqd)
             worst = max(worst, float(np.max(np.abs(got - want)) / (1.0 + np.max(np.abs(want)))))
-        assert worst < 1e-11, worst
+        assert worst < 1e-12, worst
     finally:
         c.close()
 
