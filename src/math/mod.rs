@@ -12,5 +12,6 @@ pub mod predictive_control;
 pub mod random;
 pub mod relative_orbit;
 pub mod riccati;
+pub mod spline;
 
 pub use nalgebra::{Matrix3, Quaternion, Vector3};

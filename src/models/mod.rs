@@ -19,6 +19,11 @@
 //!   (`shared::mrac::MracVariables`) outputs 30–44, parameters 100–110 and 120, calculated 200–205.
 //! - attitude plant: `inertia_xx/yy/zz` 100–102 as in the controllers; `integrator` 140,
 //!   `max_internal_step` 130.
+//! - paper 004 (`FeedbackLinearizingController`, `ReferenceCorrector`): `q_ref_dot` 50–52 and
+//!   `q_ref_ddot` 53–55 (controller inputs = corrector outputs), `u_ol` 56–58; gains `k_q` 160–162,
+//!   `k_qdot` 163–165; the corrector's plant-copy parameters keep the plant's references
+//!   (`init_euler321_*` 110–112, `init_w` 113–115, `u_max` 120–122, `effectiveness` 123–125,
+//!   `max_internal_step` 130), `mode` 150, `node_{x,y,z}_{0..5}` 170–187, `spline_t_end` 188.
 //! - plants of every family: `integrator` is an Integer with codes 0 RK4, 1 Euler, 2 Dormand–Prince.
 
 pub mod attitude;

@@ -8,4 +8,5 @@ crate::fmus! {
     plant::AttitudePlant,
     command::AttitudeCommand,
     metrics::AttitudeMetrics,
+    reference_corrector::ReferenceCorrector,
 }

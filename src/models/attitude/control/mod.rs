@@ -13,4 +13,5 @@ crate::fmus! {
     mrac_controller::MracController,
     fuzzy_pd_controller::FuzzyPdController,
     adaptive_fuzzy_controller::AdaptiveFuzzyController,
+    feedback_linearizing_controller::FeedbackLinearizingController,
 }
