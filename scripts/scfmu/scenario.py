@@ -148,12 +148,15 @@ class Scenario:
                     si, _, sv = self.connections[q].partition(".")
                     per_src.setdefault(si, []).append((inp, sv))
                     continue
-                if q in self.inputs or self._is_unconnected(dst, inp):
+                if q in self.inputs:
                     continue
                 sources = [s for s in names if s != dst and inp in ports[s][1]] if self.auto_connect else []
                 if len(sources) > 1:
                     raise ValueError(f"input {q} has several sources {sources}: add it to connections")
                 if not sources:
+                    # the unconnected patterns only name inputs that may stay open when nothing feeds them
+                    if self._is_unconnected(dst, inp):
+                        continue
                     raise ValueError(f"input {q} has no source: add it to connections, unconnected or inputs")
                 per_src.setdefault(sources[0], []).append((inp, inp))
             for src, pairs in per_src.items():  # sources in order of first appearance among dst's inputs

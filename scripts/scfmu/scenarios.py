@@ -6,6 +6,7 @@
   ``default()`` is run 000-6 (quaternion PD, large command), the set-up of ``scripts/run_default.py``.
 * ``paper001(case, dist)``: formation flying with the nonlinear predictive PID (cases a–d).
 * ``wheel_fault()``: paper 003 plant with reaction-wheel saturation and an x-wheel fault.
+* ``paper004(case)``: fault-tolerant control by reference correction, cases 1–3.
 
 ``get(name)`` looks a scenario up by name: ``"default"``, ``"paper000/<run_id>"``,
 ``"paper001/<case>"`` or ``"paper001/<case>/dist<d>"``, ``"wheel_fault"``.
@@ -181,6 +182,39 @@ def wheel_fault(stop_time: float = 120.0, step: float = 0.1, fault_time: float =
     )
 
 
+def paper004(case: str = "1", stop_time: float = 20.0, step: float = 0.01) -> Scenario:
+    """Paper 004 closed loop ReferenceCorrector → FeedbackLinearizingController → AttitudePlant:
+    case "1" healthy actuators, "2" 90 % loss of effectiveness, "3" the same fault with the reference
+    corrected by the committed optimised spline (scripts/data/paper004_nodes.json); initial 321 angles
+    (6, -4, 8) deg, at rest."""
+    import json
+    from pathlib import Path
+
+    import numpy as np
+
+    from . import paper004 as p4
+    eff = 1.0 if case == "1" else p4.A_FAULT
+    nodes = None
+    if case == "3":
+        rep = json.loads((Path(__file__).resolve().parents[1] / "data" / "paper004_nodes.json").read_text())
+        nodes = np.array([rep["nodes_N_m"][a] for a in p4.AXES], dtype=float)
+    mode = 1 if case == "3" else 0
+    names = ["q_w", "q_x", "q_y", "q_z", "w_x", "w_y", "w_z", "roll", "pitch", "yaw",
+             "torque_applied_x", "torque_applied_y", "torque_applied_z"]
+    return Scenario(
+        name=f"paper004/{case}",
+        components=[
+            Component("corrector", "ReferenceCorrector", p4.corrector_params(mode, nodes, eff, p4.INIT_DEFAULT_DEG)),
+            Component("controller", "FeedbackLinearizingController", p4.controller_params()),
+            Component("plant", "AttitudePlant", p4.plant_params(eff, p4.INIT_DEFAULT_DEG)),
+        ],
+        stop_time=stop_time, step=step,
+        log={**log_of("plant", names), **log_of("controller", [f"torque_cmd_{a}" for a in "xyz"])},
+        metrics="attitude_nometrics",
+        description=f"paper 004 case 004-{case}",
+    )
+
+
 def get(name: str, **kw) -> Scenario:
     """A standard scenario by name (see the module docstring); keyword arguments go to its builder."""
     parts = name.split("/")
@@ -193,10 +227,12 @@ def get(name: str, **kw) -> Scenario:
         return paper001(parts[1], dist, **kw)
     if parts[0] == "wheel_fault":
         return wheel_fault(**kw)
+    if parts[0] == "paper004" and len(parts) == 2:
+        return paper004(parts[1], **kw)
     raise KeyError(f"unknown scenario {name!r}; known: default, paper000/<run id>, paper001/<a|b|c|d>[/dist<N>], "
-                   f"wheel_fault")
+                   f"wheel_fault, paper004/<1|2|3>")
 
 
 def names() -> list[str]:
     return (["default"] + [f"paper000/{r.run_id}" for r in paper000_runs()]
-            + [f"paper001/{c}" for c in PAPER001_CASES] + ["wheel_fault"])
+            + [f"paper001/{c}" for c in PAPER001_CASES] + ["wheel_fault"] + [f"paper004/{c}" for c in "123"])

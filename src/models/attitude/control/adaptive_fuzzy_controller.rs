@@ -4,11 +4,11 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::shared::mrac::{mrac_outputs, MracCore, MracState, MracVariables, ReferenceGains};
+use super::shared::mrac::{Mrac, MracVariables, ReferenceGains};
 use super::shared::AttitudeControllerPorts;
 use crate::declare_variables;
 use crate::math::fuzzy::{Defuzz, PdFuzzySystem};
-use crate::model::{check_derived, check, Experiment, Feedthrough, Model, ModelInfo, ModelResult, ParamEnum};
+use crate::model::{check, Experiment, Feedthrough, Model, ModelInfo, ModelResult, ParamEnum};
 
 declare_variables! {
     pub struct AdaptiveFuzzyControllerVars {
@@ -31,10 +31,7 @@ declare_variables! {
 }
 
 #[derive(Clone, Serialize, Deserialize)]
-pub struct AdaptiveFuzzyController {
-    core: MracCore,
-    st: MracState,
-}
+pub struct AdaptiveFuzzyController(Mrac);
 
 impl Model for AdaptiveFuzzyController {
     type Vars = AdaptiveFuzzyControllerVars;
@@ -74,27 +71,22 @@ requirement checked at initialization: lambda1_min^2 >= 4 lambda2_max (real nega
             e_scale: v.e_scale,
             edot_scale: v.edot_scale,
         };
-        let (core, st) = v.mrac.core(gains)?;
         (v.c_small, v.c_big) = (fuzzy.c_small, fuzzy.c_big);
-        Ok(AdaptiveFuzzyController { core, st })
+        Ok(AdaptiveFuzzyController(Mrac::new(&mut v.mrac, gains)?))
     }
 
     fn outputs(&self, v: &mut AdaptiveFuzzyControllerVars, _t: f64) -> ModelResult {
-        let o = mrac_outputs(&self.core, &self.st, &v.ports)?;
-        v.ports.torque_cmd = o.torque;
-        v.mrac.set_outputs(&o);
+        let o = self.0.outputs(&mut v.ports, &mut v.mrac)?;
         (v.lambda1, v.lambda2) = (o.sig.lambda1, o.sig.lambda2);
         Ok(())
     }
 
     fn step(&mut self, v: &AdaptiveFuzzyControllerVars, _t: f64, h: f64) -> ModelResult {
-        self.st = self.core.advance(&self.st, &v.ports, h)?;
-        Ok(())
+        self.0.step(&v.ports, h)
     }
 
     fn validate(&self, fresh: &Self) -> ModelResult {
-        check_derived("adaptive law", &self.core, &fresh.core)?;
-        self.st.validate(&self.core)
+        self.0.validate(&fresh.0)
     }
 }
 
@@ -116,7 +108,7 @@ mod tests {
     fn lambdas_stay_in_range() {
         let mut m = Fmu::<AdaptiveFuzzyController>::default();
         m.initialize(&Experiment::default()).unwrap();
-        let core = m.model().core;
+        let core = m.model().0.core;
         for i in 0..=40 {
             for j in 0..=40 {
                 let (l1, l2) = core.gains.axis(-2.0 + 0.1 * i as f64, -2.0 + 0.1 * j as f64);

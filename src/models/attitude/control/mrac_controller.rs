@@ -4,10 +4,10 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::shared::mrac::{mrac_outputs, MracCore, MracState, MracVariables, ReferenceGains, EQUATIONS_HTML};
+use super::shared::mrac::{Mrac, MracVariables, ReferenceGains, EQUATIONS_HTML};
 use super::shared::AttitudeControllerPorts;
 use crate::declare_variables;
-use crate::model::{check_derived, Experiment, Feedthrough, Model, ModelInfo, ModelResult};
+use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult};
 
 declare_variables! {
     pub struct MracControllerVars {
@@ -19,10 +19,7 @@ declare_variables! {
 }
 
 #[derive(Clone, Serialize, Deserialize)]
-pub struct MracController {
-    core: MracCore,
-    st: MracState,
-}
+pub struct MracController(Mrac);
 
 impl Model for MracController {
     type Vars = MracControllerVars;
@@ -36,25 +33,19 @@ impl Model for MracController {
     };
 
     fn initialize(v: &mut MracControllerVars, _exp: &Experiment) -> Result<Self, String> {
-        let (core, st) = v.mrac.core(ReferenceGains::Fixed { lambda1: v.lambda1, lambda2: v.lambda2 })?;
-        Ok(MracController { core, st })
+        Ok(MracController(Mrac::new(&mut v.mrac, ReferenceGains::Fixed { lambda1: v.lambda1, lambda2: v.lambda2 })?))
     }
 
     fn outputs(&self, v: &mut MracControllerVars, _t: f64) -> ModelResult {
-        let o = mrac_outputs(&self.core, &self.st, &v.ports)?;
-        v.ports.torque_cmd = o.torque;
-        v.mrac.set_outputs(&o);
-        Ok(())
+        self.0.outputs(&mut v.ports, &mut v.mrac).map(|_| ())
     }
 
     fn step(&mut self, v: &MracControllerVars, _t: f64, h: f64) -> ModelResult {
-        self.st = self.core.advance(&self.st, &v.ports, h)?;
-        Ok(())
+        self.0.step(&v.ports, h)
     }
 
     fn validate(&self, fresh: &Self) -> ModelResult {
-        check_derived("adaptive law", &self.core, &fresh.core)?;
-        self.st.validate(&self.core)
+        self.0.validate(&fresh.0)
     }
 }
 
@@ -72,16 +63,16 @@ mod tests {
         let q = quat(0.95, 0.1, -0.2, 0.2).normalize();
         m.v.ports.q = q;
         m.v.ports.q_ref = Quaternion::new(0.75f64.sqrt(), 0.0, 0.0, 0.5);
-        let before = m.model().st;
+        let before = m.model().0.st;
         m.outputs(0.0).unwrap();
         let t1 = m.v.ports.torque_cmd;
         m.outputs(0.0).unwrap();
-        assert_eq!(m.model().st, before);
+        assert_eq!(m.model().0.st, before);
         assert_eq!(t1, m.v.ports.torque_cmd);
         // x_m(0) = x(0): zero tracking error at t0
         assert!(m.v.mrac.track_err.abs().sum() < 1e-15);
         m.step(0.0, 0.01).unwrap();
-        assert!(m.model().st.started && m.model().st != before);
-        assert!((m.model().st.xm[0] - 2.0 * q.i).abs() < 1e-3);
+        assert!(m.model().0.st.started && m.model().0.st != before);
+        assert!((m.model().0.st.xm[0] - 2.0 * q.i).abs() < 1e-3);
     }
 }

@@ -34,6 +34,42 @@ declare_variables! {
     }
 }
 
+/// The adaptive loop of an MRAC-type controller: its law and its state, with what the FMU does with
+/// them (outputs, step, restored-state check), so `MracController` and `AdaptiveFuzzyController`
+/// differ only in their reference-model gains.
+#[derive(Clone, Serialize, Deserialize)]
+pub struct Mrac {
+    pub core: MracCore,
+    pub st: MracState,
+}
+
+impl Mrac {
+    /// The loop for the given reference-model gains; writes the calculated parameters.
+    pub fn new(vars: &mut MracVariables, gains: ReferenceGains) -> Result<Self, String> {
+        let (core, st) = vars.core(gains)?;
+        Ok(Mrac { core, st })
+    }
+
+    /// Writes the torque and the common MRAC outputs; returns the signals for model-specific outputs.
+    pub fn outputs(&self, ports: &mut AttitudeControllerPorts, vars: &mut MracVariables) -> Result<MracOutputs, String> {
+        let o = mrac_outputs(&self.core, &self.st, ports)?;
+        ports.torque_cmd = o.torque;
+        vars.set_outputs(&o);
+        Ok(o)
+    }
+
+    pub fn step(&mut self, ports: &AttitudeControllerPorts, h: f64) -> Result<(), String> {
+        self.st = self.core.advance(&self.st, ports, h)?;
+        Ok(())
+    }
+
+    /// A restored loop: the law as the parameters give it, a finite state above the estimate's bound.
+    pub fn validate(&self, fresh: &Mrac) -> Result<(), String> {
+        crate::model::check_derived("adaptive law", &self.core, &fresh.core)?;
+        self.st.validate(&self.core)
+    }
+}
+
 impl MracState {
     /// Invariants of a restored state: finite, estimate not below its bound.
     pub fn validate(&self, core: &MracCore) -> Result<(), String> {
