@@ -86,3 +86,33 @@ def test_ssp_in_libcosim_equals_libcosim_run_of_the_declaration(name, t):
     assert set(out) == set(ref) - {"wall_s"}
     for k, v in out.items():
         assert v == ref[k], k
+
+
+@pytest.mark.parametrize("name", ["default", "paper001/b", "wheel_fault"])
+def test_fmpy_ssd_reader_sees_components_parameters_and_connections(name):
+    """fmpy's SSP reader (an independent parser, schema-validating the .ssd and .ssv files) finds the
+    declared instances, their parameter values and one connection per link."""
+    from fmpy.ssp.ssd import read_ssd
+    ref = scenarios.get(name)
+    ssd = read_ssd(str(ssp_file(name)))
+    comps = {e.name: e for e in ssd.system.elements}
+    assert list(comps) == [c.name for c in ref.components]
+    for c in ref.components:
+        assert comps[c.name].source == f"resources/{c.model}.fmu"
+        values = {p.name: p.value for b in comps[c.name].parameterBindings for s in b.parameterValues
+                  for p in s.parameters}
+        want = dict(c.params)
+        want.update({q.partition(".")[2]: v for q, v in ref.inputs.items() if q.startswith(c.name + ".")})
+        assert {k: float(v) for k, v in values.items()} == {k: float(v) for k, v in want.items()}
+    assert len(ssd.system.connections) == sum(1 for _ in ref.wiring(_ports(ref)))
+
+
+def _ports(sc):
+    from fmpy import read_model_description
+    from scfmu.master import fmu_path
+    out = {}
+    for c in sc.components:
+        md = read_model_description(str(fmu_path(c.model)))
+        out[c.name] = ([v.name for v in md.modelVariables if v.causality == "input"],
+                       [v.name for v in md.modelVariables if v.causality == "output"])
+    return out
