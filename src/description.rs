@@ -85,6 +85,40 @@ fn output_dependencies(entry: &ModelEntry, out: &VarDecl) -> Vec<usize> {
     }
 }
 
+/// `<InitialUnknowns>` with their dependencies, from the same declaration as `<Outputs>`.
+///
+/// FMI 2.0 lists as initial unknowns the outputs with `initial` approx/calculated and the calculated
+/// parameters, each in ScalarVariable order; their knowns in Initialization Mode are the inputs and the
+/// variables with `initial="exact"` (our parameters). An output depends on the inputs it feeds through
+/// (the model's `Feedthrough`, the same list as in `<Outputs>`) and on the parameters; a calculated
+/// parameter depends on the parameters only. The parameter part is a superset (the declarations do not
+/// say which parameter feeds which output); parameters are never connected, so it cannot create a loop.
+pub fn initial_unknowns(entry: &ModelEntry) -> Vec<(usize, Vec<usize>)> {
+    let params: Vec<usize> = entry
+        .decls
+        .iter()
+        .enumerate()
+        .filter(|(_, d)| d.causality == Causality::Parameter && d.initial() == Some(Initial::Exact))
+        .map(|(i, _)| i + 1)
+        .collect();
+    entry
+        .decls
+        .iter()
+        .enumerate()
+        .filter_map(|(i, d)| {
+            let inputs = match d.causality {
+                Causality::Output if d.initial() != Some(Initial::Exact) => output_dependencies(entry, d),
+                Causality::CalculatedParameter => vec![],
+                _ => return None,
+            };
+            let mut deps: Vec<usize> = inputs.into_iter().chain(params.iter().copied()).collect();
+            deps.sort_unstable();
+            deps.dedup();
+            Some((i + 1, deps))
+        })
+        .collect()
+}
+
 fn join(ix: &[usize]) -> String {
     ix.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(" ")
 }
@@ -292,20 +326,12 @@ fn write_xml(entry: &ModelEntry, guid: &str) -> String {
         }
         end(&mut w, "Outputs");
     }
-    let initial_unknowns: Vec<usize> = entry
-        .decls
-        .iter()
-        .enumerate()
-        .filter(|(_, d)| {
-            (d.causality == Causality::Output && d.initial() != Some(Initial::Exact)) || d.causality == Causality::CalculatedParameter
-        })
-        .map(|(i, _)| i + 1)
-        .collect();
+    let initial_unknowns = initial_unknowns(entry);
     if !initial_unknowns.is_empty() {
         start(&mut w, "InitialUnknowns", &[]);
-        for ix in initial_unknowns {
-            // No dependencies attribute: may depend on every parameter and input (FMI 2.0 default).
-            empty(&mut w, "Unknown", &[("index", ix.to_string())]);
+        for (ix, deps) in initial_unknowns {
+            // Always written: a missing attribute would mean "depends on every known" (inputs included).
+            empty(&mut w, "Unknown", &[("index", ix.to_string()), ("dependencies", join(&deps))]);
         }
         end(&mut w, "InitialUnknowns");
     }

@@ -48,14 +48,14 @@ from .scenario import Scenario
 
 CACHE = Path(os.environ.get("SCFMU_CONTAINER_DIR", Path.home() / ".cache" / "scfmu" / "containers"))
 _KINDS = ("parameter", "calculatedParameter", "input", "output")
-LAYOUT = 2  # version of the container layout below (part of the cache key)
+LAYOUT = 3  # version of the container layout below (part of the cache key)
 
 
 def _descriptions(scenario: Scenario):
     return {c.model: unpacked(fmu_path(c.model))[0] for c in scenario.components}
 
 
-def container_key(scenario: Scenario) -> tuple[str, dict]:
+def container_key(scenario: Scenario, starts: dict | None = None) -> tuple[str, dict]:
     mds = _descriptions(scenario)
     ports = {c.name: ([v.name for v in mds[c.model].modelVariables if v.causality == "input"],
                       [v.name for v in mds[c.model].modelVariables if v.causality == "output"])
@@ -64,18 +64,39 @@ def container_key(scenario: Scenario) -> tuple[str, dict]:
     key = {"components": [(c.name, c.model, mds[c.model].guid, fmu_digest(fmu_path(c.model)))
                           for c in scenario.components],
            "links": links, "step": repr(scenario.step), "layout": LAYOUT}
+    if starts:
+        key["starts"] = sorted((k, repr(v)) for k, v in starts.items())
     h = hashlib.sha256(json.dumps(key, sort_keys=True).encode()).hexdigest()[:20]
     return h, {"mds": mds, "links": links}
 
 
-def build_container(scenario: Scenario) -> Path:
-    """Path of the container FMU for this scenario's structure (built once, then cached)."""
+def scenario_starts(scenario: Scenario) -> dict:
+    """``{"instance.variable": value}`` of the scenario's parameters and fixed inputs: the start values a
+    stand-alone closed-loop FMU carries, so that it reproduces the scenario with no value set."""
+    out = {f"{c.name}.{k}": v for c in scenario.components for k, v in c.params.items()}
+    out.update(scenario.inputs)
+    return out
+
+
+def _start_text(vtype: str, value) -> str:
+    if vtype == "Real":
+        return repr(float(value))
+    if vtype == "Integer":
+        return str(int(value))
+    return "true" if value in (True, 1, "true") else "false"
+
+
+def build_container(scenario: Scenario, starts: dict | None = None) -> Path:
+    """Path of the container FMU for this scenario's structure (built once, then cached). ``starts``
+    (``"instance.variable" -> value``, e.g. :func:`scenario_starts`) replaces the nested FMUs' start
+    values of those container variables (the container applies them at instantiation)."""
     from fmpy.container_fmu import write_configuration
     from fmpy.container_fmu.config import Component as CComponent, Configuration, Connection
-    from fmpy.model_description import (CoSimulation, DefaultExperiment, ModelDescription, ModelVariable,
+    from fmpy.model_description import (CoSimulation, DefaultExperiment, ModelDescription, ModelVariable, Unknown,
                                         write_model_description)
 
-    h, info = container_key(scenario)
+    starts = dict(starts or {})
+    h, info = container_key(scenario, starts)
     path = CACHE / f"loop_{h}.fmu"
     if path.exists():
         return path
@@ -84,6 +105,7 @@ def build_container(scenario: Scenario) -> Path:
     comps, cvars = {}, {}
     container_vars = [ModelVariable(type="Real", variability="continuous", causality="independent", name="time")]
     mappings = {}
+    cv_of = {}  # (instance, nested variable name) -> container variable
     for c in scenario.components:
         md = mds[c.model]
         comp = CComponent(name=c.name, filename=fmu_path(c.model), modelDescription=md)
@@ -106,8 +128,16 @@ def build_container(scenario: Scenario) -> Path:
                 cv = ModelVariable(type=v.type, variability=v.variability, causality="output",
                                    name=f"{c.name}.{v.name}")
             cv.description = v.description
+            q = f"{c.name}.{v.name}"
+            if q in starts:
+                if v.causality not in ("parameter", "input"):
+                    raise KeyError(f"start value for {q}: not a parameter or input")
+                cv.start = _start_text(v.type, starts.pop(q))
             container_vars.append(cv)
             mappings[cv] = [(comp, v)]
+            cv_of[(c.name, v.name)] = cv
+    if starts:
+        raise KeyError(f"start values for unknown variables {sorted(starts)}")
     connections = []
     i = 0
     while i < len(links):  # consecutive links with the same (dst, src) form one connection
@@ -128,6 +158,22 @@ def build_container(scenario: Scenario) -> Path:
                                                     fixedInternalStepSize=scenario.step,
                                                     canHandleVariableCommunicationStepSize=True),
                           modelVariables=container_vars)
+    # ModelStructure: a container variable reads or writes its nested variable directly (connections are
+    # propagated only inside doStep), so each container output depends on exactly the container variables
+    # its nested output depends on, at communication points and at initialization.
+    order = {id(v): i for i, v in enumerate(container_vars)}
+    for attr in ("outputs", "initialUnknowns"):
+        unknowns = []
+        for c in scenario.components:
+            for u in getattr(mds[c.model], attr):
+                cv = cv_of.get((c.name, u.variable.name))
+                if cv is None:
+                    continue
+                deps = None if u.dependencies is None else sorted(
+                    (cv_of[(c.name, d.name)] for d in u.dependencies), key=lambda x: order[id(x)])
+                unknowns.append(Unknown(variable=cv, dependencies=deps))
+        unknowns.sort(key=lambda u: order[id(u.variable)])
+        setattr(md, attr, unknowns)
     for i, v in enumerate(md.modelVariables):
         v.valueReference = i  # "time" is 0; container variable i maps to mappings[i - 1]
     config = Configuration(parallelDoStep=False, modelDescription=md, components=list(comps.values()),

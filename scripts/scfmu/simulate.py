@@ -20,9 +20,10 @@ from .scenario import Scenario
 ENGINES = ("reference", "lean", "native")
 
 
-def reference_master(scenario: Scenario) -> tuple[CoSimulation, dict, dict]:
-    """(CoSimulation, {instance: Fmu}, log spec) for the scenario; the caller runs and closes it."""
-    fmus = build_fmus(scenario)
+def reference_master(scenario: Scenario, path_of=None) -> tuple[CoSimulation, dict, dict]:
+    """(CoSimulation, {instance: Fmu}, log spec) for the scenario; the caller runs and closes it.
+    ``path_of(model)`` gives the FMU file of a model (default ``fmus/<Model>.fmu``)."""
+    fmus = build_fmus(scenario, path_of=path_of)
     # the scenario's wiring (explicit exceptions included) replaces the master's own name matching
     sim = CoSimulation(list(fmus.values()), unconnected={n for f in fmus.values() for n in f.inputs()})
     sim.links = []
@@ -38,8 +39,8 @@ def reference_master(scenario: Scenario) -> tuple[CoSimulation, dict, dict]:
     return sim, fmus, log
 
 
-def run_reference(scenario: Scenario) -> dict[str, np.ndarray]:
-    sim, fmus, log = reference_master(scenario)
+def run_reference(scenario: Scenario, path_of=None) -> dict[str, np.ndarray]:
+    sim, fmus, log = reference_master(scenario, path_of)
     try:
         try:
             return sim.run(scenario.stop_time, scenario.step, log, t0=scenario.start_time)

@@ -1,0 +1,91 @@
+"""ModelStructure of every committed modelDescription: <InitialUnknowns> is the exact FMI 2.0 list and
+its dependencies agree with the feed-through declared in <Outputs>.
+
+FMI 2.0 (ModelStructure): the initial unknowns are the outputs with initial "approx"/"calculated" and the
+calculated parameters, in ScalarVariable order, no duplicates; a missing ``dependencies`` attribute means
+"depends on every known" (inputs included), which makes masters such as OMSimulator see algebraic loops at
+initialization through plants whose outputs depend on their state only. The knowns in Initialization Mode
+are the inputs and the variables with initial="exact" (here: the parameters).
+"""
+
+from pathlib import Path
+import xml.etree.ElementTree as ET
+
+import pytest
+
+MD_DIR = Path(__file__).resolve().parents[1] / "modelDescription"
+FILES = sorted(MD_DIR.glob("*.xml"))
+
+
+def _indices(attr):
+    return [int(i) for i in attr.split()] if attr else []
+
+
+def _children(parent, tag):
+    e = parent.find(tag)
+    return list(e) if e is not None else []
+
+
+def test_there_are_model_descriptions():
+    assert len(FILES) >= 10
+
+
+@pytest.mark.parametrize("path", FILES, ids=[p.stem for p in FILES])
+def test_initial_unknowns_match_declared_feedthrough(path):
+    root = ET.parse(path).getroot()
+    svs = root.find("ModelVariables").findall("ScalarVariable")
+    var = {i + 1: sv for i, sv in enumerate(svs)}  # 1-based ScalarVariable index
+
+    def causality(i):
+        return var[i].get("causality", "local")
+
+    def initial(i):
+        sv = var[i]
+        if sv.get("initial"):
+            return sv.get("initial")
+        return {"parameter": "exact", "input": None}.get(causality(i), "calculated")
+
+    inputs = {i for i in var if causality(i) == "input"}
+    exact = {i for i in var if initial(i) == "exact" and causality(i) == "parameter"}
+    ms = root.find("ModelStructure")
+    outputs = {int(u.get("index")): u for u in _children(ms, "Outputs")}
+    assert set(outputs) == {i for i in var if causality(i) == "output"}
+    # Outputs: the declared feed-through, always explicit, inputs only
+    out_deps = {}
+    for i, u in outputs.items():
+        assert u.get("dependencies") is not None, f"{path.stem}: output {var[i].get('name')} without dependencies"
+        deps = _indices(u.get("dependencies"))
+        assert set(deps) <= inputs and deps == sorted(set(deps))
+        out_deps[i] = set(deps)
+
+    expected = sorted([i for i in var if causality(i) == "output" and initial(i) in ("approx", "calculated")]
+                      + [i for i in var if causality(i) == "calculatedParameter"])
+    unknowns = _children(ms, "InitialUnknowns")
+    listed = [int(u.get("index")) for u in unknowns]
+    assert listed == expected, f"{path.stem}: InitialUnknowns {listed} != {expected}"
+    for u in unknowns:
+        i = int(u.get("index"))
+        name = var[i].get("name")
+        attr = u.get("dependencies")
+        assert attr is not None, f"{path.stem}: initial unknown {name} has no dependencies (= every known)"
+        deps = _indices(attr)
+        assert deps == sorted(set(deps)), f"{path.stem}: {name}: dependencies not ascending/unique"
+        assert set(deps) <= inputs | exact, f"{path.stem}: {name} depends on a variable that is not a known"
+        want_inputs = out_deps.get(i, set())  # calculated parameters depend on no input
+        assert set(deps) & inputs == want_inputs, (
+            f"{path.stem}: {name}: initial input dependencies {sorted(set(deps) & inputs)} "
+            f"!= feed-through {sorted(want_inputs)}")
+        assert set(deps) - inputs == exact, f"{path.stem}: {name}: parameter dependencies incomplete"
+
+
+def test_plant_state_outputs_do_not_depend_on_torque_inputs():
+    """The case an OMSimulator trial reported: AttitudePlant's attitude outputs at initialization."""
+    root = ET.parse(MD_DIR / "AttitudePlant.xml").getroot()
+    svs = root.find("ModelVariables").findall("ScalarVariable")
+    index = {sv.get("name"): i + 1 for i, sv in enumerate(svs)}
+    inputs = {i + 1 for i, sv in enumerate(svs) if sv.get("causality") == "input"}
+    deps = {int(u.get("index")): set(_indices(u.get("dependencies")))
+            for u in root.find("ModelStructure").find("InitialUnknowns")}
+    for n in ("q_w", "q_x", "w_x", "w_z"):
+        assert deps[index[n]] & inputs == set(), n
+    assert deps[index["torque_applied_x"]] & inputs == {index["torque_cmd_x"]}
