@@ -9,6 +9,7 @@ use crate::models::{
     attitude_plant::AttitudePlant, fuzzy_pd_controller::FuzzyPdController, lqr_controller::LqrController, mrac_controller::MracController,
     pd_controller::PdController, pole_placement_controller::PolePlacementController, predictive_pid_controller::PredictivePidController,
     relative_orbit_plant::RelativeOrbitPlant, relative_position_command::RelativePositionCommand, single_axis_plant::SingleAxisPlant,
+    fopid_controller::FopidController, pid_controller::PidController,
 };
 
 pub fn all() -> &'static [ModelEntry] {
@@ -27,6 +28,8 @@ pub fn all() -> &'static [ModelEntry] {
             ModelEntry::of::<AdaptiveFuzzyController>(),
             // single axis (paper 002)
             ModelEntry::of::<SingleAxisPlant>(),
+            ModelEntry::of::<PidController>(),
+            ModelEntry::of::<FopidController>(),
             // relative orbit (paper 001)
             ModelEntry::of::<RelativeOrbitPlant>(),
             ModelEntry::of::<RelativePositionCommand>(),
