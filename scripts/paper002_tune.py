@@ -9,7 +9,7 @@ cost improved by less than 1e-6 over 50 iterations; inertia 0.9 -> 0.4, c1 = c2 
 of each range, seed per controller = --seed + index.
 
 Writes the gains with cost, seed, iterations and wall time to scripts/paper002_gains.json (the file the
-sweep script reads); --quick (CI) runs a tiny swarm for a few iterations and writes to out/ instead.
+sweep script reads); --quick (CI) runs a tiny swarm for two iterations and writes to out/ instead.
 
 Usage: paper002_tune.py [--controllers PD,PID,FOPD,FOPID] [--seed 2] [--workers 2] [--quick]
                         [--particles 30] [--iters 400] [--out FILE]
@@ -36,12 +36,12 @@ def main(argv=None) -> int:
     ap.add_argument("--workers", type=int, default=min(2, os.cpu_count() or 1))
     ap.add_argument("--particles", type=int, default=30)
     ap.add_argument("--iters", type=int, default=400)
-    ap.add_argument("--quick", action="store_true", help="CI smoke run: 4 particles, 3 iterations, t_end 12 s")
+    ap.add_argument("--quick", action="store_true", help="CI smoke run: 3 particles, 2 iterations, t_end 12 s")
     ap.add_argument("--out", type=Path, default=None)
     a = ap.parse_args(argv)
     sc = Scenario()
     if a.quick:
-        a.particles, a.iters = 4, 3
+        a.particles, a.iters = 3, 2
         sc = Scenario(t_end=12.0)
     out = a.out or (ROOT / "out" / "paper002" / "gains_quick.json" if a.quick else GAINS_FILE)
     out.parent.mkdir(parents=True, exist_ok=True)
