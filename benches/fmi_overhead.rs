@@ -1,6 +1,6 @@
 //! Cost of one FMI co-simulation cycle through the C ABI (fmi2SetReal of the inputs, fmi2DoStep,
 //! fmi2GetReal of the outputs) against the same model work called directly in Rust
-//! (field writes, `Model::do_step`, `Model::update_outputs`, field reads).
+//! (field writes, `Fmu::step`, `Fmu::outputs`, field reads).
 //!
 //! Run: `cargo bench --bench fmi_overhead` (prints a Markdown table for docs/benchmarks.md).
 
@@ -12,9 +12,9 @@ use std::time::Instant;
 
 use common::TestFmu;
 use spacecraft_fmus::fmi::abi::{fmi2DoStep, fmi2GetReal, fmi2SetReal};
-use spacecraft_fmus::model::{Experiment, Model};
-use spacecraft_fmus::models::attitude_plant::AttitudePlant;
-use spacecraft_fmus::models::pd_controller::PdController;
+use spacecraft_fmus::model::{Experiment, Fmu};
+use spacecraft_fmus::models::attitude::control::PdController;
+use spacecraft_fmus::models::attitude::AttitudePlant;
 
 const H: f64 = 0.01;
 
@@ -79,36 +79,34 @@ fn abi_cycle(case: &Case, reps: usize, n: usize) -> f64 {
 }
 
 fn direct_plant(reps: usize, n: usize) -> f64 {
-    let mut m = AttitudePlant::default();
-    let exp = Experiment::default();
-    m.initialize(&exp).unwrap();
+    let mut m = Fmu::<AttitudePlant>::default();
+    m.initialize(&Experiment::default()).unwrap();
     let mut t = 0.0;
     time_ns(reps, n, |k| {
         let u = input_values(&PLANT, k);
-        let v = m.vars_mut();
-        (v.torque_cmd_x, v.torque_cmd_y, v.torque_cmd_z, v.torque_dist_x, v.torque_dist_y, v.torque_dist_z) = (u[6], u[7], u[8], u[9], u[4], u[5]);
-        m.do_step(t, H, &exp).unwrap();
+        let v = &mut m.v;
+        (v.torque_cmd.x, v.torque_cmd.y, v.torque_cmd.z, v.torque_dist.x, v.torque_dist.y, v.torque_dist.z) = (u[6], u[7], u[8], u[9], u[4], u[5]);
+        m.step(t, H).unwrap();
         t += H;
-        m.update_outputs(t).unwrap();
-        let v = m.vars();
-        black_box([v.q_w, v.q_x, v.q_y, v.q_z, v.w_x, v.w_y, v.w_z, v.roll, v.pitch, v.yaw]);
+        m.outputs(t).unwrap();
+        let v = &m.v;
+        black_box([v.q.w, v.q.i, v.q.j, v.q.k, v.w.x, v.w.y, v.w.z, v.roll, v.pitch, v.yaw]);
     })
 }
 
 fn direct_pd(reps: usize, n: usize) -> f64 {
-    let mut m = PdController::default();
-    let exp = Experiment::default();
-    m.initialize(&exp).unwrap();
+    let mut m = Fmu::<PdController>::default();
+    m.initialize(&Experiment::default()).unwrap();
     let mut t = 0.0;
     time_ns(reps, n, |k| {
         let u = input_values(&PD, k);
-        let v = m.vars_mut();
-        (v.q_w, v.q_x, v.q_y, v.q_z, v.w_x, v.w_y, v.w_z, v.q_ref_w, v.q_ref_x, v.q_ref_y) = (u[0], u[1], u[2], u[3], u[4], u[5], u[6], u[7], u[8], u[9]);
-        m.do_step(t, H, &exp).unwrap();
+        let p = &mut m.v.ports;
+        (p.q.w, p.q.i, p.q.j, p.q.k, p.w.x, p.w.y, p.w.z, p.q_ref.w, p.q_ref.i, p.q_ref.j) = (u[0], u[1], u[2], u[3], u[4], u[5], u[6], u[7], u[8], u[9]);
+        m.step(t, H).unwrap();
         t += H;
-        m.update_outputs(t).unwrap();
-        let v = m.vars();
-        black_box([v.torque_cmd_x, v.torque_cmd_y, v.torque_cmd_z, v.k_x, v.k_y, v.k_z, v.k_d_x, v.k_d_y, v.k_d_z]);
+        m.outputs(t).unwrap();
+        let v = &m.v;
+        black_box([v.ports.torque_cmd.x, v.ports.torque_cmd.y, v.ports.torque_cmd.z, v.k.x, v.k.y, v.k.z, v.k_d.x, v.k_d.y, v.k_d.z]);
     })
 }
 

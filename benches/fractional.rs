@@ -8,8 +8,8 @@ use std::hint::black_box;
 use std::time::Instant;
 
 use spacecraft_fmus::math::fractional::{FopidLaw, FopidParams, PidLaw};
-use spacecraft_fmus::model::{Experiment, Model};
-use spacecraft_fmus::models::single_axis_plant::SingleAxisPlant;
+use spacecraft_fmus::model::{Experiment, Fmu};
+use spacecraft_fmus::models::single_axis::SingleAxisPlant;
 
 const H: f64 = 0.001;
 
@@ -58,13 +58,12 @@ fn run_pid(n: usize) -> f64 {
 }
 
 fn run_plant(n: usize) -> f64 {
-    let mut p = SingleAxisPlant::default();
-    let exp = Experiment::default();
-    p.initialize(&exp).unwrap();
+    let mut p = Fmu::<SingleAxisPlant>::default();
+    p.initialize(&Experiment::default()).unwrap();
     let t0 = Instant::now();
     for k in 0..n {
-        p.do_step(k as f64 * H, H, &exp).unwrap();
-        p.update_outputs((k + 1) as f64 * H).unwrap();
+        p.step(k as f64 * H, H).unwrap();
+        p.outputs((k + 1) as f64 * H).unwrap();
     }
     black_box(&p);
     t0.elapsed().as_secs_f64()

@@ -1,7 +1,7 @@
 //! Benchmark (issue 3, item 4): cost of one `fmi2DoStep` of `AttitudePlant` with reaction wheels,
 //! magnetorquers and the full disturbance generator at a 0.1 s communication step (default internal
 //! RK4 step 0.01 s → 10 internal steps), through the exported C ABI, versus the direct Rust
-//! `Model::do_step` of the same configuration. Plain `std::time::Instant` loops, no harness.
+//! `Fmu::step` of the same configuration. Plain `std::time::Instant` loops, no harness.
 //!
 //! Run: `cargo bench --bench plant_step` (release profile). Results go to docs/benchmarks.md by hand.
 
@@ -9,11 +9,12 @@ use std::ffi::{c_int, CString};
 use std::hint::black_box;
 use std::time::Instant;
 
-use spacecraft_fmus::description::guid;
+use spacecraft_fmus::model::guid::guid;
 use spacecraft_fmus::fmi::abi::*;
 use spacecraft_fmus::fmi::CallbackFunctions;
-use spacecraft_fmus::model::{Experiment, Model, SlotMut, Variables};
-use spacecraft_fmus::models::attitude_plant::AttitudePlant;
+use spacecraft_fmus::model::{Experiment, Fmu, SlotMut, Variables};
+use spacecraft_fmus::models::attitude::plant::AttitudePlantVars;
+use spacecraft_fmus::models::attitude::AttitudePlant;
 use spacecraft_fmus::registry;
 
 const DT: f64 = 0.1;
@@ -66,15 +67,20 @@ fn time_block(start: &mut usize, n: usize, f: &mut impl FnMut(usize)) -> f64 {
 const ROUNDS: usize = 15;
 const BLOCK: usize = 4000;
 
-fn direct_model() -> AttitudePlant {
-    let mut m = AttitudePlant::default();
+/// Declaration index of a variable (what the FMI layer maps a value reference to).
+fn index(name: &str) -> usize {
+    AttitudePlantVars::DECLS.iter().position(|d| d.name == name).unwrap()
+}
+
+fn direct_model() -> Fmu<AttitudePlant> {
+    let mut m = Fmu::<AttitudePlant>::default();
     for (n, v) in REALS {
-        if let Some(SlotMut::Real(x)) = m.vars_mut().slot(vr(n)) {
+        if let Some(SlotMut::Real(x)) = m.v.slot(index(n)) {
             *x = *v;
         }
     }
     for (n, v) in INTS {
-        if let Some(SlotMut::Integer(x)) = m.vars_mut().slot(vr(n)) {
+        if let Some(SlotMut::Integer(x)) = m.v.slot(index(n)) {
             *x = *v;
         }
     }
@@ -110,10 +116,11 @@ fn abi_instance() -> *mut std::ffi::c_void {
 fn main() {
     println!("AttitudePlant, wheels + magnetorquers + gravity gradient + const/sin/noise disturbances,");
     println!("communication step {DT} s, RK4 internal step 0.01 s (10 internal steps); {ROUNDS} interleaved rounds of {BLOCK} steps\n");
-    let exp = Experiment::default();
     let in_vr = [vr("torque_cmd_x"), vr("torque_cmd_y"), vr("torque_cmd_z")];
+    let in_ix = [index("torque_cmd_x"), index("torque_cmd_y"), index("torque_cmd_z")];
     let out_names = ["q_w", "q_x", "q_y", "q_z", "w_x", "w_y", "w_z", "torque_applied_x", "torque_applied_y", "torque_applied_z", "h_wheel_x", "h_wheel_y", "h_wheel_z"];
     let out_vr: Vec<u32> = out_names.iter().map(|n| vr(n)).collect();
+    let out_ix: Vec<usize> = out_names.iter().map(|n| index(n)).collect();
     let mut buf = vec![0.0; out_vr.len()];
     let mut buf2 = vec![0.0; out_vr.len()];
 
@@ -121,12 +128,12 @@ fn main() {
     let mut m = direct_model();
     let mut direct = |k: usize| {
         let c = cmd(k);
-        for (i, x) in c.iter().enumerate() {
-            if let Some(SlotMut::Real(s)) = m.vars_mut().slot(i as u32) {
+        for (i, x) in in_ix.iter().zip(&c) {
+            if let Some(SlotMut::Real(s)) = m.v.slot(*i) {
                 *s = *x;
             }
         }
-        m.do_step(k as f64 * DT, DT, &exp).unwrap();
+        m.step(k as f64 * DT, DT).unwrap();
     };
     // 2. through the C ABI: fmi2SetReal(3 inputs) + fmi2DoStep
     let c = abi_instance();
@@ -139,15 +146,15 @@ fn main() {
     let mut m2 = direct_model();
     let mut direct_cycle = |k: usize| {
         let u = cmd(k);
-        for (i, x) in u.iter().enumerate() {
-            if let Some(SlotMut::Real(s)) = m2.vars_mut().slot(i as u32) {
+        for (i, x) in in_ix.iter().zip(&u) {
+            if let Some(SlotMut::Real(s)) = m2.v.slot(*i) {
                 *s = *x;
             }
         }
-        m2.do_step(k as f64 * DT, DT, &exp).unwrap();
-        m2.update_outputs((k + 1) as f64 * DT).unwrap();
-        for (b, v) in buf.iter_mut().zip(&out_vr) {
-            if let Some(spacecraft_fmus::model::Value::Real(x)) = m2.vars().value(*v) {
+        m2.step(k as f64 * DT, DT).unwrap();
+        m2.outputs((k + 1) as f64 * DT).unwrap();
+        for (b, i) in buf.iter_mut().zip(&out_ix) {
+            if let Some(spacecraft_fmus::model::Value::Real(x)) = m2.v.value(*i) {
                 *b = x;
             }
         }
@@ -176,7 +183,7 @@ fn main() {
         res[3].push(time_block(&mut idx[3], BLOCK, &mut abi_cycle));
     }
     let labels = [
-        "direct Rust Model::do_step (+ 3 inputs written)",
+        "direct Rust Fmu::step (+ 3 inputs written)",
         "C ABI fmi2SetReal(3) + fmi2DoStep",
         "direct Rust cycle: 3 inputs + do_step + update_outputs + 13 reads",
         "C ABI cycle: fmi2SetReal(3) + fmi2DoStep + fmi2GetReal(13)",

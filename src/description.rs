@@ -1,29 +1,19 @@
-//! Generates `modelDescription.xml` and `documentation/index.html` from a model's declarations.
+//! Generates `modelDescription.xml` and `documentation/index.html` from a model's declarations
+//! (packaging only: the runtime never renders XML; it shares the GUID module `crate::model::guid`).
 //!
 //! XML is written with quick-xml. (fmi-schema's FMI 2 types were the first choice, but their `<Real>`
 //! has no `unit` attribute and an empty `dependencies=""` list, which says "no direct feed-through",
 //! cannot be written; masters such as OMSimulator would then see algebraic loops that do not exist.)
-//! The GUID is a name-based UUID (v5) of the description written with an empty GUID, so it changes
-//! exactly when the interface changes.
 
-use std::collections::HashMap;
 use std::io::Cursor;
-use std::sync::OnceLock;
 
 use quick_xml::events::{BytesDecl, BytesEnd, BytesStart, BytesText, Event};
 use quick_xml::Writer;
 
-use crate::model::{Causality, Feedthrough, Initial, ModelEntry, Start, VarDecl, VarKind, Variability};
+use crate::fmi::LOG_CATEGORIES;
+use crate::model::guid::guid;
+use crate::model::{Bound, Causality, Feedthrough, Initial, ModelEntry, Start, VarDecl, VarKind, Variability};
 use crate::units;
-
-/// Log categories declared in every modelDescription and accepted by `fmi2SetDebugLogging`.
-pub const LOG_CATEGORIES: &[(&str, &str)] = &[
-    ("logStatusWarning", "Warnings (always forwarded to the logger)"),
-    ("logStatusError", "Errors (always forwarded to the logger)"),
-    ("logStatusFatal", "Fatal errors (always forwarded to the logger)"),
-    ("logCalls", "Every FMI function call with its arguments (debug logging)"),
-    ("logAll", "All of the above"),
-];
 
 pub const GENERATION_TOOL: &str = concat!("spacecraft_fmus ", env!("CARGO_PKG_VERSION"));
 
@@ -67,6 +57,10 @@ fn start_str(s: Start) -> String {
         Start::Integer(v) => v.to_string(),
         Start::Boolean(v) => v.to_string(),
     }
+}
+
+fn bound_str(kind: VarKind, v: f64) -> String {
+    if kind == VarKind::Integer { (v as i32).to_string() } else { fmt_real(v) }
 }
 
 /// 1-based indices (position in ModelVariables) of the inputs the output `out` depends on directly.
@@ -122,6 +116,16 @@ pub fn check_declarations(entry: &ModelEntry) -> Result<(), String> {
             if !v.is_finite() {
                 return Err(format!("{name}: start of {} is not finite", a.name));
             }
+        }
+        if a.causality == Causality::Parameter {
+            let ok = match a.start {
+                Start::Real(v) => a.bound.check_real(a.name, v),
+                Start::Integer(v) => a.bound.check_integer(a.name, v),
+                Start::Boolean(_) => Ok(()),
+            };
+            ok.map_err(|e| format!("{name}: start value outside the declared bound: {e}"))?;
+        } else if a.bound != Bound::Any {
+            return Err(format!("{name}: {} has a bound but is not a parameter", a.name));
         }
     }
     if let Feedthrough::Some(list) = entry.info.feedthrough {
@@ -257,6 +261,13 @@ fn write_xml(entry: &ModelEntry, guid: &str) -> String {
         if !d.unit.is_empty() {
             t.push(("unit", d.unit.into()));
         }
+        let (min, max) = d.bound.min_max();
+        if let Some(m) = min {
+            t.push(("min", bound_str(d.kind, m)));
+        }
+        if let Some(m) = max {
+            t.push(("max", bound_str(d.kind, m)));
+        }
         if d.has_start() {
             t.push(("start", start_str(d.start)));
         }
@@ -306,24 +317,20 @@ fn write_xml(entry: &ModelEntry, guid: &str) -> String {
     s
 }
 
-/// Namespace of the project's name-based GUIDs (a fixed random UUID).
-const GUID_NAMESPACE: uuid::Uuid = uuid::Uuid::from_u128(0x6f1d_2b7e_3c4a_4e55_9a61_0d2f_8c3b_71a4);
-
-fn compute_guid(entry: &ModelEntry) -> String {
-    let unsigned = write_xml(entry, "");
-    format!("{{{}}}", uuid::Uuid::new_v5(&GUID_NAMESPACE, unsigned.as_bytes()))
-}
-
-/// GUID of a registered model, computed once per process.
-pub fn guid(entry: &ModelEntry) -> &'static str {
-    static CACHE: OnceLock<HashMap<&'static str, String>> = OnceLock::new();
-    let cache = CACHE.get_or_init(|| crate::registry::all().iter().map(|e| (e.info.name, compute_guid(e))).collect());
-    cache.get(entry.info.name).map(String::as_str).expect("model is registered")
-}
-
 /// The complete modelDescription.xml of a registered model.
 pub fn model_description(entry: &ModelEntry) -> String {
     write_xml(entry, guid(entry))
+}
+
+fn bound_text(b: Bound) -> String {
+    match b {
+        Bound::Any => String::new(),
+        Bound::Positive => "> 0".into(),
+        Bound::NonNegative => ">= 0".into(),
+        Bound::Limit => ">= 0 (1e30 = no limit)".into(),
+        Bound::Range(lo, hi) => format!("[{lo}, {hi}]"),
+        Bound::Choice(codes) => format!("one of {codes:?}"),
+    }
 }
 
 fn html_escape(s: &str) -> String {
@@ -357,17 +364,18 @@ pub fn documentation_html(entry: &ModelEntry) -> String {
         if rows.is_empty() {
             continue;
         }
-        h.push_str(&format!("<h2>{title}</h2>\n<table>\n<tr><th>name</th><th>vr</th><th>type</th><th>variability</th><th>start</th><th>unit</th><th>meaning</th></tr>\n"));
+        h.push_str(&format!("<h2>{title}</h2>\n<table>\n<tr><th>name</th><th>vr</th><th>type</th><th>variability</th><th>start</th><th>unit</th><th>admissible</th><th>meaning</th></tr>\n"));
         for d in rows {
             let start = if d.has_start() { start_str(d.start) } else { String::new() };
             h.push_str(&format!(
-                "<tr><td><code>{}</code></td><td>{}</td><td>{:?}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
+                "<tr><td><code>{}</code></td><td>{}</td><td>{:?}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
                 d.name,
                 d.vr,
                 d.kind,
                 variability_str(d.variability),
                 start,
                 html_escape(d.unit),
+                html_escape(&bound_text(d.bound)),
                 html_escape(d.description)
             ));
         }
@@ -383,19 +391,8 @@ mod tests {
 
     #[test]
     fn every_registered_model_has_consistent_declarations() {
-        for e in crate::registry::all() {
+        for e in crate::registry::ALL {
             check_declarations(e).unwrap();
-        }
-    }
-
-    #[test]
-    fn guids_are_distinct_and_stable() {
-        let all = crate::registry::all();
-        for (i, a) in all.iter().enumerate() {
-            assert_eq!(guid(a), compute_guid(a));
-            for b in &all[i + 1..] {
-                assert_ne!(guid(a), guid(b));
-            }
         }
     }
 

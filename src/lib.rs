@@ -1,9 +1,9 @@
 //! Spacecraft guidance and control units as FMI 2.0 Co-Simulation FMUs.
 //!
 //! - `fmi`: the FMI 2.0 CS C ABI, state machine, logging and FMU state, written once.
-//! - `model`: what a model is (declared variables + init/step code) and the declaration macro.
-//! - `models`: one file per FMU; `registry` lists them.
-//! - `description`: modelDescription.xml and documentation generated from the declarations.
+//! - `model`: what a model is (declared variables + init/outputs/step), the declaration macro, GUIDs.
+//! - `models`: the FMUs, one folder per family; `registry` lists them.
+//! - `description`: modelDescription.xml and documentation generated from the declarations (packaging).
 //! - `math`: shared math (attitude conventions, integrators, ...), unit-tested on its own.
 //! - `package`: writes `fmus/<Model>.fmu` and `modelDescription/<Model>.xml`.
 

@@ -37,7 +37,7 @@ pub const LIB_EXT: &str = if cfg!(target_os = "windows") {
 pub fn write_model_descriptions(dir: &Path) -> std::io::Result<Vec<String>> {
     fs::create_dir_all(dir)?;
     let mut written = vec![];
-    for e in registry::all() {
+    for e in registry::ALL {
         let p = dir.join(format!("{}.xml", e.info.name));
         fs::write(&p, model_description(e))?;
         written.push(p.display().to_string());
@@ -47,7 +47,7 @@ pub fn write_model_descriptions(dir: &Path) -> std::io::Result<Vec<String>> {
 
 /// Names of the models whose committed `modelDescription/<Model>.xml` differs from the generated one.
 pub fn stale_model_descriptions(dir: &Path) -> Vec<String> {
-    registry::all()
+    registry::ALL
         .iter()
         .filter(|e| fs::read_to_string(dir.join(format!("{}.xml", e.info.name))).ok().as_deref() != Some(model_description(e).as_str()))
         .map(|e| e.info.name.to_string())

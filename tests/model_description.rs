@@ -17,7 +17,7 @@ fn committed_model_descriptions_are_not_stale() {
 
 #[test]
 fn fmi_rs_validation_finds_no_problem() {
-    for e in registry::all() {
+    for e in registry::ALL {
         let xml = model_description(e);
         let md = fmi_rs::model_description::fmi2::ModelDescription::from_string(&xml)
             .unwrap_or_else(|err| panic!("{}: fmi-rs cannot read the description: {err}", e.info.name));
@@ -28,7 +28,7 @@ fn fmi_rs_validation_finds_no_problem() {
 
 #[test]
 fn fmi_schema_reads_every_variable_back() {
-    for e in registry::all() {
+    for e in registry::ALL {
         let xml = model_description(e);
         let md = fmi_schema::fmi2::Fmi2ModelDescription::from_str(&xml).unwrap_or_else(|err| panic!("{}: {err}", e.info.name));
         assert_eq!(md.model_name, e.info.name);

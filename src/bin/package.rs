@@ -32,7 +32,7 @@ fn main() -> ExitCode {
     if check {
         let stale = stale_model_descriptions(&xml);
         if stale.is_empty() {
-            println!("modelDescription/ is up to date ({} models)", registry::all().len());
+            println!("modelDescription/ is up to date ({} models)", registry::ALL.len());
             return ExitCode::SUCCESS;
         }
         eprintln!("stale modelDescription files: {}", stale.join(", "));
@@ -49,7 +49,7 @@ fn main() -> ExitCode {
         eprintln!("package: cannot write model descriptions: {e}");
         return ExitCode::FAILURE;
     }
-    for e in registry::all() {
+    for e in registry::ALL {
         match write_fmu(e, &library, &fmus) {
             Ok(p) => println!("wrote {}", p.display()),
             Err(err) => {

@@ -12,7 +12,7 @@ use std::sync::{MutexGuard, Once};
 use super::instance::{CallResult, Fail, Instance};
 use super::state::Snapshot;
 use super::{mask, status_kind, BuildAddrHasher, CallbackFunctions, FsmState, LiveSet, Status};
-use crate::description;
+use crate::model::guid::guid;
 use crate::model::{ModelEntry, Value, VarKind};
 use crate::registry;
 
@@ -81,9 +81,9 @@ fn call(c: Component, func: &str, allowed: u16, f: impl FnOnce(&mut Instance) ->
     let Some(inst) = instance(c) else {
         return Status::Error as c_int;
     };
-    if allowed & inst.state.bit() == 0 {
-        let status = if inst.state == FsmState::Fatal { Status::Fatal } else { Status::Error };
-        inst.log_fail(func, &Fail { status, reason: format!("not allowed in state {:?} (illegal call sequence)", inst.state) });
+    if allowed & inst.run.fsm.bit() == 0 {
+        let status = if inst.run.fsm == FsmState::Fatal { Status::Fatal } else { Status::Error };
+        inst.log_fail(func, &Fail { status, reason: format!("not allowed in state {:?} (illegal call sequence)", inst.run.fsm) });
         return status as c_int;
     }
     match guarded(|| f(&mut *inst)) {
@@ -93,7 +93,7 @@ fn call(c: Component, func: &str, allowed: u16, f: impl FnOnce(&mut Instance) ->
             fail.status as c_int
         }
         Err(panic) => {
-            inst.state = FsmState::Fatal;
+            inst.run.fsm = FsmState::Fatal;
             inst.log_fail(func, &Fail { status: Status::Fatal, reason: format!("internal error (panic): {panic}") });
             Status::Fatal as c_int
         }
@@ -155,19 +155,17 @@ fn own_library_stem() -> Option<String> {
     std::path::Path::new(&path).file_stem().map(|s| s.to_string_lossy().into_owned())
 }
 
-fn find_model(guid: &str) -> Result<&'static ModelEntry, String> {
-    let all = registry::all();
+fn find_model(requested: &str) -> Result<&'static ModelEntry, String> {
+    let all = registry::ALL;
     if let Some(expected) = own_library_stem().and_then(|stem| all.iter().find(|e| e.info.name == stem)) {
-        let want = description::guid(expected);
-        return if guid == want {
+        let want = guid(expected);
+        return if requested == want {
             Ok(expected)
         } else {
-            Err(format!("fmuGUID {guid} does not match {}'s GUID {want} (modelDescription.xml and binary are from different builds)", expected.info.name))
+            Err(format!("fmuGUID {requested} does not match {}'s GUID {want} (modelDescription.xml and binary are from different builds)", expected.info.name))
         };
     }
-    all.iter()
-        .find(|e| description::guid(e) == guid)
-        .ok_or_else(|| format!("fmuGUID {guid} matches no model in this binary"))
+    all.iter().find(|e| guid(e) == requested).ok_or_else(|| format!("fmuGUID {requested} matches no model in this binary"))
 }
 
 fn log_without_instance(functions: &CallbackFunctions, name: &CStr, message: &str) {
@@ -223,8 +221,8 @@ pub extern "C" fn fmi2Instantiate(
             return Err("fmuGUID is NULL".into());
         }
         // SAFETY: non-null C string from the master.
-        let guid = unsafe { CStr::from_ptr(fmu_guid) }.to_string_lossy();
-        let entry = find_model(&guid)?;
+        let requested = unsafe { CStr::from_ptr(fmu_guid) }.to_string_lossy();
+        let entry = find_model(&requested)?;
         let inst = Box::new(Instance::new(name.to_owned(), entry, functions.logger, functions.component_environment, logging_on != 0));
         inst.trace(|| format!("fmi2Instantiate: {} instance of {}", inst.name.to_string_lossy(), entry.info.name));
         let p = Box::into_raw(inst) as Component;
@@ -294,7 +292,7 @@ pub extern "C" fn fmi2ExitInitializationMode(c: Component) -> c_int {
 #[no_mangle]
 pub extern "C" fn fmi2Terminate(c: Component) -> c_int {
     call(c, "fmi2Terminate", mask::TERMINATE, |inst| {
-        inst.state = FsmState::Terminated;
+        inst.run.fsm = FsmState::Terminated;
         Ok(())
     })
 }
@@ -430,7 +428,7 @@ pub extern "C" fn fmi2SerializedFMUstateSize(c: Component, state: *mut c_void, s
     call(c, "fmi2SerializedFMUstateSize", mask::FMU_STATE, |inst| {
         let out = out_ptr(size, "size")?;
         let snap = unsafe { Snapshot::from_handle(state as *mut Snapshot)? };
-        let bytes = snap.to_bytes(description::guid(inst.entry))?;
+        let bytes = snap.to_bytes(guid(inst.entry))?;
         *out = bytes.len();
         snap.serialized = Some(bytes);
         Ok(())
@@ -443,7 +441,7 @@ pub extern "C" fn fmi2SerializeFMUstate(c: Component, state: *mut c_void, buffer
         let snap = unsafe { Snapshot::from_handle(state as *mut Snapshot)? };
         let bytes = match snap.serialized.take() {
             Some(b) => b,
-            None => snap.to_bytes(description::guid(inst.entry))?,
+            None => snap.to_bytes(guid(inst.entry))?,
         };
         if size != bytes.len() {
             return Err(Fail::error(format!("size {size} differs from fmi2SerializedFMUstateSize = {}", bytes.len())));
@@ -459,7 +457,7 @@ pub extern "C" fn fmi2DeSerializeFMUstate(c: Component, buffer: *const c_char, s
     call(c, "fmi2DeSerializeFMUstate", mask::FMU_STATE, |inst| {
         let slot = out_ptr(state, "FMUstate")?;
         let bytes = unsafe { slice(buffer as *const u8, size, "serializedState[]")? };
-        let snap = Snapshot::from_bytes(bytes, inst, c as usize, description::guid(inst.entry))?;
+        let snap = Snapshot::from_bytes(bytes, inst, c as usize, guid(inst.entry))?;
         if slot.is_null() {
             *slot = snap.into_handle() as *mut c_void;
         } else {
@@ -539,7 +537,7 @@ pub extern "C" fn fmi2GetRealStatus(c: Component, kind: c_int, value: *mut f64) 
     status_query(c, "fmi2GetRealStatus", |inst| {
         let out = out_ptr(value, "value")?;
         if kind == status_kind::LAST_SUCCESSFUL_TIME {
-            *out = inst.time;
+            *out = inst.run.time;
             Ok(())
         } else {
             Err(Fail::discard(format!("status kind {kind} has no Real value (only fmi2LastSuccessfulTime)")))
@@ -560,7 +558,7 @@ pub extern "C" fn fmi2GetBooleanStatus(c: Component, kind: c_int, value: *mut c_
     status_query(c, "fmi2GetBooleanStatus", |inst| {
         let out = out_ptr(value, "value")?;
         if kind == status_kind::TERMINATED {
-            *out = (inst.state == FsmState::Terminated) as c_int;
+            *out = (inst.run.fsm == FsmState::Terminated) as c_int;
             Ok(())
         } else {
             Err(Fail::discard(format!("status kind {kind} has no Boolean value (only fmi2Terminated)")))
@@ -604,8 +602,8 @@ mod tests {
             component_environment: &*log as *const Log as *mut c_void,
         };
         let entry = registry::find("AttitudeMetrics").unwrap();
-        let guid = CString::new(description::guid(entry)).unwrap();
-        let c = fmi2Instantiate(c"p".as_ptr(), 1, guid.as_ptr(), std::ptr::null(), &cb, 0, 0);
+        let g = CString::new(guid(entry)).unwrap();
+        let c = fmi2Instantiate(c"p".as_ptr(), 1, g.as_ptr(), std::ptr::null(), &cb, 0, 0);
         assert!(!c.is_null());
         let st = call(c, "fmi2Probe", mask::SETUP_EXPERIMENT, |_| panic!("deliberate test panic"));
         assert_eq!(st, Status::Fatal as c_int);

@@ -4,8 +4,9 @@
 use std::collections::HashSet;
 use std::ffi::{c_int, c_void, CString};
 
-use super::{FsmState, LoggerFn, Status};
-use crate::description::LOG_CATEGORIES;
+use serde::{Deserialize, Serialize};
+
+use super::{FsmState, LoggerFn, Status, LOG_CATEGORIES};
 use crate::model::{Causality, DynModel, Experiment, ModelEntry, SlotMut, Value, VarDecl, VarKind, Variability};
 
 /// Failure of an FMI call: the status to return and the reason to log.
@@ -63,6 +64,25 @@ impl VrIndex {
     }
 }
 
+/// Everything an instance carries besides its model: where it is in the state machine, its time and
+/// experiment, and which cached values are stale. FMU states (snapshots and their serialized form)
+/// copy it whole together with the model.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Run {
+    pub fsm: FsmState,
+    pub time: f64,
+    pub exp: Experiment,
+    /// Outputs must be recomputed before the next get (an input, parameter or the state changed).
+    pub outputs_dirty: bool,
+    /// Parameters changed during initialization: derived quantities must be recomputed.
+    pub params_dirty: bool,
+}
+
+impl Run {
+    pub const INSTANTIATED: Run =
+        Run { fsm: FsmState::Instantiated, time: 0.0, exp: Experiment { start_time: 0.0, tolerance: None, stop_time: None }, outputs_dirty: true, params_dirty: true };
+}
+
 pub struct Instance {
     pub name: CString,
     pub entry: &'static ModelEntry,
@@ -70,14 +90,8 @@ pub struct Instance {
     env: *mut c_void,
     debug_logging: bool,
     categories: HashSet<&'static str>,
-    pub state: FsmState,
+    pub run: Run,
     pub model: Box<dyn DynModel>,
-    pub exp: Experiment,
-    pub time: f64,
-    /// Outputs must be recomputed before the next get (an input, parameter or the state changed).
-    pub outputs_dirty: bool,
-    /// Parameters changed during initialization: derived quantities must be recomputed.
-    pub params_dirty: bool,
     index: VrIndex,
 }
 
@@ -98,12 +112,8 @@ impl Instance {
             env,
             debug_logging: logging_on,
             categories: LOG_CATEGORIES.iter().map(|(n, _)| *n).collect(),
-            state: FsmState::Instantiated,
+            run: Run::INSTANTIATED,
             model: (entry.create)(),
-            exp: Experiment::default(),
-            time: 0.0,
-            outputs_dirty: true,
-            params_dirty: true,
             index: VrIndex::new(entry.decls),
         }
     }
@@ -163,16 +173,17 @@ impl Instance {
 
     // ----- variable access ----------------------------------------------------------------------
 
+    /// Declaration index and declaration of a value reference of the given kind.
     #[inline]
-    fn decl(&self, kind: VarKind, vr: u32) -> CallResult<&'static VarDecl> {
+    fn decl(&self, kind: VarKind, vr: u32) -> CallResult<(usize, &'static VarDecl)> {
         if let Some(i) = self.index.get(kind, vr) {
-            return Ok(&self.entry.decls[i]);
+            return Ok((i, &self.entry.decls[i]));
         }
         self.unknown_vr(kind, vr)
     }
 
     #[cold]
-    fn unknown_vr(&self, kind: VarKind, vr: u32) -> CallResult<&'static VarDecl> {
+    fn unknown_vr(&self, kind: VarKind, vr: u32) -> CallResult<(usize, &'static VarDecl)> {
         let other = [VarKind::Real, VarKind::Integer, VarKind::Boolean]
             .into_iter()
             .filter(|k| *k != kind)
@@ -185,7 +196,7 @@ impl Instance {
 
     /// Whether a variable may be set in the current state (FMI 2.0 section 4.2.4 rules).
     fn check_settable(&self, d: &VarDecl) -> CallResult {
-        let init = matches!(self.state, FsmState::Instantiated | FsmState::InitializationMode);
+        let init = matches!(self.run.fsm, FsmState::Instantiated | FsmState::InitializationMode);
         let ok = match (d.causality, d.variability) {
             (_, Variability::Constant) => false,
             (Causality::Input, _) => true,
@@ -198,7 +209,7 @@ impl Instance {
             return Ok(());
         }
         Err(Fail::error(match d.causality {
-            Causality::Parameter => format!("parameter {} is fixed and cannot be set after initialization (state {:?})", d.name, self.state),
+            Causality::Parameter => format!("parameter {} is fixed and cannot be set after initialization (state {:?})", d.name, self.run.fsm),
             Causality::Output => format!("{} is an output and cannot be set", d.name),
             Causality::CalculatedParameter => format!("{} is a calculated parameter and cannot be set", d.name),
             _ => format!("{} ({:?}, {:?}) cannot be set", d.name, d.causality, d.variability),
@@ -210,7 +221,7 @@ impl Instance {
     pub fn set_values(&mut self, kind: VarKind, vrs: &[u32], value: impl Fn(usize) -> Value) -> CallResult {
         let mut sets_parameter = false;
         for (i, vr) in vrs.iter().enumerate() {
-            let d = self.decl(kind, *vr)?;
+            let (_, d) = self.decl(kind, *vr)?;
             self.check_settable(d)?;
             if let Value::Real(x) = value(i) {
                 if !x.is_finite() {
@@ -221,29 +232,30 @@ impl Instance {
         }
         // All checked: write (the value references are known to exist with this kind).
         for (i, vr) in vrs.iter().enumerate() {
-            match (self.model.slot(*vr), value(i)) {
+            let index = self.index.get(kind, *vr).expect("checked above");
+            match (self.model.slot(index), value(i)) {
                 (Some(SlotMut::Real(s)), Value::Real(x)) => *s = x,
                 (Some(SlotMut::Integer(s)), Value::Integer(x)) => *s = x,
                 (Some(SlotMut::Boolean(s)), Value::Boolean(x)) => *s = x,
                 _ => return Err(Fail::error(format!("internal: storage of value reference {vr} does not match its declaration"))),
             }
         }
-        self.params_dirty |= sets_parameter;
-        self.outputs_dirty = true;
+        self.run.params_dirty |= sets_parameter;
+        self.run.outputs_dirty = true;
         Ok(())
     }
 
     /// Brings outputs up to date with the inputs most recently set. During initialization the
     /// parameters are (re)applied first so that initial outputs reflect them.
     pub fn ensure_outputs(&mut self) -> CallResult {
-        if self.state == FsmState::InitializationMode && self.params_dirty {
-            self.model.initialize(&self.exp).map_err(Fail::error)?;
-            self.params_dirty = false;
-            self.outputs_dirty = true;
+        if self.run.fsm == FsmState::InitializationMode && self.run.params_dirty {
+            self.model.initialize(&self.run.exp).map_err(Fail::error)?;
+            self.run.params_dirty = false;
+            self.run.outputs_dirty = true;
         }
-        if self.outputs_dirty && self.state != FsmState::Instantiated {
-            self.model.update_outputs(self.time).map_err(Fail::error)?;
-            self.outputs_dirty = false;
+        if self.run.outputs_dirty && self.run.fsm != FsmState::Instantiated {
+            self.model.update_outputs(self.run.time).map_err(Fail::error)?;
+            self.run.outputs_dirty = false;
         }
         Ok(())
     }
@@ -253,12 +265,12 @@ impl Instance {
     pub fn get_values(&mut self, kind: VarKind, vrs: &[u32], mut write: impl FnMut(usize, Value)) -> CallResult {
         self.ensure_outputs()?;
         for (i, vr) in vrs.iter().enumerate() {
-            let d = self.decl(kind, *vr)?;
-            let v = self.model.value(d.vr).ok_or_else(|| Fail::error(format!("internal: no storage for {}", d.name)))?;
+            let (index, d) = self.decl(kind, *vr)?;
+            let v = self.model.value(index).ok_or_else(|| Fail::error(format!("internal: no storage for {}", d.name)))?;
             if let Value::Real(x) = v {
                 if !x.is_finite() && d.causality == Causality::Output {
-                    self.state = FsmState::Error;
-                    return Err(Fail::error(format!("output {} is {x} at t = {}", d.name, self.time)));
+                    self.run.fsm = FsmState::Error;
+                    return Err(Fail::error(format!("output {} is {x} at t = {}", d.name, self.run.time)));
                 }
             }
             write(i, v);
@@ -282,26 +294,26 @@ impl Instance {
                 return Err(Fail::error(format!("stopTime {stop} must be finite and >= startTime {start}")));
             }
         }
-        self.exp = Experiment { start_time: start, tolerance, stop_time: stop };
-        self.time = start;
+        self.run.exp = Experiment { start_time: start, tolerance, stop_time: stop };
+        self.run.time = start;
         Ok(())
     }
 
     pub fn enter_initialization_mode(&mut self) -> CallResult {
-        self.state = FsmState::InitializationMode;
-        self.params_dirty = true;
-        self.outputs_dirty = true;
+        self.run.fsm = FsmState::InitializationMode;
+        self.run.params_dirty = true;
+        self.run.outputs_dirty = true;
         Ok(())
     }
 
     /// Applies the parameters. On invalid parameters the instance stays in initialization mode, so
     /// the master may correct them and call again.
     pub fn exit_initialization_mode(&mut self) -> CallResult {
-        self.model.initialize(&self.exp).map_err(Fail::error)?;
-        self.params_dirty = false;
-        self.outputs_dirty = true;
+        self.model.initialize(&self.run.exp).map_err(Fail::error)?;
+        self.run.params_dirty = false;
+        self.run.outputs_dirty = true;
         self.ensure_outputs()?;
-        self.state = FsmState::StepComplete;
+        self.run.fsm = FsmState::StepComplete;
         Ok(())
     }
 
@@ -309,32 +321,28 @@ impl Instance {
         if !(h.is_finite() && h > 0.0) {
             return Err(Fail::error(format!("communicationStepSize {h} must be finite and > 0")));
         }
-        let tol = 1e-9 * self.time.abs().max(1.0);
-        if !t.is_finite() || (t - self.time).abs() > tol {
-            return Err(Fail::error(format!("currentCommunicationPoint {t} does not match the FMU time {}", self.time)));
+        let tol = 1e-9 * self.run.time.abs().max(1.0);
+        if !t.is_finite() || (t - self.run.time).abs() > tol {
+            return Err(Fail::error(format!("currentCommunicationPoint {t} does not match the FMU time {}", self.run.time)));
         }
-        if let Some(stop) = self.exp.stop_time {
+        if let Some(stop) = self.run.exp.stop_time {
             if t + h > stop + 1e-9 * stop.abs().max(1.0) {
                 return Err(Fail::error(format!("step to {} goes beyond stopTime {stop} set in fmi2SetupExperiment", t + h)));
             }
         }
-        if let Err(reason) = self.model.do_step(t, h, &self.exp) {
-            self.state = FsmState::Error;
+        if let Err(reason) = self.model.do_step(t, h) {
+            self.run.fsm = FsmState::Error;
             return Err(Fail::error(format!("step from t = {t} failed: {reason}")));
         }
         // Continue on the master's grid: no accumulation of round-off in the FMU time.
-        self.time = t + h;
-        self.outputs_dirty = true; // computed when read
+        self.run.time = t + h;
+        self.run.outputs_dirty = true; // computed when read
         Ok(())
     }
 
     pub fn reset(&mut self) {
         self.model = (self.entry.create)();
-        self.exp = Experiment::default();
-        self.time = 0.0;
-        self.state = FsmState::Instantiated;
-        self.outputs_dirty = true;
-        self.params_dirty = true;
+        self.run = Run::INSTANTIATED;
     }
 
     /// Directional derivative of Real outputs with respect to Real inputs, by central differences
@@ -343,19 +351,19 @@ impl Instance {
         self.ensure_outputs()?;
         let mut known_decls = Vec::with_capacity(knowns.len());
         for vr in knowns {
-            let d = self.decl(VarKind::Real, *vr)?;
+            let (i, d) = self.decl(VarKind::Real, *vr)?;
             if d.causality != Causality::Input {
                 return Err(Fail::error(format!("known {} is not an input", d.name)));
             }
-            known_decls.push(d);
+            known_decls.push(i);
         }
         let mut unknown_decls = Vec::with_capacity(unknowns.len());
         for vr in unknowns {
-            let d = self.decl(VarKind::Real, *vr)?;
+            let (i, d) = self.decl(VarKind::Real, *vr)?;
             if d.causality != Causality::Output {
                 return Err(Fail::error(format!("unknown {} is not an output", d.name)));
             }
-            unknown_decls.push(d);
+            unknown_decls.push(i);
         }
         if let Some(x) = dv_known.iter().find(|x| !x.is_finite()) {
             return Err(Fail::error(format!("seed value {x} is not finite")));
@@ -364,31 +372,24 @@ impl Instance {
         if dmax == 0.0 {
             return Ok(vec![0.0; unknowns.len()]);
         }
-        let xmax = known_decls.iter().fold(0.0f64, |a, d| match self.model.value(d.vr) {
+        let xmax = known_decls.iter().fold(0.0f64, |a, i| match self.model.value(*i) {
             Some(Value::Real(x)) => a.max(x.abs()),
             _ => a,
         });
         let eps = 1e-6 * (1.0 + xmax) / dmax;
         let eval = |sign: f64| -> CallResult<Vec<f64>> {
             let mut m = self.model.clone_box();
-            for (d, dv) in known_decls.iter().zip(dv_known) {
-                if let Some(SlotMut::Real(s)) = m.slot(d.vr) {
+            for (i, dv) in known_decls.iter().zip(dv_known) {
+                if let Some(SlotMut::Real(s)) = m.slot(*i) {
                     *s += sign * eps * dv;
                 }
             }
-            m.update_outputs(self.time).map_err(Fail::error)?;
-            Ok(unknown_decls.iter().map(|d| if let Some(Value::Real(x)) = m.value(d.vr) { x } else { f64::NAN }).collect())
+            m.update_outputs(self.run.time).map_err(Fail::error)?;
+            Ok(unknown_decls.iter().map(|i| if let Some(Value::Real(x)) = m.value(*i) { x } else { f64::NAN }).collect())
         };
         let plus = eval(1.0)?;
         let minus = eval(-1.0)?;
         Ok(plus.iter().zip(&minus).map(|(p, m)| (p - m) / (2.0 * eps)).collect())
     }
 
-    pub fn new_model_like(&self) -> Box<dyn DynModel> {
-        self.model.clone_box()
-    }
-
-    pub fn entry(&self) -> &'static ModelEntry {
-        self.entry
-    }
 }

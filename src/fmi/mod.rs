@@ -59,6 +59,15 @@ impl Default for LiveSet {
     }
 }
 
+/// Log categories declared in every modelDescription and accepted by `fmi2SetDebugLogging`.
+pub const LOG_CATEGORIES: &[(&str, &str)] = &[
+    ("logStatusWarning", "Warnings (always forwarded to the logger)"),
+    ("logStatusError", "Errors (always forwarded to the logger)"),
+    ("logStatusFatal", "Fatal errors (always forwarded to the logger)"),
+    ("logCalls", "Every FMI function call with its arguments (debug logging)"),
+    ("logAll", "All of the above"),
+];
+
 /// `fmi2Status`.
 #[repr(i32)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]

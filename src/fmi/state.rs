@@ -11,9 +11,9 @@ use std::sync::MutexGuard;
 
 use serde::{Deserialize, Serialize};
 
-use super::instance::{CallResult, Fail, Instance};
-use super::{BuildAddrHasher, FsmState, LiveSet};
-use crate::model::{DynModel, Experiment};
+use super::instance::{CallResult, Fail, Instance, Run};
+use super::{BuildAddrHasher, LiveSet};
+use crate::model::DynModel;
 
 const MAGIC: &[u8; 8] = b"SCFMUST\0";
 const FORMAT_VERSION: u32 = 1;
@@ -24,11 +24,7 @@ pub struct Snapshot {
     /// Address of the instance that created it (freed with that instance).
     pub owner: usize,
     pub model_name: &'static str,
-    pub fsm: FsmState,
-    pub time: f64,
-    pub exp: Experiment,
-    pub outputs_dirty: bool,
-    pub params_dirty: bool,
+    pub run: Run,
     pub model: Box<dyn DynModel>,
     /// Bytes computed by `fmi2SerializedFMUstateSize`, reused by `fmi2SerializeFMUstate`.
     pub serialized: Option<Vec<u8>>,
@@ -38,11 +34,7 @@ pub struct Snapshot {
 struct Payload {
     model_name: String,
     guid: String,
-    fsm: FsmState,
-    time: f64,
-    exp: Experiment,
-    outputs_dirty: bool,
-    params_dirty: bool,
+    run: Run,
     model: Vec<u8>,
 }
 
@@ -56,12 +48,8 @@ impl Snapshot {
         Snapshot {
             owner,
             model_name: inst.entry.info.name,
-            fsm: inst.state,
-            time: inst.time,
-            exp: inst.exp,
-            outputs_dirty: inst.outputs_dirty,
-            params_dirty: inst.params_dirty,
-            model: inst.new_model_like(),
+            run: inst.run,
+            model: inst.model.clone_box(),
             serialized: None,
         }
     }
@@ -71,11 +59,7 @@ impl Snapshot {
             return Err(Fail::error(format!("FMU state belongs to {}, not to {}", self.model_name, inst.entry.info.name)));
         }
         inst.model = self.model.clone_box();
-        inst.state = self.fsm;
-        inst.time = self.time;
-        inst.exp = self.exp;
-        inst.outputs_dirty = self.outputs_dirty;
-        inst.params_dirty = self.params_dirty;
+        inst.run = self.run;
         Ok(())
     }
 
@@ -131,11 +115,7 @@ impl Snapshot {
         let payload = Payload {
             model_name: self.model_name.to_string(),
             guid: guid.to_string(),
-            fsm: self.fsm,
-            time: self.time,
-            exp: self.exp,
-            outputs_dirty: self.outputs_dirty,
-            params_dirty: self.params_dirty,
+            run: self.run,
             model: self.model.to_bytes().map_err(|e| Fail::error(format!("cannot encode model state: {e}")))?,
         };
         let body = postcard::to_stdvec(&payload).map_err(|e| Fail::error(format!("cannot encode FMU state: {e}")))?;
@@ -176,18 +156,8 @@ impl Snapshot {
         if p.guid != guid {
             return Err(Fail::error(format!("serialized state was written by a different version of {} (GUID {})", p.model_name, p.guid)));
         }
-        let mut model = inst.new_model_like();
+        let mut model = inst.model.clone_box();
         model.load_bytes(&p.model).map_err(Fail::error)?;
-        Ok(Snapshot {
-            owner,
-            model_name: inst.entry.info.name,
-            fsm: p.fsm,
-            time: p.time,
-            exp: p.exp,
-            outputs_dirty: p.outputs_dirty,
-            params_dirty: p.params_dirty,
-            model,
-            serialized: None,
-        })
+        Ok(Snapshot { owner, model_name: inst.entry.info.name, run: p.run, model, serialized: None })
     }
 }

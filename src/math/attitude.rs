@@ -1,4 +1,4 @@
-//! Attitude conventions of the project (shared/spec README): scalar-first Hamilton quaternions of the
+//! Attitude conventions of the project (README, "Conventions"): scalar-first Hamilton quaternions of the
 //! body frame B relative to the reference frame R; A(q) maps R-components into B-components.
 
 use nalgebra::{Matrix3, Quaternion, Vector3};

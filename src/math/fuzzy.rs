@@ -132,13 +132,14 @@ pub fn weighted_average(firing: &[[f64; 7]; 7], table: &[[Term; 7]; 7], c_small:
     (den > 0.0).then(|| num / den)
 }
 
-/// Defuzzification choice (`defuzz` parameter).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Defuzz {
-    /// 0: c(S) = 0, c(B) = 1.
-    Singleton,
-    /// 1: centroids of the Gaussian output sets truncated to [0, 1].
-    TruncatedCentroid,
+crate::param_enum! {
+    /// Defuzzification of the output sets (`defuzz` parameter).
+    pub enum Defuzz {
+        /// 0: c(S) = 0, c(B) = 1.
+        Singleton = 0,
+        /// 1: centroids of the Gaussian output sets truncated to [0, 1].
+        TruncatedCentroid = 1,
+    }
 }
 
 /// The fuzzy gain scheduler of paper 000 §6: (ē, ē') ∈ [−1, 1]² → (k'_p, k'_d) ∈ [0, 1]².

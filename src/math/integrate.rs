@@ -3,6 +3,8 @@
 
 use nalgebra::SVector;
 
+use crate::model::{Experiment, ParamEnum};
+
 /// One classical Runge–Kutta 4 step of ẋ = f(t, x).
 pub fn rk4<const N: usize>(f: &mut impl FnMut(f64, &SVector<f64, N>) -> SVector<f64, N>, t: f64, x: &SVector<f64, N>, h: f64) -> SVector<f64, N> {
     let k1 = f(t, x);
@@ -136,23 +138,17 @@ pub fn dopri5<const N: usize>(
     Ok(out)
 }
 
-/// Integrator option shared by the plants (`integrator` parameter): 0 = classical RK4,
-/// 1 = explicit Euler, 2 = adaptive Dormand–Prince 5(4).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub enum Method {
-    #[default]
-    Rk4,
-    Euler,
-    DormandPrince,
-}
-
-impl Method {
-    pub fn from_param(v: i32) -> Result<Self, String> {
-        Ok(match crate::model::check::choice("integrator", v, &[0, 1, 2])? {
-            0 => Method::Rk4,
-            1 => Method::Euler,
-            _ => Method::DormandPrince,
-        })
+crate::param_enum! {
+    /// Integrator option shared by the plants (`integrator` parameter).
+    #[derive(Default)]
+    pub enum Method {
+        /// 0: classical RK4 with ⌈h / max_step⌉ equal internal steps.
+        #[default]
+        Rk4 = 0,
+        /// 1: explicit Euler with ⌈h / max_step⌉ equal internal steps.
+        Euler = 1,
+        /// 2: adaptive Dormand–Prince 5(4).
+        DormandPrince = 2,
     }
 }
 
@@ -183,6 +179,40 @@ pub struct Stepper {
 impl Stepper {
     pub fn new(method: Method, max_step: f64, tol: f64) -> Self {
         Stepper { method, max_step, tol, h_adapt: 0.0 }
+    }
+
+    /// The stepper a plant's `integrator` and `max_internal_step` parameters select; the adaptive
+    /// tolerance comes from `fmi2SetupExperiment` (default 1e-8).
+    pub fn for_plant(integrator: i32, max_internal_step: f64, exp: &Experiment) -> Result<Self, String> {
+        Ok(Stepper::new(Method::from_param("integrator", integrator)?, max_internal_step, exp.tolerance_or_default()))
+    }
+
+    /// Advances a plant's state over one communication step [t, t + h] with the inputs held. The step
+    /// is cut into pieces at the `breakpoints` inside it (events such as a fault onset); `rhs(start,
+    /// len)` gives the right-hand side valid on a piece; after every internal step the state must be
+    /// finite and `after_step(x, t)` may project it (e.g. renormalise a quaternion).
+    pub fn advance<const N: usize, F>(
+        &mut self,
+        t: f64,
+        h: f64,
+        breakpoints: &[f64],
+        x: &mut SVector<f64, N>,
+        mut rhs: impl FnMut(f64, f64) -> F,
+        mut after_step: impl FnMut(&mut SVector<f64, N>, f64) -> Result<(), String>,
+    ) -> Result<(), String>
+    where
+        F: FnMut(f64, &SVector<f64, N>) -> SVector<f64, N>,
+    {
+        for (ts, len) in pieces(t, h, breakpoints) {
+            let mut f = rhs(ts, len);
+            self.piece(&mut f, ts, len, x, |xx, tt| {
+                if !xx.iter().all(|c| c.is_finite()) {
+                    return Err(format!("state became non-finite at t = {tt}"));
+                }
+                after_step(xx, tt)
+            })?;
+        }
+        Ok(())
     }
 
     /// Integrates ẋ = f(t, x) over one piece [ts, ts + len] that contains no event. Fixed-step

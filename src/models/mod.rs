@@ -1,19 +1,26 @@
-//! One file per FMU model. Each declares its variables, its init/step code and its documentation;
-//! `crate::registry` lists them.
+//! The FMU models, one folder per family. Each family's `mod.rs` lists its FMUs with `fmus!` (that list
+//! is the family's part of `crate::registry`); what several models of a family share (port blocks,
+//! laws) lives in non-FMU modules beside them (e.g. `attitude/control/shared/`), general math in
+//! `crate::math`.
+//!
+//! Value references (the same parameter has the same value reference across a family):
+//!
+//! | range   | what |
+//! |---------|------|
+//! | 0–99    | ports: inputs and outputs (diagnostic outputs from 30 up) |
+//! | 100–199 | parameters (Integer options from 120 up in controllers, 140 up in plants) |
+//! | 200–299 | calculated parameters |
+//!
+//! Family-wide assignments:
+//! - attitude controllers: ports 0–13 in (`q` 0–3, `w` 4–6, `q_ref` 7–10, `w_ref` 11–13), 20–22 out
+//!   (`torque_cmd`); reserved 14–19 for further common inputs (e.g. wheel momentum); nominal inertia
+//!   `inertia_xx/yy/zz` 100–102; `wn` 103, `zeta` 104; `error_law` 121, `defuzz` 122; fuzzy input
+//!   scales `e_scale` 115, `edot_scale` 116, `sigma` 117, `mf_half_width` 118; MRAC block
+//!   (`shared::mrac::MracVariables`) outputs 30–44, parameters 100–110 and 120, calculated 200–205.
+//! - attitude plant: `inertia_xx/yy/zz` 100–102 as in the controllers; `integrator` 140,
+//!   `max_internal_step` 130.
+//! - plants of every family: `integrator` is an Integer with codes 0 RK4, 1 Euler, 2 Dormand–Prince.
 
-pub mod adaptive_fuzzy_controller;
-pub mod attitude_command;
-pub mod attitude_controller;
-pub mod attitude_metrics;
-pub mod attitude_plant;
-pub mod fopid_controller;
-pub mod fuzzy_pd_controller;
-pub mod lqr_controller;
-pub mod mrac_controller;
-pub mod pd_controller;
-pub mod pid_controller;
-pub mod pole_placement_controller;
-pub mod predictive_pid_controller;
-pub mod relative_orbit_plant;
-pub mod relative_position_command;
-pub mod single_axis_plant;
+pub mod attitude;
+pub mod formation;
+pub mod single_axis;

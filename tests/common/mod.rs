@@ -5,7 +5,7 @@
 use std::ffi::{c_char, c_int, c_void, CStr, CString};
 use std::sync::Mutex;
 
-use spacecraft_fmus::description::guid;
+use spacecraft_fmus::model::guid::guid;
 use spacecraft_fmus::fmi::abi::*;
 use spacecraft_fmus::fmi::{CallbackFunctions, LoggerFn};
 use spacecraft_fmus::registry;

@@ -1,0 +1,265 @@
+//! `declare_variables!`: the one declaration of a model's variables, and the const helpers it uses.
+//!
+//! ```ignore
+//! declare_variables! {
+//!     /// Variables of a controller.
+//!     pub struct MyControllerVars {
+//!         ports: AttitudeControllerPorts;          // a shared port block, embedded by name (optional)
+//!         // vr  field    kind = start,              causality, unit,   description [, bound]
+//!         103 => wn: Real = 1.0,                     Parameter, "rad/s", "Natural frequency", Positive;
+//!         105 => kp: Vec3 = [1000.0, 500.0, 700.0],  Parameter, "N.m/rad", "Proportional gain";
+//!         120 => mode: Integer = 0,                  Parameter, "", "0 = a, 1 = b", Choice(&[0, 1]);
+//!     }
+//! }
+//! ```
+//!
+//! Kinds: `Real` (f64), `Integer` (i32), `Boolean` (bool), `Vec3` (`nalgebra::Vector3`, FMI names
+//! `<field>_x/_y/_z` at vr, vr+1, vr+2), `Diag3` (a Vector3 named `<field>_xx/_yy/_zz`, for inertia
+//! diagonals) and `Quat` (`nalgebra::Quaternion`, names `<field>_w/_x/_y/_z` at vr … vr+3, scalar first).
+//! Variability follows from causality and kind ([`Variability::derived`](super::Variability::derived)).
+//! Bounds ([`Bound`](super::Bound)) are checked before the model initializes and written as min/max.
+//! A duplicated value reference or name anywhere in the block (embedded blocks included) is a compile
+//! error.
+
+use super::VarDecl;
+
+/// Sum of the lengths of slices (array length of their concatenation).
+pub const fn total_len<T>(parts: &[&[T]]) -> usize {
+    let mut n = 0;
+    let mut i = 0;
+    while i < parts.len() {
+        n += parts[i].len();
+        i += 1;
+    }
+    n
+}
+
+/// Concatenation of slices at compile time; `filler` only initialises the array.
+pub const fn concat<T: Copy, const N: usize>(parts: &[&[T]], filler: T) -> [T; N] {
+    let mut out = [filler; N];
+    let mut k = 0;
+    let mut i = 0;
+    while i < parts.len() {
+        let mut j = 0;
+        while j < parts[i].len() {
+            out[k] = parts[i][j];
+            k += 1;
+            j += 1;
+        }
+        i += 1;
+    }
+    assert!(k == N, "concatenation length mismatch");
+    out
+}
+
+pub const fn no_duplicate_vrs(d: &[VarDecl]) -> bool {
+    let mut i = 0;
+    while i < d.len() {
+        let mut j = i + 1;
+        while j < d.len() {
+            if d[i].vr == d[j].vr {
+                return false;
+            }
+            j += 1;
+        }
+        i += 1;
+    }
+    true
+}
+
+const fn same_str(a: &str, b: &str) -> bool {
+    let (a, b) = (a.as_bytes(), b.as_bytes());
+    if a.len() != b.len() {
+        return false;
+    }
+    let mut i = 0;
+    while i < a.len() {
+        if a[i] != b[i] {
+            return false;
+        }
+        i += 1;
+    }
+    true
+}
+
+pub const fn no_duplicate_names(d: &[VarDecl]) -> bool {
+    let mut i = 0;
+    while i < d.len() {
+        let mut j = i + 1;
+        while j < d.len() {
+            if same_str(d[i].name, d[j].name) {
+                return false;
+            }
+            j += 1;
+        }
+        i += 1;
+    }
+    true
+}
+
+#[macro_export]
+macro_rules! declare_variables {
+    (
+        $(#[$meta:meta])*
+        $vis:vis struct $Name:ident {
+            $( $block:ident : $Block:ty ; )*
+            $( $vr:literal => $field:ident : $kind:ident = $start:expr, $caus:ident, $unit:literal, $desc:literal
+               $(, $bound:ident $( ( $($barg:expr),* ) )? )? ; )*
+        }
+    ) => {
+        $(#[$meta])*
+        #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+        $vis struct $Name {
+            $( pub $block: $Block, )*
+            $( #[doc = $desc] pub $field: $crate::declare_variables!(@type $kind), )*
+        }
+
+        impl Default for $Name {
+            fn default() -> Self {
+                Self {
+                    $( $block: Default::default(), )*
+                    $( $field: $crate::declare_variables!(@default $kind $start), )*
+                }
+            }
+        }
+
+        impl $Name {
+            const PARTS: &'static [&'static [$crate::model::VarDecl]] = &[
+                $( <$Block as $crate::model::Variables>::DECLS, )*
+                $( &$crate::declare_variables!(@decls $kind $vr, $field, $start, $caus, $unit, $desc,
+                       $crate::declare_variables!(@bound $( $bound $( ( $($barg),* ) )? )? )), )*
+            ];
+            const ALL_DECLS: [$crate::model::VarDecl; $crate::model::total_len($Name::PARTS)] =
+                $crate::model::concat($Name::PARTS, $crate::model::VarDecl::PLACEHOLDER);
+        }
+
+        const _: () = assert!($crate::model::no_duplicate_vrs(&$Name::ALL_DECLS), concat!("duplicate value reference in ", stringify!($Name)));
+        const _: () = assert!($crate::model::no_duplicate_names(&$Name::ALL_DECLS), concat!("duplicate variable name in ", stringify!($Name)));
+
+        impl $crate::model::Variables for $Name {
+            const DECLS: &'static [$crate::model::VarDecl] = &$Name::ALL_DECLS;
+
+            fn slot(&mut self, index: usize) -> Option<$crate::model::SlotMut<'_>> {
+                const PARTS: &[&[$crate::model::SlotFn<$Name>]] = &[ $( &$crate::declare_variables!(@slots $kind $field), )* ];
+                const SLOTS: [$crate::model::SlotFn<$Name>; $crate::model::total_len(PARTS)] = $crate::model::concat(PARTS, |_| unreachable!());
+                #[allow(unused_mut)]
+                let mut i = index;
+                $(
+                    let n = <$Block as $crate::model::Variables>::DECLS.len();
+                    if i < n {
+                        return $crate::model::Variables::slot(&mut self.$block, i);
+                    }
+                    i -= n;
+                )*
+                SLOTS.get(i).map(|f| f(self))
+            }
+
+            fn value(&self, index: usize) -> Option<$crate::model::Value> {
+                const PARTS: &[&[$crate::model::ValueFn<$Name>]] = &[ $( &$crate::declare_variables!(@values $kind $field), )* ];
+                const VALUES: [$crate::model::ValueFn<$Name>; $crate::model::total_len(PARTS)] = $crate::model::concat(PARTS, |_| unreachable!());
+                #[allow(unused_mut)]
+                let mut i = index;
+                $(
+                    let n = <$Block as $crate::model::Variables>::DECLS.len();
+                    if i < n {
+                        return $crate::model::Variables::value(&self.$block, i);
+                    }
+                    i -= n;
+                )*
+                VALUES.get(i).map(|f| f(self))
+            }
+        }
+    };
+
+    (@type Real) => { f64 };
+    (@type Integer) => { i32 };
+    (@type Boolean) => { bool };
+    (@type Vec3) => { nalgebra::Vector3<f64> };
+    (@type Diag3) => { nalgebra::Vector3<f64> };
+    (@type Quat) => { nalgebra::Quaternion<f64> };
+
+    (@default Real $s:expr) => { $s };
+    (@default Integer $s:expr) => { $s };
+    (@default Boolean $s:expr) => { $s };
+    (@default Vec3 $s:expr) => { nalgebra::Vector3::from($s) };
+    (@default Diag3 $s:expr) => { nalgebra::Vector3::from($s) };
+    (@default Quat $s:expr) => {{
+        let s: [f64; 4] = $s;
+        nalgebra::Quaternion::new(s[0], s[1], s[2], s[3])
+    }};
+
+    (@bound) => { $crate::model::Bound::Any };
+    (@bound $b:ident) => { $crate::model::Bound::$b };
+    (@bound $b:ident ( $($a:expr),* )) => { $crate::model::Bound::$b($($a),*) };
+
+    (@one $vr:expr, $name:expr, $kind:ident, $start:expr, $caus:ident, $unit:literal, $desc:expr, $bound:expr) => {
+        $crate::model::VarDecl {
+            vr: $vr,
+            name: $name,
+            kind: $crate::model::VarKind::$kind,
+            causality: $crate::model::Causality::$caus,
+            variability: $crate::model::Variability::derived($crate::model::Causality::$caus, $crate::model::VarKind::$kind),
+            unit: $unit,
+            description: $desc,
+            start: $crate::model::Start::$kind($start),
+            bound: $bound,
+        }
+    };
+    (@decls Real $vr:literal, $f:ident, $s:expr, $c:ident, $u:literal, $d:literal, $b:expr) => {
+        [$crate::declare_variables!(@one $vr, stringify!($f), Real, $s, $c, $u, $d, $b)]
+    };
+    (@decls Integer $vr:literal, $f:ident, $s:expr, $c:ident, $u:literal, $d:literal, $b:expr) => {
+        [$crate::declare_variables!(@one $vr, stringify!($f), Integer, $s, $c, $u, $d, $b)]
+    };
+    (@decls Boolean $vr:literal, $f:ident, $s:expr, $c:ident, $u:literal, $d:literal, $b:expr) => {
+        [$crate::declare_variables!(@one $vr, stringify!($f), Boolean, $s, $c, $u, $d, $b)]
+    };
+    (@decls Vec3 $vr:literal, $f:ident, $s:expr, $c:ident, $u:literal, $d:literal, $b:expr) => {[
+        $crate::declare_variables!(@one $vr, concat!(stringify!($f), "_x"), Real, $s[0], $c, $u, concat!($d, ", x"), $b),
+        $crate::declare_variables!(@one $vr + 1, concat!(stringify!($f), "_y"), Real, $s[1], $c, $u, concat!($d, ", y"), $b),
+        $crate::declare_variables!(@one $vr + 2, concat!(stringify!($f), "_z"), Real, $s[2], $c, $u, concat!($d, ", z"), $b),
+    ]};
+    (@decls Diag3 $vr:literal, $f:ident, $s:expr, $c:ident, $u:literal, $d:literal, $b:expr) => {[
+        $crate::declare_variables!(@one $vr, concat!(stringify!($f), "_xx"), Real, $s[0], $c, $u, concat!($d, ", xx"), $b),
+        $crate::declare_variables!(@one $vr + 1, concat!(stringify!($f), "_yy"), Real, $s[1], $c, $u, concat!($d, ", yy"), $b),
+        $crate::declare_variables!(@one $vr + 2, concat!(stringify!($f), "_zz"), Real, $s[2], $c, $u, concat!($d, ", zz"), $b),
+    ]};
+    (@decls Quat $vr:literal, $f:ident, $s:expr, $c:ident, $u:literal, $d:literal, $b:expr) => {[
+        $crate::declare_variables!(@one $vr, concat!(stringify!($f), "_w"), Real, $s[0], $c, $u, concat!($d, ", scalar part"), $b),
+        $crate::declare_variables!(@one $vr + 1, concat!(stringify!($f), "_x"), Real, $s[1], $c, $u, concat!($d, ", x component"), $b),
+        $crate::declare_variables!(@one $vr + 2, concat!(stringify!($f), "_y"), Real, $s[2], $c, $u, concat!($d, ", y component"), $b),
+        $crate::declare_variables!(@one $vr + 3, concat!(stringify!($f), "_z"), Real, $s[3], $c, $u, concat!($d, ", z component"), $b),
+    ]};
+
+    (@slots Real $f:ident) => { [|s| $crate::model::SlotMut::Real(&mut s.$f)] };
+    (@slots Integer $f:ident) => { [|s| $crate::model::SlotMut::Integer(&mut s.$f)] };
+    (@slots Boolean $f:ident) => { [|s| $crate::model::SlotMut::Boolean(&mut s.$f)] };
+    (@slots Vec3 $f:ident) => {[
+        |s| $crate::model::SlotMut::Real(&mut s.$f.x),
+        |s| $crate::model::SlotMut::Real(&mut s.$f.y),
+        |s| $crate::model::SlotMut::Real(&mut s.$f.z),
+    ]};
+    (@slots Diag3 $f:ident) => { $crate::declare_variables!(@slots Vec3 $f) };
+    (@slots Quat $f:ident) => {[
+        |s| $crate::model::SlotMut::Real(&mut s.$f.w),
+        |s| $crate::model::SlotMut::Real(&mut s.$f.i),
+        |s| $crate::model::SlotMut::Real(&mut s.$f.j),
+        |s| $crate::model::SlotMut::Real(&mut s.$f.k),
+    ]};
+
+    (@values Real $f:ident) => { [|s| $crate::model::Value::Real(s.$f)] };
+    (@values Integer $f:ident) => { [|s| $crate::model::Value::Integer(s.$f)] };
+    (@values Boolean $f:ident) => { [|s| $crate::model::Value::Boolean(s.$f)] };
+    (@values Vec3 $f:ident) => {[
+        |s| $crate::model::Value::Real(s.$f.x),
+        |s| $crate::model::Value::Real(s.$f.y),
+        |s| $crate::model::Value::Real(s.$f.z),
+    ]};
+    (@values Diag3 $f:ident) => { $crate::declare_variables!(@values Vec3 $f) };
+    (@values Quat $f:ident) => {[
+        |s| $crate::model::Value::Real(s.$f.w),
+        |s| $crate::model::Value::Real(s.$f.i),
+        |s| $crate::model::Value::Real(s.$f.j),
+        |s| $crate::model::Value::Real(s.$f.k),
+    ]};
+}

@@ -1,0 +1,42 @@
+//! Integer parameters that select an option: one helper turns the code into an enum, and the same
+//! list of codes is the parameter's declared [`Bound::Choice`](super::Bound::Choice).
+
+/// An option selected by an Integer parameter.
+pub trait ParamEnum: Sized + Copy {
+    /// The admissible codes, for the declaration: `Choice(Kinematics::CODES)`.
+    const CODES: &'static [i32];
+    fn from_code(code: i32) -> Option<Self>;
+
+    /// The option of a parameter value; the message names the parameter (normally unreachable,
+    /// because the declared bound has already refused unknown codes).
+    fn from_param(name: &str, code: i32) -> Result<Self, String> {
+        Self::from_code(code).ok_or_else(|| format!("parameter {name} = {code} is not one of {:?}", Self::CODES))
+    }
+}
+
+/// Declares an enum selected by an Integer parameter and its codes:
+///
+/// ```ignore
+/// param_enum! {
+///     /// Kinematics option.
+///     pub enum Kinematics { Quaternion = 0, Dcm = 1 }
+/// }
+/// ```
+#[macro_export]
+macro_rules! param_enum {
+    ($(#[$meta:meta])* $vis:vis enum $Name:ident { $( $(#[$vmeta:meta])* $variant:ident = $code:literal ),+ $(,)? }) => {
+        $(#[$meta])*
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+        $vis enum $Name { $( $(#[$vmeta])* $variant ),+ }
+
+        impl $crate::model::ParamEnum for $Name {
+            const CODES: &'static [i32] = &[$($code),+];
+            fn from_code(code: i32) -> Option<Self> {
+                match code {
+                    $( $code => Some($Name::$variant), )+
+                    _ => None,
+                }
+            }
+        }
+    };
+}

@@ -1,0 +1,16 @@
+//! Three-axis attitude controllers. Every controller embeds the common port block
+//! (`shared::AttitudeControllerPorts`: `q_*`, `w_*`, `q_ref_*`, `w_ref_*` → `torque_cmd_*`), so they
+//! swap as black boxes; what several controllers share lives in `shared/` (not FMUs).
+//!
+//! A new controller: one file here, and one line in the list below.
+
+pub mod shared;
+
+crate::fmus! {
+    pd_controller::PdController,
+    lqr_controller::LqrController,
+    pole_placement_controller::PolePlacementController,
+    mrac_controller::MracController,
+    fuzzy_pd_controller::FuzzyPdController,
+    adaptive_fuzzy_controller::AdaptiveFuzzyController,
+}

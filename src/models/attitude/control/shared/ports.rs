@@ -1,0 +1,28 @@
+//! The port block every three-axis attitude controller embeds (`ports: AttitudeControllerPorts;`), so
+//! controllers swap as black boxes on `AttitudePlant` and `AttitudeCommand`.
+
+use crate::declare_variables;
+
+declare_variables! {
+    /// Common controller ports: measured and commanded attitude in, commanded torque out
+    /// (value references 0–13 inputs, 20–22 outputs).
+    pub struct AttitudeControllerPorts {
+        0 => q: Quat = [1.0, 0.0, 0.0, 0.0], Input, "", "Measured attitude quaternion of B relative to R";
+        4 => w: Vec3 = [0.0; 3], Input, "rad/s", "Measured body rate";
+        7 => q_ref: Quat = [1.0, 0.0, 0.0, 0.0], Input, "", "Commanded attitude quaternion";
+        11 => w_ref: Vec3 = [0.0; 3], Input, "rad/s", "Commanded body rate";
+        20 => torque_cmd: Vec3 = [0.0; 3], Output, "N.m", "Commanded control torque, body axes";
+    }
+}
+
+/// Rejects a measured or commanded quaternion that is far from unit norm (wrong wiring, e.g. a
+/// quaternion port left unconnected at 0).
+pub fn check_unit_quaternions(p: &AttitudeControllerPorts) -> Result<(), String> {
+    for (name, q) in [("q", p.q), ("q_ref", p.q_ref)] {
+        let n = q.norm();
+        if (n - 1.0).abs() > 1e-3 {
+            return Err(format!("input quaternion {name} has norm {n}, expected 1 (is it connected?)"));
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,84 @@
+//! Actuators: ideal torque with saturation and faults (mode 0), or three reaction wheels with lag,
+//! torque and momentum limits plus magnetorquer momentum dumping (mode 1).
+
+use nalgebra::{Matrix3, Vector3};
+
+use super::environment::Segment;
+use super::kinematics::{v3, State, HW, TW};
+use super::{AttitudePlant, AttitudePlantVars};
+
+/// Actuator outputs at one instant.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Actuation {
+    /// τ_act = τ_rw + τ_mtq (mode 1) or the clamped command (mode 0).
+    pub torque: Vector3<f64>,
+    /// Wheel torque on the body τ_rw; ḣ_w = −τ_rw.
+    pub wheel: Vector3<f64>,
+    /// dτ_w/dt of the wheel lag.
+    pub lag_rate: Vector3<f64>,
+    pub dipole: Vector3<f64>,
+}
+
+fn clamp3(v: Vector3<f64>, l: Vector3<f64>) -> Vector3<f64> {
+    Vector3::new(v.x.clamp(-l.x, l.x), v.y.clamp(-l.y, l.y), v.z.clamp(-l.z, l.z))
+}
+
+/// Command after the stuck/bias faults (project choice: both act on the command entering the
+/// actuator, so the torque and momentum limits still hold).
+fn faulty_cmd(v: &AttitudePlantVars, faulted: bool) -> Vector3<f64> {
+    let c = v.torque_cmd;
+    if !faulted {
+        return c;
+    }
+    let stuck = v.stuck();
+    Vector3::from_fn(|i, _| if stuck[i] { v.fault_stuck_value[i] } else { c[i] + v.fault_bias[i] })
+}
+
+impl AttitudePlant {
+    pub(super) fn wheels(v: &AttitudePlantVars) -> bool {
+        v.actuator_mode == 1
+    }
+
+    pub(super) fn mtq(v: &AttitudePlantVars) -> bool {
+        Self::wheels(v) && v.mtq_enable == 1
+    }
+
+    /// Actuators for state x at time t.
+    pub(super) fn actuate(&self, v: &AttitudePlantVars, t: f64, x: &State, a: &Matrix3<f64>, seg: &Segment) -> Actuation {
+        let u = faulty_cmd(v, seg.faulted);
+        let eff = if seg.faulted { v.effectiveness } else { Vector3::repeat(1.0) };
+        if !Self::wheels(v) {
+            return Actuation { torque: clamp3(u, v.u_max.component_mul(&eff)), ..Default::default() };
+        }
+        let hw = v3(x, HW);
+        // magnetorquers: momentum dumping m = k (h_w × B)/|B|², uniformly scaled into ±m_max
+        let mut dipole = Vector3::zeros();
+        let mut tau_mtq = Vector3::zeros();
+        if Self::mtq(v) {
+            let b = self.field_body(t, a);
+            let b2 = b.norm_squared();
+            if b2.sqrt() >= 1e-12 {
+                let raw = hw.cross(&b) * (v.mtq_k_dump / b2);
+                let peak = raw.amax();
+                dipole = if peak > self.d.dipole_max { raw * (self.d.dipole_max / peak) } else { raw };
+                tau_mtq = dipole.cross(&b);
+            }
+        }
+        // wheel torque command with the known magnetic torque fed forward, first-order lag
+        let rw_cmd = (u - tau_mtq) * v.wheel_gain;
+        let (tau_w, lag_rate) = if v.wheel_time_constant > 0.0 {
+            let tw = v3(x, TW);
+            (tw, (rw_cmd - tw) / v.wheel_time_constant)
+        } else {
+            (rw_cmd, Vector3::zeros())
+        };
+        let mut tau_rw = clamp3(tau_w, eff * self.d.wheel_torque_max);
+        // momentum (speed) limit: no torque that would grow |h_w| beyond h_max (ḣ_w = −τ_rw)
+        for i in 0..3 {
+            if hw[i].abs() >= self.d.wheel_momentum_max && -tau_rw[i] * hw[i] > 0.0 {
+                tau_rw[i] = 0.0;
+            }
+        }
+        Actuation { torque: tau_rw + tau_mtq, wheel: tau_rw, lag_rate, dipole }
+    }
+}

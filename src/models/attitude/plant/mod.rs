@@ -1,0 +1,179 @@
+//! `AttitudePlant`: three-axis rigid body (gyrostat) with full inertia, selectable kinematics
+//! (quaternion, DCM, paper 000's Euler-angle rates, linear small-angle model), ideal torque actuators
+//! or reaction wheels with magnetorquers, actuator faults, disturbance generator and gravity
+//! gradient on a circular orbit.
+//!
+//! Files: `variables.rs` (the declaration), `kinematics.rs`, `actuators.rs`, `environment.rs`
+//! (disturbances, gravity gradient, field, step events), `docs.html` (equations for the FMU's
+//! documentation), `tests.rs`.
+
+mod actuators;
+mod environment;
+mod kinematics;
+#[cfg(test)]
+mod tests;
+mod variables;
+
+use nalgebra::Matrix3;
+use serde::{Deserialize, Serialize};
+
+pub use kinematics::Kinematics;
+pub use variables::AttitudePlantVars;
+
+use self::environment::{breakpoints, segment_at, segment_of_piece, Segment};
+use self::kinematics::{attitude_rates, initial_attitude, post_step, v3, State, ATT, HW, TW, W};
+use crate::math::attitude::{euler321_from_dcm, euler321_from_quat, wxyz};
+use crate::math::environment::CircularOrbit;
+use crate::math::integrate::Stepper;
+use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult, ParamEnum};
+
+/// Parameters derived at initialization.
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize)]
+struct Derived {
+    orbit: CircularOrbit,
+    n2: f64,
+    wheel_torque_max: f64,
+    wheel_momentum_max: f64,
+    dipole_max: f64,
+}
+
+#[derive(Clone, Serialize, Deserialize)]
+pub struct AttitudePlant {
+    x: State,
+    inertia: Matrix3<f64>,
+    inertia_inv: Matrix3<f64>,
+    /// Integrator with its adaptive step proposal.
+    stepper: Stepper,
+    kin: Kinematics,
+    d: Derived,
+    /// Quaternion output of the DCM mode: Shepperd's quaternion of A with the sign continuous with the
+    /// previous output (updated after every internal step).
+    q_dcm: [f64; 4],
+}
+
+impl AttitudePlant {
+    /// ẋ with the inputs held.
+    fn derivative(&self, v: &AttitudePlantVars, t: f64, x: &State, seg: &Segment) -> State {
+        let w = v3(x, W);
+        let needs_a = v.gg_enable == 1 || Self::mtq(v);
+        let a = if needs_a { self.attitude(x) } else { Matrix3::identity() };
+        let act = self.actuate(v, t, x, &a, seg);
+        let tau = act.torque + self.external(v, t, &a, seg);
+        let mut d = State::zeros();
+        if Self::wheels(v) {
+            d.fixed_rows_mut::<3>(HW).copy_from(&(-act.wheel));
+            d.fixed_rows_mut::<3>(TW).copy_from(&act.lag_rate);
+        }
+        attitude_rates(self.kin, x, &w, &mut d);
+        if self.kin == Kinematics::LinearSmallAngle {
+            // per-axis double integrator with the diagonal of I_true (paper 000 Eq. 1)
+            d.fixed_rows_mut::<3>(W).copy_from(&tau.component_div(&self.inertia.diagonal()));
+            return d;
+        }
+        // gyrostat: I ω̇ = τ_act + τ_ext − ω × (I ω + h_w)
+        let hw = v3(x, HW);
+        let wdot = self.inertia_inv * (tau - w.cross(&(self.inertia * w + hw)));
+        d.fixed_rows_mut::<3>(W).copy_from(&wdot);
+        d
+    }
+}
+
+impl Model for AttitudePlant {
+    type Vars = AttitudePlantVars;
+    const INFO: ModelInfo = ModelInfo {
+        name: "AttitudePlant",
+        description: "Three-axis rigid spacecraft (gyrostat) with full inertia, selectable kinematics, saturating fault-prone torque actuators or reaction wheels with magnetorquers, disturbance generator and gravity gradient",
+        source: "rigid-body attitude dynamics and kinematics of papers 000, 003 and 004; reaction-wheel lag of paper 002",
+        equations_html: include_str!("docs.html"),
+        feedthrough: Feedthrough::Some(&[
+            // per axis also in wheel mode: τ_applied,i = sat(K_w (u_i − τ_mtq,i)) + τ_mtq,i with τ_mtq from the state
+            ("torque_applied_x", &["torque_cmd_x"]),
+            ("torque_applied_y", &["torque_cmd_y"]),
+            ("torque_applied_z", &["torque_cmd_z"]),
+            ("torque_ext_x", &["torque_dist_x"]),
+            ("torque_ext_y", &["torque_dist_y"]),
+            ("torque_ext_z", &["torque_dist_z"]),
+        ]),
+        ..ModelInfo::DEFAULT
+    };
+
+    fn initialize(v: &mut AttitudePlantVars, exp: &Experiment) -> Result<Self, String> {
+        let stepper = Stepper::for_plant(v.integrator, v.max_internal_step, exp)?;
+        let kin = Kinematics::from_param("kinematics", v.kinematics)?;
+        let i = v.inertia;
+        let nominal = Matrix3::new(i.x, v.inertia_xy, v.inertia_xz, v.inertia_xy, i.y, v.inertia_yz, v.inertia_xz, v.inertia_yz, i.z);
+        let s = Matrix3::from_diagonal(&v.inertia_scale.map(f64::sqrt));
+        let inertia = s * nominal * s;
+        // Positive definite iff the Cholesky factorisation exists.
+        let chol = nalgebra::Cholesky::new(inertia).ok_or_else(|| format!("inertia matrix {:?} is not positive definite", inertia.as_slice()))?;
+        let orbit = CircularOrbit { mu: v.mu, radius: v.orbit_radius, inclination: v.orbit_inclination, arg_lat0: v.orbit_arg_lat0, dipole: v.earth_dipole };
+        let d = Derived {
+            orbit,
+            n2: v.mu / v.orbit_radius.powi(3),
+            wheel_torque_max: v.wheel_torque_coeff * v.wheel_max_current,
+            wheel_momentum_max: v.wheel_inertia * v.wheel_max_speed,
+            dipole_max: v.mtq_turns * v.mtq_coil_area * v.mtq_max_current,
+        };
+        let angles = (v.init_euler321_roll, v.init_euler321_pitch, v.init_euler321_yaw);
+        let mut x = State::zeros();
+        initial_attitude(kin, &mut x, angles)?;
+        x.fixed_rows_mut::<3>(W).copy_from(&v.init_w);
+        if Self::wheels(v) {
+            x.fixed_rows_mut::<3>(HW).copy_from(&v.init_h_wheel);
+        }
+        v.wheel_torque_max = d.wheel_torque_max;
+        v.wheel_momentum_max = d.wheel_momentum_max;
+        v.mtq_dipole_max = d.dipole_max;
+        v.orbit_rate = d.n2.sqrt();
+        let q0 = crate::math::attitude::quat_from_euler321(angles.0, angles.1, angles.2);
+        Ok(AttitudePlant { x, inertia, inertia_inv: chol.inverse(), stepper, kin, d, q_dcm: wxyz(&q0) })
+    }
+
+    fn outputs(&self, v: &mut AttitudePlantVars, t: f64) -> ModelResult {
+        let x = self.x;
+        let q = self.quaternion(&x);
+        let a = self.attitude(&x);
+        let w = v3(&x, W);
+        let hw = v3(&x, HW);
+        let [rl, pt, yw] = match self.kin {
+            Kinematics::Quaternion => euler321_from_quat(&q),
+            Kinematics::Dcm => euler321_from_dcm(&a),
+            Kinematics::Euler213Rates | Kinematics::LinearSmallAngle => [x[ATT], x[ATT + 1], x[ATT + 2]],
+        };
+        let seg = segment_at(v, t);
+        let act = self.actuate(v, t, &x, &a, &seg);
+        let ext = self.external(v, t, &a, &seg);
+        v.b_body = self.field_body(t, &a);
+        v.h_total_ref = a.transpose() * (self.inertia * w + hw);
+        v.wheel_speed = hw / v.wheel_inertia;
+        v.q = q;
+        v.w = w;
+        (v.roll, v.pitch, v.yaw) = (rl, pt, yw);
+        (v.roll_deg, v.pitch_deg, v.yaw_deg) = (rl.to_degrees(), pt.to_degrees(), yw.to_degrees());
+        v.torque_applied = act.torque;
+        v.torque_ext = ext;
+        v.h_wheel = hw;
+        v.dipole = act.dipole;
+        Ok(())
+    }
+
+    fn step(&mut self, v: &AttitudePlantVars, t: f64, h: f64) -> ModelResult {
+        let (kin, ortho) = (self.kin, v.dcm_orthonormalize == 1);
+        let (mut stepper, mut x, mut q_dcm) = (self.stepper, self.x, self.q_dcm);
+        let this = &*self;
+        // fault state and noise are constant over a piece: pieces are cut at the events
+        stepper.advance(
+            t,
+            h,
+            &breakpoints(v, t, h)?,
+            &mut x,
+            |ts, len| {
+                let seg = segment_of_piece(v, ts, len);
+                move |tt: f64, xx: &State| this.derivative(v, tt, xx, &seg)
+            },
+            |xx, tt| post_step(kin, ortho, &mut q_dcm, xx, tt),
+        )?;
+        (self.stepper, self.x, self.q_dcm) = (stepper, x, q_dcm);
+        Ok(())
+    }
+}

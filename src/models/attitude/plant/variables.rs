@@ -1,0 +1,96 @@
+//! The declared variables of `AttitudePlant` (ports 0–43, parameters 100–183, calculated 200–203).
+
+use super::kinematics::Kinematics;
+use crate::declare_variables;
+use crate::math::integrate::Method;
+use crate::model::{ParamEnum, SWITCH};
+
+declare_variables! {
+    pub struct AttitudePlantVars {
+        // inputs
+        0 => torque_cmd: Vec3 = [0.0; 3], Input, "N.m", "Commanded control torque, body axes";
+        3 => torque_dist: Vec3 = [0.0; 3], Input, "N.m", "External disturbance torque, body axes (added to the internal generator)";
+        // outputs
+        10 => q: Quat = [1.0, 0.0, 0.0, 0.0], Output, "", "Attitude quaternion of B relative to R";
+        14 => w: Vec3 = [0.0; 3], Output, "rad/s", "Body rate of B relative to R, body axes (kinematics 3: the angle rates)";
+        17 => roll: Real = 0.0, Output, "rad", "Roll angle of the 321 sequence (kinematics 2, 3: the state angle)";
+        18 => pitch: Real = 0.0, Output, "rad", "Pitch angle of the 321 sequence (kinematics 2, 3: the state angle)";
+        19 => yaw: Real = 0.0, Output, "rad", "Yaw angle of the 321 sequence (kinematics 2, 3: the state angle)";
+        20 => roll_deg: Real = 0.0, Output, "deg", "Roll angle in degrees";
+        21 => pitch_deg: Real = 0.0, Output, "deg", "Pitch angle in degrees";
+        22 => yaw_deg: Real = 0.0, Output, "deg", "Yaw angle in degrees";
+        23 => torque_applied: Vec3 = [0.0; 3], Output, "N.m", "Control torque acting on the body after the actuators (wheels + magnetorquers)";
+        26 => torque_ext: Vec3 = [0.0; 3], Output, "N.m", "Total external torque (input + generator + gravity gradient)";
+        29 => h_total_ref: Vec3 = [0.0; 3], Output, "N.m.s", "Total angular momentum A(q)^T (I w + h_w) in R";
+        32 => h_wheel: Vec3 = [0.0; 3], Output, "N.m.s", "Reaction-wheel momentum h_w, body axes (actuator_mode 1)";
+        35 => wheel_speed: Vec3 = [0.0; 3], Output, "rad/s", "Wheel spin relative to the body h_w/J_w";
+        38 => dipole: Vec3 = [0.0; 3], Output, "A.m2", "Magnetorquer dipole m, body axes";
+        41 => b_body: Vec3 = [0.0; 3], Output, "T", "Geomagnetic field in body axes";
+        // parameters: body
+        100 => inertia: Diag3 = [1000.0, 500.0, 700.0], Parameter, "kg.m2", "Inertia matrix diagonal entry (paper 000 default)", Positive;
+        103 => inertia_xy: Real = 0.0, Parameter, "kg.m2", "Inertia matrix entry xy (matrix entry, not product of inertia)";
+        104 => inertia_xz: Real = 0.0, Parameter, "kg.m2", "Inertia matrix entry xz";
+        105 => inertia_yz: Real = 0.0, Parameter, "kg.m2", "Inertia matrix entry yz";
+        106 => inertia_scale: Vec3 = [1.0; 3], Parameter, "", "Uncertainty factor s: I_true = S I S, S = diag(sqrt(s))", Positive;
+        110 => init_euler321_roll: Real = 0.0, Parameter, "rad", "Initial roll (321 sequence; kinematics 2, 3: initial state angle)";
+        111 => init_euler321_pitch: Real = 0.0, Parameter, "rad", "Initial pitch (321 sequence)";
+        112 => init_euler321_yaw: Real = 0.0, Parameter, "rad", "Initial yaw (321 sequence)";
+        113 => init_w: Vec3 = [0.0; 3], Parameter, "rad/s", "Initial body rate (kinematics 3: the angle rates)";
+        116 => init_h_wheel: Vec3 = [0.0; 3], Parameter, "N.m.s", "Initial wheel momentum (actuator_mode 1)";
+        // parameters: actuator mode 0 and faults
+        120 => u_max: Vec3 = [1e30; 3], Parameter, "N.m", "Actuator mode 0: torque limit (1e30 = no limit)", Limit;
+        123 => effectiveness: Vec3 = [1.0; 3], Parameter, "", "Effectiveness a in [0, 1] after fault_time: limit a u_max (mode 0) or a k_t i_max (mode 1) (paper 004)", Range(0.0, 1.0);
+        126 => fault_time: Real = 0.0, Parameter, "s", "Onset time of all actuator faults (effectiveness, bias, stuck)";
+        127 => fault_bias: Vec3 = [0.0; 3], Parameter, "N.m", "Bias fault: added to the torque command after fault_time (before the limits)";
+        130 => max_internal_step: Real = 0.01, Parameter, "s", "Internal step of RK4/Euler (integrator 2 ignores it: adaptive steps)", Positive;
+        131 => fault_stuck_value: Vec3 = [0.0; 3], Parameter, "N.m", "Stuck fault: the torque command is replaced by this value after fault_time where fault_stuck_* = 1";
+        // Integer parameters
+        140 => integrator: Integer = 0, Parameter, "", "Internal integrator: 0 = classical RK4, 1 = explicit Euler, 2 = adaptive Dormand-Prince 5(4) (tolerance from fmi2SetupExperiment, default 1e-8)", Choice(Method::CODES);
+        141 => kinematics: Integer = 0, Parameter, "", "Kinematics: 0 = quaternion, 1 = DCM, 2 = paper 000 Euler-angle rates (213 rates, angles output as 321), 3 = linear small-angle double integrator", Choice(Kinematics::CODES);
+        142 => actuator_mode: Integer = 0, Parameter, "", "Actuators: 0 = ideal torque with saturation and fault, 1 = three reaction wheels (+ magnetorquers if mtq_enable = 1)", Choice(SWITCH);
+        143 => dcm_orthonormalize: Integer = 0, Parameter, "", "Kinematics 1 only: 1 = re-orthonormalise the DCM after every internal step, 0 = never", Choice(SWITCH);
+        144 => mtq_enable: Integer = 0, Parameter, "", "Actuator mode 1: 1 = magnetorquers dump wheel momentum, 0 = off", Choice(SWITCH);
+        145 => gg_enable: Integer = 0, Parameter, "", "1 = gravity-gradient torque of the circular orbit, 0 = off", Choice(SWITCH);
+        146 => dist_noise_seed: Integer = 1, Parameter, "", "Seed of the counter-based white-noise generator";
+        147 => fault_stuck_x: Integer = 0, Parameter, "", "1 = actuator x stuck at fault_stuck_value_x after fault_time", Choice(SWITCH);
+        148 => fault_stuck_y: Integer = 0, Parameter, "", "1 = actuator y stuck after fault_time", Choice(SWITCH);
+        149 => fault_stuck_z: Integer = 0, Parameter, "", "1 = actuator z stuck after fault_time", Choice(SWITCH);
+        // reaction wheels (paper 003 values, all project choice)
+        150 => wheel_time_constant: Real = 0.0, Parameter, "s", "Wheel torque lag T_w (0 = no lag) (paper 002 Eq. 7 form)", NonNegative;
+        151 => wheel_gain: Real = 1.0, Parameter, "", "Wheel gain K_w";
+        152 => wheel_inertia: Real = 1.2e-3, Parameter, "kg.m2", "Wheel spin inertia J_w", Positive;
+        153 => wheel_torque_coeff: Real = 0.05, Parameter, "N.m/A", "Wheel motor torque coefficient k_t", NonNegative;
+        154 => wheel_max_current: Real = 1.0, Parameter, "A", "Wheel motor current limit i_max (torque limit k_t i_max)", NonNegative;
+        155 => wheel_max_speed: Real = 420.0, Parameter, "rad/s", "Wheel speed limit Omega_max (momentum limit J_w Omega_max)", Limit;
+        // magnetorquers (project choice)
+        156 => mtq_turns: Real = 500.0, Parameter, "", "Magnetorquer coil turns N", NonNegative;
+        157 => mtq_coil_area: Real = 0.01, Parameter, "m2", "Magnetorquer coil area A", NonNegative;
+        158 => mtq_max_current: Real = 0.2, Parameter, "A", "Magnetorquer current limit (dipole limit N A i)", NonNegative;
+        159 => mtq_k_dump: Real = 0.005, Parameter, "1/s", "Momentum-dumping gain k_dump (> 0 dumps): m = k_dump (h_w x B)/|B|^2", NonNegative;
+        // environment (project choice)
+        160 => mu: Real = 3.986004418e14, Parameter, "m3/s2", "Earth gravitational parameter", Positive;
+        161 => orbit_radius: Real = 7078137.0, Parameter, "m", "Circular orbit radius (700 km altitude)", Positive;
+        162 => orbit_inclination: Real = 1.7104226669544429, Parameter, "rad", "Orbit inclination (98 deg)";
+        163 => orbit_arg_lat0: Real = 0.0, Parameter, "rad", "Argument of latitude at t = 0";
+        164 => earth_dipole: Real = 7.96e15, Parameter, "T.m3", "Earth dipole strength M_E";
+        // disturbance generator
+        170 => dist_const: Vec3 = [0.0; 3], Parameter, "N.m", "Constant disturbance torque c";
+        173 => dist_sin_amp: Vec3 = [0.0; 3], Parameter, "N.m", "Sinusoidal disturbance amplitude A";
+        176 => dist_sin_freq: Real = 0.0, Parameter, "rad/s", "Sinusoidal disturbance frequency Omega_d";
+        177 => dist_sin_phase: Vec3 = [0.0; 3], Parameter, "rad", "Sinusoidal disturbance phase phi";
+        180 => dist_noise_std: Vec3 = [0.0; 3], Parameter, "N.m", "White-noise standard deviation sigma (zero-order held)", NonNegative;
+        183 => dist_noise_hold: Real = 0.1, Parameter, "s", "Hold interval T_n of the noise (PSD about sigma^2 T_n)", Positive;
+        // calculated parameters
+        200 => wheel_torque_max: Real = 0.05, CalculatedParameter, "N.m", "Wheel torque limit k_t i_max before faults";
+        201 => wheel_momentum_max: Real = 0.504, CalculatedParameter, "N.m.s", "Wheel momentum limit J_w Omega_max";
+        202 => mtq_dipole_max: Real = 1.0, CalculatedParameter, "A.m2", "Magnetorquer dipole limit N A i_max";
+        203 => orbit_rate: Real = 0.0, CalculatedParameter, "rad/s", "Orbital rate n = sqrt(mu / r^3)";
+    }
+}
+
+impl AttitudePlantVars {
+    /// The stuck flags as booleans.
+    pub fn stuck(&self) -> [bool; 3] {
+        [self.fault_stuck_x == 1, self.fault_stuck_y == 1, self.fault_stuck_z == 1]
+    }
+}
