@@ -64,7 +64,7 @@ def main(argv=None) -> int:
         check = run_case(c, gains, sc)
         data["controllers"][c] = {"gains": gains, "cost": r["cost"], "mae_deg": check["mae_deg"],
                                   "late_max_deg": check["late_max_deg"], "seed": seed,
-                                  "iterations": r["iterations"], "evaluations": r["evaluations"],
+                                  "particles": a.particles, "max_iterations": a.iters, "iterations": r["iterations"], "evaluations": r["evaluations"],
                                   "seconds": round(r["seconds"], 1), "workers": a.workers}
         print(f"{c:6s} cost {r['cost']:.6f}  MAE {check['mae_deg']:.6f} deg  "
               + "  ".join(f"{k}={v:.6g}" for k, v in gains.items())
