@@ -178,7 +178,7 @@ impl GlConvolution {
         let mut k = 0;
         loop {
             let l = NEAR << k;
-            if n1 % l != 0 || (self.memory > 0 && l >= self.memory) {
+            if !n1.is_multiple_of(l) || (self.memory > 0 && l >= self.memory) {
                 break;
             }
             self.add_block_product(k, l, n1);
