@@ -1,10 +1,12 @@
 //! Shared math used by the models: attitude representations and conversions, integrators, the
 //! Riccati equation (LQR), pole placement, fuzzy inference, relative orbital motion, predictive-control
-//! gains, counter-based random numbers and the orbit environment.
+//! gains, counter-based random numbers, the orbit environment and Grünwald–Letnikov fractional calculus
+//! with the PID / PI^λD^μ laws.
 //! Each module carries its own unit tests against closed-form results.
 
 pub mod attitude;
 pub mod environment;
+pub mod fractional;
 pub mod fuzzy;
 pub mod integrate;
 pub mod pole_placement;

@@ -1,0 +1,203 @@
+"""Paper 002: PidController / FopidController FMUs against independent references (scipy binomials,
+numpy difference equations), the PSO driver on a problem with a known minimum, bad parameters and the
+FMU state round trip."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from fmpy.validation import validate_fmu
+
+from scfmu.master import CoSimulation, Fmu, fmu_path
+from scfmu.paper002 import Scenario, gl_weights, pso_minimize, reference_loop, run_case
+
+ROOT = Path(__file__).resolve().parents[1]
+H = 0.001
+
+
+def drive(model: str, params: dict, theta: np.ndarray, theta_ref: float = 0.0) -> np.ndarray:
+    """Open loop: feed θ_n, read u_n, doStep (Δ = step) for every sample."""
+    f = Fmu(model, params)
+    try:
+        h = params.get("step", H)
+        u = np.empty(len(theta))
+        for n, th in enumerate(theta):
+            f.set_reals(["theta", "theta_ref"], [th, theta_ref])
+            u[n] = f.get("u")
+            f.do_step(n * h, h)
+        return u
+    finally:
+        f.close()
+
+
+@pytest.mark.parametrize("model", ["PidController", "FopidController"])
+def test_fmu_validates(model):
+    assert validate_fmu(str(fmu_path(model))) == []
+
+
+@pytest.mark.parametrize("alpha", [0.35, 1.0, 1.7, 2.0, 0.0])
+def test_gl_weights_match_scipy_binomials(alpha):
+    """Impulse e_0 = 1, e_k = 0 through K_D D^μ only: u_n = h^{-μ} w_n = h^{-μ} (-1)^n binom(μ, n)."""
+    n = 300
+    theta = np.zeros(n)
+    theta[0] = -1.0  # e = θ_ref − θ = 1 at n = 0
+    u = drive("FopidController", {"kp": 0.0, "ki": 0.0, "kd": 1.0, "mu": alpha}, theta)
+    w = gl_weights(alpha, n) * H ** (-alpha)
+    err = np.max(np.abs(u - w) / np.maximum(np.abs(w), 1e-300 + np.abs(w).max() * 1e-15))
+    print(f"mu = {alpha}: max relative |u_n − h^-mu (−1)^n binom(mu, n)| = {err:.2e}")
+    assert err < 1e-12
+
+
+def test_fopid_unit_orders_equal_pid_through_fmus():
+    rng = np.random.default_rng(5)
+    theta = np.cumsum(rng.normal(0, 0.01, 20_000))
+    for extra in ({}, {"history_before_start": 1}, {"gl_memory": 500}):
+        common = {"kp": 2.0, "ki": 0.7, "kd": 8.0, **extra}
+        a = drive("PidController", common, theta, 0.5)
+        b = drive("FopidController", {**common, "lambda": 1.0, "mu": 1.0}, theta, 0.5)
+        d = np.max(np.abs(a - b))
+        print(f"{extra}: max |u_PID − u_FOPID(1, 1)| over 20000 steps = {d:.2e}")
+        assert d <= 1e-12
+
+
+@pytest.mark.parametrize("controller,gains,extra", [
+    ("PID", {"kp": 2.0, "ki": 0.1, "kd": 8.0}, {}),
+    ("PID", {"kp": 3.0, "ki": 0.5, "kd": 5.0}, {"history_before_start": 1}),
+    ("FOPID", {"kp": 2.0, "ki": 0.4, "kd": 6.0, "lambda": 0.8, "mu": 0.9}, {}),
+    ("FOPID", {"kp": 2.0, "ki": 0.4, "kd": 6.0, "lambda": 1.3, "mu": 0.6}, {"gl_memory": 700, "history_before_start": 1}),
+])
+def test_closed_loop_matches_numpy_difference_equations(controller, gains, extra):
+    """Linear, unsaturated plant (T_sat = 1e30, M_d = 0): the FMU loop equals the numpy recursion
+    (Euler plant, direct GL sums with scipy binomial weights)."""
+    sc = Scenario(t_end=4.0, theta_ref_deg=10.0, plant={"torque_limit": 1e30, "md_amp": 0.0, "md_const": 0.0}, **extra)
+    a = run_case(controller, gains, sc, record=True)
+    b = reference_loop(controller, gains, sc)
+    d_th = np.max(np.abs(a["theta"] - b["theta"]))
+    d_u = np.max(np.abs(a["u"] - b["u"]) / (1.0 + np.abs(b["u"])))
+    print(f"{controller} {extra}: max |θ_FMU − θ_numpy| = {d_th:.2e} rad, max rel |Δu| = {d_u:.2e}")
+    assert np.all(np.isfinite(a["theta"])) and np.ptp(a["theta"]) > 0.05
+    assert d_th < 1e-11 and d_u < 1e-10
+
+
+@pytest.mark.parametrize("controller,model,gains", [
+    ("FOPID", "FopidController", {"kp": 5.0, "ki": 1.0, "kd": 10.0, "lambda": 0.9, "mu": 1.1}),
+    ("PID", "PidController", {"kp": 5.0, "ki": 1.0, "kd": 10.0}),
+])
+def test_project_master_gives_the_same_loop(controller, model, gains):
+    """scfmu.master.CoSimulation (wired by port name, theta_ref set once) equals the direct loop."""
+    sc = Scenario(t_end=2.0)
+    ctrl = Fmu(model, {**gains, "step": H})
+    plant = Fmu("SingleAxisPlant", {"integrator": 1, "max_internal_step": H})
+    ctrl.set("theta_ref", math.radians(sc.theta_ref_deg))
+    sim = CoSimulation([ctrl, plant], unconnected={"theta_ref"})
+    try:
+        out = sim.run(sc.t_end, H, {"theta": (plant, "theta"), "u": (ctrl, "u")})
+    finally:
+        sim.close()
+    ref = run_case(controller, gains, sc, record=True)
+    assert np.array_equal(out["theta"], ref["theta"]) and np.array_equal(out["u"], ref["u"])
+
+
+def test_nominal_loop_with_saturation_and_disturbance_matches_numpy():
+    sc = Scenario(t_end=3.0)
+    a = run_case("FOPID", {"kp": 5.0, "ki": 1.0, "kd": 10.0, "lambda": 0.9, "mu": 1.1}, sc, record=True)
+    b = reference_loop("FOPID", {"kp": 5.0, "ki": 1.0, "kd": 10.0, "lambda": 0.9, "mu": 1.1}, sc)
+    assert np.max(np.abs(a["applied_torque"])) == 1.0  # saturation active
+    assert np.max(np.abs(a["theta"] - b["theta"])) < 1e-11
+
+
+def test_pso_finds_known_minimum_and_is_reproducible():
+    """Shifted, scaled quadratic plus a Rastrigin-like ripple, minimum 0 at x* inside the box."""
+    x_star = np.array([3.0, 12.5, 0.4, 1.6])
+    r1 = pso_minimize(_test_cost, [0, 0, 0, 0], [20, 20, 2, 2], n_particles=30, max_iter=300, seed=7, progress=False)
+    r2 = pso_minimize(_test_cost, [0, 0, 0, 0], [20, 20, 2, 2], n_particles=30, max_iter=300, seed=7, workers=2,
+                      progress=False)
+    print(f"PSO: x = {np.round(r1['x'], 6)}, cost = {r1['cost']:.2e}, {r1['iterations']} iterations")
+    assert np.allclose(r1["x"], x_star, atol=1e-3) and r1["cost"] < 1e-5
+    assert r1["x"] == r2["x"] and r1["history"] == r2["history"]  # same seed, any worker count
+    assert r1["iterations"] < 300  # the stall rule stopped it
+
+
+def _test_cost(x):
+    x_star = np.array([3.0, 12.5, 0.4, 1.6])
+    z = (np.asarray(x) - x_star) / np.array([20, 20, 2, 2])
+    return float(np.sum(100 * z**2) + 0.1 * np.sum(1 - np.cos(40 * np.pi * z)))
+
+
+@pytest.mark.parametrize("model,params,name", [
+    ("FopidController", {"lambda": 2.5}, "lambda"),
+    ("FopidController", {"mu": -0.1}, "mu"),
+    ("FopidController", {"gl_memory": -1}, "gl_memory"),
+    ("PidController", {"gl_memory": -5}, "gl_memory"),
+    ("PidController", {"step": 0.0}, "step"),
+    ("FopidController", {"history_before_start": 2}, "history_before_start"),
+    ("PidController", {"kd": math.nan}, "kd"),
+])
+def test_bad_parameters_are_fmi_errors_with_message(model, params, name):
+    f = Fmu(model, initialize=False)
+    try:
+        f.slave.setupExperiment(startTime=0.0)
+        f.slave.enterInitializationMode()
+        with pytest.raises(Exception):  # refused when set (non-finite) or at exitInitializationMode
+            for k, v in params.items():
+                f.set(k, v)
+            f.slave.exitInitializationMode()
+        assert any(name in m[2] for m in f.messages), f.messages
+    finally:
+        f.close()
+
+
+@pytest.mark.parametrize("model", ["PidController", "FopidController"])
+def test_step_other_than_sample_time_is_an_error(model):
+    f = Fmu(model, {"step": 0.001})
+    try:
+        f.do_step(0.0, 0.001)
+        with pytest.raises(Exception):
+            f.do_step(0.001, 0.002)
+        assert any("step" in m[2] for m in f.messages), f.messages
+    finally:
+        f.close()
+
+
+@pytest.mark.parametrize("model,extra", [("FopidController", {"lambda": 0.7, "mu": 1.3}), ("PidController", {})])
+def test_state_serialize_restore_continues_bit_identically(model, extra):
+    """Serialize after 3000 steps (history crosses several FFT block levels), continue 3000 steps; a
+    fresh instance deserialized from the bytes gives bit-identical outputs."""
+    params = {"kp": 2.0, "ki": 0.5, "kd": 4.0, **extra}
+    theta = np.sin(np.arange(6000) * 0.003) * 0.3
+    a = Fmu(model, params)
+    b = Fmu(model, params)
+    try:
+        for n in range(3000):
+            a.set_reals(["theta", "theta_ref"], [theta[n], 0.2])
+            a.do_step(n * H, H)
+        blob = a.slave.serializeFMUstate(a.slave.getFMUstate())
+        b.slave.setFMUstate(b.slave.deSerializeFMUstate(blob))
+        ua, ub = [], []
+        for n in range(3000, 6000):
+            for f, out in ((a, ua), (b, ub)):
+                f.set_reals(["theta", "theta_ref"], [theta[n], 0.2])
+                out.append(f.get("u"))
+                f.do_step(n * H, H)
+        assert np.array_equal(np.array(ua).view(np.int64), np.array(ub).view(np.int64))
+    finally:
+        a.close()
+        b.close()
+
+
+def test_tuner_and_sweeps_quick(tmp_path):
+    gains = tmp_path / "gains.json"
+    r = subprocess.run([sys.executable, ROOT / "scripts" / "paper002_tune.py", "--quick", "--out", gains,
+                        "--controllers", "PD,PID,FOPD,FOPID"], capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stderr[-2000:]
+    r = subprocess.run([sys.executable, ROOT / "scripts" / "paper002_sweeps.py", "--quick", "--gains", gains,
+                        "--out", tmp_path / "sweeps"], capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stderr[-2000:]
+    for run in ("002-1_step_responses", "002-2_phase_plane", "002-3", "002-4", "002-5", "002-6"):
+        assert (tmp_path / "sweeps" / f"{run}.csv").exists() and (tmp_path / "sweeps" / f"{run}.png").exists()
+    assert "002-6" in r.stdout and (tmp_path / "sweeps" / "summary.csv").exists()
