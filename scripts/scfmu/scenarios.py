@@ -6,6 +6,7 @@
   ``default()`` is run 000-6 (quaternion PD, large command), the set-up of ``scripts/run_default.py``.
 * ``paper001(case, dist)``: formation flying with the nonlinear predictive PID (cases a–d).
 * ``wheel_fault()``: paper 003 plant with reaction-wheel saturation and an x-wheel fault.
+* ``paper002(controller)``: single-axis wheel plant with a tuned PD, PID, FOPD or FOPID.
 * ``paper004(case)``: fault-tolerant control by reference correction, cases 1–3.
 
 ``get(name)`` looks a scenario up by name: ``"default"``, ``"paper000/<run_id>"``,
@@ -17,7 +18,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from .scenario import Component, Scenario, log_of
+from .scenario import DEFAULT_UNCONNECTED, Component, Scenario, log_of
 
 D = math.radians
 COMMANDS = {
@@ -215,6 +216,33 @@ def paper004(case: str = "1", stop_time: float = 20.0, step: float = 0.01) -> Sc
     )
 
 
+def paper002(controller: str = "FOPID", theta_ref_deg: float = 30.0, stop_time: float = 20.0,
+             step: float = 0.001) -> Scenario:
+    """Paper 002 single-axis loop: PidController or FopidController (PD, PID, FOPD, FOPID with the
+    committed PSO-tuned gains of scripts/paper002_gains.json) → SingleAxisPlant (explicit Euler, internal
+    step = communication step = the controller's sample time), step command theta_ref."""
+    import json
+    from pathlib import Path
+
+    from . import paper002 as p2
+    tuned = json.loads((Path(__file__).resolve().parents[1] / "paper002_gains.json").read_text())
+    sc = p2.Scenario(theta_ref_deg=theta_ref_deg, t_end=stop_time, h=step)
+    model, cparams = p2.controller_params(controller, tuned["controllers"][controller]["gains"], sc)
+    return Scenario(
+        name=f"paper002/{controller}",
+        components=[
+            Component("controller", model, cparams),
+            Component("plant", "SingleAxisPlant", {"integrator": 1, "max_internal_step": step}),
+        ],
+        stop_time=stop_time, step=step,
+        log=log_of("plant", ["theta", "omega", "applied_torque", "theta_deg"]) | log_of("controller", ["u"]),
+        inputs={"controller.theta_ref": math.radians(theta_ref_deg)},
+        unconnected=[*DEFAULT_UNCONNECTED, "torque_dist"],
+        metrics="",
+        description=f"paper 002 single-axis loop, {controller} with the tuned gains, {theta_ref_deg:g} deg step",
+    )
+
+
 def get(name: str, **kw) -> Scenario:
     """A standard scenario by name (see the module docstring); keyword arguments go to its builder."""
     parts = name.split("/")
@@ -227,12 +255,15 @@ def get(name: str, **kw) -> Scenario:
         return paper001(parts[1], dist, **kw)
     if parts[0] == "wheel_fault":
         return wheel_fault(**kw)
+    if parts[0] == "paper002" and len(parts) == 2:
+        return paper002(parts[1], **kw)
     if parts[0] == "paper004" and len(parts) == 2:
         return paper004(parts[1], **kw)
     raise KeyError(f"unknown scenario {name!r}; known: default, paper000/<run id>, paper001/<a|b|c|d>[/dist<N>], "
-                   f"wheel_fault, paper004/<1|2|3>")
+                   f"wheel_fault, paper002/<PD|PID|FOPD|FOPID>, paper004/<1|2|3>")
 
 
 def names() -> list[str]:
     return (["default"] + [f"paper000/{r.run_id}" for r in paper000_runs()]
-            + [f"paper001/{c}" for c in PAPER001_CASES] + ["wheel_fault"] + [f"paper004/{c}" for c in "123"])
+            + [f"paper001/{c}" for c in PAPER001_CASES] + ["wheel_fault"] + [f"paper002/{c}" for c in ("PD", "PID", "FOPD", "FOPID")]
+            + [f"paper004/{c}" for c in "123"])
