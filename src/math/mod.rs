@@ -1,6 +1,7 @@
 //! Shared math used by the models: attitude representations and conversions, integrators, the
 //! Riccati equation (LQR), pole placement, fuzzy inference, relative orbital motion, predictive-control
-//! gains, counter-based random numbers and the orbit environment.
+//! gains, counter-based random numbers, the orbit environment and interval type-2 fuzzy inference
+//! (Karnik–Mendel type reduction).
 //! Each module carries its own unit tests against closed-form results.
 
 pub mod attitude;
@@ -12,5 +13,6 @@ pub mod predictive_control;
 pub mod random;
 pub mod relative_orbit;
 pub mod riccati;
+pub mod type2_fuzzy;
 
 pub use nalgebra::{Matrix3, Quaternion, Vector3};

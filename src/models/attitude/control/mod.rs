@@ -13,4 +13,6 @@ crate::fmus! {
     mrac_controller::MracController,
     fuzzy_pd_controller::FuzzyPdController,
     adaptive_fuzzy_controller::AdaptiveFuzzyController,
+    sliding_mode_controller::SlidingModeController,
+    type2_fuzzy_smc_controller::Type2FuzzySmcController,
 }
