@@ -134,16 +134,17 @@ def run_many(cases: list[Case], workers: int, desc: str) -> list[tuple[dict, dic
 
 # ----- genetic algorithm ----------------------------------------------------------------------------
 def _blx_crossover(p_cross: float, alpha: float, lo: np.ndarray, hi: np.ndarray):
-    """BLX-alpha crossover for pygad (custom operator; pygad seeds numpy's global generator)."""
+    """BLX-alpha crossover for pygad (custom operator drawing from the GA's own seeded generator)."""
     def op(parents, offspring_size, ga):
+        rng = ga.numpy_random_generator
         out = np.empty(offspring_size)
         for k in range(offspring_size[0]):
             a = parents[k % parents.shape[0]]
             b = parents[(k + 1) % parents.shape[0]]
-            if np.random.random() < p_cross:
+            if rng.random_sample() < p_cross:
                 mn, mx = np.minimum(a, b), np.maximum(a, b)
                 span = mx - mn
-                child = np.random.uniform(mn - alpha * span, mx + alpha * span)
+                child = rng.uniform(mn - alpha * span, mx + alpha * span)
             else:
                 child = a.copy()
             out[k] = np.clip(child, lo, hi)
@@ -154,10 +155,11 @@ def _blx_crossover(p_cross: float, alpha: float, lo: np.ndarray, hi: np.ndarray)
 def _gauss_mutation(p_gene: float, lo: np.ndarray, hi: np.ndarray):
     """Gaussian mutation, σ = 10 % of each gene's range, probability p_gene per gene."""
     def op(offspring, ga):
+        rng = ga.numpy_random_generator
         for k in range(offspring.shape[0]):
             for g in range(offspring.shape[1]):
-                if np.random.random() < p_gene:
-                    offspring[k, g] = np.clip(offspring[k, g] + np.random.normal(0.0, 0.1 * (hi[g] - lo[g])), lo[g], hi[g])
+                if rng.random_sample() < p_gene:
+                    offspring[k, g] = np.clip(offspring[k, g] + rng.normal(0.0, 0.1 * (hi[g] - lo[g])), lo[g], hi[g])
         return offspring
     return op
 

@@ -165,7 +165,7 @@ def test_km_endpoints_agree_with_pyit2fls_on_a_grid(transpose):
                 e = float(np.clip(qv[i] / e_scale, -1, 1))
                 d = float(np.clip(qv_dot[i] / edot_scale, -1, 1))
                 ol, orr = it2_oracle(e, d, 0.3, 0.5, bool(transpose))
-                assert yl[i] == pytest.approx(ol, abs=2e-6) and yr[i] == pytest.approx(orr, abs=2e-6), (e, d)
+                assert yl[i] == pytest.approx(ol, abs=1e-12) and yr[i] == pytest.approx(orr, abs=1e-12), (e, d)
                 assert yl[i] <= vec(f, "fuzzy_y")[i] <= yr[i]
                 n += 1
             np.testing.assert_allclose(vec(f, "k_gain"), k * (1 + kappa * (yl + yr) / 2), rtol=1e-14)
