@@ -1,7 +1,7 @@
 //! Shared math used by the models: attitude representations and conversions, integrators, the
 //! Riccati equation (LQR), pole placement, fuzzy inference, relative orbital motion, predictive-control
-//! gains, counter-based random numbers, the orbit environment and Grünwald–Letnikov fractional calculus
-//! with the PID / PI^λD^μ laws.
+//! gains, counter-based random numbers, the orbit environment, Grünwald–Letnikov fractional calculus
+//! with the PID / PI^λD^μ laws, and interval type-2 fuzzy inference (Karnik–Mendel type reduction).
 //! Each module carries its own unit tests against closed-form results.
 
 pub mod attitude;
@@ -15,5 +15,6 @@ pub mod random;
 pub mod relative_orbit;
 pub mod riccati;
 pub mod spline;
+pub mod type2_fuzzy;
 
 pub use nalgebra::{Matrix3, Quaternion, Vector3};

@@ -14,4 +14,6 @@ crate::fmus! {
     fuzzy_pd_controller::FuzzyPdController,
     adaptive_fuzzy_controller::AdaptiveFuzzyController,
     feedback_linearizing_controller::FeedbackLinearizingController,
+    sliding_mode_controller::SlidingModeController,
+    type2_fuzzy_smc_controller::Type2FuzzySmcController,
 }

@@ -1,12 +1,14 @@
 //! What the attitude controllers share — not FMUs themselves: the common port block, paper 000's error
-//! laws and per-axis linear law, the model-reference adaptive (MRAC) core with its variable block, and
-//! paper 004's feedback-linearising law with the reference corrector's open-loop plant copy.
+//! laws and per-axis linear law, the model-reference adaptive (MRAC) core with its variable block,
+//! paper 003's quaternion sliding-mode law with its variable block, and paper 004's
+//! feedback-linearising law with the reference corrector's open-loop plant copy.
 //! A new controller takes its ports from here; a law two controllers need goes here.
 
 pub mod error_law;
 pub mod feedback_linearization;
 pub mod mrac;
 pub mod ports;
+pub mod smc;
 
 pub use error_law::{linear_law, ErrorLaw};
 pub use ports::{check_unit_quaternions, AttitudeControllerPorts};
