@@ -80,7 +80,9 @@ fn every_packaged_fmu_runs_in_fmi_rs() {
             .filter(|d| d.causality == spacecraft_fmus::model::Causality::Output && d.kind == spacecraft_fmus::model::VarKind::Real)
             .map(|d| d.name)
             .collect();
-        let (t, out) = simulate(&fmu_file(&format!("{name}.fmu")), 0.5, 0.05, &[], &outputs);
+        // sampled controllers (PID, FOPID) require the communication step to equal their `step` parameter
+        let start: &[(&str, &str)] = if e.decl("step").is_some() { &[("step", "0.05")] } else { &[] };
+        let (t, out) = simulate(&fmu_file(&format!("{name}.fmu")), 0.5, 0.05, start, &outputs);
         assert_eq!(t.len(), 11, "{name}: {t:?}");
         for (n, v) in &out {
             assert!(v.iter().all(|x| x.is_finite()), "{name}.{n} not finite: {v:?}");

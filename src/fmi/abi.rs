@@ -46,7 +46,7 @@ thread_local! {
 }
 
 /// Panics inside an FMI call are reported through the logger, not printed: the hook records the
-/// message and location; outside FMI calls (Rust tests) the default report is printed as usual. The
+/// message and location; outside FMI calls (Rust tests) a one-line report goes to stderr. The
 /// hook is installed while at least one instance lives (changed only under the live-instance lock)
 /// and removed with the last one, so an unloaded library leaves no hook behind.
 fn install_panic_hook() {
