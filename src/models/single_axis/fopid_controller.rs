@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::shared::{check_step, law_params};
+use super::shared::{law_params, sampled_output, sampled_step};
 use crate::declare_variables;
 use crate::math::fractional::FopidLaw;
 use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult, SWITCH};
@@ -60,19 +60,12 @@ directly, older ones in FFT blocks. The FMU state holds the whole history.</p>",
     }
 
     fn outputs(&self, v: &mut FopidControllerVars, _t: f64) -> ModelResult {
-        let e = v.theta_ref - v.theta;
-        let u = self.law.output(e);
-        if !u.is_finite() {
-            return Err(format!("u = {u} is not finite (error e = {e})"));
-        }
-        (v.u, v.error) = (u, e);
+        (v.u, v.error) = sampled_output(&self.law, v.theta_ref, v.theta)?;
         Ok(())
     }
 
     fn step(&mut self, v: &FopidControllerVars, _t: f64, h: f64) -> ModelResult {
-        check_step(h, v.step)?;
-        self.law.push(v.theta_ref - v.theta);
-        Ok(())
+        sampled_step(&mut self.law, h, v.step, v.theta_ref, v.theta)
     }
 }
 

@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::shared::{check_step, law_params};
+use super::shared::{law_params, sampled_output, sampled_step};
 use crate::declare_variables;
 use crate::math::fractional::PidLaw;
 use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult, SWITCH};
@@ -56,19 +56,12 @@ sum (O(1) per step). The FMU state holds the whole history.</p>",
     }
 
     fn outputs(&self, v: &mut PidControllerVars, _t: f64) -> ModelResult {
-        let e = v.theta_ref - v.theta;
-        let u = self.law.output(e);
-        if !u.is_finite() {
-            return Err(format!("u = {u} is not finite (error e = {e})"));
-        }
-        (v.u, v.error) = (u, e);
+        (v.u, v.error) = sampled_output(&self.law, v.theta_ref, v.theta)?;
         Ok(())
     }
 
     fn step(&mut self, v: &PidControllerVars, _t: f64, h: f64) -> ModelResult {
-        check_step(h, v.step)?;
-        self.law.push(v.theta_ref - v.theta);
-        Ok(())
+        sampled_step(&mut self.law, h, v.step, v.theta_ref, v.theta)
     }
 }
 
