@@ -24,24 +24,7 @@ SMALL = (math.radians(4.0), math.radians(-4.0), math.radians(-6.0))
 AX = "xyz"
 
 
-# ----- independent quaternion helpers (README conventions) --------------------------------------
-def qmul(a, b):
-    aw, av = a[0], np.asarray(a[1:])
-    bw, bv = b[0], np.asarray(b[1:])
-    return np.concatenate([[aw * bw - av @ bv], aw * bv + bw * av + np.cross(av, bv)])
-
-
-def qconj(q):
-    return np.array([q[0], -q[1], -q[2], -q[3]])
-
-
-def q321(roll, pitch, yaw):
-    def el(axis, a):
-        q = np.zeros(4)
-        q[0] = math.cos(a / 2)
-        q[axis] = math.sin(a / 2)
-        return q
-    return qmul(qmul(el(3, yaw), el(2, pitch)), el(1, roll))
+from quat_oracle import q321, qconj, qmul  # noqa: E402  (independent helpers shared by the tests)
 
 
 def set_att(ctrl: Fmu, q, w, q_ref):
