@@ -1,0 +1,1 @@
+"""Reproduction report: paper sections (paperNNN.py), shared types (types.py), rendering (render.py)."""

@@ -1,0 +1,98 @@
+"""What a paper section of the reproduction report is made of (plain data, rendered by ``render``).
+
+Each paper module ``scfmu.report.paperNNN`` exposes ``build(ctx: Context) -> PaperSection``: it runs its
+experiments on the campaign engine through ``ctx`` (one Dask client for the whole report), writes its
+figures under ``ctx.out_dir / "figures"`` and returns the claims with their evidence and verdicts. The
+renderer turns the sections into ``index.html`` and ``report.md``; the paper modules never write HTML.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+CONFIRMED = "confirmed"
+NOT_CONFIRMED = "not confirmed"
+DEPENDS = "depends on a reading"
+VERDICTS = (CONFIRMED, NOT_CONFIRMED, DEPENDS)
+
+
+@dataclass
+class Figure:
+    """A PNG under the report folder; ``path`` is relative to it (e.g. "figures/000_ranking.png")."""
+    path: str
+    caption: str
+
+
+@dataclass
+class Table:
+    """A small table; cells are str, int or float (floats are printed with ``digits`` significant digits)."""
+    caption: str
+    columns: list[str]
+    rows: list[list]
+    digits: int = 4
+
+
+@dataclass
+class Sensitivity:
+    """How a verdict moves with one project-choice reading: the values swept and where the claim holds."""
+    parameter: str            # e.g. "FuzzyPdController.e_scale"
+    values: list              # values tried (today's default included)
+    default: object           # today's default value
+    holds_where: str          # e.g. "e_scale ≤ 0.3 rad" or "nowhere in [0.1, 2]" or "everywhere tried"
+    figure: Figure | None = None
+    table: Table | None = None
+
+
+@dataclass
+class Claim:
+    id: str                   # "C000-4", as in the list of the papers' claims
+    statement: str            # the paper's claim in our words
+    verdict: str              # one of VERDICTS
+    evidence: str             # a short paragraph: what we ran and what it showed (plain text)
+    tables: list[Table] = field(default_factory=list)
+    figures: list[Figure] = field(default_factory=list)
+    sensitive_to: list[str] = field(default_factory=list)   # project-choice parameters the verdict depends on
+    sensitivity: list[Sensitivity] = field(default_factory=list)
+
+    def __post_init__(self):
+        if self.verdict not in VERDICTS:
+            raise ValueError(f"{self.id}: verdict {self.verdict!r} is not one of {VERDICTS}")
+
+
+@dataclass
+class PaperSection:
+    paper: str                # "000" … "004"
+    title: str                # the paper's title
+    setup: str                # what we simulated (FMUs, scenarios, run counts, quick or full)
+    claims: list[Claim]
+    figures: list[Figure] = field(default_factory=list)   # section-level figures (overview plots)
+    tables: list[Table] = field(default_factory=list)
+    notes: str = ""           # readings, deviations, what differs in --quick
+    runtime_s: float = 0.0
+
+
+@dataclass
+class Context:
+    """Shared by every paper module during one report build."""
+    out_dir: Path             # out/report (index.html goes here)
+    quick: bool               # reduced run counts/grids for CI
+    workers: int              # Dask workers
+    client: object = None     # a dask.distributed Client, started once by scripts/report.py
+
+    @property
+    def figures_dir(self) -> Path:
+        p = self.out_dir / "figures"
+        p.mkdir(parents=True, exist_ok=True)
+        return p
+
+    def runs_dir(self, name: str) -> Path:
+        """Folder for one campaign's results (out/report/runs/<name>); campaigns resume from it."""
+        p = self.out_dir / "runs" / name
+        p.parent.mkdir(parents=True, exist_ok=True)
+        return p
+
+    def campaign(self, c, name: str):
+        """Runs a ``scfmu.campaign.Campaign`` on the shared client; returns its results table."""
+        from .. import campaign
+        return campaign.run(c, self.runs_dir(name), client=self.client, overwrite=True)
