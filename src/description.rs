@@ -27,7 +27,7 @@ fn causality_str(c: Causality) -> &'static str {
     }
 }
 
-fn variability_str(v: Variability) -> &'static str {
+pub(crate) fn variability_str(v: Variability) -> &'static str {
     match v {
         Variability::Constant => "constant",
         Variability::Fixed => "fixed",
@@ -51,7 +51,7 @@ pub fn fmt_real(v: f64) -> String {
     format!("{v:?}")
 }
 
-fn start_str(s: Start) -> String {
+pub(crate) fn start_str(s: Start) -> String {
     match s {
         Start::Real(v) => fmt_real(v),
         Start::Integer(v) => v.to_string(),
@@ -348,7 +348,7 @@ pub fn model_description(entry: &ModelEntry) -> String {
     write_xml(entry, guid(entry))
 }
 
-fn bound_text(b: Bound) -> String {
+pub(crate) fn bound_text(b: Bound) -> String {
     match b {
         Bound::Any => String::new(),
         Bound::Positive => "> 0".into(),
@@ -359,7 +359,7 @@ fn bound_text(b: Bound) -> String {
     }
 }
 
-fn html_escape(s: &str) -> String {
+pub(crate) fn html_escape(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
 }
 
@@ -406,6 +406,14 @@ pub fn documentation_html(entry: &ModelEntry) -> String {
             ));
         }
         h.push_str("</table>\n");
+    }
+    let cited = crate::references::cited_in(crate::docs::model_texts(entry));
+    if !cited.is_empty() {
+        h.push_str("<h2>References</h2>\n<ul>\n");
+        for r in cited {
+            h.push_str(&format!("<li><b>[{}]</b> {}</li>\n", r.key, html_escape(&crate::references::citation(r))));
+        }
+        h.push_str("</ul>\n");
     }
     h.push_str("</body>\n</html>\n");
     h

@@ -5,18 +5,46 @@
 use crate::model::{concat, total_len, ModelEntry};
 use crate::models::{attitude, formation, single_axis};
 
-const FAMILIES: &[&[ModelEntry]] = &[
-    // three-axis attitude: plant, reference, metrics (papers 000, 003, 004) …
-    attitude::FMUS,
-    // … and its controllers
-    attitude::control::FMUS,
-    // single axis (paper 002)
-    single_axis::FMUS,
-    // formation flying, relative orbit (paper 001)
-    formation::FMUS,
+/// A family of FMUs (one folder under `src/models/`) and its documentation page `docs/models/<slug>.md`.
+pub struct Family {
+    pub slug: &'static str,
+    pub title: &'static str,
+    /// Markdown overview: the family folder's README.md.
+    pub overview: &'static str,
+    pub fmus: &'static [ModelEntry],
+}
+
+pub const FAMILIES: &[Family] = &[
+    Family {
+        slug: "attitude",
+        title: "Three-axis attitude: plant, command, metrics and reference corrector",
+        overview: include_str!("models/attitude/README.md"),
+        fmus: attitude::FMUS,
+    },
+    Family {
+        slug: "attitude-control",
+        title: "Three-axis attitude controllers",
+        overview: include_str!("models/attitude/control/README.md"),
+        fmus: attitude::control::FMUS,
+    },
+    Family {
+        slug: "single-axis",
+        title: "Single axis with reaction-wheel lag: plant, PID and fractional-order PID",
+        overview: include_str!("models/single_axis/README.md"),
+        fmus: single_axis::FMUS,
+    },
+    Family {
+        slug: "formation",
+        title: "Formation flying: relative orbit, command and predictive PID",
+        overview: include_str!("models/formation/README.md"),
+        fmus: formation::FMUS,
+    },
 ];
 
-const LIST: [ModelEntry; total_len(FAMILIES)] = concat(FAMILIES, FAMILIES[0][0]);
+const LISTS: [&[ModelEntry]; 4] = [FAMILIES[0].fmus, FAMILIES[1].fmus, FAMILIES[2].fmus, FAMILIES[3].fmus];
+const _: () = assert!(FAMILIES.len() == LISTS.len(), "every family goes into the registry");
+
+const LIST: [ModelEntry; total_len(&LISTS)] = concat(&LISTS, LISTS[0][0]);
 
 /// Every registered FMU, grouped by family.
 pub const ALL: &[ModelEntry] = &LIST;

@@ -1,4 +1,5 @@
-//! `package`: writes `modelDescription/<Model>.xml` and `fmus/<Model>.fmu` for every model.
+//! `package`: writes `modelDescription/<Model>.xml`, `fmus/<Model>.fmu` and the generated model pages
+//! (`docs/models/<family>.md`, `docs/references.md`) for every model.
 //!
 //! Usage: `package [--lib PATH] [--fmus DIR] [--xml DIR] [--check]`
 //! - `--lib`: the release cdylib (default `target/release/libspacecraft_fmus.so`)
@@ -30,12 +31,13 @@ fn main() -> ExitCode {
         }
     }
     if check {
-        let stale = stale_model_descriptions(&xml);
+        let mut stale = stale_model_descriptions(&xml);
+        stale.extend(spacecraft_fmus::docs::stale_pages(&root.join("docs")));
         if stale.is_empty() {
-            println!("modelDescription/ is up to date ({} models)", registry::ALL.len());
+            println!("modelDescription/ and docs/ are up to date ({} models)", registry::ALL.len());
             return ExitCode::SUCCESS;
         }
-        eprintln!("stale modelDescription files: {}", stale.join(", "));
+        eprintln!("stale generated files: {}", stale.join(", "));
         return ExitCode::FAILURE;
     }
     let library = match std::fs::read(&lib) {
@@ -47,6 +49,10 @@ fn main() -> ExitCode {
     };
     if let Err(e) = write_model_descriptions(&xml) {
         eprintln!("package: cannot write model descriptions: {e}");
+        return ExitCode::FAILURE;
+    }
+    if let Err(e) = spacecraft_fmus::docs::write_pages(&root.join("docs")) {
+        eprintln!("package: cannot write docs/models and docs/references.md: {e}");
         return ExitCode::FAILURE;
     }
     for e in registry::ALL {

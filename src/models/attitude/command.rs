@@ -30,7 +30,7 @@ impl Model for AttitudeCommand {
     const INFO: ModelInfo = ModelInfo {
         name: "AttitudeCommand",
         description: "Attitude reference: a constant 321 Euler-angle command applied as a step",
-        source: "command of the large- and small-angle slews (papers 000, 003)",
+        source: "command of the large- and small-angle slews ([Navabi-2019], [T2FSMC-LEO])",
         equations_html: "<pre>t &lt; step_time:  q_ref = (1, 0, 0, 0), angles 0\n\
 t &gt;= step_time: q_ref = q321(roll, pitch, yaw) = q_z(yaw) (x) q_y(pitch) (x) q_x(roll)\n\
 w_ref = 0</pre>",

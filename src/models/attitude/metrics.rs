@@ -12,8 +12,8 @@ declare_variables! {
         0 => q: Quat = [1.0, 0.0, 0.0, 0.0], Input, "", "Attitude quaternion";
         4 => q_ref: Quat = [1.0, 0.0, 0.0, 0.0], Input, "", "Commanded attitude quaternion";
         8 => torque_applied: Vec3 = [0.0; 3], Input, "N.m", "Applied control torque, body axes";
-        20 => eulerint_deg_s: Real = 0.0, Output, "deg.s", "EULERINT: integral of alpha_deg over [0, t] (paper 000 Eq. 5)";
-        21 => alpha_deg: Real = 0.0, Output, "deg", "Euler-axis angle between body and reference (paper 000 Eq. 4)";
+        20 => eulerint_deg_s: Real = 0.0, Output, "deg.s", "EULERINT: integral of alpha_deg over [0, t] ([Navabi-2019] Eq. 5)";
+        21 => alpha_deg: Real = 0.0, Output, "deg", "Euler-axis angle between body and reference ([Navabi-2019] Eq. 4)";
         22 => ise: Real = 0.0, Output, "rad2.s", "Integral of the squared 321 Euler-angle errors, summed over axes";
         23 => isf: Real = 0.0, Output, "N2.m2.s", "Integral of the squared applied torques, summed over axes";
         24 => effort_abs: Real = 0.0, Output, "N.m.s", "Integral of the sum of absolute applied torques";
@@ -45,9 +45,9 @@ impl Model for AttitudeMetrics {
     const INFO: ModelInfo = ModelInfo {
         name: "AttitudeMetrics",
         description: "Running attitude performance integrals: EULERINT, ISE, ISF and control effort",
-        source: "EULERINT: paper 000 (adaptive-fuzzy EULERINT design), Eqs. 4-5; ISE and ISF as in paper 003",
-        equations_html: "<pre>alpha      = 2 atan2(|q_E,v|, |q_E,w|),  q_E = q* (x) q_ref    (Euler-axis angle, paper 000 Eq. 4)\n\
-eulerint   = integral of alpha [deg] dt                         (paper 000 Eq. 5)\n\
+        source: "EULERINT: [Navabi-2019], Eqs. 4-5; ISE and ISF as in [T2FSMC-LEO]",
+        equations_html: "<pre>alpha      = 2 atan2(|q_E,v|, |q_E,w|),  q_E = q* (x) q_ref    (Euler-axis angle, [Navabi-2019] Eq. 4)\n\
+eulerint   = integral of alpha [deg] dt                         ([Navabi-2019] Eq. 5)\n\
 ise        = integral of sum_i wrap(euler321(q_ref) - euler321(q))_i^2 dt\n\
 isf        = effort_sq = integral of |tau_applied|^2 dt\n\
 effort_abs = integral of sum_i |tau_applied,i| dt</pre>\n\

@@ -21,17 +21,17 @@ declare_variables! {
         10 => q_ref: Quat = [1.0, 0.0, 0.0, 0.0], Output, "", "Corrected attitude reference; scalar part sqrt(max(0, 1 - |q_ref_v|^2))";
         14 => w_ref: Vec3 = [0.0; 3], Output, "rad/s", "Commanded body rate (always 0; the law uses q_ref_dot instead)";
         50 => q_ref_dot: Vec3 = [0.0; 3], Output, "1/s", "Time derivative of the reference's vector part";
-        53 => q_ref_ddot: Vec3 = [0.0; 3], Output, "1/s2", "Second time derivative of the reference's vector part (paper 004 Eq. 17)";
+        53 => q_ref_ddot: Vec3 = [0.0; 3], Output, "1/s2", "Second time derivative of the reference's vector part ([Moradi-FTC] Eq. 17)";
         56 => u_ol: Vec3 = [0.0; 3], Output, "N.m", "Open-loop torque: the spline through the node parameters up to spline_t_end, 0 after";
-        100 => inertia: Diag3 = [449.5, 264.5, 312.5], Parameter, "kg.m2", "Inertia of the internal plant copy and of the law (diagonal; paper 004)", Positive;
+        100 => inertia: Diag3 = [449.5, 264.5, 312.5], Parameter, "kg.m2", "Inertia of the internal plant copy and of the law (diagonal; [Moradi-FTC])", Positive;
         160 => k_q: Vec3 = [0.5; 3], Parameter, "1/s2", "Stiffness k_q of the controller's error dynamics (same value as the controller)", Positive;
         163 => k_qdot: Vec3 = [2.0; 3], Parameter, "1/s", "Damping k_qdot of the controller's error dynamics (same value as the controller)", Positive;
         110 => init_euler321_roll: Real = 0.0, Parameter, "rad", "Initial roll of the plant (321 sequence)";
         111 => init_euler321_pitch: Real = 0.0, Parameter, "rad", "Initial pitch of the plant (321 sequence)";
         112 => init_euler321_yaw: Real = 0.0, Parameter, "rad", "Initial yaw of the plant (321 sequence)";
         113 => init_w: Vec3 = [0.0; 3], Parameter, "rad/s", "Initial body rate of the plant";
-        120 => u_max: Vec3 = [10.0; 3], Parameter, "N.m", "Torque limit of the plant before the fault (paper 004: 10 N m)", Limit;
-        123 => effectiveness: Vec3 = [0.1; 3], Parameter, "", "Effectiveness a of the faulty actuators: the copy's limit is a u_max (paper 004: 0.1)", Range(0.0, 1.0);
+        120 => u_max: Vec3 = [10.0; 3], Parameter, "N.m", "Torque limit of the plant before the fault ([Moradi-FTC]: 10 N m)", Limit;
+        123 => effectiveness: Vec3 = [0.1; 3], Parameter, "", "Effectiveness a of the faulty actuators: the copy's limit is a u_max ([Moradi-FTC]: 0.1)", Range(0.0, 1.0);
         130 => max_internal_step: Real = 0.01, Parameter, "s", "Internal RK4 step of the plant copy (use the plant's value)", Positive;
         150 => mode: Integer = 0, Parameter, "", "0 = identity reference (no correction), 1 = reference corrected by the open-loop spline", Choice(&[0, 1]);
         170 => node_x_0: Real = 0.0, Parameter, "N.m", "Spline node value x at t = 0";
@@ -52,7 +52,7 @@ declare_variables! {
         185 => node_z_3: Real = 0.0, Parameter, "N.m", "Spline node value z at t = 3 spline_t_end/5";
         186 => node_z_4: Real = 0.0, Parameter, "N.m", "Spline node value z at t = 4 spline_t_end/5";
         187 => node_z_5: Real = 0.0, Parameter, "N.m", "Spline node value z at t = spline_t_end";
-        188 => spline_t_end: Real = 20.0, Parameter, "s", "Time of the last node (nodes equally spaced on [0, spline_t_end]; paper 004: 20 s)", Positive;
+        188 => spline_t_end: Real = 20.0, Parameter, "s", "Time of the last node (nodes equally spaced on [0, spline_t_end]; [Moradi-FTC]: 20 s)", Positive;
         190 => init_ref_error: Vec3 = [0.0; 3], Parameter, "", "Initial reference error e(0) = q_v(0) - q_ref_v(0) (0: the reference starts on the plant)";
         193 => init_ref_error_rate: Vec3 = [0.0; 3], Parameter, "1/s", "Initial reference error rate e'(0)";
     }
@@ -88,8 +88,8 @@ impl Model for ReferenceCorrector {
     type Vars = ReferenceCorrectorVars;
     const INFO: ModelInfo = ModelInfo {
         name: "ReferenceCorrector",
-        description: "Paper 004 reference corrector: attitude reference from an internal open-loop plant copy driven by a spline torque",
-        source: "paper 004 (active fault-tolerant control under actuator fault), section 3-3, Eq. 17",
+        description: "Reference corrector: attitude reference from an internal open-loop plant copy driven by a spline torque",
+        source: "[Moradi-FTC], section 3-3, Eq. 17",
         equations_html: "<pre>u_ol(t)  = not-a-knot cubic spline through (k spline_t_end/5, node_*_k), k = 0..5;  0 for t &gt; spline_t_end\n\
 mode 0:  q_ref = (1, 0, 0, 0), q_ref_dot = q_ref_ddot = 0\n\
 mode 1:  internal copy of the plant (same inertia, limit a u_max, initial state, RK4 step):\n\
@@ -97,7 +97,7 @@ mode 1:  internal copy of the plant (same inertia, limit a u_max, initial state,
          e'' = -k_qdot e' - k_q e,     e(0) = init_ref_error, e'(0) = init_ref_error_rate\n\
          q_ref_v    = q_v - e\n\
          q_ref_dot  = 1/2 (q_w w + q_v x w) - e'\n\
-         q_ref_ddot = k_qdot (q_v' - q_ref_dot) + k_q (q_v - q_ref_v) + chi + 1/2 M(q) sat(u_ol)/I      (paper 004 Eq. 17)\n\
+         q_ref_ddot = k_qdot (q_v' - q_ref_dot) + k_q (q_v - q_ref_v) + chi + 1/2 M(q) sat(u_ol)/I      ([Moradi-FTC] Eq. 17)\n\
          q_ref_w    = sqrt(max(0, 1 - |q_ref_v|^2)),  w_ref = 0\n\
 chi = -1/4 q_v |w|^2 + 1/2 M(q) g, M(q) = q_w I3 + [q_v x], g as in FeedbackLinearizingController</pre>\n\
 <p>Eq. 17 is the feedback-linearising law solved for the reference acceleration: with this reference the \

@@ -13,11 +13,11 @@ declare_variables! {
         10 => pos_ref: Vec3 = [0.0; 3], Output, "m", "Commanded relative position, LVLH";
         13 => vel_ref: Vec3 = [0.0; 3], Output, "m/s", "Commanded relative velocity, LVLH";
         16 => acc_ref: Vec3 = [0.0; 3], Output, "m/s2", "Commanded relative acceleration, LVLH";
-        100 => target_pos: Vec3 = [50.0, 40.0, 60.0], Parameter, "m", "Set-point after step_time (paper 001: 50, 40, 60 m)";
+        100 => target_pos: Vec3 = [50.0, 40.0, 60.0], Parameter, "m", "Set-point after step_time ([NPPID-Formation]: 50, 40, 60 m)";
         103 => start_pos: Vec3 = [0.0; 3], Parameter, "m", "Reference before step_time (start of the transfer)";
         106 => step_time: Real = 0.0, Parameter, "s", "Time of the step / start of the transfer";
         107 => transfer_time: Real = 60.0, Parameter, "s", "Duration of the polynomial transfer (profile 1)";
-        120 => profile: Integer = 0, Parameter, "", "0 = step to the set-point (paper 001), 1 = fifth-order polynomial transfer", Choice(SWITCH);
+        120 => profile: Integer = 0, Parameter, "", "0 = step to the set-point ([NPPID-Formation]), 1 = fifth-order polynomial transfer", Choice(SWITCH);
     }
 }
 
@@ -44,7 +44,7 @@ impl Model for RelativePositionCommand {
     const INFO: ModelInfo = ModelInfo {
         name: "RelativePositionCommand",
         description: "Relative-position reference: constant set-point step or smooth fifth-order polynomial transfer",
-        source: "set-point of paper 001 (nonlinear predictive PID for formation flying)",
+        source: "set-point of [NPPID-Formation]",
         equations_html: "<pre>profile 0:  pos_ref = start_pos for t &lt; step_time, target_pos after; vel_ref = acc_ref = 0\n\
 profile 1:  tau = (t - step_time) / transfer_time clamped to [0, 1]\n\
             s = 10 tau^3 - 15 tau^4 + 6 tau^5\n\

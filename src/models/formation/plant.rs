@@ -23,10 +23,10 @@ declare_variables! {
         17 => leader_radius: Real = 6.0e6, Output, "m", "Leader orbit radius R(nu)";
         // parameters
         100 => mu: Real = 3.986004418e14, Parameter, "m3/s2", "Gravitational parameter (project choice)", Positive;
-        101 => semi_major_axis: Real = 6.0e6, Parameter, "m", "Leader semi-major axis a (paper 001: 6000 km, below the Earth's radius, kept as printed)", Positive;
+        101 => semi_major_axis: Real = 6.0e6, Parameter, "m", "Leader semi-major axis a ([NPPID-Formation]: 6000 km, below the Earth's radius, kept as printed)", Positive;
         102 => eccentricity: Real = 0.0, Parameter, "", "Leader eccentricity e in [0, 1)";
         103 => nu0: Real = 0.0, Parameter, "rad", "Leader true anomaly at the start time";
-        104 => mass: Real = 100.0, Parameter, "kg", "Follower mass m (paper 001)", Positive;
+        104 => mass: Real = 100.0, Parameter, "kg", "Follower mass m ([NPPID-Formation])", Positive;
         105 => init_pos: Vec3 = [0.0; 3], Parameter, "m", "Initial relative position";
         108 => init_vel: Vec3 = [0.0; 3], Parameter, "m/s", "Initial relative velocity";
         111 => max_internal_step: Real = 0.001, Parameter, "s", "Largest internal integration step; at most 1e6 internal steps per doStep", Range(1e-6, 1000.0);
@@ -59,7 +59,7 @@ impl Model for RelativeOrbitPlant {
     const INFO: ModelInfo = ModelInfo {
         name: "RelativeOrbitPlant",
         description: "Nonlinear leader-follower relative orbital motion in LVLH (3 translational DOF), eccentric leader orbit",
-        source: "paper 001 (nonlinear predictive PID for spacecraft formation flying), Eqs. 3-5 with the printed typos fixed",
+        source: "[NPPID-Formation], Eqs. 3-5 with the printed typos fixed",
         equations_html: EQUATIONS_HTML,
         default_stop_time: 300.0,
         default_step: 0.001,

@@ -26,13 +26,13 @@ declare_variables! {
         23 => dist_est: Vec3 = [0.0; 3], Output, "N", "Estimated disturbance force m d_hat, LVLH";
         26 => int_error: Vec3 = [0.0; 3], Output, "m.s", "Integral of the position error E (structure 0)";
         // parameters
-        100 => T1: Real = 0.0, Parameter, "s", "Start of the prediction interval T1 (paper 001: 0)";
+        100 => T1: Real = 0.0, Parameter, "s", "Start of the prediction interval T1 ([NPPID-Formation]: 0)";
         101 => T2: Real = 5.0, Parameter, "s", "End of the prediction interval T2 = prediction horizon T";
         102 => c: Real = 5.0, Parameter, "1/s", "Disturbance-observer gain c (L = c I3), all axes unless c_* >= 0", NonNegative;
         103 => c_x: Real = -1.0, Parameter, "1/s", "Observer gain for axis x; < 0: use c";
         104 => c_y: Real = -1.0, Parameter, "1/s", "Observer gain for axis y; < 0: use c";
         105 => c_z: Real = -1.0, Parameter, "1/s", "Observer gain for axis z; < 0: use c";
-        106 => mass: Real = 100.0, Parameter, "kg", "Follower mass m used by the controller (paper 001)", Positive;
+        106 => mass: Real = 100.0, Parameter, "kg", "Follower mass m used by the controller ([NPPID-Formation])", Positive;
         107 => mu: Real = 3.986004418e14, Parameter, "m3/s2", "Gravitational parameter for the feed-forward G";
         108 => semi_major_axis: Real = 6.0e6, Parameter, "m", "Leader semi-major axis for the feed-forward G";
         109 => eccentricity: Real = 0.0, Parameter, "", "Leader eccentricity for the feed-forward G";
@@ -114,8 +114,8 @@ impl Model for PredictivePidController {
     type Vars = PredictivePidControllerVars;
     const INFO: ModelInfo = ModelInfo {
         name: "PredictivePidController",
-        description: "Paper 001 nonlinear predictive PID (predictive law + disturbance observer) for leader-follower formation control",
-        source: "paper 001 (nonlinear predictive PID for spacecraft formation flying), Eqs. 22, 25, 26, 28, 39-47",
+        description: "Nonlinear predictive PID (predictive law + disturbance observer) for leader-follower formation control",
+        source: "[NPPID-Formation], Eqs. 22, 25, 26, 28, 39-47",
         equations_html: EQUATIONS_HTML,
         feedthrough: Feedthrough::AllInputs,
         default_stop_time: 300.0,

@@ -36,8 +36,8 @@ impl Model for FopidController {
     type Vars = FopidControllerVars;
     const INFO: ModelInfo = ModelInfo {
         name: "FopidController",
-        description: "Fractional-order PI^lambda D^mu controller with Grunwald-Letnikov operators (paper 002)",
-        source: "paper 002 (fractional-order attitude control under environmental disturbances), Eqs. 16-17; Grunwald-Letnikov discretisation",
+        description: "Fractional-order PI^lambda D^mu controller with Grunwald-Letnikov operators ([Khatoonabadi-FO])",
+        source: "[Khatoonabadi-FO], Eqs. 16-17; Grunwald-Letnikov discretisation",
         equations_html: "<pre>e_n = theta_ref(t_n) - theta(t_n)\n\
 u_n = K_P e_n + K_I D^(-lambda) e_n + K_D D^(mu) e_n\n\
 D^alpha e(t_n) = h^(-alpha) sum_{j=0}^{min(n, L-1)} w_j e_(n-j),  w_0 = 1,  w_j = (1 - (alpha + 1)/j) w_(j-1)\n\

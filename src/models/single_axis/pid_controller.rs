@@ -34,8 +34,8 @@ impl Model for PidController {
     type Vars = PidControllerVars;
     const INFO: ModelInfo = ModelInfo {
         name: "PidController",
-        description: "Discrete PID controller, the lambda = mu = 1 case of FopidController (paper 002)",
-        source: "paper 002 (fractional-order attitude control under environmental disturbances), Eqs. 16-17 with lambda = mu = 1",
+        description: "Discrete PID controller, the lambda = mu = 1 case of FopidController ([Khatoonabadi-FO])",
+        source: "[Khatoonabadi-FO], Eqs. 16-17 with lambda = mu = 1",
         equations_html: "<pre>e_n = theta_ref(t_n) - theta(t_n)\n\
 u_n = K_P e_n + K_I h sum_{j=0}^{min(n, L-1)} e_(n-j) + K_D (e_n - e_(n-1)) / h\n\
 e_k = 0 for k &lt; 0; L = gl_memory (0 = full memory)</pre>\n\

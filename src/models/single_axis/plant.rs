@@ -17,18 +17,18 @@ declare_variables! {
         12 => wheel_torque: Real = 0.0, Output, "N.m", "Wheel torque T_c after the lag (before saturation)";
         13 => applied_torque: Real = 0.0, Output, "N.m", "Saturated control torque M_c acting on the body";
         14 => theta_deg: Real = 0.0, Output, "deg", "Attitude angle in degrees";
-        100 => inertia: Real = 7.7, Parameter, "kg.m2", "Nominal inertia J (paper 002; damaged digits, 7.7 is a project choice)", Positive;
+        100 => inertia: Real = 7.7, Parameter, "kg.m2", "Nominal inertia J ([Khatoonabadi-FO]; damaged digits, 7.7 is a project choice)", Positive;
         101 => inertia_scale: Real = 1.0, Parameter, "", "Uncertainty factor: J_true = inertia_scale J", Positive;
-        102 => wheel_gain: Real = 1.0, Parameter, "", "Wheel gain K (paper 002; 1 is a project choice)";
-        103 => wheel_time_constant: Real = 0.2, Parameter, "s", "Wheel time constant T (paper 002)", Positive;
+        102 => wheel_gain: Real = 1.0, Parameter, "", "Wheel gain K ([Khatoonabadi-FO]; 1 is a project choice)";
+        103 => wheel_time_constant: Real = 0.2, Parameter, "s", "Wheel time constant T ([Khatoonabadi-FO])", Positive;
         104 => torque_limit: Real = 1.0, Parameter, "N.m", "Saturation T_sat of the wheel torque (project choice; 1e30 = no limit)", Limit;
-        105 => md_amp: Real = 0.01, Parameter, "N.m", "Disturbance amplitude: M_d = md_amp sin(md_freq t) + md_const (paper 002 form)";
+        105 => md_amp: Real = 0.01, Parameter, "N.m", "Disturbance amplitude: M_d = md_amp sin(md_freq t) + md_const ([Khatoonabadi-FO] form)";
         106 => md_freq: Real = 0.1, Parameter, "rad/s", "Disturbance frequency";
         107 => md_const: Real = 0.0001, Parameter, "N.m", "Constant disturbance";
-        108 => max_internal_step: Real = 0.001, Parameter, "s", "Internal step h (paper 002 Euler step; 0.001 is a project choice); at most 1e6 internal steps per doStep", Range(1e-6, 1000.0);
+        108 => max_internal_step: Real = 0.001, Parameter, "s", "Internal step h ([Khatoonabadi-FO] Euler step; 0.001 is a project choice); at most 1e6 internal steps per doStep", Range(1e-6, 1000.0);
         109 => init_theta: Real = 0.0, Parameter, "rad", "Initial angle theta(0)";
         110 => init_omega: Real = 0.0, Parameter, "rad/s", "Initial rate omega(0)";
-        120 => integrator: Integer = 1, Parameter, "", "Internal integrator: 1 = explicit Euler (paper 002, default), 0 = classical RK4, 2 = adaptive Dormand-Prince 5(4)", Choice(Method::CODES);
+        120 => integrator: Integer = 1, Parameter, "", "Internal integrator: 1 = explicit Euler ([Khatoonabadi-FO], default), 0 = classical RK4, 2 = adaptive Dormand-Prince 5(4)", Choice(Method::CODES);
     }
 }
 
@@ -58,8 +58,8 @@ impl Model for SingleAxisPlant {
     type Vars = SingleAxisPlantVars;
     const INFO: ModelInfo = ModelInfo {
         name: "SingleAxisPlant",
-        description: "Single-axis spacecraft with first-order reaction-wheel lag, torque saturation and sinusoidal disturbance (paper 002)",
-        source: "paper 002 (fractional-order attitude control under environmental disturbances), Fig. 1, Eqs. 4, 7",
+        description: "Single-axis spacecraft with first-order reaction-wheel lag, torque saturation and sinusoidal disturbance ([Khatoonabadi-FO])",
+        source: "[Khatoonabadi-FO], Fig. 1, Eqs. 4, 7",
         equations_html: EQUATIONS_HTML,
         default_stop_time: 50.0,
         ..ModelInfo::DEFAULT
@@ -93,10 +93,10 @@ impl Model for SingleAxisPlant {
 
 const EQUATIONS_HTML: &str = "<pre>d(theta)/dt = omega\n\
 d(omega)/dt = (M_c + M_d) / J_true,      J_true = inertia_scale J\n\
-d(T_c)/dt   = (K u - T_c) / T              (paper 002 Eq. 7)\n\
-M_c         = clamp(T_c, -T_sat, T_sat)    (paper 002 Eq. 4; saturation after the lag)\n\
+d(T_c)/dt   = (K u - T_c) / T              ([Khatoonabadi-FO] Eq. 7)\n\
+M_c         = clamp(T_c, -T_sat, T_sat)    ([Khatoonabadi-FO] Eq. 4; saturation after the lag)\n\
 M_d         = torque_dist + md_amp sin(md_freq t) + md_const</pre>\n\
-<p>Integration: explicit Euler (integrator = 1, default, paper 002), classical RK4 (integrator = 0) or adaptive Dormand-Prince 5(4) (integrator = 2, tolerance from fmi2SetupExperiment) with \
+<p>Integration: explicit Euler (integrator = 1, default, [Khatoonabadi-FO]), classical RK4 (integrator = 0) or adaptive Dormand-Prince 5(4) (integrator = 2, tolerance from fmi2SetupExperiment) with \
 ceil(step / max_internal_step) equal internal steps per communication step; Euler evaluates every right-hand side at t_n. \
 Inputs are held over the communication step. theta(0) = init_theta, omega(0) = init_omega, T_c(0) = 0.</p>";
 

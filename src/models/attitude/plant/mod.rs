@@ -83,7 +83,7 @@ impl Model for AttitudePlant {
     const INFO: ModelInfo = ModelInfo {
         name: "AttitudePlant",
         description: "Three-axis rigid spacecraft (gyrostat) with full inertia, selectable kinematics, saturating fault-prone torque actuators or reaction wheels with magnetorquers, disturbance generator and gravity gradient",
-        source: "rigid-body attitude dynamics and kinematics of papers 000, 003 and 004; reaction-wheel lag of paper 002",
+        source: "rigid-body attitude dynamics and kinematics of [Navabi-2019], [T2FSMC-LEO] and [Moradi-FTC]; reaction-wheel lag of [Khatoonabadi-FO]",
         equations_html: include_str!("docs.html"),
         feedthrough: Feedthrough::Some(&[
             // per axis also in wheel mode: τ_applied,i = sat(K_w (u_i − τ_mtq,i)) + τ_mtq,i with τ_mtq from the state

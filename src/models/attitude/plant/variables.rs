@@ -27,7 +27,7 @@ declare_variables! {
         38 => dipole: Vec3 = [0.0; 3], Output, "A.m2", "Magnetorquer dipole m, body axes";
         41 => b_body: Vec3 = [0.0; 3], Output, "T", "Geomagnetic field in body axes";
         // parameters: body
-        100 => inertia: Diag3 = [1000.0, 500.0, 700.0], Parameter, "kg.m2", "Inertia matrix diagonal entry (paper 000 default)", Positive;
+        100 => inertia: Diag3 = [1000.0, 500.0, 700.0], Parameter, "kg.m2", "Inertia matrix diagonal entry ([Navabi-2019] default)", Positive;
         103 => inertia_xy: Real = 0.0, Parameter, "kg.m2", "Inertia matrix entry xy (matrix entry, not product of inertia)";
         104 => inertia_xz: Real = 0.0, Parameter, "kg.m2", "Inertia matrix entry xz";
         105 => inertia_yz: Real = 0.0, Parameter, "kg.m2", "Inertia matrix entry yz";
@@ -39,14 +39,14 @@ declare_variables! {
         116 => init_h_wheel: Vec3 = [0.0; 3], Parameter, "N.m.s", "Initial wheel momentum (actuator_mode 1)";
         // parameters: actuator mode 0 and faults
         120 => u_max: Vec3 = [1e30; 3], Parameter, "N.m", "Actuator mode 0: torque limit (1e30 = no limit)", Limit;
-        123 => effectiveness: Vec3 = [1.0; 3], Parameter, "", "Effectiveness a in [0, 1] after fault_time: limit a u_max (mode 0) or a k_t i_max (mode 1) (paper 004)", Range(0.0, 1.0);
+        123 => effectiveness: Vec3 = [1.0; 3], Parameter, "", "Effectiveness a in [0, 1] after fault_time: limit a u_max (mode 0) or a k_t i_max (mode 1) ([Moradi-FTC])", Range(0.0, 1.0);
         126 => fault_time: Real = 0.0, Parameter, "s", "Onset time of all actuator faults (effectiveness, bias, stuck)";
         127 => fault_bias: Vec3 = [0.0; 3], Parameter, "N.m", "Bias fault: added to the torque command after fault_time (before the limits)";
         130 => max_internal_step: Real = 0.01, Parameter, "s", "Internal step of RK4/Euler (integrator 2 ignores it: adaptive steps); at most 1e6 internal steps per doStep", Range(1e-6, 1000.0);
         131 => fault_stuck_value: Vec3 = [0.0; 3], Parameter, "N.m", "Stuck fault: the torque command is replaced by this value after fault_time where fault_stuck_* = 1";
         // Integer parameters
         140 => integrator: Integer = 0, Parameter, "", "Internal integrator: 0 = classical RK4, 1 = explicit Euler, 2 = adaptive Dormand-Prince 5(4) (tolerance from fmi2SetupExperiment, default 1e-8)", Choice(Method::CODES);
-        141 => kinematics: Integer = 0, Parameter, "", "Kinematics: 0 = quaternion, 1 = DCM, 2 = paper 000 Euler-angle rates (213 rates, angles output as 321), 3 = linear small-angle double integrator", Choice(Kinematics::CODES);
+        141 => kinematics: Integer = 0, Parameter, "", "Kinematics: 0 = quaternion, 1 = DCM, 2 = [Navabi-2019] Euler-angle rates (213 rates, angles output as 321), 3 = linear small-angle double integrator", Choice(Kinematics::CODES);
         142 => actuator_mode: Integer = 0, Parameter, "", "Actuators: 0 = ideal torque with saturation and fault, 1 = three reaction wheels (+ magnetorquers if mtq_enable = 1)", Choice(SWITCH);
         143 => dcm_orthonormalize: Integer = 0, Parameter, "", "Kinematics 1 only: 1 = re-orthonormalise the DCM after every internal step, 0 = never", Choice(SWITCH);
         144 => mtq_enable: Integer = 0, Parameter, "", "Actuator mode 1: 1 = magnetorquers dump wheel momentum, 0 = off", Choice(SWITCH);
@@ -56,7 +56,7 @@ declare_variables! {
         148 => fault_stuck_y: Integer = 0, Parameter, "", "1 = actuator y stuck after fault_time", Choice(SWITCH);
         149 => fault_stuck_z: Integer = 0, Parameter, "", "1 = actuator z stuck after fault_time", Choice(SWITCH);
         // reaction wheels (paper 003 values, all project choice)
-        150 => wheel_time_constant: Real = 0.0, Parameter, "s", "Wheel torque lag T_w (0 = no lag) (paper 002 Eq. 7 form)", NonNegative;
+        150 => wheel_time_constant: Real = 0.0, Parameter, "s", "Wheel torque lag T_w (0 = no lag) ([Khatoonabadi-FO] Eq. 7 form)", NonNegative;
         151 => wheel_gain: Real = 1.0, Parameter, "", "Wheel gain K_w";
         152 => wheel_inertia: Real = 1.2e-3, Parameter, "kg.m2", "Wheel spin inertia J_w", Positive;
         153 => wheel_torque_coeff: Real = 0.05, Parameter, "N.m/A", "Wheel motor torque coefficient k_t", NonNegative;
