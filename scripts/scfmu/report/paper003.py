@@ -170,7 +170,7 @@ def _plot_overview(summary: dict, path) -> None:
         ax[j].set_ylabel(ylabel)
         ax[j].set_xlabel("scenario (003-U: mean of the Monte Carlo runs)")
         ax[j].grid(True, axis="y", alpha=0.3)
-        ax[j].legend()
+        ax[j].legend(loc="lower left", framealpha=0.9)
         if key == "sse":
             ax[j].set_yscale("log")
     fig.suptitle("Paper 003: GA-SMC vs T2F-SMC per scenario (lower is better)")
@@ -200,6 +200,8 @@ def _plot_sweep(name: str, unit: str, values: list, summaries: list[dict], path)
             ax[j].set_xscale("log")
         if not numeric:
             ax[j].set_xticks(xs, [str(v) for v in values])
+        elif all(isinstance(v, int) for v in values):
+            ax[j].set_xticks(xs)
         ax[j].grid(True, alpha=0.3)
         ax[j].legend(fontsize=7)
     fig.suptitle(f"Sensitivity to {name}: below 1 = T2F-SMC lower")
@@ -367,7 +369,7 @@ def build(ctx) -> PaperSection:
                                  f"body reading: {holds_where(values, [b for b, _ in h2], dflt)}; abstract reading: "
                                  f"{holds_where(values, [a for _, a in h2], dflt)}", fig, tab))
         flips1.append((sw["name"], h1))
-        flips2.append((sw["name"], [b for b, _ in h2]))
+        flips2.append((sw["name"], [tuple(x) for x in h2]))  # either reading flipping counts
         sweep_holds1 += [h for v, h in zip(values, h1) if v != dflt]
         sweep_holds2_body += [b for v, (b, _) in zip(values, h2) if v != dflt]
         sweep_holds2_abs += [a for v, (_, a) in zip(values, h2) if v != dflt]
