@@ -308,9 +308,13 @@ def test_monte_carlo_on_the_engine_is_bit_reproducible_and_independent_of_worker
     seeds = [1, 2, 3]
     c = p3.mc_campaign("T2FSMC", seeds, {}, t_end=3.0)
     t1 = campaign.run(c, tmp_path / "w1", n_workers=1, progress=False)
-    t2 = campaign.run(c, tmp_path / "w2", n_workers=2, progress=False)
-    assert t1.equals(t2)
-    rows = p3.rows(t1)
+    t2 = campaign.run(c, tmp_path / "w2", n_workers=2, chunk=1, progress=False)
+    rows, rows2 = p3.rows(t1), p3.rows(t2)
+    assert len(rows) == len(rows2) == 3
+    for x, y in zip(rows, rows2):  # bit-identical, NaN where both are NaN (e.g. settling in 3 s)
+        assert x.keys() == y.keys()
+        for k in x:
+            assert x[k] == y[k] or (isinstance(x[k], float) and math.isnan(x[k]) and math.isnan(y[k])), k
     assert [r["status"] for r in rows] == ["ok"] * 3
     assert len({r["ise"] for r in rows}) == 3, "different seeds, different plants"
     for s, r in zip(seeds, rows):
