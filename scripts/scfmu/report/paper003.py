@@ -194,6 +194,10 @@ def _plot_sweep(name: str, unit: str, values: list, summaries: list[dict], path)
             ax[j].plot(xs, ys, marker=mk, label=f"003-{case}")
         ax[j].axhline(1.0, color="k", lw=0.8)
         ax[j].set_yscale("log")
+        from matplotlib.ticker import FuncFormatter
+        plain = FuncFormatter(lambda y, _: f"{y:g}")
+        ax[j].yaxis.set_major_formatter(plain)
+        ax[j].yaxis.set_minor_formatter(plain)
         ax[j].set_xlabel(f"{name}{f' ({unit})' if unit else ''}")
         ax[j].set_ylabel(f"{key.upper() if key != 'sse' else 'steady-state error'} ratio T2F-SMC / GA-SMC (-)")
         if numeric and min(values) > 0 and max(values) / min(values) > 20:
