@@ -46,7 +46,7 @@ def test_standard_scenarios_resolve():
 
 # ----- masters -----------------------------------------------------------------------------------------
 @pytest.mark.parametrize("name,t", [("default", 3.0), ("paper000/000-9L", 2.0), ("wheel_fault", 20.0),
-                                    ("paper001/c/dist0.01", 2.0)])
+                                    ("paper001/c/dist0.01", 2.0), ("paper003/T2FSMC/W", 3.0)])
 def test_lean_and_native_bit_identical_to_reference_master(name, t):
     sc = short(name, t)
     ref = simulate(sc, "reference")

@@ -61,7 +61,8 @@ def test_ssp_reads_back_to_the_declared_scenario(name, tmp_path):
 
 
 @pytest.mark.parametrize("name,t", [("default", 3.0), ("paper000/000-9L", 2.0), ("paper000/000-11L", 2.0),
-                                    ("paper001/c", 0.5), ("wheel_fault", 5.0)])
+                                    ("paper001/c", 0.5), ("wheel_fault", 5.0),
+                                    ("paper003/T2FSMC/N", 2.0), ("paper003/SMC/N", 2.0)])
 def test_ssp_run_is_bit_identical_to_reference(name, t, tmp_path):
     ref = run_reference(scenarios.get(name, stop_time=t))
     sc, files = ssp.read_ssp(ssp_file(name), tmp_path)

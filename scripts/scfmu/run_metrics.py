@@ -109,7 +109,14 @@ def formation(r: dict) -> dict:
     return out
 
 
-FUNCTIONS = {"attitude": attitude, "attitude_nometrics": attitude_nometrics, "formation": formation}
+def paper003(r: dict) -> dict:
+    """Paper 003 loops: attitude columns plus steady-state error per Euler angle, torque extremes, GA cost."""
+    from .paper003 import metrics
+    return metrics(r)
+
+
+FUNCTIONS = {"attitude": attitude, "attitude_nometrics": attitude_nometrics, "formation": formation,
+             "paper003": paper003}
 
 
 def compute(name: str, r: dict) -> dict:
@@ -128,4 +135,7 @@ def columns(name: str) -> list[str]:
         "formation": [f"{k}_{a}{u}" for a in "xyz" for k, u in (("settling", "_s"), ("overshoot", "_pct"),
                                                                ("final_error", "_m"), ("dist_est_end", ""))] + ["peak_force"],
     }.get(name, [])
+    if name == "paper003":
+        from .paper003 import EXTRA_COLUMNS
+        extra = columns("attitude")[len(COMMON):] + list(EXTRA_COLUMNS)
     return [*COMMON, *extra]

@@ -8,6 +8,8 @@
 * ``wheel_fault()``: paper 003 plant with reaction-wheel saturation and an x-wheel fault.
 * ``paper002(controller)``: single-axis wheel plant with a tuned PD, PID, FOPD or FOPID.
 * ``paper004(case)``: fault-tolerant control by reference correction, cases 1–3.
+* ``paper003/<SMC|T2FSMC>/<N|C|S|W|U>``: GA-SMC or T2F-SMC (tuned), cases 003-N … 003-U
+  (builder in ``scfmu.paper003``; keyword ``seed`` picks the 003-U inertia scaling).
 
 ``get(name)`` looks a scenario up by name: ``"default"``, ``"paper000/<run_id>"``,
 ``"paper001/<case>"`` or ``"paper001/<case>/dist<d>"``, ``"wheel_fault"``.
@@ -259,11 +261,15 @@ def get(name: str, **kw) -> Scenario:
         return paper002(parts[1], **kw)
     if parts[0] == "paper004" and len(parts) == 2:
         return paper004(parts[1], **kw)
+    if parts[0] == "paper003" and len(parts) == 3:  # paper003/<SMC|T2FSMC>/<N|C|S|W|U>
+        from .paper003 import scenario as paper003
+        return paper003(parts[1], parts[2], **kw)
     raise KeyError(f"unknown scenario {name!r}; known: default, paper000/<run id>, paper001/<a|b|c|d>[/dist<N>], "
-                   f"wheel_fault, paper002/<PD|PID|FOPD|FOPID>, paper004/<1|2|3>")
+                   f"wheel_fault, paper002/<PD|PID|FOPD|FOPID>, paper004/<1|2|3>, paper003/<SMC|T2FSMC>/<N|C|S|W|U>")
 
 
 def names() -> list[str]:
     return (["default"] + [f"paper000/{r.run_id}" for r in paper000_runs()]
             + [f"paper001/{c}" for c in PAPER001_CASES] + ["wheel_fault"] + [f"paper002/{c}" for c in ("PD", "PID", "FOPD", "FOPID")]
-            + [f"paper004/{c}" for c in "123"])
+            + [f"paper004/{c}" for c in "123"]
+            + [f"paper003/{c}/{k}" for c in ("SMC", "T2FSMC") for k in "NCSWU"])

@@ -49,7 +49,8 @@ for _p, _u in NS.items():
 # paper 000 default slew (command L, quaternion kinematics) with each controller, the paper 001 formation
 # cases, and the paper 003 wheel-fault loop
 STANDARD = ("default", "paper000/000-7L", "paper000/000-8L", "paper000/000-9L", "paper000/000-10L",
-            "paper000/000-11L", "paper001/a", "paper001/b", "paper001/c", "paper001/d", "wheel_fault", "paper002/FOPID", "paper004/3")
+            "paper000/000-11L", "paper001/a", "paper001/b", "paper001/c", "paper001/d", "wheel_fault", "paper002/FOPID", "paper004/3",
+            "paper003/SMC/N", "paper003/T2FSMC/N")
 
 
 def file_stem(scenario_name: str) -> str:
