@@ -106,6 +106,8 @@ def main(argv=None) -> int:
     args.out.mkdir(parents=True, exist_ok=True)
     print(f"report: papers {', '.join(papers)}, {'quick' if args.quick else 'full'} mode, {args.workers} Dask "
           f"workers -> {args.out}", flush=True)
+    import warnings
+    warnings.filterwarnings("ignore", message=".*Port .* is already in use.*")
     client, cluster = campaign._client(None, args.workers)
     ctx = ReportContext(out_dir=args.out, quick=args.quick, workers=args.workers, client=client)
     sections = []

@@ -255,7 +255,7 @@ def build(ctx) -> PaperSection:
                sensitive_to=["damaged digits J, K (run 002-7)", "materiality margin"],
                sensitivity=[Sensitivity("damaged digits (J, K)", dlabels, "J=7.7 K=1", rules.holds_at(dlabels, d1),
                                         figure=fig_dig, table=tab_dig),
-                            Sensitivity("materiality margin of 'better'", list(MARGINS), MARGIN,
+                            Sensitivity("materiality margin of 'better'", [f"{m:.1%}" for m in MARGINS], f"{MARGIN:.1%}",
                                         rules.holds_at([f"{m:.1%}" for m in MARGINS], marg1)),
                             Sensitivity("sweeps (FO MAE lower at ≥ 75 % of the points, both pairs)", list(SWEEP_LABEL),
                                         "-", rules.holds_at(list(SWEEP_LABEL), list(sweep_hold1.values())),
@@ -275,7 +275,7 @@ def build(ctx) -> PaperSection:
                sensitive_to=["damaged digits J, K (run 002-7)", "materiality margin"],
                sensitivity=[Sensitivity("damaged digits (J, K)", dlabels, "J=7.7 K=1", rules.holds_at(dlabels, d2),
                                         table=tab_dig),
-                            Sensitivity("materiality margin of 'better'", list(MARGINS), MARGIN,
+                            Sensitivity("materiality margin of 'better'", [f"{m:.1%}" for m in MARGINS], f"{MARGIN:.1%}",
                                         rules.holds_at([f"{m:.1%}" for m in MARGINS], marg2))])
     sp = spread_rule(mae_of(sweeps["inertia_scale"]))
     fr = [0.25, 0.5, 0.75, 1.0]
@@ -309,12 +309,12 @@ def build(ctx) -> PaperSection:
                tables=[sweep_table("wheel_time_constant"), sweep_table("disturbance_factor")], figures=[fig_sweeps],
                sensitive_to=["wheel time-constant range (lost in the paper)", "disturbance scale (project choice)"],
                sensitivity=[Sensitivity("wheel time constant T (s)", pl["wheel_time_constant"], 0.2,
-                                        "FO better in both pairs at " + rules.holds_where(
+                                        "fractional MAE lower in both pairs: " + rules.holds_where(
                                             pl["wheel_time_constant"],
                                             [all(rules.better(wt[f][j], wt[i][j], MARGIN) for i, f in PAIRS)
                                              for j in range(len(pl["wheel_time_constant"]))], "T", "s")),
                             Sensitivity("disturbance factor (×M_d)", pl["disturbance_factor"], 1.0,
-                                        "FO better in both pairs at " + rules.holds_where(
+                                        "fractional MAE lower in both pairs: " + rules.holds_where(
                                             pl["disturbance_factor"],
                                             [all(rules.better(ds[f][j], ds[i][j], MARGIN) for i, f in PAIRS)
                                              for j in range(len(pl["disturbance_factor"]))], "factor"))])
@@ -330,7 +330,7 @@ def build(ctx) -> PaperSection:
                f"FOPID>PID at {br['FOPID>PID'][0]}/{br['FOPID>PID'][1]} angles. Rule: at ≥ 75 % of the angles in both pairs.",
                tables=[sweep_table("theta_ref_deg")], figures=[fig_sweeps],
                sensitive_to=["reference angle (damaged digit: 10, 30 or 50 deg)"],
-               sensitivity=[Sensitivity("reference angle θ_ref (deg)", refs, THETA_REF, "FO better in both pairs at " +
+               sensitivity=[Sensitivity("reference angle θ_ref (deg)", refs, THETA_REF, "fractional MAE lower in both pairs: " +
                                         rules.holds_where(refs, [all(rules.better(rm[f][j], rm[i][j], MARGIN)
                                                                      for i, f in PAIRS) for j in range(len(refs))],
                                                           "θ_ref", "deg"))])
