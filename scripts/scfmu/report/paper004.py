@@ -182,6 +182,7 @@ def build(ctx) -> PaperSection:
     axs[1].axhline(P.W_REQ_DEG_S, color="k", ls=":", label="requirement 0.01 deg/s")
     axs[0].set_ylabel("max |roll, pitch, yaw| (deg)")
     axs[1].set_ylabel("max |ω_i| (deg/s)")
+    axs[1].set_ylim(bottom=1e-4)
     axs[2].set_ylabel("applied torque τ_x (N·m)")
     axs[2].set_xlabel("time (s)")
     for ax in axs:
