@@ -206,6 +206,11 @@ def test_paper002_rules():
     assert b["FOPD>PD"] == (3, 4) and b["holds"]
     assert not p.sweep_better_rule({"PD": [2, 2], "PID": [2, 2], "FOPD": [1, 3], "FOPID": [1, 1]})["holds"]
     assert p.grows_rule({"PD": [1, 1, 2], "FOPD": [0.5, 0.6, 0.7]}) and not p.grows_rule({"PD": [2, 1]})
+    wt = {"PD": [3, 2, 4], "PID": [3, 2, 4], "FOPD": [2.5, 1.9, 3], "FOPID": [2.5, 1.9, 3]}
+    ds = {"PD": [2, 3, 5], "PID": [2, 3, 5], "FOPD": [1.5, 2, 3], "FOPID": [1.5, 2, 3]}
+    assert all(p.c4_parts(wt, ds).values())
+    parts = p.c4_parts(wt, {**ds, "FOPD": [1.5, 1.4, 6]})      # fractional varies more and the error falls once
+    assert not parts["vary less, disturbance"] and not parts["error grows with disturbance"] and parts["better, wheel T"]
 
 
 def test_paper004_rules():

@@ -103,6 +103,16 @@ def grows_rule(sweep_mae: dict) -> bool:
     return all(rules.monotone_fraction(v, True) == 1.0 for v in sweep_mae.values())
 
 
+def c4_parts(wheel_mae: dict, dist_mae: dict) -> dict:
+    """C002-4 in five parts (all must hold): fractional better along the wheel-lag and the disturbance sweeps,
+    fractional spread not larger in either, and the error growing with the disturbance."""
+    return {"better, wheel T": sweep_better_rule(wheel_mae)["holds"],
+            "better, disturbance": sweep_better_rule(dist_mae)["holds"],
+            "vary less, wheel T": all(rules.spread(wheel_mae[f]) <= rules.spread(wheel_mae[i]) for i, f in PAIRS),
+            "vary less, disturbance": all(rules.spread(dist_mae[f]) <= rules.spread(dist_mae[i]) for i, f in PAIRS),
+            "error grows with disturbance": grows_rule(dist_mae)}
+
+
 # ----- the section ----------------------------------------------------------------------------------
 def build(ctx) -> PaperSection:
     t0 = time.time()
@@ -119,11 +129,15 @@ def build(ctx) -> PaperSection:
         return index[k]
 
     nominal_i = add({})
-    sweeps = {kind: [add(point_ov(kind, x)) for x in pl[kind]] for kind in SWEEP_LABEL}
+    # every sweep is run for every damaged-digit candidate (J, K); today's reading is J = 7.7, K = 1
+    cand_sweeps = {jk: {kind: [add({**point_ov(kind, x), **point_ov("digits", jk)}) for x in pl[kind]]
+                        for kind in SWEEP_LABEL} for jk in pl["digits"]}
+    sweeps = cand_sweeps[(7.7, 1.0)]
     digit_i = [add(point_ov("digits", jk)) for jk in pl["digits"]]
     ref_of = {}
-    for x, i in zip(pl["theta_ref_deg"], sweeps["theta_ref_deg"]):
-        ref_of[i] = x
+    for sw in cand_sweeps.values():
+        for x, i in zip(pl["theta_ref_deg"], sw["theta_ref_deg"]):
+            ref_of[i] = x
 
     res, ts_nom = {}, {}
     for c in NAMES:
@@ -210,17 +224,31 @@ def build(ctx) -> PaperSection:
         return Table(f"MAE (deg) against {SWEEP_LABEL[kind]}", [SWEEP_LABEL[kind], *NAMES],
                      [[x, *(m[c][j] for c in NAMES)] for j, x in enumerate(pl[kind])], digits=5)
 
-    # ---- digits (002-7) for the nominal claims --------------------------------------------------------
+    # ---- digits (002-7): every claim's rule at every candidate -----------------------------------------
+    def sweep_claims(sw) -> dict:
+        ridx_ = [i for x, i in zip(pl["theta_ref_deg"], sw["theta_ref_deg"]) if x != THETA_REF]
+        return {"C002-3": spread_rule(mae_of(sw["inertia_scale"]))["holds"],
+                "C002-4": all(c4_parts(mae_of(sw["wheel_time_constant"]), mae_of(sw["disturbance_factor"])).values()),
+                "C002-5": sweep_better_rule(mae_of(ridx_))["holds"]}
+
     dlabels = [f"J={j:g} K={k:g}" for j, k in pl["digits"]]
-    d1, d2 = [], []
-    for i in digit_i:
+    d1, d2, dsw = [], [], []
+    for jk, i in zip(pl["digits"], digit_i):
         d = {c: res[c][i] for c in NAMES}
         d1.append(all(pair_rule(d[f], d[n])["holds"] for n, f in PAIRS))
         d2.append(phase_rule({c: d[c]["mae_deg"] for c in NAMES})["holds"])
-    tab_dig = Table("Damaged-digit candidates (run 002-7; J in kg·m², wheel gain K), gains fixed: MAE (deg) and whether "
-                    "C002-1 / C002-2 hold", ["candidate", *NAMES, "C002-1 holds", "C002-2 holds"],
-                    [[lab, *(res[c][i]["mae_deg"] for c in NAMES), "yes" if a else "no", "yes" if b else "no"]
-                     for lab, i, a, b in zip(dlabels, digit_i, d1, d2)], digits=5)
+        dsw.append(sweep_claims(cand_sweeps[jk]))
+    yn = lambda b: "yes" if b else "no"  # noqa: E731
+    tab_dig = Table("Damaged-digit candidates (run 002-7; J in kg·m², wheel gain K), gains fixed: nominal MAE (deg) and "
+                    "whether each claim's rule holds (C002-3 … 5 from the full sweeps run at that candidate)",
+                    ["candidate", *NAMES, "C002-1", "C002-2", "C002-3", "C002-4", "C002-5"],
+                    [[lab, *(res[c][i]["mae_deg"] for c in NAMES), yn(a), yn(b), yn(w["C002-3"]), yn(w["C002-4"]),
+                      yn(w["C002-5"])] for lab, i, a, b, w in zip(dlabels, digit_i, d1, d2, dsw)], digits=5)
+
+    def digit_sens(cid, table=None):
+        h = [w[cid] for w in dsw]
+        return Sensitivity("damaged digits (J, K), full sweeps at each", dlabels, "J=7.7 K=1", rules.holds_at(dlabels, h),
+                           table=table)
     p_d, rel_d = common.figure(ctx, "002_digits.png")
     fig, ax = plt.subplots(figsize=(9, 4.2))
     xs = np.arange(len(digit_i))
@@ -279,36 +307,38 @@ def build(ctx) -> PaperSection:
                                         rules.holds_at([f"{m:.1%}" for m in MARGINS], marg2))])
     sp = spread_rule(mae_of(sweeps["inertia_scale"]))
     fr = [0.25, 0.5, 0.75, 1.0]
+    dv = {cid: dict(zip(dlabels, [w[cid] for w in dsw])) for cid in ("C002-3", "C002-4", "C002-5")}
     c3 = Claim("C002-3", "Under ±20 % inertia the mean absolute pointing error varies much less with fractional "
                          "controllers.",
-               rules.verdict(sp["holds"]),
+               rules.combine(sp["holds"], dv["C002-3"]),
                f"Inertia sweep {pl['inertia_scale'][0]:g} … {pl['inertia_scale'][-1]:g} ({len(pl['inertia_scale'])} points), "
                f"gains fixed. Spread (max − min) of the MAE: " + ", ".join(f"{c} {sp['spread'][c]:.4g} deg" for c in NAMES)
-               + f". Rule: for both pairs the fractional spread is below {MUCH_LESS:g} × the integer one.",
+               + f". Rule: for both pairs the fractional spread is below {MUCH_LESS:g} × the integer one. Verdict combined with "
+               f"the damaged-digit candidates (the sweep repeated at each) as for C002-1.",
                tables=[sweep_table("inertia_scale")], figures=[fig_sweeps],
-               sensitive_to=["threshold of 'much less'"],
-               sensitivity=[Sensitivity("threshold of 'much less' (FO spread / integer spread below)", fr, MUCH_LESS,
+               sensitive_to=["threshold of 'much less'", "damaged digits J, K (run 002-7)"],
+               sensitivity=[digit_sens("C002-3"),
+                            Sensitivity("threshold of 'much less' (FO spread / integer spread below)", fr, MUCH_LESS,
                                         rules.holds_where(fr, [spread_rule(mae_of(sweeps["inertia_scale"]), f)["holds"]
                                                                for f in fr], "factor"))])
     wt, ds = mae_of(sweeps["wheel_time_constant"]), mae_of(sweeps["disturbance_factor"])
     bw, bd = sweep_better_rule(wt), sweep_better_rule(ds)
-    lw = all(rules.spread(wt[f]) <= rules.spread(wt[i]) for i, f in PAIRS)
-    ld = all(rules.spread(ds[f]) <= rules.spread(ds[i]) for i, f in PAIRS)
-    grows = grows_rule(ds)
-    parts = {"better, wheel T": bw["holds"], "better, disturbance": bd["holds"], "vary less, wheel T": lw,
-             "vary less, disturbance": ld, "error grows with disturbance": grows}
+    parts = c4_parts(wt, ds)
     c4 = Claim("C002-4", "Under wheel time-constant and disturbance changes, fractional controllers perform better and "
                          "vary less; the error grows with the disturbance.",
-               rules.verdict(all(parts.values())),
+               rules.combine(all(parts.values()), dv["C002-4"]),
                "Wheel time-constant sweep (002-4) and disturbance-factor sweep (002-5), gains fixed. Fractional MAE lower "
                f"(by more than {MARGIN:.1%}): wheel T FOPD>PD {bw['FOPD>PD'][0]}/{bw['FOPD>PD'][1]}, FOPID>PID "
                f"{bw['FOPID>PID'][0]}/{bw['FOPID>PID'][1]} points; disturbance FOPD>PD {bd['FOPD>PD'][0]}/{bd['FOPD>PD'][1]}, "
                f"FOPID>PID {bd['FOPID>PID'][0]}/{bd['FOPID>PID'][1]}. Rule: all five parts hold: better at ≥ 75 % of the "
                f"points in both sweeps and pairs, spread not larger in both sweeps, MAE non-decreasing with the "
-               f"disturbance for every controller. Parts: " + ", ".join(f"{k}: {'yes' if v else 'no'}" for k, v in parts.items()),
+               f"disturbance for every controller. Parts: " + ", ".join(f"{k}: {'yes' if v else 'no'}" for k, v in parts.items())
+               + ". Verdict combined with the damaged-digit candidates (the sweeps repeated at each) as for C002-1.",
                tables=[sweep_table("wheel_time_constant"), sweep_table("disturbance_factor")], figures=[fig_sweeps],
-               sensitive_to=["wheel time-constant range (lost in the paper)", "disturbance scale (project choice)"],
-               sensitivity=[Sensitivity("wheel time constant T (s)", pl["wheel_time_constant"], 0.2,
+               sensitive_to=["wheel time-constant range (lost in the paper)", "disturbance scale (project choice)",
+                             "damaged digits J, K (run 002-7)"],
+               sensitivity=[digit_sens("C002-4"),
+                            Sensitivity("wheel time constant T (s)", pl["wheel_time_constant"], 0.2,
                                         "fractional MAE lower in both pairs: " + rules.holds_where(
                                             pl["wheel_time_constant"],
                                             [all(rules.better(wt[f][j], wt[i][j], MARGIN) for i, f in PAIRS)
@@ -324,13 +354,15 @@ def build(ctx) -> PaperSection:
     br = sweep_better_rule(rm)
     c5 = Claim("C002-5", "For reference angles other than the tuning one, fractional controllers keep better pointing "
                          "accuracy.",
-               rules.verdict(br["holds"]),
+               rules.combine(br["holds"], dv["C002-5"]),
                f"Reference sweep θ_ref ∈ {{{', '.join(f'{x:g}' for x in refs)}}} deg (the tuning angle 30 deg left out), "
                f"gains fixed. Fractional MAE lower by more than {MARGIN:.1%}: FOPD>PD at {br['FOPD>PD'][0]}/{br['FOPD>PD'][1]}, "
-               f"FOPID>PID at {br['FOPID>PID'][0]}/{br['FOPID>PID'][1]} angles. Rule: at ≥ 75 % of the angles in both pairs.",
+               f"FOPID>PID at {br['FOPID>PID'][0]}/{br['FOPID>PID'][1]} angles. Rule: at ≥ 75 % of the angles in both pairs. "
+               f"Verdict combined with the damaged-digit candidates (the sweep repeated at each) as for C002-1.",
                tables=[sweep_table("theta_ref_deg")], figures=[fig_sweeps],
-               sensitive_to=["reference angle (damaged digit: 10, 30 or 50 deg)"],
-               sensitivity=[Sensitivity("reference angle θ_ref (deg)", refs, THETA_REF, "fractional MAE lower in both pairs: " +
+               sensitive_to=["reference angle (damaged digit: 10, 30 or 50 deg)", "damaged digits J, K (run 002-7)"],
+               sensitivity=[digit_sens("C002-5", tab_dig),
+                            Sensitivity("reference angle θ_ref (deg)", refs, THETA_REF, "fractional MAE lower in both pairs: " +
                                         rules.holds_where(refs, [all(rules.better(rm[f][j], rm[i][j], MARGIN)
                                                                      for i, f in PAIRS) for j in range(len(refs))],
                                                           "θ_ref", "deg"))])
@@ -347,7 +379,8 @@ def build(ctx) -> PaperSection:
         claims=[c1, c2, c3, c4, c5],
         notes=(f"Thresholds (project choices): 'better' means lower by more than {MARGIN:.1%}; 'much less' means below "
                f"{MUCH_LESS:g} × the spread; 'performs better along a sweep' means at ≥ 75 % of its points. The damaged "
-               f"digits are checked for the nominal claims C002-1 and C002-2 only (a full sweep per candidate is not run). "
+               f"digits are checked for every claim: the nominal runs and all sweeps are repeated at each candidate, and a "
+               f"verdict is 'depends on a reading' when the rule's outcome differs between candidates. "
                + ("Quick mode: 3 points per sweep and 4 of the 12 digit candidates." if ctx.quick else
                   "Full mode: the sweeps of the experiment table and all 12 digit candidates.")),
         runtime_s=time.time() - t0)
