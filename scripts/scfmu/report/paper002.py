@@ -252,18 +252,20 @@ def build(ctx) -> PaperSection:
     p_d, rel_d = common.figure(ctx, "002_digits.png")
     fig, ax = plt.subplots(figsize=(9, 4.2))
     xs = np.arange(len(digit_i))
-    for k_, c in enumerate(NAMES):
-        ax.bar(xs + (k_ - 1.5) * 0.2, [res[c][i]["mae_deg"] for i in digit_i], 0.2, label=c)
+    for k_, c in enumerate(NAMES[1:]):
+        rel = [100.0 * (res[c][i]["mae_deg"] / res["PD"][i]["mae_deg"] - 1.0) for i in digit_i]
+        ax.bar(xs + (k_ - 1) * 0.25, rel, 0.25, label=f"{c} vs PD", color=f"C{k_ + 1}")
+    ax.axhline(0.0, color="k", lw=0.8)
     ax.set_xticks(xs, [lab.replace(" ", "\n") for lab in dlabels], fontsize=8)
     ax.set_xlabel("candidate reading of the damaged digits: inertia J (kg·m²), wheel gain K (-)")
-    ax.set_ylabel("MAE (deg)")
-    ax.set_yscale("log")
+    ax.set_ylabel("MAE relative to PD (%)")
     ax.grid(alpha=0.3, axis="y")
     ax.legend(fontsize=8)
-    ax.set_title("Paper 002 run 002-7: MAE for the damaged-digit candidates (gains tuned for J = 7.7, K = 1)", fontsize=10)
+    ax.set_title("Paper 002 run 002-7: MAE of PID, FOPD, FOPID relative to PD per candidate (gains tuned for J = 7.7, "
+                 "K = 1; below 0 = better than PD)", fontsize=9)
     common.save(fig, p_d)
-    fig_dig = Figure(rel_d, "MAE of the four controllers for each candidate reading of the damaged digits J and K "
-                            "(log scale); gains fixed at their nominal tuning.")
+    fig_dig = Figure(rel_d, "Nominal-step MAE of PID, FOPD and FOPID relative to PD for each candidate reading of the "
+                            "damaged digits J and K; gains fixed at their nominal tuning (absolute values in the table).")
 
     # ---- claims -----------------------------------------------------------------------------------------
     pr = {f: pair_rule(nom[f], nom[i]) for i, f in PAIRS}
