@@ -261,8 +261,7 @@ def build(ctx) -> PaperSection:
     ax.set_ylabel("MAE relative to PD (%)")
     ax.grid(alpha=0.3, axis="y")
     ax.legend(fontsize=8)
-    ax.set_title("Paper 002 run 002-7: MAE of PID, FOPD, FOPID relative to PD per candidate (gains tuned for J = 7.7, "
-                 "K = 1; below 0 = better than PD)", fontsize=9)
+    ax.set_title("Paper 002 run 002-7: MAE relative to PD per candidate (below 0: better than PD)", fontsize=10)
     common.save(fig, p_d)
     fig_dig = Figure(rel_d, "Nominal-step MAE of PID, FOPD and FOPID relative to PD for each candidate reading of the "
                             "damaged digits J and K; gains fixed at their nominal tuning (absolute values in the table).")
