@@ -170,10 +170,21 @@ def verdict(at_default: bool, swept: list[bool]) -> str:
     return DEPENDS
 
 
-def holds_where(param: str, values: list, holds: list[bool], fmt=lambda v: f"{v:.3g}") -> str:
-    """A readable region from a sweep: contiguous runs of holding values (values sorted as given)."""
+def _fmt_cat(v) -> str:
+    return "(" + ", ".join(f"{e:.3g}" for e in v) + ")" if isinstance(v, tuple) else str(v)
+
+
+def holds_where(param: str, values: list, holds: list[bool], fmt=lambda v: f"{v:.3g}", categorical=False) -> str:
+    """A readable region from a sweep: contiguous runs of holding values (values sorted as given), or for a
+    categorical reading the set of values where it holds."""
     if not values:
         return "not swept"
+    if categorical:
+        if all(holds):
+            return f"every value tried ({', '.join(fmt(v) for v in values)})"
+        if not any(holds):
+            return f"none of {', '.join(fmt(v) for v in values)}"
+        return f"{param} ∈ {{{', '.join(fmt(v) for v, h in zip(values, holds) if h)}}} (of {', '.join(fmt(v) for v in values)})"
     if all(holds):
         return f"everywhere tried ({param} ∈ [{fmt(values[0])}, {fmt(values[-1])}])" if len(values) > 1 else "everywhere tried"
     if not any(holds):
@@ -222,7 +233,7 @@ def sweeps(quick: bool) -> list[dict]:
              extra={"controller.defuzz": 1}, values=g(geo(0.1, 1.0, 8), [0.25, 1.0]), default=None,
              runs=fuzzy_runs, claims=main),
         dict(param="FuzzyPdController.t_r", key="controller.t_r", unit="s",
-             values=g(geo(2.0, 30.0, 12), [5.834, 15.0]), default=5.834, runs=fuzzy_runs, claims=main),
+             values=g(geo(2.0, 80.0, 14), [5.834, 30.0, 60.0]), default=5.834, runs=fuzzy_runs, claims=main),
         dict(param="AdaptiveFuzzyController λ-range scale s", key="lam_scale", unit="",
              values=g(geo(0.5, 16.0, 16), [1.0, 4.0, 12.0]), default=1.0, runs=af_runs, claims=main),
         dict(param="AdaptiveFuzzyController.e_scale", key="controller.e_scale", unit="",
@@ -233,10 +244,17 @@ def sweeps(quick: bool) -> list[dict]:
              values=g([0.0] + geo(1.0, 1e5, 11), [0.0, 1000.0, 1e5]), default=1000.0, runs=af_runs, claims=main),
         dict(param="MracController.gamma", key="controller.gamma", unit="kg·m²·s²",
              values=g([0.0] + geo(1.0, 1e5, 11), [0.0, 1000.0, 1e5]), default=1000.0, runs=mrac_runs, claims=main),
+        # two readings together: the fuzzy PD's reference settling time and the adaptive-fuzzy λ-range scale
+        dict(param="(FuzzyPdController.t_r [s], adaptive-fuzzy λ-range scale s)", key="joint",
+             values=[(t, s) for t in g([5.834, 15.0, 30.0, 60.0], [5.834, 30.0]) for s in g([1.0, 2.0, 4.0], [1.0, 4.0])],
+             default=(5.834, 1.0), runs=fuzzy_runs + af_runs, claims=main, categorical=True),
     ]
 
 
-def _override(sw: dict, v) -> dict:
+def _override(sw: dict, v, rid: str = "") -> dict:
+    if sw["key"] == "joint":
+        fuzzy = rid.startswith("000-10") or "-FuzzyPD-" in rid
+        return {"controller.t_r": v[0]} if fuzzy else _lam_scale(v[1])
     if sw["key"] == "lam_scale":
         return _lam_scale(v)
     return {**sw.get("extra", {}), sw["key"]: v}
@@ -270,7 +288,7 @@ def run_sweep(ctx: Context, sw: dict, idx: int) -> dict:
     """{base run id: [row per value]} for one sweep (one campaign per run id it replaces)."""
     out = {}
     for rid in sw["runs"]:
-        c = Campaign(scenarios.paper000(rid), [_override(sw, v) for v in sw["values"]], engine="native")
+        c = Campaign(scenarios.paper000(rid), [_override(sw, v, rid) for v in sw["values"]], engine="native")
         out[rid] = _rows(ctx.campaign(c, f"000/sweep{idx:02d}/{rid}"))
     return out
 
@@ -377,19 +395,23 @@ def fig_robust(ctx, ts) -> Figure:
 
 def fig_sweep(ctx, base, sw, idx, rows, holds: dict) -> Figure:
     plt = _plt()
-    rid = sw["runs"][0]
+    plotted = [r for r in sw["runs"] if r in L_RUNS]
+    rid = plotted[0]
     vals = sw["values"]
     cat = sw.get("categorical", False)
     x = np.arange(len(vals)) if cat else np.asarray(vals, float)
-    ei = [r[EI] if r["status"] == "ok" else np.nan for r in rows[rid]]
-    ef = [r[EFF] if r["status"] == "ok" else np.nan for r in rows[rid]]
     fig, axs = plt.subplots(1, 2, figsize=(11, 4))
-    axs[0].plot(x, ei, "o-", label=f"{_label(rid)} (swept)")
-    axs[1].plot(x, ef, "o-", label=f"{_label(rid)} (swept)")
+    ei = None
+    for j, r_ in enumerate(plotted):
+        e_ = [r[EI] if r["status"] == "ok" else np.nan for r in rows[r_]]
+        f_ = [r[EFF] if r["status"] == "ok" else np.nan for r in rows[r_]]
+        ei = e_ if ei is None else [min(a, b) for a, b in zip(ei, e_)]
+        axs[0].plot(x, e_, "o-", color=f"C{j}" if j else "C0", label=f"{_label(r_)} (swept)")
+        axs[1].plot(x, f_, "o-", color=f"C{j}" if j else "C0", label=f"{_label(r_)} (swept)")
     return_refs = [("000-6", "PD quat"), ("000-9L", "MRAC"), ("000-10L", "fuzzy PD"), ("000-11L", "adaptive fuzzy"),
                    ("000-2", "PD Euler")]
     for k, lab in return_refs:
-        if k == rid:
+        if k in plotted:
             continue
         axs[0].axhline(base[k][EI], ls=":", lw=1, color=f"C{1 + return_refs.index((k, lab))}",
                        label=f"{lab} (default)")
@@ -405,7 +427,8 @@ def fig_sweep(ctx, base, sw, idx, rows, holds: dict) -> Figure:
     for a in axs:
         if cat:
             a.set_xticks(x)
-            a.set_xticklabels([str(v) for v in vals])
+            a.set_xticklabels([str(v) if not isinstance(v, tuple) else "\n".join(f"{e:.3g}" for e in v) for v in vals],
+                              fontsize=7)
         elif min(vals) > 0 and max(vals) / min(vals) > 20:
             a.set_xscale("log")
         elif min(vals) == 0 and len(vals) > 2 and max(vals) / min(v for v in vals if v > 0) > 20:
@@ -425,7 +448,7 @@ def fig_sweep(ctx, base, sw, idx, rows, holds: dict) -> Figure:
     p = ctx.figures_dir / f"000_sweep{idx:02d}.png"
     fig.savefig(p, dpi=100)
     plt.close(fig)
-    return Figure(f"figures/{p.name}", f"EULERINT (left) and effort (right) of {_label(rid)} against {sw['param']}; "
+    return Figure(f"figures/{p.name}", f"EULERINT (left) and effort (right) of {', '.join(map(_label, plotted))} against {sw['param']}; "
                                        f"markers below the curve show where each claim's rule holds.")
 
 
@@ -483,16 +506,19 @@ def build(ctx: Context) -> PaperSection:
         rows = run_sweep(ctx, sw, idx)
         holds = {c: evaluate_sweep(base, sw, rows, c) for c in sw["claims"]}
         fig = fig_sweep(ctx, base, sw, idx, rows, holds)
-        rid = sw["runs"][0]
-        fmt = (lambda v: str(v)) if sw.get("categorical") else (lambda v: f"{v:.3g}")
+        plotted = [r for r in sw["runs"] if r in L_RUNS]
+        fmt = _fmt_cat if sw.get("categorical") else (lambda v: f"{v:.3g}")
         for c, h in holds.items():
-            tab = Table(f"{sw['param']}: {_label(rid)} and whether {c} holds",
-                        [sw["param"], "EULERINT [deg·s]", "∫Σ|τ| [N·m·s]", f"{c} holds"],
-                        [[(DCM_READINGS.get(v, v) if sw["key"] == "controller.dcm_error" else v),
-                          rows[rid][i][EI], rows[rid][i][EFF], "yes" if h[i] else "no"]
-                         for i, v in enumerate(sw["values"])])
+            cols = [sw["param"]]
+            for r_ in plotted:
+                cols += [f"{_label(r_)} EULERINT [deg·s]", f"{_label(r_)} ∫Σ|τ| [N·m·s]"]
+            tab = Table(f"{sw['param']}: large-command runs and whether {c} holds (one reading changed, the rest at "
+                        f"defaults)", cols + [f"{c} holds"],
+                        [[DCM_READINGS[v] if sw["key"] == "controller.dcm_error" else _fmt_cat(v)]
+                         + [x for r_ in plotted for x in (rows[r_][i][EI], rows[r_][i][EFF])]
+                         + ["yes" if h[i] else "no"] for i, v in enumerate(sw["values"])])
             default = "defuzz 0 (σ unused)" if sw["default"] is None else sw["default"]
-            s = Sensitivity(sw["param"], list(sw["values"]), default, holds_where(sw["param"], sw["values"], h, fmt),
+            s = Sensitivity(sw["param"], list(sw["values"]), default, holds_where(sw["param"], sw["values"], h, fmt, sw.get("categorical", False)),
                             fig, tab)
             per_claim[c].append((sw, h, s))
 
