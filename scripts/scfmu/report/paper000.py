@@ -246,37 +246,33 @@ def sweeps(quick: bool) -> list[dict]:
         dict(param="AttitudePlant.dcm_orthonormalize", key="plant.dcm_orthonormalize", values=[0, 1], default=0,
              runs=["000-4"], claims=["C000-1", "C000-5"], categorical=True),
         dict(param="FuzzyPdController.e_scale", key="controller.e_scale", unit="rad",
-             values=g(geo(0.1, 4.0, 16), [0.25, 1.0, 3.0]), default=1.0, runs=fuzzy_runs, claims=main),
+             values=g(geo(0.1, 4.0, 25), [0.25, 1.0, 3.0]), default=1.0, runs=fuzzy_runs, claims=main),
         dict(param="FuzzyPdController.edot_scale", key="controller.edot_scale", unit="rad/s",
-             values=g(geo(0.05, 4.0, 16), [0.1, 0.5, 2.0]), default=0.5, runs=fuzzy_runs, claims=main),
+             values=g(geo(0.05, 4.0, 25), [0.1, 0.5, 2.0]), default=0.5, runs=fuzzy_runs, claims=main),
         dict(param="FuzzyPdController.mf_half_width", key="controller.mf_half_width", unit="",
-             values=g(lin(1 / 3, 1.0, 9), [1 / 3, 1.0]), default=1 / 3, runs=fuzzy_runs, claims=main),
+             values=g(lin(1 / 3, 1.0, 13), [1 / 3, 1.0]), default=1 / 3, runs=fuzzy_runs, claims=main),
         dict(param="FuzzyPdController.sigma (defuzz = 1)", key="controller.sigma", unit="",
-             extra={"controller.defuzz": 1}, values=g(geo(0.1, 1.0, 8), [0.25, 1.0]), default=None,
+             extra={"controller.defuzz": 1}, values=g(geo(0.1, 1.0, 13), [0.25, 1.0]), default=None,
              runs=fuzzy_runs, claims=main),
         dict(param="FuzzyPdController.t_r", key="controller.t_r", unit="s",
-             values=g(geo(2.0, 80.0, 14), [5.834, 30.0, 60.0]), default=5.834, runs=fuzzy_runs, claims=main),
+             values=g(sorted(geo(2.0, 80.0, 24) + [5.834]), [5.834, 30.0, 45.0]), default=5.834, runs=fuzzy_runs, claims=main),
         dict(param="AdaptiveFuzzyController λ-range scale s", key="lam_scale", unit="",
-             values=g(geo(0.5, 16.0, 16), [1.0, 4.0, 12.0]), default=1.0, runs=af_runs, claims=main),
+             values=g(sorted(geo(0.5, 16.0, 24) + [1.0]), [1.0, 4.0, 12.0]), default=1.0, runs=af_runs, claims=main),
         dict(param="AdaptiveFuzzyController.e_scale", key="controller.e_scale", unit="",
-             values=g(geo(0.1, 4.0, 12), [0.25, 3.0]), default=1.0, runs=af_runs, claims=main),
+             values=g(geo(0.1, 4.0, 20), [0.25, 3.0]), default=1.0, runs=af_runs, claims=main),
         dict(param="AdaptiveFuzzyController.edot_scale", key="controller.edot_scale", unit="1/s",
-             values=g(geo(0.05, 4.0, 12), [0.1, 2.0]), default=0.5, runs=af_runs, claims=main),
+             values=g(geo(0.05, 4.0, 20), [0.1, 2.0]), default=0.5, runs=af_runs, claims=main),
         dict(param="AdaptiveFuzzyController.gamma", key="controller.gamma", unit="kg·m²·s²",
              values=g([0.0] + geo(1.0, 1e5, 11), [0.0, 1000.0, 1e5]), default=1000.0, runs=af_runs, claims=main),
         dict(param="MracController.gamma", key="controller.gamma", unit="kg·m²·s²",
              values=g([0.0] + geo(1.0, 1e5, 11), [0.0, 1000.0, 1e5]), default=1000.0, runs=mrac_runs, claims=main),
-        # two readings together: the fuzzy PD's reference settling time and the adaptive-fuzzy λ-range scale
-        dict(param="(FuzzyPdController.t_r [s], adaptive-fuzzy λ-range scale s)", key="joint",
-             values=[(t, s) for t in g([5.834, 15.0, 30.0, 60.0], [5.834, 30.0]) for s in g([1.0, 2.0, 4.0], [1.0, 4.0])],
-             default=(5.834, 1.0), runs=fuzzy_runs + af_runs, claims=main, categorical=True),
     ]
 
 
+JOINT = ("FuzzyPdController.t_r", "AdaptiveFuzzyController λ-range scale s")  # evaluated together, no extra runs
+
+
 def _override(sw: dict, v, rid: str = "") -> dict:
-    if sw["key"] == "joint":
-        fuzzy = rid.startswith("000-10") or "-FuzzyPD-" in rid
-        return {"controller.t_r": v[0]} if fuzzy else _lam_scale(v[1])
     if sw["key"] == "lam_scale":
         return _lam_scale(v)
     return {**sw.get("extra", {}), sw["key"]: v}
@@ -328,6 +324,35 @@ def evaluate_sweep(base: dict, sw: dict, rows: dict, claim: str) -> list[bool]:
             m[rid] = rr[i]
         res.append(False if bad else RULES[claim](m)[0])
     return res
+
+
+def evaluate_joint(base: dict, swa: dict, rowsa: dict, swb: dict, rowsb: dict, claim: str) -> np.ndarray:
+    """The claim's rule on the grid of two sweeps that replace different runs (holds[i, j]: value i of the first,
+    value j of the second)."""
+    out = np.zeros((len(swa["values"]), len(swb["values"])), bool)
+    for i in range(len(swa["values"])):
+        for j in range(len(swb["values"])):
+            m = dict(base)
+            bad = False
+            for rows, k in ((rowsa, i), (rowsb, j)):
+                for rid, rr in rows.items():
+                    bad |= rr[k]["status"] != "ok"
+                    m[rid] = rr[k]
+            out[i, j] = False if bad else RULES[claim](m)[0]
+    return out
+
+
+def joint_where(swa, swb, h: np.ndarray) -> str:
+    if h.all():
+        return "every pair tried"
+    if not h.any():
+        return (f"no pair of {swa['param']} ∈ [{swa['values'][0]:.3g}, {swa['values'][-1]:.3g}] × {swb['param']} ∈ "
+                f"[{swb['values'][0]:.3g}, {swb['values'][-1]:.3g}]")
+    parts = []
+    for j, vb in enumerate(swb["values"]):
+        if h[:, j].any():
+            parts.append(f"s = {vb:.3g}: " + holds_where("t_r", swa["values"], list(h[:, j])).split(" (of")[0])
+    return f"{int(h.sum())} of {h.size} pairs; " + "; ".join(parts)
 
 
 # ----- figures ----------------------------------------------------------------------------------------------------
@@ -474,6 +499,32 @@ def fig_sweep(ctx, base, sw, idx, rows, holds: dict) -> Figure:
                                        f"markers below the curve show where each claim's rule holds.")
 
 
+def fig_joint(ctx, swa, swb, holds: dict) -> Figure:
+    plt = _plt()
+    from matplotlib.colors import ListedColormap
+    fig, axs = plt.subplots(1, len(holds), figsize=(3.6 * len(holds), 3.8), sharey=True)
+    axs = np.atleast_1d(axs)
+    xa, xb = np.asarray(swa["values"], float), np.asarray(swb["values"], float)
+    for ax, (c, h) in zip(axs, holds.items()):
+        ax.pcolormesh(xb, xa, h.astype(float), cmap=ListedColormap(["#f4c7c3", "#b7e1cd"]), vmin=0, vmax=1,
+                      shading="nearest")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.plot([swb["default"]], [swa["default"]], "k*", ms=10, label="today's defaults")
+        ax.set_title(f"{c}: green = holds", fontsize=9)
+        ax.set_xlabel("adaptive-fuzzy λ-range scale s [-]")
+    axs[0].set_ylabel("fuzzy PD reference settling time T_r [s]")
+    axs[0].legend(fontsize=7, loc="lower left")
+    fig.suptitle("Paper 000: where each claim holds when T_r (fuzzy PD) and the λ ranges (adaptive fuzzy) change "
+                 "together", fontsize=9)
+    fig.tight_layout()
+    p = ctx.figures_dir / "000_joint_tr_lambda.png"
+    fig.savefig(p, dpi=100)
+    plt.close(fig)
+    return Figure(f"figures/{p.name}", "Regions (green) where C000-4 … C000-7 hold on the grid of the fuzzy PD's T_r "
+                                       "and the adaptive-fuzzy λ-range scale, other readings at their defaults.")
+
+
 # ----- the section ------------------------------------------------------------------------------------------------
 STATEMENTS = {
     "C000-1": "The kinematic representation matters: for the large slew with PD, EULERINT ranks quaternion < DCM < "
@@ -525,8 +576,10 @@ def build(ctx: Context) -> PaperSection:
     sws = sweeps(ctx.quick)
     per_claim: dict[str, list[tuple[dict, list[bool], Sensitivity]]] = {c: [] for c in RULES}
     needed = [(c6_needed_ratio(base), "the defaults")]
+    all_rows = {}
     for idx, sw in enumerate(sws):
         rows = run_sweep(ctx, sw, idx)
+        all_rows[sw["param"]] = rows
         if "C000-6" in sw["claims"]:
             for i, v in enumerate(sw["values"]):
                 if all(rr[i]["status"] == "ok" for rr in rows.values()):
@@ -549,6 +602,24 @@ def build(ctx: Context) -> PaperSection:
             s = Sensitivity(sw["param"], list(sw["values"]), default, holds_where(sw["param"], sw["values"], h, fmt, sw.get("categorical", False)),
                             fig, tab)
             per_claim[c].append((sw, h, s))
+
+    swa, swb = (next(sw for sw in sws if sw["param"] == n) for n in JOINT)
+    ra, rb = all_rows[swa["param"]], all_rows[swb["param"]]
+    jh = {c: evaluate_joint(base, swa, ra, swb, rb, c) for c in ("C000-4", "C000-5", "C000-6", "C000-7")}
+    jfig = fig_joint(ctx, swa, swb, jh)
+    for i, va in enumerate(swa["values"]):
+        for j, vb in enumerate(swb["values"]):
+            m = dict(base)
+            for rows, k in ((ra, i), (rb, j)):
+                m.update({rid: rr[k] for rid, rr in rows.items()})
+            if all(r["status"] == "ok" for r in m.values()):
+                needed.append((c6_needed_ratio(m), f"T_r = {va:.3g} s with λ-range scale s = {vb:.3g}"))
+    for c, h in jh.items():
+        per_claim[c].append(({"param": "joint"}, list(h.ravel()),
+                             Sensitivity(f"({JOINT[0]}, {JOINT[1]}) together", [(a, b) for a in swa["values"]
+                                                                                 for b in swb["values"]],
+                                         (swa["default"], swb["default"]), joint_where(swa, swb, h), jfig)))
+    figs.append(jfig)
 
     claims = []
     for c, rule in RULES.items():
