@@ -163,7 +163,7 @@ def test_quick_build(tmp_path):
     assert by["C000-3"].verdict == CONFIRMED and by["C000-2"].verdict == CONFIRMED
     # the DCM readings 4 and 5 make C000-1 hold, reading 0 (default) does not
     s = [x for x in by["C000-1"].sensitivity if x.parameter == "PdController.dcm_error"][0]
-    assert s.holds_where.startswith("PdController.dcm_error ∈ {4, 5}") and by["C000-1"].verdict == DEPENDS
+    assert s.holds_where.startswith("PdController.dcm_error ∈ {3, 4, 5}") and by["C000-1"].verdict == DEPENDS
     for f in sec.figures:
         assert (tmp_path / f.path).stat().st_size > 10_000
     assert time.time() - t0 < 300

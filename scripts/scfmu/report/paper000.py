@@ -501,6 +501,7 @@ def fig_sweep(ctx, base, sw, idx, rows, holds: dict) -> Figure:
 
 def fig_joint(ctx, swa, swb, holds: dict) -> Figure:
     plt = _plt()
+    from matplotlib import ticker
     from matplotlib.colors import ListedColormap
     fig, axs = plt.subplots(1, len(holds), figsize=(3.6 * len(holds), 3.8), sharey=True)
     axs = np.atleast_1d(axs)
@@ -510,6 +511,12 @@ def fig_joint(ctx, swa, swb, holds: dict) -> Figure:
                       shading="nearest")
         ax.set_xscale("log")
         ax.set_yscale("log")
+        ax.set_xticks([t for t in (0.5, 1, 2, 4, 8, 16) if xb[0] <= t <= xb[-1]])
+        ax.set_yticks([t for t in (2, 3, 5, 10, 20, 40, 80) if xa[0] <= t <= xa[-1]])
+        ax.xaxis.set_major_formatter(ticker.ScalarFormatter())
+        ax.yaxis.set_major_formatter(ticker.ScalarFormatter())
+        ax.xaxis.set_minor_formatter(ticker.NullFormatter())
+        ax.yaxis.set_minor_formatter(ticker.NullFormatter())
         ax.plot([swb["default"]], [swa["default"]], "k*", ms=10, label="today's defaults")
         ax.set_title(f"{c}: green = holds", fontsize=9)
         ax.set_xlabel("adaptive-fuzzy λ-range scale s [-]")
