@@ -159,8 +159,12 @@ def test_quick_build(tmp_path):
     assert isinstance(sec, PaperSection)
     assert [c.id for c in sec.claims] == [f"C000-{i}" for i in range(1, 8)]
     by = {c.id: c for c in sec.claims}
-    # defaults (issue 14): identical PD/LQR/pole placement, small-command agreement
-    assert by["C000-3"].verdict == CONFIRMED and by["C000-2"].verdict == CONFIRMED
+    # identical PD/LQR/pole placement; small-command agreement except with the doubled-gain DCM reading 2
+    assert by["C000-3"].verdict == CONFIRMED
+    s2 = [x for x in by["C000-2"].sensitivity if x.parameter == "PdController.dcm_error"][0]
+    assert by["C000-2"].verdict == DEPENDS and s2.holds_where.startswith("PdController.dcm_error ∈ {0, 1, 3, 4, 5}")
+    # issue 14's contradictions under today's defaults: the large-slew ranking depends on a reading
+    assert by["C000-4"].verdict == DEPENDS and "AdaptiveFuzzyController λ-range scale s" in by["C000-4"].sensitive_to
     # the DCM readings 4 and 5 make C000-1 hold, reading 0 (default) does not
     s = [x for x in by["C000-1"].sensitivity if x.parameter == "PdController.dcm_error"][0]
     assert s.holds_where.startswith("PdController.dcm_error ∈ {3, 4, 5}") and by["C000-1"].verdict == DEPENDS
