@@ -255,7 +255,7 @@ def sweeps(quick: bool) -> list[dict]:
              extra={"controller.defuzz": 1}, values=g(geo(0.1, 1.0, 13), [0.25, 1.0]), default=None,
              runs=fuzzy_runs, claims=main),
         dict(param="FuzzyPdController.t_r", key="controller.t_r", unit="s",
-             values=g(sorted(geo(2.0, 80.0, 24) + [5.834]), [5.834, 30.0, 45.0]), default=5.834, runs=fuzzy_runs, claims=main),
+             values=g(sorted(geo(2.0, 80.0, 32) + [5.834]), [5.834, 30.0, 45.0]), default=5.834, runs=fuzzy_runs, claims=main),
         dict(param="AdaptiveFuzzyController λ-range scale s", key="lam_scale", unit="",
              values=g(sorted(geo(0.5, 16.0, 24) + [1.0]), [1.0, 4.0, 12.0]), default=1.0, runs=af_runs, claims=main),
         dict(param="AdaptiveFuzzyController.e_scale", key="controller.e_scale", unit="",
@@ -606,8 +606,11 @@ def build(ctx: Context) -> PaperSection:
                          + [x for r_ in plotted for x in (rows[r_][i][EI], rows[r_][i][EFF])]
                          + ["yes" if h[i] else "no"] for i, v in enumerate(sw["values"])])
             default = "defuzz 0 (σ unused)" if sw["default"] is None else sw["default"]
-            s = Sensitivity(sw["param"], list(sw["values"]), default, holds_where(sw["param"], sw["values"], h, fmt, sw.get("categorical", False)),
-                            fig, tab)
+            # the table only where the reading moves the verdict (keeps the report short); the figure always
+            moves = any(x != RULES[c](base)[0] for x in h)
+            s = Sensitivity(sw["param"], list(sw["values"]), default,
+                            holds_where(sw["param"], sw["values"], h, fmt, sw.get("categorical", False)), fig,
+                            tab if moves else None)
             per_claim[c].append((sw, h, s))
 
     swa, swb = (next(sw for sw in sws if sw["param"] == n) for n in JOINT)
@@ -623,8 +626,11 @@ def build(ctx: Context) -> PaperSection:
                 needed.append((c6_needed_ratio(m), f"T_r = {va:.3g} s with λ-range scale s = {vb:.3g}"))
     for c, h in jh.items():
         per_claim[c].append(({"param": "joint"}, list(h.ravel()),
-                             Sensitivity(f"({JOINT[0]}, {JOINT[1]}) together", [(a, b) for a in swa["values"]
-                                                                                 for b in swb["values"]],
+                             Sensitivity(f"({JOINT[0]}, {JOINT[1]}) together",
+                                         [f"T_r: {len(swa['values'])} values in [{swa['values'][0]:.3g}, "
+                                          f"{swa['values'][-1]:.3g}] s",
+                                          f"s: {len(swb['values'])} values in [{swb['values'][0]:.3g}, "
+                                          f"{swb['values'][-1]:.3g}]"],
                                          (swa["default"], swb["default"]), joint_where(swa, swb, h), jfig)))
     figs.append(jfig)
 
@@ -651,10 +657,14 @@ def build(ctx: Context) -> PaperSection:
             ok2, why2 = rule(base, ("L2",))
             swept.append(ok2)
             extra = f" On command L2 (R1 not mirror-symmetric): {'holds' if ok2 else 'fails'} ({why2})."
+            sens.append(Sensitivity("robustness command (L or L2)", ["L", "L2"], "L",
+                                    "both" if ok and ok2 else "L" if ok else "L2" if ok2 else "neither"))
         v = verdict(ok, swept)
         flips = [s.parameter for (sw, h, s) in per_claim[c] if any(x != ok for x in h)]
         if c in ("C000-5", "C000-6") and (rule(base, "effort_sq")[0] != ok):
             flips.append("effort metric")
+        if c == "C000-7" and rule(base, ("L2",))[0] != ok:
+            flips.append("robustness command (L or L2)")
         evidence = (f"Rule: {RULE_TEXT[c]} At the defaults it {'holds' if ok else 'fails'}: {why}.{extra} "
                     + (f"The verdict flips with: {', '.join(flips)}." if flips else
                        "No reading swept here changes it."))
@@ -669,10 +679,19 @@ def build(ctx: Context) -> PaperSection:
              f"{len(base)} runs of the paper 000 table (000-1 … 000-11 and the robustness runs R1, R2) plus "
              f"{n_sweep} sweep runs on the campaign engine (native), Δ = 0.01 s, t_end = 30 s"
              + (" (quick mode: a few points per sweep)" if ctx.quick else "") + ".")
-    notes = ("Readings: EULERINT in deg·s over [0, 30] s; effort = ∫Σ|τ| dt (the paper's formula is unknown; ∫‖τ‖² dt "
-             "is shown too). The DCM error law has six plausible readings (PdController parameter dcm_error, "
-             "default 0 = the elements as printed); see docs/paper000.md. Sweeps change one reading at a time, the "
-             "other controllers stay at their defaults. The adaptive-fuzzy 'λ-range scale' s multiplies λ2's range by "
-             "s and λ1's by √s (the reference model's time scale, roots stay real).")
+    notes = (
+        "Readings: EULERINT in deg·s over [0, 30] s; effort = ∫Σ|τ| dt (the paper's formula is unknown; ∫‖τ‖² dt is "
+        "evaluated too). Thresholds: rankings need a 0.5 % margin, 'about the same' ≤ 10 % spread, 'identical' ≤ 1e-6, "
+        "'without much more effort' ≤ 1.5 × the quaternion PD's effort. The DCM error law has six readings "
+        "(PdController parameter dcm_error, default 0 = the elements of A(q)A(q_ref)ᵀ as printed; 4 = attitude "
+        "matrix read body → inertial, 5 = elements of A(q_ref)ᵀA(q)); the DCM kinematics was checked through the "
+        "plant's re-orthonormalisation switch (the other form of the kinematics equation, Ȧ = A[Ω], would rotate "
+        "about inertial axes and is not a consistent reading). Sweeps change one reading at a time, the other "
+        "controllers at their defaults; the fuzzy PD's reference settling time T_r (which sets its damping range) "
+        "and the adaptive-fuzzy λ-range scale s (λ2 range × s, λ1 range × √s: the reference model sped up by √s, "
+        "roots stay real) are also evaluated together on their grid, from the same runs. "
+        + ("Quick mode: 2–3 points per sweep (the regions are coarse; the verdicts are those of the full grids "
+           "except where a region falls between the quick points)." if ctx.quick else
+           "Full mode: 13–26 points per sweep."))
     return PaperSection("000", TITLE, setup, claims, figures=figs, tables=[_metrics_table(base)], notes=notes,
                         runtime_s=time.time() - t0)
