@@ -469,6 +469,8 @@ def fig_sweep(ctx, base, sw, idx, rows, holds: dict) -> Figure:
     for i, (c, h) in enumerate(holds.items()):
         xs = [xx for xx, hh in zip(x, h) if hh]
         ys = [yy for yy, hh in zip(ei, h) if hh]
+        if not xs:
+            continue
         axs[0].scatter(xs, np.asarray(ys) * (0.93 - 0.05 * i), marker=mk[c], s=28, color=f"C{6 + i}",
                        label=f"{c} holds here")
     for a in axs:
@@ -477,7 +479,10 @@ def fig_sweep(ctx, base, sw, idx, rows, holds: dict) -> Figure:
             a.set_xticklabels([str(v) if not isinstance(v, tuple) else "\n".join(f"{e:.3g}" for e in v) for v in vals],
                               fontsize=7)
         elif min(vals) > 0 and max(vals) / min(vals) > 20:
+            from matplotlib import ticker
             a.set_xscale("log")
+            a.xaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+            a.xaxis.set_minor_formatter(ticker.NullFormatter())
         elif min(vals) == 0 and len(vals) > 2 and max(vals) / min(v for v in vals if v > 0) > 20:
             a.set_xscale("symlog", linthresh=min(v for v in vals if v > 0))
         unit = sw.get("unit", "")
