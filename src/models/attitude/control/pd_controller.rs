@@ -63,7 +63,10 @@ w_ref is not used (paper 000 commands are constant).</p>",
             0 => (v.inertia * v.wn * v.wn, v.inertia * (-2.0 * v.zeta * v.wn)),
             _ => (v.kp, v.kd),
         };
-        Ok(PdController { law: ErrorLaw::from_param("error_law", v.error_law)?, dcm: DcmError::from_param("dcm_error", v.dcm_error)? })
+        Ok(PdController {
+            law: ErrorLaw::from_param("error_law", v.error_law)?,
+            dcm: DcmError::from_param("dcm_error", v.dcm_error)?,
+        })
     }
 
     fn outputs(&self, v: &mut PdControllerVars, _t: f64) -> ModelResult {
