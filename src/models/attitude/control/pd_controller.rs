@@ -3,7 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::shared::{linear_law, AttitudeControllerPorts, ErrorLaw};
+use super::shared::{check_unit_quaternions, AttitudeControllerPorts, DcmError, ErrorLaw};
 use crate::declare_variables;
 use crate::model::{check_derived, Experiment, Feedthrough, Model, ModelInfo, ModelResult, ParamEnum};
 
@@ -17,6 +17,7 @@ declare_variables! {
         108 => kd: Vec3 = [-2000.0, -1000.0, -1400.0], Parameter, "N.m.s/rad", "Explicit rate gain k_d, negative in the paper's convention (gain_mode = 1)";
         120 => gain_mode: Integer = 0, Parameter, "", "0 = gains from wn, zeta and inertia; 1 = explicit kp_*, kd_*", Choice(&[0, 1]);
         121 => error_law: Integer = 0, Parameter, "", "Error signal: 0 = quaternion, 1 = DCM, 2 = Euler 321 angles", Choice(ErrorLaw::CODES);
+        122 => dcm_error: Integer = 0, Parameter, "", "Reading of the DCM error (error_law = 1): 0 = elements of A(q)A(q_ref)^T as printed; 1 = vex of its skew part (= quaternion law); 2 = twice that; 3 = -(transposed elements); 4 = body-to-inertial attitude matrix; 5 = transposed elements of A(q_ref)^T A(q)", Choice(DcmError::CODES);
         200 => k: Vec3 = [0.0; 3], CalculatedParameter, "N.m/rad", "Proportional gain in use";
         203 => k_d: Vec3 = [0.0; 3], CalculatedParameter, "N.m.s/rad", "Rate gain in use (negative)";
     }
@@ -26,6 +27,7 @@ declare_variables! {
 #[derive(Clone, Serialize, Deserialize)]
 pub struct PdController {
     law: ErrorLaw,
+    dcm: DcmError,
 }
 
 impl Model for PdController {
@@ -37,8 +39,19 @@ impl Model for PdController {
         equations_html: "<pre>T_i   = k_i e_i + k_d,i w_i\n\
 k_i   = wn^2 I_i,   k_d,i = -2 zeta wn I_i      (k_d is negative: the paper's law adds +k_d * rate)\n\
 e^Q   = 2 q_E,w q_E,v,   q_E = q* (x) q_ref                 (error_law = 0)\n\
-e^D   = (A_E[3,2], A_E[1,3], A_E[2,1]),  A_E = A(q) A(q_ref)^T  (error_law = 1)\n\
-e^E   = wrap(euler321(q_ref) - euler321(q))                 (error_law = 2)</pre>\n\
+e^D   = (A_E[3,2], A_E[1,3], A_E[2,1]),  A_E = A(q) A(q_ref)^T  (error_law = 1, dcm_error = 0)\n\
+e^E   = wrap(euler321(q_ref) - euler321(q))                 (error_law = 2)\n\
+DCM error readings (dcm_error), M = A(q) A(q_ref)^T, N = A(q)^T A(q_ref), A(q) inertial -> body:\n\
+  0  e = ( M32,  M13,  M21)            elements as printed (default)\n\
+  1  e = vex((M - M^T)/2) = sin(alpha) axis   (identical to the quaternion law)\n\
+  2  e = vex(M - M^T)     = 2 sin(alpha) axis\n\
+  3  e = -(M23, M31, M12)              printed elements of A(q_ref) A(q)^T, sign for commanded - actual\n\
+  4  e = -(N32, N13, N21)              attitude matrix read as body -> inertial\n\
+  5  e = ( N23, N31, N12)              printed elements of A(q_ref)^T A(q)</pre>\n\
+<p>All six DCM readings agree to first order for small angles (small attitude and small error, the paper's \
+linearisation: e = commanded - actual angle); at large angles they differ by the symmetric part \
+(1 - cos alpha) n n^T of the error matrix, its sign, and (readings 4, 5) the frame in which the error axis is \
+expressed (reference instead of body). Paper 000 does not say which one it used; reading 0 is the default.</p>\n\
 <p>For a constant command and the linear small-angle plant each axis closes to s^2 + 2 zeta wn s + wn^2. \
 w_ref is not used (paper 000 commands are constant).</p>",
         feedthrough: Feedthrough::AllInputs,
@@ -50,16 +63,25 @@ w_ref is not used (paper 000 commands are constant).</p>",
             0 => (v.inertia * v.wn * v.wn, v.inertia * (-2.0 * v.zeta * v.wn)),
             _ => (v.kp, v.kd),
         };
-        Ok(PdController { law: ErrorLaw::from_param("error_law", v.error_law)? })
+        Ok(PdController {
+            law: ErrorLaw::from_param("error_law", v.error_law)?,
+            dcm: DcmError::from_param("dcm_error", v.dcm_error)?,
+        })
     }
 
     fn outputs(&self, v: &mut PdControllerVars, _t: f64) -> ModelResult {
-        v.ports.torque_cmd = linear_law(self.law, &v.ports, &v.k, &v.k_d)?;
+        check_unit_quaternions(&v.ports)?;
+        let e = match self.law {
+            ErrorLaw::Dcm => self.dcm.error(&v.ports),
+            law => law.error(&v.ports),
+        };
+        v.ports.torque_cmd = v.k.component_mul(&e) + v.k_d.component_mul(&v.ports.w);
         Ok(())
     }
 
     fn validate(&self, fresh: &Self) -> ModelResult {
-        check_derived("error law", &self.law, &fresh.law)
+        check_derived("error law", &self.law, &fresh.law)?;
+        check_derived("DCM error reading", &self.dcm, &fresh.dcm)
     }
 }
 
@@ -79,5 +101,38 @@ mod tests {
         c.v.wn = -1.0;
         let e = c.initialize(&Experiment::default()).unwrap_err();
         assert!(e.contains("wn = -1"), "{e}");
+    }
+
+    #[test]
+    fn dcm_readings_agree_for_small_errors_and_skew_half_is_the_quaternion_law() {
+        use crate::math::attitude::quat_from_euler321;
+        let mut c = Fmu::<PdController>::default();
+        c.v.error_law = 1;
+        // first-order agreement needs small angles for both the attitude and the error (the paper's
+        // small-angle derivation); readings 4 and 5 express the axis in the reference frame
+        let q = quat_from_euler321(1e-4, -2e-4, 1e-4);
+        let small = quat_from_euler321(-1e-4, 2e-4, 3e-4);
+        let large = quat_from_euler321(0.7, -0.7, -1.0);
+        let mut first = None;
+        for code in DcmError::CODES {
+            c.v.dcm_error = *code;
+            c.initialize(&Experiment::default()).unwrap();
+            (c.v.ports.q, c.v.ports.q_ref, c.v.ports.w) = (q, small, Vector3::zeros());
+            c.outputs(0.0).unwrap();
+            let t = c.v.ports.torque_cmd.component_div(&c.v.k) / if *code == 2 { 2.0 } else { 1.0 };
+            let f = *first.get_or_insert(t);
+            assert!((t - f).norm() < 2e-3 * f.norm(), "reading {code}: {t} vs {f}");
+            // reading 1 (vex of the skew part) is exactly the quaternion law at any angle
+            if *code == 1 {
+                (c.v.ports.q, c.v.ports.q_ref) = (quat_from_euler321(0.3, -0.2, 0.5), large);
+                c.outputs(0.0).unwrap();
+                let e = crate::math::attitude::error_quaternion(&c.v.ports.q, &large);
+                let eq = e.vector() * (2.0 * e.w);
+                assert!((c.v.ports.torque_cmd.component_div(&c.v.k) - eq).norm() < 1e-14);
+            }
+        }
+        c.v.dcm_error = 6;
+        let e = c.initialize(&Experiment::default()).unwrap_err();
+        assert!(e.contains("dcm_error"), "{e}");
     }
 }

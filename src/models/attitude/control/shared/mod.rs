@@ -10,5 +10,5 @@ pub mod mrac;
 pub mod ports;
 pub mod smc;
 
-pub use error_law::{linear_law, ErrorLaw};
+pub use error_law::{linear_law, DcmError, ErrorLaw};
 pub use ports::{check_unit_quaternions, AttitudeControllerPorts};
