@@ -37,8 +37,8 @@ impl Model for AdaptiveFuzzyController {
     type Vars = AdaptiveFuzzyControllerVars;
     const INFO: ModelInfo = ModelInfo {
         name: "AdaptiveFuzzyController",
-        description: "Paper 000 adaptive-fuzzy attitude controller: MRAC whose reference-model lambda1, lambda2 are fuzzy-scheduled",
-        source: "paper 000 (adaptive-fuzzy EULERINT design), §7, Eqs. 48, 54-57",
+        description: "Adaptive-fuzzy attitude controller: MRAC whose reference-model lambda1, lambda2 are fuzzy-scheduled",
+        source: "[Navabi-2019], §7, Eqs. 48, 54-57",
         equations_html: "<pre>MracController with, per axis and at every instant,\n\
 e_m = r - x_m,  edot_m = -x_m'          (fuzzy inputs, scaled by e_scale, edot_scale; sets and tables of FuzzyPdController)\n\
 lambda2 = lambda2_min + (lambda2_max - lambda2_min) k'_p      (stiffness from the k_p table)\n\
@@ -55,7 +55,7 @@ requirement checked at initialization: lambda1_min^2 >= 4 lambda2_max (real nega
         check::ordered("lambda2_min", l2min, "lambda2_max", l2max)?;
         if l1min * l1min < 4.0 * l2max * (1.0 - 1e-12) {
             return Err(format!(
-                "lambda1_min^2 = {} < 4 lambda2_max = {}: the reference model could get complex roots (paper 000 requires two real negative roots)",
+                "lambda1_min^2 = {} < 4 lambda2_max = {}: the reference model could get complex roots ([Navabi-2019] requires two real negative roots)",
                 l1min * l1min,
                 4.0 * l2max
             ));

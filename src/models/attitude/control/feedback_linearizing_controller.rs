@@ -14,9 +14,9 @@ declare_variables! {
         ports: AttitudeControllerPorts;
         50 => q_ref_dot: Vec3 = [0.0; 3], Input, "1/s", "Time derivative of the commanded quaternion's vector part (0 = constant command)";
         53 => q_ref_ddot: Vec3 = [0.0; 3], Input, "1/s2", "Second time derivative of the commanded quaternion's vector part (0 = constant command)";
-        100 => inertia: Diag3 = [449.5, 264.5, 312.5], Parameter, "kg.m2", "Controller's nominal inertia (diagonal; paper 004 default)", Positive;
-        160 => k_q: Vec3 = [0.5; 3], Parameter, "1/s2", "Stiffness k_q of the error dynamics e'' + k_qdot e' + k_q e = 0 (paper 004)", Positive;
-        163 => k_qdot: Vec3 = [2.0; 3], Parameter, "1/s", "Damping k_qdot of the error dynamics (paper 004)", Positive;
+        100 => inertia: Diag3 = [449.5, 264.5, 312.5], Parameter, "kg.m2", "Controller's nominal inertia (diagonal; [Moradi-FTC] default)", Positive;
+        160 => k_q: Vec3 = [0.5; 3], Parameter, "1/s2", "Stiffness k_q of the error dynamics e'' + k_qdot e' + k_q e = 0 ([Moradi-FTC])", Positive;
+        163 => k_qdot: Vec3 = [2.0; 3], Parameter, "1/s", "Damping k_qdot of the error dynamics ([Moradi-FTC])", Positive;
     }
 }
 
@@ -28,8 +28,8 @@ impl Model for FeedbackLinearizingController {
     type Vars = FeedbackLinearizingControllerVars;
     const INFO: ModelInfo = ModelInfo {
         name: "FeedbackLinearizingController",
-        description: "Paper 004 feedback-linearising quaternion attitude law with reference-derivative inputs",
-        source: "paper 004 (active fault-tolerant control under actuator fault), Eqs. 1-7",
+        description: "Feedback-linearising quaternion attitude law with reference-derivative inputs",
+        source: "[Moradi-FTC], Eqs. 1-7",
         equations_html: "<pre>q_v'   = 1/2 (q_w w + q_v x w)                          (from the measured q and w)\n\
 u''    = q_ref_ddot - k_qdot (q_v' - q_ref_dot) - k_q (q_v - q_ref_v)      (componentwise)\n\
 g      = ((I_y - I_z)/I_x w_y w_z, (I_z - I_x)/I_y w_x w_z, (I_x - I_y)/I_z w_x w_y)\n\

@@ -17,15 +17,15 @@ declare_variables! {
         100 => inertia: Diag3 = [1000.0, 500.0, 700.0], Parameter, "kg.m2", "Controller's nominal inertia", Positive;
         103 => wn: Real = 1.0, Parameter, "rad/s", "Reference PD natural frequency: k_r,i = wn^2 I_i (project choice)", Positive;
         104 => t_r: Real = 5.834, Parameter, "s", "Reference settling time T_r (project choice: 2 % settling of wn = 1, zeta = 1)", Positive;
-        105 => kp_min_factor: Real = 0.28, Parameter, "", "k_p,min = kp_min_factor k_r (paper 000 Eq. 47)", NonNegative;
-        106 => kp_max_factor: Real = 3.0, Parameter, "", "k_p,max = kp_max_factor k_r (paper 000 Eq. 47)", NonNegative;
-        107 => kd_min_factor: Real = 0.08, Parameter, "", "k_d,min = kd_min_factor k_r T_r (paper 000 Eq. 47)", NonNegative;
-        108 => kd_max_factor: Real = 0.15, Parameter, "", "k_d,max = kd_max_factor k_r T_r (paper 000 Eq. 47)", NonNegative;
+        105 => kp_min_factor: Real = 0.28, Parameter, "", "k_p,min = kp_min_factor k_r ([Navabi-2019] Eq. 47)", NonNegative;
+        106 => kp_max_factor: Real = 3.0, Parameter, "", "k_p,max = kp_max_factor k_r ([Navabi-2019] Eq. 47)", NonNegative;
+        107 => kd_min_factor: Real = 0.08, Parameter, "", "k_d,min = kd_min_factor k_r T_r ([Navabi-2019] Eq. 47)", NonNegative;
+        108 => kd_max_factor: Real = 0.15, Parameter, "", "k_d,max = kd_max_factor k_r T_r ([Navabi-2019] Eq. 47)", NonNegative;
         115 => e_scale: Real = 1.0, Parameter, "rad", "Error normalisation: e_bar = clamp(e / e_scale, -1, 1)", Positive;
         116 => edot_scale: Real = 0.5, Parameter, "rad/s", "Error-rate normalisation: edot_bar = clamp(edot / edot_scale, -1, 1)", Positive;
         117 => sigma: Real = 0.25, Parameter, "", "Width of the Gaussian output sets Small (centre 0) and Big (centre 1)", Positive;
         118 => mf_half_width: Real = 0.3333333333333333, Parameter, "", "Half-width of the seven triangular input sets centred at -1, -2/3, ..., 1 (>= 1/3)";
-        121 => error_law: Integer = 0, Parameter, "", "Error signal: 0 = quaternion (paper 000), 1 = DCM, 2 = Euler 321 angles", Choice(ErrorLaw::CODES);
+        121 => error_law: Integer = 0, Parameter, "", "Error signal: 0 = quaternion ([Navabi-2019]), 1 = DCM, 2 = Euler 321 angles", Choice(ErrorLaw::CODES);
         122 => defuzz: Integer = 0, Parameter, "", "Defuzzification: 0 = weighted average with c(S) = 0, c(B) = 1; 1 = truncated-centroid representatives", Choice(Defuzz::CODES);
         200 => kr: Vec3 = [0.0; 3], CalculatedParameter, "N.m/rad", "Reference gain k_r";
         203 => kp_min: Vec3 = [0.0; 3], CalculatedParameter, "N.m/rad", "k_p,min";
@@ -47,12 +47,12 @@ impl Model for FuzzyPdController {
     type Vars = FuzzyPdControllerVars;
     const INFO: ModelInfo = ModelInfo {
         name: "FuzzyPdController",
-        description: "Paper 000 quaternion PD attitude controller with gains scheduled by a 7x7-rule fuzzy system",
-        source: "paper 000 (adaptive-fuzzy EULERINT design), §6, Eqs. 44-47, Tables 1-2",
+        description: "Quaternion PD attitude controller with gains scheduled by a 7x7-rule fuzzy system",
+        source: "[Navabi-2019], §6, Eqs. 44-47, Tables 1-2",
         equations_html: "<pre>per axis: e = e^Q_i (error_law 0),  edot = -w_i\n\
 e_bar = clamp(e / e_scale, -1, 1),  edot_bar = clamp(edot / edot_scale, -1, 1)\n\
 mu_jk = mu_j(e_bar) mu_k(edot_bar)                         (product firing; 7 triangles NB..PB)\n\
-k'_p = sum mu_jk c(P_jk) / sum mu_jk,  k'_d = sum mu_jk c(D_jk) / sum mu_jk   (paper 000 Tables 1-2)\n\
+k'_p = sum mu_jk c(P_jk) / sum mu_jk,  k'_d = sum mu_jk c(D_jk) / sum mu_jk   ([Navabi-2019] Tables 1-2)\n\
 k_p = k_p,min + (k_p,max - k_p,min) k'_p,  k_d = k_d,min + (k_d,max - k_d,min) k'_d\n\
 k_p,min = 0.28 k_r, k_p,max = 3 k_r, k_d,min = 0.08 k_r T_r, k_d,max = 0.15 k_r T_r,  k_r = wn^2 I\n\
 T_i = k_p e - k_d w_i</pre>\n\

@@ -13,10 +13,10 @@ declare_variables! {
     pub struct LqrControllerVars {
         ports: AttitudeControllerPorts;
         100 => inertia: Diag3 = [1000.0, 500.0, 700.0], Parameter, "kg.m2", "Controller's nominal inertia", Positive;
-        103 => q11: Real = 1.0, Parameter, "", "State weight Q[1,1] on the angle error (paper 000 Eq. 26)", NonNegative;
-        104 => q22: Real = 2.0, Parameter, "", "State weight Q[2,2] on the rate (paper 000 Eq. 26)", NonNegative;
+        103 => q11: Real = 1.0, Parameter, "", "State weight Q[1,1] on the angle error ([Navabi-2019] Eq. 26)", NonNegative;
+        104 => q22: Real = 2.0, Parameter, "", "State weight Q[2,2] on the rate ([Navabi-2019] Eq. 26)", NonNegative;
         105 => q12: Real = 0.0, Parameter, "", "Off-diagonal state weight Q[1,2] = Q[2,1] (project addition; Q must be positive semi-definite)";
-        106 => lqr_r_scale: Real = 1.0, Parameter, "", "Control weight scale: R_i = lqr_r_scale / I_i^2 (paper 000 Eq. 26)", Positive;
+        106 => lqr_r_scale: Real = 1.0, Parameter, "", "Control weight scale: R_i = lqr_r_scale / I_i^2 ([Navabi-2019] Eq. 26)", Positive;
         121 => error_law: Integer = 0, Parameter, "", "Error signal: 0 = quaternion, 1 = DCM, 2 = Euler 321 angles", Choice(ErrorLaw::CODES);
         200 => k1: Vec3 = [0.0; 3], CalculatedParameter, "N.m/rad", "LQR gain K_1 on the angle error (from the Riccati equation)";
         203 => k2: Vec3 = [0.0; 3], CalculatedParameter, "N.m.s/rad", "LQR gain K_2 on the rate";
@@ -33,12 +33,12 @@ impl Model for LqrController {
     type Vars = LqrControllerVars;
     const INFO: ModelInfo = ModelInfo {
         name: "LqrController",
-        description: "Paper 000 per-axis LQR attitude controller; gains from the Riccati equation solved at initialization",
-        source: "paper 000 (adaptive-fuzzy EULERINT design), Eqs. 19-27",
+        description: "Per-axis LQR attitude controller; gains from the Riccati equation solved at initialization",
+        source: "[Navabi-2019], Eqs. 19-27",
         equations_html: "<pre>per axis: A = [0 1; 0 0],  B = [0; 1/I_i],  Q = [q11 q12; q12 q22],  R_i = lqr_r_scale / I_i^2\n\
 A^T P + P A + Q - P B R^-1 B^T P = 0    (solved numerically: Hamiltonian sign function + Newton-Kleinman)\n\
 K_i = R_i^-1 B^T P = [K_i1, K_i2]\n\
-T_i = K_i1 e_i - K_i2 w_i               (u = -K [x - x_com; w], x - x_com = -e; paper 000 Eq. 27)</pre>\n\
+T_i = K_i1 e_i - K_i2 w_i               (u = -K [x - x_com; w], x - x_com = -e; [Navabi-2019] Eq. 27)</pre>\n\
 <p>e is the error of error_law (0 quaternion, 1 DCM, 2 Euler angles), as in PdController. \
 Defaults give K_i = [I_i, 2 I_i] (closed loop s^2 + 2 s + 1). w_ref is not used.</p>",
         feedthrough: Feedthrough::AllInputs,

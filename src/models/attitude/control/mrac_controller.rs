@@ -13,8 +13,8 @@ declare_variables! {
     pub struct MracControllerVars {
         ports: AttitudeControllerPorts;
         mrac: MracVariables;
-        107 => lambda1: Real = 2.0, Parameter, "1/s", "Reference-model damping coefficient lambda1 (paper 000 Eq. 37)", Positive;
-        108 => lambda2: Real = 1.0, Parameter, "1/s2", "Reference-model stiffness lambda2 (paper 000 Eq. 37)", Positive;
+        107 => lambda1: Real = 2.0, Parameter, "1/s", "Reference-model damping coefficient lambda1 ([Navabi-2019] Eq. 37)", Positive;
+        108 => lambda2: Real = 1.0, Parameter, "1/s2", "Reference-model stiffness lambda2 ([Navabi-2019] Eq. 37)", Positive;
     }
 }
 
@@ -25,8 +25,8 @@ impl Model for MracController {
     type Vars = MracControllerVars;
     const INFO: ModelInfo = ModelInfo {
         name: "MracController",
-        description: "Paper 000 model-reference adaptive attitude controller (Slotine-Li adaptation of the inertia per axis)",
-        source: "paper 000 (adaptive-fuzzy EULERINT design), Eqs. 37-43",
+        description: "Model-reference adaptive attitude controller (Slotine-Li adaptation of the inertia per axis)",
+        source: "[Navabi-2019], Eqs. 37-43",
         equations_html: EQUATIONS_HTML,
         feedthrough: Feedthrough::AllInputs,
         ..ModelInfo::DEFAULT

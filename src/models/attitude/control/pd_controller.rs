@@ -34,8 +34,8 @@ impl Model for PdController {
     type Vars = PdControllerVars;
     const INFO: ModelInfo = ModelInfo {
         name: "PdController",
-        description: "Paper 000 PD attitude controller with quaternion, DCM or Euler-angle error law",
-        source: "paper 000 (adaptive-fuzzy EULERINT design), Eqs. 2, 3, 7, 11, 13, 15",
+        description: "PD attitude controller with quaternion, DCM or Euler-angle error law",
+        source: "[Navabi-2019], Eqs. 2, 3, 7, 11, 13, 15",
         equations_html: "<pre>T_i   = k_i e_i + k_d,i w_i\n\
 k_i   = wn^2 I_i,   k_d,i = -2 zeta wn I_i      (k_d is negative: the paper's law adds +k_d * rate)\n\
 e^Q   = 2 q_E,w q_E,v,   q_E = q* (x) q_ref                 (error_law = 0)\n\
@@ -51,9 +51,9 @@ DCM error readings (dcm_error), M = A(q) A(q_ref)^T, N = A(q)^T A(q_ref), A(q) i
 <p>All six DCM readings agree to first order for small angles (small attitude and small error, the paper's \
 linearisation: e = commanded - actual angle); at large angles they differ by the symmetric part \
 (1 - cos alpha) n n^T of the error matrix, its sign, and (readings 4, 5) the frame in which the error axis is \
-expressed (reference instead of body). Paper 000 does not say which one it used; reading 0 is the default.</p>\n\
+expressed (reference instead of body). [Navabi-2019] does not say which one it used; reading 0 is the default.</p>\n\
 <p>For a constant command and the linear small-angle plant each axis closes to s^2 + 2 zeta wn s + wn^2. \
-w_ref is not used (paper 000 commands are constant).</p>",
+w_ref is not used ([Navabi-2019] commands are constant).</p>",
         feedthrough: Feedthrough::AllInputs,
         ..ModelInfo::DEFAULT
     };

@@ -39,13 +39,13 @@ impl Model for PolePlacementController {
     type Vars = PolePlacementControllerVars;
     const INFO: ModelInfo = ModelInfo {
         name: "PolePlacementController",
-        description: "Paper 000 per-axis pole-placement attitude controller; gains by Ackermann's formula at initialization",
-        source: "paper 000 (adaptive-fuzzy EULERINT design), Eqs. 28-36",
+        description: "Per-axis pole-placement attitude controller; gains by Ackermann's formula at initialization",
+        source: "[Navabi-2019], Eqs. 28-36",
         equations_html: "<pre>per axis: A = [0 1; 0 0],  b = [0; 1/I_i]\n\
 phi(s) = s^2 + 2 zeta wn s + wn^2   (pole_mode = 0)   or  (s - p1)(s - p2)   (pole_mode = 1)\n\
 [k1, k2] = [0 1] [b  A b]^-1 phi(A)          (Ackermann)  -> k1 = I wn^2, k2 = 2 zeta wn I\n\
 T_i = k1 e_i - k2 w_i</pre>\n\
-<p>e is the error of error_law (0 quaternion, 1 DCM, 2 Euler angles). Paper 000's Eq. 32 prints an extra \
+<p>e is the error of error_law (0 quaternion, 1 DCM, 2 Euler angles). [Navabi-2019]'s Eq. 32 prints an extra \
 factor 2 on k2/I (typo). w_ref is not used.</p>",
         feedthrough: Feedthrough::AllInputs,
         ..ModelInfo::DEFAULT

@@ -27,8 +27,8 @@ impl Model for SlidingModeController {
     type Vars = SlidingModeControllerVars;
     const INFO: ModelInfo = ModelInfo {
         name: "SlidingModeController",
-        description: "Paper 003 quaternion sliding-mode attitude controller (equivalent control + boundary-layer switching, K = (k, k, k))",
-        source: "paper 003 (GA-tuned sliding mode with reaction wheels and magnetorquers); law: project choice keeping the paper's structure",
+        description: "Quaternion sliding-mode attitude controller (equivalent control + boundary-layer switching, K = (k, k, k))",
+        source: "[T2FSMC-LEO]; law: project choice keeping the paper's structure",
         equations_html: SMC_EQUATIONS_HTML,
         feedthrough: Feedthrough::AllInputs,
         ..ModelInfo::DEFAULT

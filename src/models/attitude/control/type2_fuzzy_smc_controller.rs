@@ -37,8 +37,8 @@ impl Model for Type2FuzzySmcController {
     type Vars = Type2FuzzySmcControllerVars;
     const INFO: ModelInfo = ModelInfo {
         name: "Type2FuzzySmcController",
-        description: "Paper 003 quaternion sliding-mode attitude controller with the switching gain scheduled by an interval type-2 fuzzy system",
-        source: "paper 003 (type-2 fuzzy sliding mode with reaction wheels and magnetorquers); law, sets and type reduction: project choice keeping the paper's structure",
+        description: "Quaternion sliding-mode attitude controller with the switching gain scheduled by an interval type-2 fuzzy system",
+        source: "[T2FSMC-LEO]; law, sets and type reduction: project choice keeping the paper's structure",
         equations_html: "<pre>q_e   = q_ref* (x) q, sign flipped so that q_e,w >= 0\n\
 w_e   = w - A(q_e) w_ref,   s = w_e + lambda q_e,v,   q_e,v' = 1/2 (q_e,w w_e + q_e,v x w_e)\n\
 T_eq  = w x (I w + h_w) - I (lambda q_e,v' + w_e x A(q_e) w_ref)\n\

@@ -26,7 +26,7 @@ declare_variables! {
         100 => inertia: Diag3 = [1000.0, 500.0, 700.0], Parameter, "kg.m2", "Controller's nominal inertia", Positive;
         103 => ihat0: Vec3 = [0.0; 3], Parameter, "kg.m2", "Initial estimate I^(0); 0 = the nominal inertia", NonNegative;
         106 => ihat_min_ratio: Real = 0.1, Parameter, "", "Lower bound of the estimate: I^_min = ihat_min_ratio * I^(0)", Range(0.0, 1.0);
-        109 => lambda: Real = 2.0, Parameter, "1/s", "Sliding-surface bandwidth lambda (paper 000 Eqs. 38-39)", Positive;
+        109 => lambda: Real = 2.0, Parameter, "1/s", "Sliding-surface bandwidth lambda ([Navabi-2019] Eqs. 38-39)", Positive;
         110 => gamma: Real = 1000.0, Parameter, "kg.m2.s2", "Adaptation gain gamma (project choice)", NonNegative;
         120 => coordinates: Integer = 0, Parameter, "", "0 = quaternion feedback linearisation; 1 = linear (321 angles, T = I^ v)", Choice(MracCoordinates::CODES);
         200 => ihat_init: Vec3 = [0.0; 3], CalculatedParameter, "kg.m2", "I^(0) in use";

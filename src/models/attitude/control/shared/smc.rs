@@ -31,7 +31,7 @@ declare_variables! {
         33 => k_gain: Vec3 = [0.0; 3], Output, "N.m", "Switching gain K in use per axis";
         39 => s: Vec3 = [0.0; 3], Output, "rad/s", "Sliding variable s = w_e + lambda q_e,v";
         42 => torque_eq: Vec3 = [0.0; 3], Output, "N.m", "Equivalent control T_eq";
-        100 => inertia: Diag3 = [4.0, 5.0, 3.5], Parameter, "kg.m2", "Controller's nominal inertia, diagonal entries (paper 003 plant default)", Positive;
+        100 => inertia: Diag3 = [4.0, 5.0, 3.5], Parameter, "kg.m2", "Controller's nominal inertia, diagonal entries ([T2FSMC-LEO] plant default)", Positive;
         109 => lambda: Real = 0.2, Parameter, "1/s", "Sliding-surface slope lambda_s", Positive;
         130 => k_switch: Real = 0.005, Parameter, "N.m", "Switching gain k (GA-tuned; 0 = equivalent control only)", NonNegative;
         131 => boundary_layer: Real = 0.005, Parameter, "rad/s", "Boundary-layer width Phi of sat(s/Phi)", Positive;
