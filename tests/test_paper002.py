@@ -195,12 +195,15 @@ def test_tuner_and_sweeps_quick(tmp_path):
     r = subprocess.run([sys.executable, ROOT / "scripts" / "paper002_tune.py", "--quick", "--out", gains,
                         "--controllers", "PD,PID,FOPD,FOPID"], capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stderr[-2000:]
-    r = subprocess.run([sys.executable, ROOT / "scripts" / "paper002_sweeps.py", "--quick", "--gains", gains,
+    r = subprocess.run([sys.executable, ROOT / "scripts" / "paper002_sweeps.py", "--quick", "--digits", "--gains", gains,
                         "--out", tmp_path / "sweeps"], capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stderr[-2000:]
-    for run in ("002-1_step_responses", "002-2_phase_plane", "002-3", "002-4", "002-5", "002-6"):
+    for run in ("002-1_step_responses", "002-2_phase_plane", "002-3", "002-4", "002-5", "002-6", "002-7"):
         assert (tmp_path / "sweeps" / f"{run}.csv").exists() and (tmp_path / "sweeps" / f"{run}.png").exists()
     assert "002-6" in r.stdout and (tmp_path / "sweeps" / "summary.csv").exists()
+    rows = (tmp_path / "sweeps" / "002-7.csv").read_text().splitlines()
+    assert rows[0].startswith("inertia_kg_m2,wheel_gain,mae_deg_PD") and rows[1].startswith("7.7,1.0,")
+    assert rows[-1].startswith("9.9,5.0,")
 
 
 def test_declared_scenario_equals_the_tuner_loop():
