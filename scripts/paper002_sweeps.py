@@ -11,7 +11,9 @@ step at t = 0, explicit Euler, h = Δ = 1 ms, t_end = 20 s, full GL memory.
   002-4  MAE vs wheel time constant T ∈ {0.10, 0.15, 0.20, 0.25, 0.30, 0.40} s
   002-5  MAE vs disturbance factor (md_amp and md_const × {0, 0.5, 1, 2, 5, 10})
   002-6  MAE vs θ_ref ∈ {10, 20, 30, 40, 50}°
-  002-7  (--digits) MAE for J ∈ {7.7, 7.9, 9.7, 9.9} × K ∈ {1, 3, 5}
+  002-7  (--digits) MAE for the damaged-digit candidates of the paper's plant, J ∈ {7.7, 7.9, 9.7, 9.9} kg m²
+         × wheel gain K ∈ {1, 3, 5}, gains fixed (tuned at J = 7.7, K = 1); 002-7.csv has one row per
+         (J, K), 002-7.png one panel of MAE vs J per K
 
 MAE = mean |θ_ref - θ_n| in degrees over n < N = t_end/h. Writes out/paper002/<run>.csv and .png, and
 out/paper002/summary.csv (run, swept value, MAE per controller), and prints the summary table.
@@ -39,6 +41,7 @@ from scfmu.results import write_csv  # noqa: E402
 
 NAMES = list(CONTROLLERS)
 MD_AMP, MD_CONST = 0.01, 0.0001
+DIGITS_J, DIGITS_K = (7.7, 7.9, 9.7, 9.9), (1.0, 3.0, 5.0)  # run 002-7
 
 
 def sweeps(quick: bool, digits: bool) -> dict[str, tuple[str, list[tuple[float, Scenario]]]]:
@@ -53,8 +56,10 @@ def sweeps(quick: bool, digits: bool) -> dict[str, tuple[str, list[tuple[float, 
         "002-6": ("theta_ref_deg", [(x, replace(base, theta_ref_deg=x)) for x in (10.0, 20.0, 30.0, 40.0, 50.0)]),
     }
     if digits:
-        s["002-7"] = ("J_K", [(f"J={j:g} K={k:g}", replace(base, plant={"inertia": j, "wheel_gain": k}))
-                              for j in (7.7, 7.9, 9.7, 9.9) for k in (1.0, 3.0, 5.0)])
+        # damaged digits of the paper: inertia J and wheel gain K candidates (gains stay those tuned at
+        # J = 7.7, K = 1)
+        s["002-7"] = ("J_K", [((j, k), replace(base, plant={"inertia": j, "wheel_gain": k}))
+                              for k in DIGITS_K for j in DIGITS_J])
     if quick:
         s = {k: (n, [pts[0], pts[-1]]) for k, (n, pts) in s.items()}
     return s
@@ -150,21 +155,40 @@ def main(argv=None) -> int:
         for x, _ in pts:
             mae = [next(rest)["mae_deg"] for _ in NAMES]
             rows.append([x, *mae])
-            summary.append([run, xname, x, *mae])
+            summary.append([run, xname, f"J={x[0]:g} K={x[1]:g}" if run == "002-7" else x, *mae])
         with open(out / f"{run}.csv", "w", newline="") as f:
             w = csv.writer(f)
-            w.writerow([xname, *[f"mae_deg_{c}" for c in NAMES]])
-            w.writerows(rows)
+            if run == "002-7":
+                w.writerow(["inertia_kg_m2", "wheel_gain", *[f"mae_deg_{c}" for c in NAMES]])
+                w.writerows([[x[0], x[1], *m] for x, *m in rows])
+            else:
+                w.writerow([xname, *[f"mae_deg_{c}" for c in NAMES]])
+                w.writerows(rows)
         arr = np.array([r[1:] for r in rows], float)
+        if run == "002-7":  # one panel per wheel gain K, MAE vs J
+            ks = sorted({x[1] for x, *_ in rows})
+            fig, axs = plt.subplots(1, len(ks), figsize=(4.2 * len(ks), 4.2), squeeze=False)
+            for ax, k in zip(axs[0], ks):
+                sel = [i for i, r in enumerate(rows) if r[0][1] == k]
+                js = [rows[i][0][0] for i in sel]
+                for i, c in enumerate(NAMES):
+                    ax.plot(js, arr[sel, i], marker="o", ls="-" if c.startswith("FO") else "--", label=c)
+                ax.set_xlabel("inertia J (kg m²)")
+                ax.set_ylabel("MAE (deg)")
+                ax.set_title(f"002-7: wheel gain K = {k:g}")
+                ax.legend()
+                ax.grid(alpha=0.3)
+            fig.suptitle(f"002-7: damaged-digit candidates, gains tuned at J = 7.7, K = 1 (MAE over [0, {base.t_end:g}) s)")
+            fig.tight_layout()
+            fig.savefig(out / f"{run}.png", dpi=120)
+            plt.close(fig)
+            continue
         fig, ax = plt.subplots(figsize=(6.5, 4.2))
-        xs = np.arange(len(arr)) if run == "002-7" else np.array([r[0] for r in rows], float)
+        xs = np.array([r[0] for r in rows], float)
         for i, c in enumerate(NAMES):
             ax.plot(xs, arr[:, i], marker="o", ls="-" if c.startswith("FO") else "--", label=c)
-        if run == "002-7":
-            ax.set_xticks(xs, [str(r[0]).replace(" ", "\n") for r in rows], fontsize=7)
         ax.set_xlabel({"inertia_scale": "inertia scale J_true/J (-)", "wheel_time_constant_s": "wheel time constant T (s)",
-                       "disturbance_factor": "disturbance factor (-)", "theta_ref_deg": "θ_ref (deg)",
-                       "J_K": "inertia J (kg m²), wheel gain K"}[xname])
+                       "disturbance_factor": "disturbance factor (-)", "theta_ref_deg": "θ_ref (deg)"}[xname])
         ax.set_ylabel("MAE (deg)")
         ax.set_title(f"{run}: MAE over [0, {base.t_end:g}) s")
         ax.legend()

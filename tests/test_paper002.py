@@ -195,12 +195,15 @@ def test_tuner_and_sweeps_quick(tmp_path):
     r = subprocess.run([sys.executable, ROOT / "scripts" / "paper002_tune.py", "--quick", "--out", gains,
                         "--controllers", "PD,PID,FOPD,FOPID"], capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stderr[-2000:]
-    r = subprocess.run([sys.executable, ROOT / "scripts" / "paper002_sweeps.py", "--quick", "--gains", gains,
+    r = subprocess.run([sys.executable, ROOT / "scripts" / "paper002_sweeps.py", "--quick", "--digits", "--gains", gains,
                         "--out", tmp_path / "sweeps"], capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stderr[-2000:]
-    for run in ("002-1_step_responses", "002-2_phase_plane", "002-3", "002-4", "002-5", "002-6"):
+    for run in ("002-1_step_responses", "002-2_phase_plane", "002-3", "002-4", "002-5", "002-6", "002-7"):
         assert (tmp_path / "sweeps" / f"{run}.csv").exists() and (tmp_path / "sweeps" / f"{run}.png").exists()
     assert "002-6" in r.stdout and (tmp_path / "sweeps" / "summary.csv").exists()
+    rows = (tmp_path / "sweeps" / "002-7.csv").read_text().splitlines()
+    assert rows[0].startswith("inertia_kg_m2,wheel_gain,mae_deg_PD") and rows[1].startswith("7.7,1.0,")
+    assert rows[-1].startswith("9.9,5.0,")
 
 
 def test_declared_scenario_equals_the_tuner_loop():
@@ -217,3 +220,67 @@ def test_declared_scenario_equals_the_tuner_loop():
     got = simulate(scenarios.get("paper002/FOPID"), engine="lean")
     assert np.array_equal(got["theta"], ref["theta"])
     assert np.array_equal(got["u"], ref["u"])
+
+
+# ----- the tuner on the campaign engine ----------------------------------------------------------------
+ENGINE_GAINS = {"kp": 5.0, "ki": 1.0, "kd": 10.0, "lambda": 0.9, "mu": 1.1}
+
+
+@pytest.mark.parametrize("controller", ["PD", "PID", "FOPD", "FOPID"])
+def test_engine_cost_equals_direct_loop_and_numpy(controller):
+    """One gain set, 11 s (so the t >= 10 s penalty window is in play): the cost of the campaign run
+    (native path, scenario paper002/<controller> + gain overrides) equals the cost of the direct two-FMU
+    loop of the old tuner to round-off (the engine sees θ_ref through radians → degrees) and the cost of
+    the independent numpy difference equations to 1e-9."""
+    from scfmu import paper002 as p2
+
+    sc = Scenario(t_end=11.0)
+    row = p2.engine_cost(controller, ENGINE_GAINS, sc)
+    direct = run_case(controller, ENGINE_GAINS, sc)
+    numpy_ref = reference_loop(controller, ENGINE_GAINS, sc)
+    print(f"{controller}: engine {row['cost']!r}, direct loop {direct['cost']!r}, numpy {numpy_ref['cost']!r}")
+    assert row["status"] == "ok"
+    assert abs(row["cost"] - direct["cost"]) <= 1e-12 * direct["cost"]
+    assert abs(row["mae_deg"] - numpy_ref["mae_deg"]) < 1e-9
+    assert abs(row["late_max_deg"] - numpy_ref["late_max_deg"]) < 1e-9
+    assert (row["cost"] > 1000) == (numpy_ref["cost"] > 1000)
+    assert p2.row_cost({"status": "nonfinite", "cost": float("nan")}) == 1e6 + 1000
+
+
+def test_engine_tuner_same_for_any_worker_count_and_resumes(tmp_path):
+    """Tiny swarms (3 particles, 3 iterations, PD and FOPD in lockstep, 11 s runs): in this process and
+    on a 2-worker Dask cluster the swarms follow the same trajectory; a tuning interrupted after its
+    second iteration and resumed from its checkpoint ends identically; the reported best cost is the
+    direct loop's cost of the reported gains."""
+    from scfmu import campaign
+    from scfmu import paper002 as p2
+
+    sc = Scenario(t_end=11.0)
+    kw = dict(n_particles=3, max_iter=3, seed=2, progress=False)
+    serial = p2.tune(["PD", "FOPD"], sc, **kw)
+    client, cluster = campaign._client(None, 2)
+    try:
+        dask = p2.tune(["PD", "FOPD"], sc, client=client, **kw)
+    finally:
+        client.close()
+        cluster.close()
+
+    class Kill(Exception):
+        pass
+
+    def kill_after_two(swarms, info):
+        if min(s.it for s in swarms.values()) == 2:
+            raise Kill
+
+    ck = tmp_path / "ck.json"
+    with pytest.raises(Kill):
+        p2.tune(["PD", "FOPD"], sc, checkpoint=ck, on_round=kill_after_two, **kw)
+    resumed = p2.tune(["PD", "FOPD"], sc, checkpoint=ck, **kw)
+    for c in ("PD", "FOPD"):
+        print(c, serial[c]["history"], serial[c]["gains"])
+        assert serial[c]["seed"] == {"PD": 2, "FOPD": 4}[c]
+        for other in (dask, resumed):
+            assert other[c]["history"] == serial[c]["history"] and other[c]["x"] == serial[c]["x"]
+        assert serial[c]["iterations"] == 3 and serial[c]["stop"] == "max_iter"
+        direct = run_case(c, serial[c]["gains"], sc)["cost"]
+        assert abs(serial[c]["cost"] - direct) <= 1e-12 * direct

@@ -76,16 +76,29 @@ def controller_params(controller: str, gains: dict, sc: Scenario) -> tuple[str, 
 
 
 # ----- metrics -----------------------------------------------------------------------------------
+LATE_T = 10.0  # start of the steady-state window of the penalty [s]
+PENALTY_LATE, PENALTY_NONFINITE = 1000.0, 1e6
+
+
+def cost_from_series(t: np.ndarray, theta: np.ndarray, theta_ref_deg: float) -> dict:
+    """PSO cost terms of one run sampled at every step t_0 … t_N: MAE (deg) over the samples n < N, the
+    largest error over t_n >= 10 s (n < N) and cost = MAE + 1000 if that exceeds 0.5°; a non-finite
+    trajectory costs 1e6 + 1000."""
+    theta = np.asarray(theta, float)
+    if not np.all(np.isfinite(theta)):
+        return {"mae_deg": math.inf, "late_max_deg": math.inf, "cost": PENALTY_NONFINITE + PENALTY_LATE}
+    n = len(theta) - 1
+    e_deg = np.abs(theta_ref_deg - np.degrees(theta[:n]))
+    mae = float(np.mean(e_deg))
+    h = (float(t[-1]) - float(t[0])) / n
+    late = e_deg[int(round((LATE_T - float(t[0])) / h)):]
+    late_max = float(np.max(late)) if late.size else 0.0
+    return {"mae_deg": mae, "late_max_deg": late_max, "cost": mae + (PENALTY_LATE if late_max > 0.5 else 0.0)}
+
+
 def cost_terms(theta: np.ndarray, sc: Scenario) -> dict:
     """MAE (deg) over samples n < N, the steady-state check over t_n >= 10 s and the PSO cost."""
-    n = sc.n
-    e_deg = np.abs(sc.theta_ref_deg - np.degrees(theta[:n]))
-    if not np.all(np.isfinite(theta)):
-        return {"mae_deg": math.inf, "late_max_deg": math.inf, "cost": 1e6 + 1000.0}
-    mae = float(np.mean(e_deg))
-    late = e_deg[int(round(10.0 / sc.h)):]
-    late_max = float(np.max(late)) if late.size else 0.0
-    return {"mae_deg": mae, "late_max_deg": late_max, "cost": mae + (1000.0 if late_max > 0.5 else 0.0)}
+    return cost_from_series(np.array([0.0, sc.t_end]), np.asarray(theta, float)[: sc.n + 1], sc.theta_ref_deg)
 
 
 def step_metrics(t: np.ndarray, theta: np.ndarray, sc: Scenario) -> dict:
@@ -216,6 +229,111 @@ def reference_loop(controller: str, gains: dict, sc: Scenario = Scenario()) -> d
 
 
 # ----- PSO (pyswarms backend, in the unit cube) -------------------------------------------------
+class Pso:
+    """Global-best PSO over the box [lower, upper] as an ask/tell object (``positions()`` → evaluate →
+    ``tell(costs)``), so that several swarms can share one batch of evaluations.
+
+    Positions live in the unit cube (x = lower + z (upper - lower)), so the velocity clamp is `vclamp` of
+    each range; uniform initial positions, positions clipped to the box ("nearest"), inertia weight linear
+    from w_start (first iteration) to w_end (last possible iteration), stop when the best cost improved by
+    less than `stall_tol` over `stall_iters` iterations. The swarm update is pyswarms' backend (star
+    topology). pyswarms draws from numpy's global generator; each swarm keeps its own generator state
+    (seeded by `seed`) and swaps it in only for its own draws, so a swarm's trajectory depends on its seed
+    and its costs only, whatever other swarms run beside it. ``state()`` / ``from_state()`` give a JSON-ready
+    checkpoint from which the run continues bit-identically."""
+
+    def __init__(self, lower, upper, n_particles=30, max_iter=400, seed=0, stall_iters=50, stall_tol=1e-6,
+                 w_start=0.9, w_end=0.4, c1=2.0, c2=2.0, vclamp=0.2):
+        import pyswarms.backend as P
+        self.lower, self.upper = np.asarray(lower, float), np.asarray(upper, float)
+        self.cfg = dict(n_particles=int(n_particles), max_iter=int(max_iter), seed=int(seed),
+                        stall_iters=int(stall_iters), stall_tol=float(stall_tol), w_start=float(w_start),
+                        w_end=float(w_end), c1=float(c1), c2=float(c2), vclamp=float(vclamp))
+        d = self.lower.size
+        self._bounds = (np.zeros(d), np.ones(d))
+        self._clamp = (-vclamp, vclamp)
+        keep = np.random.get_state()
+        try:
+            np.random.seed(seed)
+            self.swarm = P.create_swarm(n_particles=n_particles, dimensions=d,
+                                        options={"c1": c1, "c2": c2, "w": w_start}, bounds=self._bounds,
+                                        clamp=self._clamp)
+            self._rng = np.random.get_state()
+        finally:
+            np.random.set_state(keep)
+        self.it = 0  # iterations evaluated
+        self.history: list[float] = []  # best cost after each iteration
+        self.done = False
+        self.stalled = False
+
+    def positions(self) -> np.ndarray:
+        """The particles to evaluate in the current iteration, in the box."""
+        return self.lower + self.swarm.position * (self.upper - self.lower)
+
+    def tell(self, costs) -> None:
+        from pyswarms.backend import compute_pbest
+        from pyswarms.backend.handlers import BoundaryHandler, VelocityHandler
+        from pyswarms.backend.topology import Star
+        c = self.cfg
+        sw, it = self.swarm, self.it
+        sw.options["w"] = c["w_start"] - (c["w_start"] - c["w_end"]) * it / max(1, c["max_iter"] - 1)
+        sw.current_cost = np.asarray(costs, float)
+        if it == 0:
+            sw.pbest_pos, sw.pbest_cost = sw.position.copy(), sw.current_cost.copy()
+        else:
+            sw.pbest_pos, sw.pbest_cost = compute_pbest(sw)
+        topo = Star()
+        sw.best_pos, sw.best_cost = topo.compute_gbest(sw)
+        self.history.append(float(sw.best_cost))
+        self.it = it + 1
+        if it >= c["stall_iters"] and self.history[it - c["stall_iters"]] - self.history[it] < c["stall_tol"]:
+            self.done = self.stalled = True
+            return
+        if self.it >= c["max_iter"]:
+            self.done = True
+            return
+        keep = np.random.get_state()
+        try:
+            np.random.set_state(self._rng)
+            sw.velocity = topo.compute_velocity(sw, self._clamp, VelocityHandler(strategy="unmodified"), self._bounds)
+            sw.position = topo.compute_position(sw, self._bounds, BoundaryHandler(strategy="nearest"))
+            self._rng = np.random.get_state()
+        finally:
+            np.random.set_state(keep)
+
+    @property
+    def best_x(self) -> list[float]:
+        return (self.lower + np.asarray(self.swarm.best_pos) * (self.upper - self.lower)).tolist()
+
+    @property
+    def best_cost(self) -> float:
+        return float(self.swarm.best_cost)
+
+    def state(self) -> dict:
+        sw = self.swarm
+        arrays = {k: np.asarray(getattr(sw, k)).tolist() for k in
+                  ("position", "velocity", "pbest_pos", "pbest_cost", "best_pos", "current_cost")}
+        r = self._rng
+        return {"cfg": self.cfg, "lower": self.lower.tolist(), "upper": self.upper.tolist(), "it": self.it,
+                "history": self.history, "done": self.done, "stalled": self.stalled, "swarm": arrays,
+                "best_cost": float(sw.best_cost) if np.size(sw.best_cost) else None, "w": sw.options["w"],
+                "rng": [r[0], np.asarray(r[1]).tolist(), int(r[2]), int(r[3]), float(r[4])]}
+
+    @classmethod
+    def from_state(cls, st: dict) -> "Pso":
+        p = cls(st["lower"], st["upper"], **st["cfg"])
+        sw = p.swarm
+        for k, v in st["swarm"].items():
+            setattr(sw, k, np.asarray(v, float))
+        if st["best_cost"] is not None:
+            sw.best_cost = np.float64(st["best_cost"])
+        sw.options["w"] = st["w"]
+        r = st["rng"]
+        p._rng = (r[0], np.asarray(r[1], np.uint32), r[2], r[3], r[4])
+        p.it, p.history, p.done, p.stalled = st["it"], list(st["history"]), st["done"], st["stalled"]
+        return p
+
+
 def _eval_chunk(args):
     fn, rows = args
     return [fn(r) for r in rows]
@@ -224,65 +342,169 @@ def _eval_chunk(args):
 def pso_minimize(cost, lower, upper, n_particles=30, max_iter=400, seed=0, workers=1,
                  stall_iters=50, stall_tol=1e-6, w_start=0.9, w_end=0.4, c1=2.0, c2=2.0, vclamp=0.2,
                  progress=True, desc="PSO"):
-    """Global-best PSO of `cost(x) -> float` over the box [lower, upper].
-
-    Positions live in the unit cube (x = lower + z (upper - lower)), so the velocity clamp is
-    `vclamp` of each range; uniform initial positions, positions clipped to the box ("nearest"),
-    inertia weight linear from w_start (first iteration) to w_end (last possible iteration),
-    stop when the best cost improved by less than `stall_tol` over `stall_iters` iterations.
-    Particles are evaluated in `workers` processes (cost must be picklable). Reproducible by `seed`
-    (for any worker count: the random draws all happen in this process).
-    Returns dict(x, cost, iterations, history, evaluations, seconds)."""
-    import pyswarms.backend as P
-    from pyswarms.backend.handlers import BoundaryHandler, VelocityHandler
-    from pyswarms.backend.topology import Star
+    """:class:`Pso` driven by a plain function ``cost(x) -> float``, evaluated in `workers` processes
+    (cost must be picklable). Reproducible by `seed` for any worker count (all random draws happen in
+    this process). Returns dict(x, cost, iterations, history, evaluations, seconds, stalled)."""
     from tqdm import tqdm
 
-    lower, upper = np.asarray(lower, float), np.asarray(upper, float)
-    d = lower.size
-    state = np.random.get_state()
-    np.random.seed(seed)
-    bounds = (np.zeros(d), np.ones(d))
-    clamp = (-vclamp, vclamp)
-    swarm = P.create_swarm(n_particles=n_particles, dimensions=d,
-                           options={"c1": c1, "c2": c2, "w": w_start}, bounds=bounds, clamp=clamp)
-    topo, vh, bh = Star(), VelocityHandler(strategy="unmodified"), BoundaryHandler(strategy="nearest")
-    history = []
+    pso = Pso(lower, upper, n_particles, max_iter, seed, stall_iters, stall_tol, w_start, w_end, c1, c2, vclamp)
     t0 = time.perf_counter()
     pool = ProcessPoolExecutor(workers) if workers > 1 else None
     bar = tqdm(total=max_iter, desc=desc, disable=not progress, leave=False)
     try:
-        it = 0
-        for it in range(max_iter):
-            swarm.options["w"] = w_start - (w_start - w_end) * it / max(1, max_iter - 1)
-            xs = lower + swarm.position * (upper - lower)
+        while not pso.done:
+            xs = pso.positions()
             if pool is None:
                 costs = [cost(x) for x in xs]
             else:
                 chunks = np.array_split(np.arange(n_particles), workers)
                 parts = pool.map(_eval_chunk, [(cost, xs[c]) for c in chunks])
                 costs = [c for part in parts for c in part]
-            swarm.current_cost = np.asarray(costs, float)
-            if it == 0:
-                swarm.pbest_pos, swarm.pbest_cost = swarm.position.copy(), swarm.current_cost.copy()
-            else:
-                swarm.pbest_pos, swarm.pbest_cost = P.compute_pbest(swarm)
-            swarm.best_pos, swarm.best_cost = topo.compute_gbest(swarm)
-            history.append(float(swarm.best_cost))
+            pso.tell(costs)
             bar.update(1)
-            bar.set_postfix(best=f"{swarm.best_cost:.6g}")
-            if it >= stall_iters and history[it - stall_iters] - history[it] < stall_tol:
-                break
-            swarm.velocity = topo.compute_velocity(swarm, clamp, vh, bounds)
-            swarm.position = topo.compute_position(swarm, bounds, bh)
+            bar.set_postfix(best=f"{pso.best_cost:.6g}")
     finally:
         bar.close()
         if pool is not None:
             pool.shutdown()
-        np.random.set_state(state)
-    best = lower + swarm.best_pos * (upper - lower)
-    return {"x": best.tolist(), "cost": float(swarm.best_cost), "iterations": len(history), "history": history,
-            "evaluations": len(history) * n_particles, "seconds": time.perf_counter() - t0}
+    return {"x": pso.best_x, "cost": pso.best_cost, "iterations": pso.it, "history": pso.history,
+            "evaluations": pso.it * n_particles, "seconds": time.perf_counter() - t0, "stalled": pso.stalled}
+
+
+# ----- particle evaluations on the campaign engine ---------------------------------------------------
+def engine_scenario(controller: str, sc: Scenario = Scenario()):
+    """The declared scenario ``paper002/<controller>`` for this setup (stop time, step, reference), with the
+    plant and memory options of `sc` as overrides."""
+    from . import scenarios
+    base = scenarios.paper002(controller, theta_ref_deg=sc.theta_ref_deg, stop_time=sc.t_end, step=sc.h)
+    ov = {f"plant.{k}": v for k, v in sc.plant.items()}
+    ov.update({"controller.gl_memory": sc.gl_memory, "controller.history_before_start": sc.history_before_start})
+    return base.with_overrides(ov)
+
+
+def gain_overrides(controller: str, x) -> dict:
+    """Campaign overrides ``controller.<gain>`` for the tuned variables x of `controller`."""
+    return {f"controller.{k}": float(v) for k, v in zip(CONTROLLERS[controller][1], x)}
+
+
+def row_cost(row: dict) -> float:
+    """PSO cost of a campaign row: its ``cost`` metric, or the non-finite cost for a failed run."""
+    c = row.get("cost", math.nan)
+    if row.get("status") != "ok" or not math.isfinite(c):
+        return PENALTY_NONFINITE + PENALTY_LATE
+    return float(c)
+
+
+def _timed_chunk(specs: list[dict], fmu_dir: str) -> list[tuple[dict, float]]:
+    """Worker task: campaign.run_one per spec, with the wall time of each run."""
+    from . import campaign
+    out = []
+    for s in specs:
+        t0 = time.perf_counter()
+        row, _ = campaign.run_one(s, fmu_dir)
+        out.append((row, time.perf_counter() - t0))
+    return out
+
+
+def engine_rows(batches: list[tuple[str, np.ndarray]], sc: Scenario = Scenario(), client=None,
+                chunk: int = 4) -> list[list[tuple[dict, float]]]:
+    """Evaluates particles on the campaign engine (native path): ``batches`` = [(controller, xs)], each xs a
+    (particles × variables) array; every particle is one campaign run of ``paper002/<controller>`` with its
+    gains as overrides. With a dask.distributed ``client`` the runs go to its workers in tasks of `chunk`
+    runs (all batches at once); without, they run in this process. Returns, per batch, the (row, seconds)
+    of each particle in order. Rows depend only on (scenario, overrides), never on the worker count."""
+    from . import campaign, master
+    fmu_dir = str(master.FMU_DIR.resolve())
+    specs = []
+    for b, (c, xs) in enumerate(batches):
+        camp = campaign.Campaign(engine_scenario(c, sc), [gain_overrides(c, x) for x in xs], engine="native")
+        specs += [(b, s) for s in camp.runs()]
+    if client is None:
+        done = _timed_chunk([s for _, s in specs], fmu_dir)
+    else:
+        futs = [client.submit(_timed_chunk, [s for _, s in specs[i:i + chunk]], fmu_dir, pure=False)
+                for i in range(0, len(specs), chunk)]
+        done = [r for f in futs for r in f.result()]
+    out: list[list] = [[] for _ in batches]
+    for (b, _), r in zip(specs, done):
+        out[b].append(r)
+    return out
+
+
+def engine_cost(controller: str, gains: dict, sc: Scenario = Scenario(), client=None) -> dict:
+    """One gain set evaluated on the campaign engine: the run's row (metrics incl. ``cost``)."""
+    x = [gains[k] for k in CONTROLLERS[controller][1]]
+    row, _ = engine_rows([(controller, np.array([x]))], sc, client)[0][0]
+    return row
+
+
+def tune(controllers: list[str], sc: Scenario = Scenario(), n_particles: int = 30, max_iter: int = 400,
+         seed: int = 2, client=None, checkpoint: Path | None = None, deadline: float | None = None,
+         progress: bool = True, on_round=None, **pso_kw) -> dict:
+    """PSO tuning of several controllers in lockstep on the campaign engine: each iteration, the particles
+    of every swarm still running are evaluated as one batch of campaign runs (``engine_rows``), so the
+    workers stay busy while swarms stop at different iterations. Controller c gets the seed
+    ``seed + index of c in CONTROLLERS`` (PD 2, PID 3, FOPD 4, FOPID 5 by default) whichever subset runs.
+
+    `checkpoint`: JSON file written after every iteration (swarm states, generator states, run times);
+    an existing checkpoint of the same set-up is resumed. `deadline`: a time.time() value; no iteration
+    starts after it (the result then says ``stop = "deadline"``). Returns {controller: result dict}."""
+    from tqdm import tqdm
+    setup = {"controllers": list(controllers), "scenario": {"theta_ref_deg": sc.theta_ref_deg, "t_end": sc.t_end,
+             "h": sc.h, "plant": sc.plant, "gl_memory": sc.gl_memory, "history_before_start": sc.history_before_start},
+             "n_particles": n_particles, "max_iter": max_iter, "seed": seed, "pso": pso_kw}
+    swarms, info = {}, {}
+    if checkpoint is not None and Path(checkpoint).exists():
+        ck = json.loads(Path(checkpoint).read_text())
+        if ck.get("setup") == json.loads(json.dumps(setup)):
+            swarms = {c: Pso.from_state(st) for c, st in ck["swarms"].items()}
+            info = ck["info"]
+    for c in controllers:
+        if c not in swarms:
+            var = CONTROLLERS[c][1]
+            swarms[c] = Pso([BOUNDS[v][0] for v in var], [BOUNDS[v][1] for v in var], n_particles, max_iter,
+                            seed + list(CONTROLLERS).index(c), **pso_kw)
+            info[c] = {"run_seconds": 0.0, "wall_seconds": 0.0, "stop": None}
+    bar = tqdm(total=max_iter, initial=min(s.it for s in swarms.values()), desc="PSO " + ",".join(controllers),
+               disable=not progress)
+    t_last = time.perf_counter()
+    try:
+        while True:
+            active = [c for c in controllers if not swarms[c].done]
+            if not active:
+                break
+            if deadline is not None and time.time() >= deadline:
+                for c in active:
+                    info[c]["stop"] = "deadline"
+                break
+            res = engine_rows([(c, swarms[c].positions()) for c in active], sc, client)
+            now = time.perf_counter()
+            for c, rows in zip(active, res):
+                swarms[c].tell([row_cost(r) for r, _ in rows])
+                info[c]["run_seconds"] += sum(t for _, t in rows)
+                info[c]["wall_seconds"] += now - t_last
+                if swarms[c].done:
+                    info[c]["stop"] = "stall" if swarms[c].stalled else "max_iter"
+            t_last = now
+            if checkpoint is not None:
+                tmp = Path(str(checkpoint) + ".tmp")
+                tmp.write_text(json.dumps({"setup": setup, "swarms": {c: s.state() for c, s in swarms.items()},
+                                           "info": info}))
+                tmp.replace(checkpoint)
+            bar.n = max(s.it for s in swarms.values())
+            bar.set_postfix_str(" ".join(f"{c}:{swarms[c].best_cost:.6g}" for c in controllers))
+            if on_round is not None:
+                on_round(swarms, info)
+    finally:
+        bar.close()
+    out = {}
+    for c in controllers:
+        s = swarms[c]
+        out[c] = {"x": s.best_x, "gains": dict(zip(CONTROLLERS[c][1], s.best_x)), "cost": s.best_cost,
+                  "iterations": s.it, "evaluations": s.it * n_particles, "history": s.history,
+                  "stalled": s.stalled, "stop": info[c]["stop"], "seed": s.cfg["seed"],
+                  "run_seconds": info[c]["run_seconds"], "wall_seconds": info[c]["wall_seconds"]}
+    return out
 
 
 @dataclass(frozen=True)
@@ -305,5 +527,6 @@ def load_gains(path: Path = GAINS_FILE) -> dict:
     return {c: {k: DEFAULT_GAINS[k] for k in CONTROLLERS[c][1]} for c in CONTROLLERS}
 
 
-__all__ = ["CONTROLLERS", "BOUNDS", "Scenario", "run_case", "reference_loop", "pso_minimize", "TuneCost",
+__all__ = ["CONTROLLERS", "BOUNDS", "Scenario", "run_case", "reference_loop", "Pso", "pso_minimize", "TuneCost",
+           "tune", "engine_rows", "engine_cost", "engine_scenario", "row_cost", "cost_from_series",
            "load_gains", "cost_terms", "step_metrics", "gl_weights", "full_gains"]

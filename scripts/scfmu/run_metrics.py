@@ -115,8 +115,29 @@ def paper003(r: dict) -> dict:
     return metrics(r)
 
 
+def single_axis(r: dict) -> dict:
+    """Single-axis step response (paper 002): needs ``theta`` [rad] and the ``theta_ref`` [rad] input logged
+    at every communication step. ``mae_deg``, ``late_max_deg`` and ``cost`` are the PSO cost terms of
+    ``scfmu.paper002.cost_from_series`` (MAE over the samples of [t0, t_end), max error for t >= 10 s)."""
+    from .paper002 import cost_from_series
+    t, th = r["time"], r["theta"]
+    ref = float(r["theta_ref"][-1])
+    out = _nan_row()
+    out.update(cost_from_series(t, th, math.degrees(ref)))
+    out["settling_s"] = settling_time(t, th, ref)
+    out["overshoot_pct"] = overshoot_percent(th, ref)
+    out["final_error"] = math.degrees(ref - float(th[-1]))
+    if "applied_torque" in r:
+        dt = np.diff(t)
+        tq = np.asarray(r["applied_torque"])[:-1]
+        out["effort_abs"] = float(np.sum(np.abs(tq) * dt))
+        out["effort_sq"] = float(np.sum(tq**2 * dt))
+        out["peak_torque"] = float(np.max(np.abs(r["applied_torque"])))
+    return out
+
+
 FUNCTIONS = {"attitude": attitude, "attitude_nometrics": attitude_nometrics, "formation": formation,
-             "paper003": paper003}
+             "single_axis": single_axis, "paper003": paper003}
 
 
 def compute(name: str, r: dict) -> dict:
@@ -134,6 +155,7 @@ def columns(name: str) -> list[str]:
                                for k, u in (("settling", "_s"), ("overshoot", "_pct"), ("final_error", "_deg"))] + ["peak_torque"],
         "formation": [f"{k}_{a}{u}" for a in "xyz" for k, u in (("settling", "_s"), ("overshoot", "_pct"),
                                                                ("final_error", "_m"), ("dist_est_end", ""))] + ["peak_force"],
+        "single_axis": ["mae_deg", "late_max_deg", "cost", "overshoot_pct", "peak_torque"],
     }.get(name, [])
     if name == "paper003":
         from .paper003 import EXTRA_COLUMNS

@@ -237,10 +237,10 @@ def paper002(controller: str = "FOPID", theta_ref_deg: float = 30.0, stop_time: 
             Component("plant", "SingleAxisPlant", {"integrator": 1, "max_internal_step": step}),
         ],
         stop_time=stop_time, step=step,
-        log=log_of("plant", ["theta", "omega", "applied_torque", "theta_deg"]) | log_of("controller", ["u"]),
+        log=log_of("plant", ["theta", "omega", "applied_torque", "theta_deg"]) | log_of("controller", ["u", "theta_ref"]),
         inputs={"controller.theta_ref": math.radians(theta_ref_deg)},
         unconnected=[*DEFAULT_UNCONNECTED, "torque_dist"],
-        metrics="",
+        metrics="single_axis",  # PSO cost terms (mae_deg, late_max_deg, cost) per run
         description=f"paper 002 single-axis loop, {controller} with the tuned gains, {theta_ref_deg:g} deg step",
     )
 
