@@ -1,6 +1,8 @@
 //! Packaging: `modelDescription/<Model>.xml` and `fmus/<Model>.fmu` for every registered model.
-//! One cdylib build serves every FMU: it is copied into each archive as
-//! `binaries/linux64/<Model>.so`, and `fmi2Instantiate` picks the model by file name and GUID.
+//! One cdylib build per platform serves every FMU: it is copied into each archive as
+//! `binaries/linux64/<Model>.so` (and, when the Windows cross build exists, `binaries/win64/<Model>.dll`
+//! next to it), and `fmi2Instantiate` picks the model by file name and GUID. All platforms share the one
+//! `modelDescription.xml`.
 
 use std::fs;
 use std::io::Write;
@@ -54,8 +56,29 @@ pub fn stale_model_descriptions(dir: &Path) -> Vec<String> {
         .collect()
 }
 
-/// Writes one `.fmu` archive (deterministic: fixed timestamps, fixed order).
-pub fn write_fmu(entry: &ModelEntry, library: &[u8], out_dir: &Path) -> std::io::Result<std::path::PathBuf> {
+/// One platform's build of the cdylib, to be stored as `binaries/<platform>/<Model>.<ext>`.
+#[derive(Clone, Copy, Debug)]
+pub struct Binary<'a> {
+    /// FMI 2.0 platform folder: `linux64`, `win64`, `darwin64`.
+    pub platform: &'a str,
+    /// Shared-library extension on that platform: `so`, `dll`, `dylib`.
+    pub ext: &'a str,
+    pub bytes: &'a [u8],
+}
+
+impl<'a> Binary<'a> {
+    /// The build for the platform this code was compiled for.
+    pub fn host(bytes: &'a [u8]) -> Self {
+        Binary { platform: PLATFORM, ext: LIB_EXT, bytes }
+    }
+}
+
+/// Writes one `.fmu` archive (deterministic: fixed timestamps, fixed order) holding the model
+/// description, one binary per entry of `binaries` (in the given order) and the documentation.
+pub fn write_fmu(entry: &ModelEntry, binaries: &[Binary], out_dir: &Path) -> std::io::Result<std::path::PathBuf> {
+    if binaries.is_empty() {
+        return Err(std::io::Error::other("no binary to package"));
+    }
     fs::create_dir_all(out_dir)?;
     let path = out_dir.join(format!("{}.fmu", entry.info.name));
     let mut zip = ZipWriter::new(fs::File::create(&path)?);
@@ -65,7 +88,9 @@ pub fn write_fmu(entry: &ModelEntry, library: &[u8], out_dir: &Path) -> std::io:
         zip.write_all(data)
     };
     add(&mut zip, "modelDescription.xml", model_description(entry).as_bytes(), 0o644)?;
-    add(&mut zip, &format!("binaries/{PLATFORM}/{}.{LIB_EXT}", entry.info.name), library, 0o755)?;
+    for b in binaries {
+        add(&mut zip, &format!("binaries/{}/{}.{}", b.platform, entry.info.name, b.ext), b.bytes, 0o755)?;
+    }
     add(&mut zip, "documentation/index.html", documentation_html(entry).as_bytes(), 0o644)?;
     zip.finish().map_err(std::io::Error::other)?;
     Ok(path)
