@@ -159,7 +159,9 @@ def loop_args(info, lib_ext: str, steps: int, dt: float) -> list[str]:
     state = ["q_w", "q_x", "q_y", "q_z", "w_x", "w_y", "w_z"]
     torque = ["torque_cmd_x", "torque_cmd_y", "torque_cmd_z"]
     out = state + ["torque_applied_x", "torque_applied_y", "torque_applied_z", "h_wheel_x", "h_wheel_y", "h_wheel_z"]
-    return [f"AttitudePlant.{lib_ext}", pg, f"PdController.{lib_ext}", cg, str(steps), repr(dt),
+    # dlopen needs a path ("./"), LoadLibrary finds bare names in the program's folder
+    prefix = "./" if lib_ext == "so" else ""
+    return [f"{prefix}AttitudePlant.{lib_ext}", pg, f"{prefix}PdController.{lib_ext}", cg, str(steps), repr(dt),
             ",".join(f"{pv[k]}={v!r}" for k, v in plant_set.items()), "-",
             ",".join(f"{pv[k]}:{cv[k]}" for k in state),
             ",".join(f"{cv[k]}:{pv[k]}" for k in torque),

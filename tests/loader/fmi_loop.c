@@ -29,14 +29,18 @@ typedef HMODULE Lib;
 static Lib lib_open(const char *path) { return LoadLibraryA(path); }
 static void *lib_sym(Lib l, const char *name) { return (void *)GetProcAddress(l, name); }
 static void lib_close(Lib l) { FreeLibrary(l); }
-static unsigned long lib_error(void) { return (unsigned long)GetLastError(); }
+static const char *lib_error(void) {
+    static char text[32];
+    snprintf(text, sizeof text, "error %lu", (unsigned long)GetLastError());
+    return text;
+}
 #else
 #include <dlfcn.h>
 typedef void *Lib;
 static Lib lib_open(const char *path) { return dlopen(path, RTLD_NOW | RTLD_LOCAL); }
 static void *lib_sym(Lib l, const char *name) { return dlsym(l, name); }
 static void lib_close(Lib l) { dlclose(l); }
-static unsigned long lib_error(void) { return 0; }
+static const char *lib_error(void) { return dlerror(); }
 #endif
 
 typedef void *C;
@@ -82,7 +86,7 @@ static void *sym(Lib lib, const char *name) {
 static Fmu load(const char *path) {
     Fmu f;
     f.lib = lib_open(path);
-    if (!f.lib) { printf("FAIL cannot load %s (error %lu)\n", path, lib_error()); exit(1); }
+    if (!f.lib) { printf("FAIL cannot load %s (%s)\n", path, lib_error()); exit(1); }
     f.types_platform = (const char *(*)(void))sym(f.lib, "fmi2GetTypesPlatform");
     f.version = (const char *(*)(void))sym(f.lib, "fmi2GetVersion");
     f.instantiate = (C (*)(const char *, int, const char *, const char *, const Callbacks *, int, int))sym(f.lib, "fmi2Instantiate");
