@@ -13,7 +13,7 @@ if [ "${SCFMU_NO_WIN64:-0}" = 1 ]; then
     echo "build_fmus: SCFMU_NO_WIN64=1: packaging linux64 binaries only (no binaries/win64)" >&2
 elif scripts/build_win64.sh --check; then
     dll=$(scripts/build_win64.sh | tail -n 1)
-    package_args+=(--win64-lib "$dll")
+    package_args+=(--add-lib "win64=$dll")
 else
     echo "build_fmus: Windows cross toolchain not installed: packaging linux64 binaries only (no binaries/win64)" >&2
 fi

@@ -35,6 +35,16 @@ pub const LIB_EXT: &str = if cfg!(target_os = "windows") {
     "so"
 };
 
+/// Shared-library extension of an FMI 2.0 platform folder (`None` for a folder we do not build).
+pub fn platform_lib_ext(platform: &str) -> Option<&'static str> {
+    match platform {
+        "linux64" => Some("so"),
+        "win64" => Some("dll"),
+        "darwin64" => Some("dylib"),
+        _ => None,
+    }
+}
+
 /// Writes `modelDescription/<Model>.xml` for every model; returns the paths written.
 pub fn write_model_descriptions(dir: &Path) -> std::io::Result<Vec<String>> {
     fs::create_dir_all(dir)?;
@@ -94,4 +104,36 @@ pub fn write_fmu(entry: &ModelEntry, binaries: &[Binary], out_dir: &Path) -> std
     add(&mut zip, "documentation/index.html", documentation_html(entry).as_bytes(), 0o644)?;
     zip.finish().map_err(std::io::Error::other)?;
     Ok(path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_archive_holds_every_platform_binary_and_one_model_description() {
+        let entry = &registry::ALL[0];
+        let dir = std::env::temp_dir().join(format!("scfmu-package-test-{}", std::process::id()));
+        let bins = [
+            Binary { platform: "linux64", ext: "so", bytes: b"ELF..." },
+            Binary { platform: "win64", ext: "dll", bytes: b"MZ..." },
+        ];
+        let path = write_fmu(entry, &bins, &dir).unwrap();
+        let mut zip = zip::ZipArchive::new(fs::File::open(&path).unwrap()).unwrap();
+        let names: Vec<String> = (0..zip.len()).map(|i| zip.by_index(i).unwrap().name().unwrap().to_string()).collect();
+        let n = entry.info.name;
+        assert_eq!(names, vec![
+            "modelDescription.xml".to_string(),
+            format!("binaries/linux64/{n}.so"),
+            format!("binaries/win64/{n}.dll"),
+            "documentation/index.html".to_string(),
+        ]);
+        let mut dll = vec![];
+        std::io::Read::read_to_end(&mut zip.by_name(&format!("binaries/win64/{n}.dll")).unwrap(), &mut dll).unwrap();
+        assert_eq!(dll, b"MZ...");
+        assert!(write_fmu(entry, &[], &dir).is_err());
+        fs::remove_dir_all(&dir).ok();
+        assert_eq!(platform_lib_ext("win64"), Some("dll"));
+        assert_eq!(platform_lib_ext("win32"), None);
+    }
 }
