@@ -17,6 +17,10 @@ elif scripts/build_win64.sh --check; then
 else
     echo "build_fmus: Windows cross toolchain not installed: packaging linux64 binaries only (no binaries/win64)" >&2
 fi
+# A macOS build made elsewhere (see .github/workflows/macos.yml, untested) joins as darwin64.
+if [ -n "${SCFMU_DARWIN64_LIB:-}" ]; then
+    package_args+=(--add-lib "darwin64=$SCFMU_DARWIN64_LIB")
+fi
 ./target/release/package "${package_args[@]}"
 if [ -x .venv/bin/python ]; then
     PYTHONPATH=scripts .venv/bin/python -m scfmu.ssp --out fmus/ssp
