@@ -21,6 +21,9 @@ missing=()
 if [ -x "$RUSTC_DEB" ] && [ ! -d "$("$RUSTC_DEB" --print sysroot)/lib/rustlib/src/rust/library/std" ]; then
     missing+=("std sources (rust-web-src)")
 fi
+if [ -x "$RUSTC_DEB" ] && ! "$RUSTC_DEB" --print target-list | grep -qx "$TARGET"; then
+    missing+=("a $RUSTC_DEB that knows $TARGET (rustc-web 1.96; found $("$RUSTC_DEB" --version))")
+fi
 command -v "$LINKER" >/dev/null 2>&1 || missing+=("$LINKER (gcc-mingw-w64-x86-64)")
 if [ ${#missing[@]} -gt 0 ]; then
     echo "build_win64: cross toolchain not installed: ${missing[*]}" >&2
