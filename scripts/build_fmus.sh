@@ -2,11 +2,26 @@
 # Builds the release cdylib and writes modelDescription/<Model>.xml and fmus/<Model>.fmu, then the
 # scenario files for other tools: fmus/ssp/<scenario>.ssp (SSP 1.0) and fmus/loops/<scenario>.fmu (one
 # container FMU per standard closed loop). The last two need the Python venv (scripts/setup.sh); without
-# it they are skipped with a message.
+# it they are skipped with a message. When the Windows cross toolchain is installed (scripts/setup.sh
+# installs it), every FMU also carries binaries/win64/<Model>.dll (scripts/build_win64.sh); without it
+# the FMUs carry linux64 only and this script says so. SCFMU_NO_WIN64=1 skips the Windows build.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --release --locked
-./target/release/package
+package_args=()
+if [ "${SCFMU_NO_WIN64:-0}" = 1 ]; then
+    echo "build_fmus: SCFMU_NO_WIN64=1: packaging linux64 binaries only (no binaries/win64)" >&2
+elif scripts/build_win64.sh --check; then
+    dll=$(scripts/build_win64.sh | tail -n 1)
+    package_args+=(--add-lib "win64=$dll")
+else
+    echo "build_fmus: Windows cross toolchain not installed: packaging linux64 binaries only (no binaries/win64)" >&2
+fi
+# A macOS build made elsewhere (see .github/workflows/macos.yml, untested) joins as darwin64.
+if [ -n "${SCFMU_DARWIN64_LIB:-}" ]; then
+    package_args+=(--add-lib "darwin64=$SCFMU_DARWIN64_LIB")
+fi
+./target/release/package "${package_args[@]}"
 if [ -x .venv/bin/python ]; then
     PYTHONPATH=scripts .venv/bin/python -m scfmu.ssp --out fmus/ssp
     PYTHONPATH=scripts .venv/bin/python -m scfmu.loops --out fmus/loops

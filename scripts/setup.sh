@@ -11,15 +11,41 @@ if ! command -v cargo >/dev/null 2>&1; then
 fi
 # System tools the tests use: gcc (the hostile C master of tests/test_hardening.py) and valgrind
 # (memcheck). Installed with apt-get where missing and we are root (CI, fresh machines).
+can_apt() { [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; }
+apt_updated=0
+apt_install() {
+    [ "$apt_updated" = 1 ] || { apt-get update -qq && apt_updated=1; }
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "$@" >/dev/null
+}
 missing=()
 command -v gcc >/dev/null 2>&1 || missing+=(gcc libc6-dev)
 command -v valgrind >/dev/null 2>&1 || missing+=(valgrind)
 if [ ${#missing[@]} -gt 0 ]; then
-    if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+    if can_apt; then
         echo "setup: installing ${missing[*]}"
-        apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${missing[@]}" >/dev/null
+        apt_install "${missing[@]}"
     else
         echo "setup: please install ${missing[*]} (needed by tests/test_hardening.py)" >&2
+    fi
+fi
+# Windows x86-64 binaries (scripts/build_win64.sh) and their smoke test (tests/test_win64.py): Debian's
+# Rust 1.96 with its std sources (rustc-web, cargo-web, rust-web-src), the MinGW-w64 linker and Wine.
+# Checked with dpkg, so a machine that has them costs no apt call. Best effort: where they cannot be
+# installed (not Debian 12, not root) the FMUs carry linux64 binaries only and scripts/build_fmus.sh
+# says so.
+win_missing=()
+if command -v dpkg-query >/dev/null 2>&1; then
+    for p in rustc-web cargo-web rust-web-src gcc-mingw-w64-x86-64 wine wine64; do
+        dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "ok installed" || win_missing+=("$p")
+    done
+fi
+if [ ${#win_missing[@]} -gt 0 ]; then
+    if can_apt; then
+        echo "setup: installing the Windows cross toolchain and Wine: ${win_missing[*]}"
+        apt_install "${win_missing[@]}" ||
+            echo "setup: could not install ${win_missing[*]}: FMUs will carry linux64 binaries only" >&2
+    else
+        echo "setup: for Windows binaries in the FMUs install ${win_missing[*]} (Debian 12)" >&2
     fi
 fi
 PY=${PYTHON:-python3}

@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Cross-builds the cdylib for Windows x86-64 on Linux: target/win64/x86_64-win7-windows-gnu/release/
+# spacecraft_fmus.dll. Uses Debian's Rust (rustc-web, cargo-web, rust-web-src: /usr/bin/rustc,
+# /usr/bin/cargo and the std sources in /usr/lib/rustlib/src) to build std for the target itself
+# (-Z build-std, allowed on a stable compiler by RUSTC_BOOTSTRAP=1) and the MinGW-w64 linker
+# (gcc-mingw-w64-x86-64). scripts/setup.sh installs these packages. Why the win7 target: docs/tools.md.
+#
+#   scripts/build_win64.sh            build; prints the DLL path on the last line
+#   scripts/build_win64.sh --check    exit 0 when the cross toolchain is installed, 1 (with the reason) if not
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+TARGET=x86_64-win7-windows-gnu
+RUSTC_DEB=/usr/bin/rustc
+CARGO_DEB=/usr/bin/cargo
+LINKER=x86_64-w64-mingw32-gcc
+
+missing=()
+[ -x "$RUSTC_DEB" ] || missing+=("$RUSTC_DEB (rustc-web)")
+[ -x "$CARGO_DEB" ] || missing+=("$CARGO_DEB (cargo-web)")
+if [ -x "$RUSTC_DEB" ] && [ ! -d "$("$RUSTC_DEB" --print sysroot)/lib/rustlib/src/rust/library/std" ]; then
+    missing+=("std sources (rust-web-src)")
+fi
+if [ -x "$RUSTC_DEB" ] && ! "$RUSTC_DEB" --print target-list | grep -qx "$TARGET"; then
+    missing+=("a $RUSTC_DEB that knows $TARGET (rustc-web 1.96; found $("$RUSTC_DEB" --version))")
+fi
+command -v "$LINKER" >/dev/null 2>&1 || missing+=("$LINKER (gcc-mingw-w64-x86-64)")
+if [ ${#missing[@]} -gt 0 ]; then
+    echo "build_win64: cross toolchain not installed: ${missing[*]}" >&2
+    exit 1
+fi
+if [ "${1:-}" = "--check" ]; then
+    exit 0
+fi
+
+# The Debian compiler is used for everything of this build (RUSTC), never the rustup one: std is
+# compiled from the sources that match it exactly. Separate target dir: the Linux build is untouched.
+RUSTC_BOOTSTRAP=1 RUSTC="$RUSTC_DEB" RUSTDOC=/usr/bin/rustdoc \
+CARGO_TARGET_X86_64_WIN7_WINDOWS_GNU_LINKER="$LINKER" \
+    "$CARGO_DEB" build --release --locked --lib -Z build-std=std,panic_unwind \
+    --target "$TARGET" --target-dir target/win64 >&2
+dll=target/win64/$TARGET/release/spacecraft_fmus.dll
+[ -f "$dll" ] || { echo "build_win64: $dll was not produced" >&2; exit 1; }
+echo "$dll"
