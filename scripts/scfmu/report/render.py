@@ -126,7 +126,7 @@ def claim_html(c: Claim, out_dir: Path) -> str:
     for f in c.figures:
         out.append(figure_html(f, out_dir))
     if c.sensitive_to:
-        out.append("<p><i>Sensitive to:</i> " + _e(", ".join(c.sensitive_to)) + "</p>")
+        out.append("<p><i>Readings examined:</i> " + _e(", ".join(c.sensitive_to)) + "</p>")
     for s in c.sensitivity:
         out.append(sensitivity_html(s, out_dir))
     out.append("</div>")
@@ -165,7 +165,7 @@ def render_html(sections: list[PaperSection], out_dir: Path, meta: dict) -> str:
         f"<tr><td><a href=\"#{_e(cid)}\">{_e(cid)}</a></td><td>{_e(st)}</td><td>{badge(v)}</td><td>{_e(sens)}</td></tr>"
         for _, cid, st, v, sens in summary_rows(sections))
     head.append("<table id=\"claims\"><thead><tr><th>claim</th><th>statement</th><th>verdict</th>"
-                f"<th>sensitive to</th></tr></thead><tbody>{rows}</tbody></table>")
+                f"<th>readings examined</th></tr></thead><tbody>{rows}</tbody></table>")
     head.append("<table><caption>Runs and runtime per paper</caption><thead><tr><th>paper</th><th>title</th>"
                 "<th>simulation runs</th><th>runtime (s)</th></tr></thead><tbody>" + "".join(
                     f"<tr><td><a href=\"#paper{_e(s.paper)}\">{_e(s.paper)}</a></td><td>{_e(s.title)}</td>"
@@ -213,7 +213,7 @@ def render_md(sections: list[PaperSection], out_dir: Path, meta: dict) -> str:
            f"{meta.get('workers', '?')} · total runtime {fmt_cell(float(meta.get('runtime_s', 0.0)), 4)} s", ""]
     if meta.get("intro"):
         out += [meta["intro"], ""]
-    out += ["## Summary of the claims", "", "| claim | statement | verdict | sensitive to |", "|---|---|---|---|"]
+    out += ["## Summary of the claims", "", "| claim | statement | verdict | readings examined |", "|---|---|---|---|"]
     for _, cid, st, v, sens in summary_rows(sections):
         out.append(f"| {_md(cid)} | {_md(st)} | {_md(MD_MARK.get(v, v))} | {_md(sens)} |")
     out += ["", "| paper | title | simulation runs | runtime (s) |", "|---|---|---:|---:|"]
@@ -231,7 +231,7 @@ def render_md(sections: list[PaperSection], out_dir: Path, meta: dict) -> str:
             for f in c.figures:
                 out += figure_md(f, out_dir)
             if c.sensitive_to:
-                out += [f"**Sensitive to:** {', '.join(c.sensitive_to)}", ""]
+                out += [f"**Readings examined:** {', '.join(c.sensitive_to)}", ""]
             for sv in c.sensitivity:
                 vals = ", ".join(fmt_cell(v) for v in sv.values)
                 out += [f"> **Sensitivity to {sv.parameter}**: values tried {vals}; today's default "
@@ -254,7 +254,7 @@ def render_md(sections: list[PaperSection], out_dir: Path, meta: dict) -> str:
 def claims_text(sections: list[PaperSection], width: int = 70) -> str:
     """The summary table as plain text for the terminal."""
     rows = summary_rows(sections)
-    lines = [f"{'claim':8s} {'verdict':22s} {'statement':{width}s} sensitive to"]
+    lines = [f"{'claim':8s} {'verdict':22s} {'statement':{width}s} readings examined"]
     for _, cid, st, v, sens in rows:
         st1 = st if len(st) <= width else st[: width - 1] + "…"
         lines.append(f"{cid:8s} {v:22s} {st1:{width}s} {sens}")
