@@ -4,6 +4,7 @@
 
 pub mod abi;
 pub mod instance;
+mod library_path;
 pub mod state;
 
 use std::collections::HashSet;
