@@ -7,13 +7,13 @@ from __future__ import annotations
 
 import ctypes
 import math
-from ctypes import POINTER, byref, c_char, c_int, c_size_t, c_void_p
+from ctypes import byref, c_char, c_int, c_size_t, c_void_p
 
 import pytest
 from fmpy.fmi1 import FMICallException
-from fmpy.fmi2 import FMU2Slave, fmi2Real, fmi2ValueReference
+from fmpy.fmi2 import fmi2Real, fmi2ValueReference
 
-from scfmu.master import Fmu, recording_callbacks
+from scfmu.master import Fmu
 
 OK, WARNING, DISCARD, ERROR, FATAL = 0, 1, 2, 3, 4
 

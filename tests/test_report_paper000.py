@@ -2,7 +2,6 @@
 expected outcome of each rule is known), and one quick build on the campaign engine."""
 
 import math
-import os
 import sys
 import time
 from pathlib import Path
