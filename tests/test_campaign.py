@@ -190,6 +190,20 @@ def test_resume_runs_only_what_is_missing(reference_rows, tmp_path):
     # a different campaign in the same folder is refused
     with pytest.raises(RuntimeError, match="another campaign"):
         campaign.run(small_campaign(t=1.0), tmp_path, n_workers=1, progress=False)
+    # the same campaign with rows from another FMU build is not resumed: refused, or redone with overwrite
+    import json
+    man = json.loads((tmp_path / "manifest.json").read_text())
+    man["fmus"]["PdController"]["sha256"] = "0" * 64
+    (tmp_path / "manifest.json").write_text(json.dumps(man))
+    with pytest.raises(RuntimeError, match="other FMU builds.*PdController"):
+        campaign.run(c, tmp_path, n_workers=1, progress=False)
+    import time
+    t0 = time.time_ns()
+    redone = rows_of(campaign.run(c, tmp_path, n_workers=1, progress=False, overwrite=True))
+    same_rows(full, redone)
+    parts = list((tmp_path / "parts").glob("rows-*.parquet"))
+    assert parts and all(p.stat().st_mtime_ns >= t0 for p in parts)  # every run done again
+    assert json.loads((tmp_path / "manifest.json").read_text())["fmus"]["PdController"]["sha256"] != "0" * 64
 
 
 def test_cli_grid_and_plots(tmp_path):

@@ -15,10 +15,11 @@ campaign goes on.
 Output folder:
 
 * ``manifest.json``: scenario (plain data), overrides, seeds, engine, FMU GUIDs and SHA-256, package
-  versions, and a hash of all that (``campaign_id``);
+  versions, and a hash of the scenario, overrides, seeds and engine (``campaign_id``);
 * ``parts/rows-*.parquet``: rows as they complete (written every ``flush_every`` rows), so an
   interrupted campaign resumes: ``run()`` on the same folder skips the runs already written (a folder
-  holding a different campaign is refused unless ``overwrite=True``);
+  holding a different campaign, or this one run with other FMU builds (GUID or SHA-256 of any FMU
+  differs), is refused unless ``overwrite=True``, which starts afresh);
 * ``results.parquet``: all rows sorted by ``run`` (written at the end);
 * ``timeseries/run-<run>.parquet`` when ``timeseries`` is set (logged keys, every ``ts_every``-th sample).
 
@@ -315,18 +316,24 @@ def run(c: Campaign, out_dir: str | Path, scheduler: str | None = None, n_worker
     out_dir.mkdir(parents=True, exist_ok=True)
     cid = c.campaign_id()
     man_path = out_dir / "manifest.json"
+    fmus = fmu_versions(c.scenario)
     if man_path.exists():
         old = json.loads(man_path.read_text())
-        if old.get("campaign_id") != cid:
+        # Rows made with other FMU builds (any change of a binary or modelDescription) must not be mixed
+        # with new ones: such a folder counts as another campaign.
+        other = (f"another campaign ({old.get('campaign_id')} ≠ {cid})" if old.get("campaign_id") != cid else
+                 "this campaign run with other FMU builds "
+                 f"({', '.join(sorted(m for m in fmus if old.get('fmus', {}).get(m) != fmus[m]))} changed)"
+                 if old.get("fmus") != fmus else None)
+        if other:
             if not overwrite:
-                raise RuntimeError(f"{out_dir} holds another campaign ({old.get('campaign_id')} ≠ {cid}); "
-                                   f"choose another folder or overwrite")
+                raise RuntimeError(f"{out_dir} holds {other}; choose another folder or overwrite")
             import shutil
             for sub in ("parts", "timeseries"):
                 shutil.rmtree(out_dir / sub, ignore_errors=True)
             (out_dir / "results.parquet").unlink(missing_ok=True)
     specs = c.runs()
-    manifest = {"campaign_id": cid, **c.describe(), "n_runs": len(specs), "fmus": fmu_versions(c.scenario),
+    manifest = {"campaign_id": cid, **c.describe(), "n_runs": len(specs), "fmus": fmus,
                 "packages": package_versions(), "created": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
                 "row_columns": _row_columns(c)}
     if man_path.exists():
