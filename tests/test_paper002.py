@@ -275,6 +275,22 @@ def test_engine_tuner_same_for_any_worker_count_and_resumes(tmp_path):
     ck = tmp_path / "ck.json"
     with pytest.raises(Kill):
         p2.tune(["PD", "FOPD"], sc, checkpoint=ck, on_round=kill_after_two, **kw)
+    # a checkpoint from another FMU build is not resumed: the swarms start again at iteration 0
+    import json
+    saved = ck.read_text()
+    st = json.loads(saved)
+    st["setup"]["fmus"]["PidController"] = "0" * 64
+    ck.write_text(json.dumps(st))
+    starts = []
+
+    def note_first_round(swarms, info):
+        starts.append(min(s.it for s in swarms.values()))
+        raise Kill
+
+    with pytest.raises(Kill):
+        p2.tune(["PD", "FOPD"], sc, checkpoint=ck, on_round=note_first_round, **kw)
+    assert starts == [1]  # after its first iteration, not the third
+    ck.write_text(saved)
     resumed = p2.tune(["PD", "FOPD"], sc, checkpoint=ck, **kw)
     for c in ("PD", "FOPD"):
         print(c, serial[c]["history"], serial[c]["gains"])

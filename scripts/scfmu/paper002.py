@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from . import master
 from .master import Fmu
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -447,12 +448,15 @@ def tune(controllers: list[str], sc: Scenario = Scenario(), n_particles: int = 3
     ``seed + index of c in CONTROLLERS`` (PD 2, PID 3, FOPD 4, FOPID 5 by default) whichever subset runs.
 
     `checkpoint`: JSON file written after every iteration (swarm states, generator states, run times);
-    an existing checkpoint of the same set-up is resumed. `deadline`: a time.time() value; no iteration
+    an existing checkpoint of the same set-up (and the same FMU builds) is resumed. `deadline`: a time.time() value; no iteration
     starts after it (the result then says ``stop = "deadline"``). Returns {controller: result dict}."""
     from tqdm import tqdm
     setup = {"controllers": list(controllers), "scenario": {"theta_ref_deg": sc.theta_ref_deg, "t_end": sc.t_end,
              "h": sc.h, "plant": sc.plant, "gl_memory": sc.gl_memory, "history_before_start": sc.history_before_start},
-             "n_particles": n_particles, "max_iter": max_iter, "seed": seed, "pso": pso_kw}
+             "n_particles": n_particles, "max_iter": max_iter, "seed": seed, "pso": pso_kw,
+             # a checkpoint made with other FMU builds is not resumed (costs from two builds never mix)
+             "fmus": {m: master.fmu_digest(master.fmu_path(m))
+                      for m in ("SingleAxisPlant", "PidController", "FopidController")}}
     swarms, info = {}, {}
     if checkpoint is not None and Path(checkpoint).exists():
         ck = json.loads(Path(checkpoint).read_text())
