@@ -39,9 +39,9 @@ def plt():
     return plt_
 
 
-def save(fig, path: Path) -> None:
+def save(fig, path: Path, dpi: int = 110) -> None:
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    fig.savefig(path, dpi=dpi)
     plt().close(fig)
 
 

@@ -24,6 +24,7 @@ import numpy as np
 
 from .. import scenarios
 from ..campaign import Campaign, read_timeseries
+from . import common
 from .types import CONFIRMED, DEPENDS, NOT_CONFIRMED, Claim, Context, PaperSection, Sensitivity, Table
 
 TITLE = "Design of an adaptive-fuzzy controller based on the EULERINT criterion for a satellite"
@@ -282,10 +283,6 @@ def _override(sw: dict, v, rid: str = "") -> dict:
 TS_KEYS = ["alpha_deg", "roll", "pitch", "yaw", "torque_applied_x", "torque_applied_y", "torque_applied_z"]
 
 
-def _rows(table) -> list[dict]:
-    return table.to_pylist()
-
-
 def run_base(ctx: Context) -> tuple[dict, dict]:
     """Every run of the paper 000 table, one campaign each; robustness runs keep α(t) and the angles."""
     base, ts = {}, {}
@@ -293,7 +290,7 @@ def run_base(ctx: Context) -> tuple[dict, dict]:
         keep = TS_KEYS if r.run_id.startswith("R") or r.run_id in L_RUNS else None
         c = Campaign(scenarios.paper000(r.run_id), [{}], engine="native", timeseries=keep, ts_every=5)
         name = f"000/base/{r.run_id}"
-        row = _rows(ctx.campaign(c, name))[0]
+        row = common.rows(ctx.campaign(c, name))[0]
         if row["status"] != "ok":
             raise RuntimeError(f"paper 000 run {r.run_id} failed: {row['message']}")
         base[r.run_id] = row
@@ -307,7 +304,7 @@ def run_sweep(ctx: Context, sw: dict, idx: int) -> dict:
     out = {}
     for rid in sw["runs"]:
         c = Campaign(scenarios.paper000(rid), [_override(sw, v, rid) for v in sw["values"]], engine="native")
-        out[rid] = _rows(ctx.campaign(c, f"000/sweep{idx:02d}/{rid}"))
+        out[rid] = common.rows(ctx.campaign(c, f"000/sweep{idx:02d}/{rid}"))
     return out
 
 

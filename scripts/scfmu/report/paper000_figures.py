@@ -7,18 +7,12 @@ from __future__ import annotations
 import numpy as np
 
 from .paper000 import EFF, EFFORT_RATIO, EI, L_RUNS, ROBUST_CASES, ROBUST_CTRL, S_RUNS, _label
+from . import common
 from .types import Figure
 
 
-def _plt():
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    return plt
-
-
 def fig_ranking(ctx, base) -> Figure:
-    plt = _plt()
+    plt = common.plt()
     fig, axs = plt.subplots(1, 2, figsize=(11, 4.2))
     for ax, ids, title in ((axs[0], L_RUNS, "large command L (40, −40, −60) deg"),
                            (axs[1], S_RUNS, "small command S (4, −4, −6) deg")):
@@ -33,16 +27,14 @@ def fig_ranking(ctx, base) -> Figure:
         ax.set_xlim(0, max(vals) * 1.18)
     fig.suptitle("Paper 000: EULERINT of every controller (lower is better); paper's order for L: "
                  "adaptive fuzzy < fuzzy < MRAC < PD quat = LQR = pole pl. < PD DCM < PD Euler", fontsize=9)
-    fig.tight_layout()
     p = ctx.figures_dir / "000_ranking.png"
-    fig.savefig(p, dpi=100)
-    plt.close(fig)
+    common.save(fig, p, dpi=100)
     return Figure(f"figures/{p.name}", "EULERINT per controller, large (left) and small (right) command, default "
                                        "parameters; horizontal bars sorted from best to worst.")
 
 
 def fig_effort(ctx, base) -> Figure:
-    plt = _plt()
+    plt = common.plt()
     fig, axs = plt.subplots(1, 2, figsize=(11, 4.2))
     for ax, key, unit in ((axs[0], "effort_abs", "∫Σ|τ_i| dt [N·m·s]"), (axs[1], "effort_sq", "∫‖τ‖² dt [N²·m²·s]")):
         for k in ["000-2", "000-4", "000-6", "000-9L", "000-10L", "000-11L"]:
@@ -55,16 +47,14 @@ def fig_effort(ctx, base) -> Figure:
     axs[0].legend(fontsize=7)
     fig.suptitle("Paper 000, large command: control effort against EULERINT (two effort metrics; the paper's "
                  "formula is unknown)", fontsize=9)
-    fig.tight_layout()
     p = ctx.figures_dir / "000_effort_vs_eulerint.png"
-    fig.savefig(p, dpi=100)
-    plt.close(fig)
+    common.save(fig, p, dpi=100)
     return Figure(f"figures/{p.name}", "Control effort against EULERINT for the three PD variants, MRAC, fuzzy PD "
                                        "and adaptive fuzzy, large command; left ∫Σ|τ|, right ∫‖τ‖².")
 
 
 def fig_robust(ctx, ts) -> Figure:
-    plt = _plt()
+    plt = common.plt()
     fig, axs = plt.subplots(2, 3, figsize=(13, 6.5), sharex=True)
     for j, (case, title) in enumerate(ROBUST_CASES.items()):
         for c, lab in ROBUST_CTRL.items():
@@ -86,16 +76,14 @@ def fig_robust(ctx, ts) -> Figure:
     axs[1, 0].legend(fontsize=8)
     fig.suptitle("Paper 000 robustness (C000-7): PD, MRAC, fuzzy and adaptive fuzzy under a constant disturbance "
                  "and ±20 % inertia", fontsize=9)
-    fig.tight_layout()
     p = ctx.figures_dir / "000_robustness.png"
-    fig.savefig(p, dpi=100)
-    plt.close(fig)
+    common.save(fig, p, dpi=100)
     return Figure(f"figures/{p.name}", "Responses under the 10 N·m disturbance (R1) and the inertia uncertainty (R2): "
                                        "α(t) on a log scale (top) and the yaw angle (bottom), command L.")
 
 
 def fig_sweep(ctx, base, sw, idx, rows, holds: dict) -> Figure:
-    plt = _plt()
+    plt = common.plt()
     plotted = [r for r in sw["runs"] if r in L_RUNS]
     vals = sw["values"]
     cat = sw.get("categorical", False)
@@ -149,16 +137,14 @@ def fig_sweep(ctx, base, sw, idx, rows, holds: dict) -> Figure:
     axs[0].legend(fontsize=6.5)
     axs[1].legend(fontsize=6.5)
     fig.suptitle(f"Paper 000 sensitivity: {sw['param']} (other controllers at their defaults)", fontsize=9)
-    fig.tight_layout()
     p = ctx.figures_dir / f"000_sweep{idx:02d}.png"
-    fig.savefig(p, dpi=100)
-    plt.close(fig)
+    common.save(fig, p, dpi=100)
     return Figure(f"figures/{p.name}", f"EULERINT (left) and effort (right) of {', '.join(map(_label, plotted))} against {sw['param']}; "
                                        f"markers below the curve show where each claim's rule holds.")
 
 
 def fig_joint(ctx, swa, swb, holds: dict) -> Figure:
-    plt = _plt()
+    plt = common.plt()
     from matplotlib import ticker
     from matplotlib.colors import ListedColormap
     fig, axs = plt.subplots(1, len(holds), figsize=(3.6 * len(holds), 3.8), sharey=True)
@@ -182,10 +168,8 @@ def fig_joint(ctx, swa, swb, holds: dict) -> Figure:
     axs[0].legend(fontsize=7, loc="lower left")
     fig.suptitle("Paper 000: where each claim holds when T_r (fuzzy PD) and the λ ranges (adaptive fuzzy) change "
                  "together", fontsize=9)
-    fig.tight_layout()
     p = ctx.figures_dir / "000_joint_tr_lambda.png"
-    fig.savefig(p, dpi=100)
-    plt.close(fig)
+    common.save(fig, p, dpi=100)
     return Figure(f"figures/{p.name}", "Regions (green) where C000-4 … C000-7 hold on the grid of the fuzzy PD's T_r "
                                        "and the adaptive-fuzzy λ-range scale, other readings at their defaults.")
 

@@ -29,6 +29,7 @@ import time
 import numpy as np
 
 from .. import paper003 as p3
+from . import common
 from ..campaign import Campaign, read_timeseries
 from .types import CONFIRMED, DEPENDS, NOT_CONFIRMED, Claim, Figure, PaperSection, Sensitivity, Table
 
@@ -157,9 +158,7 @@ def _fmt(v):
 
 # ----- figures ----------------------------------------------------------------------------------------
 def _plot_overview(summary: dict, path) -> None:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = common.plt()
     fig, ax = plt.subplots(1, 3, figsize=(14, 4))
     x = np.arange(len(CASES))
     for j, (key, ylabel) in enumerate((("ise", "ISE (rad² s)"), ("isf", "ISF (N² m² s)"),
@@ -174,16 +173,12 @@ def _plot_overview(summary: dict, path) -> None:
         if key == "sse":
             ax[j].set_yscale("log")
     fig.suptitle("Paper 003: GA-SMC vs T2F-SMC per scenario (lower is better)")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    common.save(fig, path)
 
 
 def _plot_sweep(name: str, unit: str, values: list, summaries: list[dict], path) -> None:
     """Ratio T2F-SMC / GA-SMC of ISE, ISF and steady-state error per case against the swept value."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = common.plt()
     fig, ax = plt.subplots(1, 3, figsize=(14, 4))
     numeric = all(isinstance(v, (int, float)) for v in values)
     xs = values if numeric else list(range(len(values)))
@@ -209,9 +204,7 @@ def _plot_sweep(name: str, unit: str, values: list, summaries: list[dict], path)
         ax[j].grid(True, alpha=0.3)
         ax[j].legend(fontsize=7)
     fig.suptitle(f"Sensitivity to {name}: below 1 = T2F-SMC lower")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    common.save(fig, path)
 
 
 # ----- the section ------------------------------------------------------------------------------------
