@@ -33,10 +33,9 @@ EULER = (math.radians(40.0), math.radians(-40.0), math.radians(-60.0))  # comman
 
 
 def native_run() -> dict:
-    sys.path.insert(0, str(ROOT / "scripts"))
-    from scfmu import scenarios
-    from scfmu.native import NativeLoop
-    sc = scenarios.default(T_END, DT)
+    from scfmu import scenario as scenarios
+    from scfmu.engines.native import NativeLoop
+    sc = scenarios.get("default", stop_time=T_END, step=DT)
     sc.components = [c for c in sc.components if c.name != "metrics"]
     sc.components[2].params["max_internal_step"] = DT  # one RK4 step per 0.1 s, as Basilisk's task
     sc.log = {"roll": "plant.roll", "pitch": "plant.pitch", "yaw": "plant.yaw"}

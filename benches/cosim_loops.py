@@ -2,14 +2,14 @@
 """Co-simulation loop speed, measured side by side in one run (docs/benchmarks.md, issue 9).
 
 Loops: 2 FMUs (PdController + AttitudePlant, reference fixed at the paper 000 large command) and the
-4-FMU run 000-6 of scripts/run_default.py (AttitudeCommand + PdController + AttitudePlant +
+4-FMU run 000-6 of `scfmu run default` (AttitudeCommand + PdController + AttitudePlant +
 AttitudeMetrics), Δ = 0.01 s, 3,000 communication steps. Per loop, µs per communication step of:
 
-* reference: scfmu.master.CoSimulation (fmpy high-level calls, logging the scenario's signals);
-* lean: scfmu.lean.LeanMaster (logging), and without logging;
+* reference: scfmu.engines.reference.CoSimulation (fmpy high-level calls, logging the scenario's signals);
+* lean: scfmu.engines.lean.LeanMaster (logging), and without logging;
 * minimal ctypes: the same FMI calls as straight-line Python code (generated, unrolled, no logging,
   no status checks): the floor of any master written in Python;
-* native: scfmu.native.NativeLoop, the loop inside fmpy's container FMU, logging every step (one
+* native: scfmu.engines.native.NativeLoop, the loop inside fmpy's container FMU, logging every step (one
   fmi2DoStep + one fmi2GetReal from Python per step) and with no Python call per step (log_every=0);
 * C floor: the lean master's exact call list run by a small C function (benches/cosim_floor.c,
   compiled here with cc): the cost of the FMUs themselves plus the FMI call overhead;
@@ -38,19 +38,19 @@ from ctypes import c_double, c_long, c_size_t, c_void_p
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "scripts"))
 
-from scfmu import scenarios  # noqa: E402
-from scfmu.lean import LeanMaster  # noqa: E402
-from scfmu.master import Fmu  # noqa: E402
-from scfmu.native import NativeLoop  # noqa: E402
-from scfmu.scenario import Component, Scenario, log_of  # noqa: E402
-from scfmu.libcosim_run import run_libcosim  # noqa: E402
-from scfmu.simulate import reference_master  # noqa: E402
+from scfmu import scenario as scenarios
+from scfmu.papers.paper000 import scenarios as p000_scenarios
+from scfmu.engines.lean import LeanMaster
+from scfmu.fmu import Fmu
+from scfmu.engines.native import NativeLoop
+from scfmu.scenario.model import Component, Scenario, log_of
+from scfmu.engines.libcosim import run_libcosim
+from scfmu.engines import reference_master
 
 
 def two_fmu_scenario(stop_time=30.0) -> Scenario:
-    c = scenarios.COMMANDS["L"]
+    c = p000_scenarios.COMMANDS["L"]
     cmd = Fmu("AttitudeCommand", {"ref_euler321_roll": c[0], "ref_euler321_pitch": c[1], "ref_euler321_yaw": c[2]})
     qref = {f"controller.q_ref_{a}": cmd.get(f"q_ref_{a}") for a in "wxyz"}
     cmd.close()
@@ -152,7 +152,7 @@ METHODS = [("reference master (fmpy, CoSimulation)", t_reference), ("lean master
 
 
 def loops(repeat: int):
-    scs = {"2 FMUs": two_fmu_scenario(), "4 FMUs (run 000-6)": scenarios.default()}
+    scs = {"2 FMUs": two_fmu_scenario(), "4 FMUs (run 000-6)": scenarios.get("default")}
     best = {(ln, mn): float("inf") for ln in scs for mn, _ in METHODS}
     for _ in range(repeat):
         for ln, sc in scs.items():
@@ -179,10 +179,9 @@ def unrolled_calls(sc):
 def campaign_throughput(n_runs: int):
     from dask.distributed import Client, LocalCluster
     from scfmu import campaign
-    sc = scenarios.default()
+    sc = scenarios.get("default")
     sets = campaign.random_sample({"controller.wn": ("uniform", 0.5, 2.0)}, n_runs, 1)
     res = {}
-    os.environ["PYTHONPATH"] = str(ROOT / "scripts")
     for nw in (1, 2):
         with LocalCluster(n_workers=nw, threads_per_worker=1, processes=True, dashboard_address=None,
                           host="127.0.0.1", silence_logs=logging.CRITICAL) as cl, Client(cl) as client:

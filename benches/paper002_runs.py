@@ -2,7 +2,7 @@
 """Cost of one paper 002 tuner evaluation (one 20 s closed-loop run at h = 1 ms, 20,001 samples of θ
 logged) per controller: the campaign engine's native path (``campaign.run_one`` of paper002/<controller>
 with the gains as overrides, container instance reused as in a campaign) against the direct two-FMU
-Python loop (``scfmu.paper002.run_case``), side by side in one process. Minimum of --repeat runs each;
+Python loop (``scfmu.papers.paper002.model.run_case``), side by side in one process. Minimum of --repeat runs each;
 the costs of both paths are printed too (they agree to round-off).
 
 Usage: .venv/bin/python benches/paper002_runs.py [--repeat 3]
@@ -12,12 +12,9 @@ from __future__ import annotations
 
 import argparse
 import os
-import sys
 import time
-from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts"))
-from scfmu import paper002 as p2  # noqa: E402
+from scfmu import paper002 as p2
 
 
 def main() -> int:

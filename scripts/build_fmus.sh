@@ -23,8 +23,8 @@ if [ -n "${SCFMU_DARWIN64_LIB:-}" ]; then
 fi
 ./target/release/package "${package_args[@]}"
 if [ -x .venv/bin/python ]; then
-    PYTHONPATH=scripts .venv/bin/python -m scfmu.ssp --out fmus/ssp
-    PYTHONPATH=scripts .venv/bin/python -m scfmu.loops --out fmus/loops
+    .venv/bin/scfmu export ssp --out fmus/ssp
+    .venv/bin/scfmu export loop --out fmus/loops
 else
     echo "build_fmus: no .venv (run scripts/setup.sh): fmus/ssp and fmus/loops not written" >&2
 fi

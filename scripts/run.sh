@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Builds every FMU and runs the default scenario (paper 000 large-angle command, quaternion PD):
-# prints EULERINT, settling time and control effort, writes out/default/default_run.{csv,png}.
+# prints EULERINT, settling time and control effort, writes out/default/default.{csv,png}.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
 scripts/build_fmus.sh
-.venv/bin/python scripts/run_default.py "$@"
+.venv/bin/scfmu run default "$@"

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # One-time (idempotent) set-up on a fresh machine: checks the Rust toolchain and creates the Python
-# virtual environment .venv with the pinned packages of requirements.txt. Re-running is cheap: the
-# venv is rebuilt only when requirements.txt changes.
+# virtual environment .venv with the pinned packages of requirements.txt and this package (scfmu, editable,
+# with its `scfmu` command). Re-running is cheap: the venv is rebuilt only when requirements.txt or
+# pyproject.toml changes.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -62,4 +63,13 @@ if [ ! -x .venv/bin/python ] || [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; th
     .venv/bin/python -m pip install --quiet --upgrade pip
     .venv/bin/python -m pip install --quiet -r requirements.txt
     echo "$want" > "$stamp"
+fi
+# The package itself, editable: `scfmu` on .venv/bin, the plug-ins' entry points registered, FMUs taken from
+# this checkout's fmus/. Re-installed when pyproject.toml changes (e.g. a new paper plug-in).
+pstamp=.venv/.pyproject.sha256
+pwant=$(sha256sum pyproject.toml | cut -d' ' -f1)
+if [ "$(cat "$pstamp" 2>/dev/null)" != "$pwant" ] || [ ! -x .venv/bin/scfmu ]; then
+    echo "setup: installing the scfmu package (editable) into .venv"
+    .venv/bin/python -m pip install --quiet --no-deps --no-build-isolation -e .
+    echo "$pwant" > "$pstamp"
 fi

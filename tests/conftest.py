@@ -1,7 +1,2 @@
-"""pytest configuration: the FMU tests drive the built FMUs in fmus/ through fmpy."""
-
-import sys
-from pathlib import Path
-
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "scripts"))
+"""pytest configuration: the FMU tests drive the built FMUs in fmus/ through fmpy and the installed
+scfmu package (scripts/setup.sh installs it, editable, into .venv)."""

@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from scfmu import CoSimulation, Fmu
+from scfmu.engines.reference import CoSimulation
+from scfmu.fmu import Fmu
 
 I_P000 = np.diag([1000.0, 500.0, 700.0])
 LARGE = (math.radians(40.0), math.radians(-40.0), math.radians(-60.0))

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from scfmu.master import Fmu
+from scfmu.fmu import Fmu
 
 SUMMARY: list[str] = []
 

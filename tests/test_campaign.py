@@ -11,9 +11,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from scfmu import campaign, scenarios
-from scfmu.scenario import Component, Scenario
-from scfmu.simulate import simulate
+from scfmu import campaign
+from scfmu import scenario as scenarios
+from scfmu.scenario.model import Component, Scenario
+from scfmu.engines import simulate
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -60,7 +61,7 @@ def test_lean_and_native_bit_identical_to_reference_master(name, t):
 
 def test_native_full_run_000_6_eulerint_matches_reference():
     """Run 000-6 over its 30 s: the container loop (no Python per step) gives the reference EULERINT."""
-    sc = scenarios.default()
+    sc = scenarios.get("default")
     ref = simulate(sc, "reference")["eulerint_deg_s"][-1]
     nat = simulate(sc, "native", log_every=0)
     assert len(nat["time"]) == 2 and nat["time"][-1] == 30.0
@@ -69,7 +70,7 @@ def test_native_full_run_000_6_eulerint_matches_reference():
 
 
 def test_failing_runs_raise_simulation_error():
-    from scfmu.lean import SimulationError
+    from scfmu.engines.lean import SimulationError
     for engine in ("lean", "native"):
         with pytest.raises((SimulationError, Exception)) as e:
             simulate(short().with_overrides({"controller.wn": -1.0}), engine)
@@ -207,7 +208,7 @@ def test_resume_runs_only_what_is_missing(reference_rows, tmp_path):
 
 
 def test_cli_grid_and_plots(tmp_path):
-    r = subprocess.run([sys.executable, str(ROOT / "scripts" / "campaign.py"), "default", "--t-end", "2",
+    r = subprocess.run([sys.executable, "-m", "scfmu", "campaign", "default", "--t-end", "2",
                         "--grid", "controller.wn=0.5,1,2", "--workers", "1", "--timeseries", "alpha_deg",
                         "--plot-vs", "controller.wn", "--out", str(tmp_path), "--no-progress"],
                        capture_output=True, text=True, timeout=300, cwd=ROOT)
@@ -220,8 +221,8 @@ def test_cli_grid_and_plots(tmp_path):
 
 def test_native_instance_reuse_after_reset_gives_fresh_results():
     """A container instance reset after a run (also after a failed one) gives the fresh-instance results."""
-    from scfmu import native
-    from scfmu.lean import SimulationError
+    from scfmu.engines import native
+    from scfmu.engines.lean import SimulationError
     a = short(t=2.0).with_overrides({"controller.wn": 1.7, "plant.dist_noise_std_x": 0.5}).with_seed(7)
     b = short(t=2.0).with_overrides({"controller.wn": 0.6}).with_seed(1)
     fresh_a = simulate(a, "native", reuse=False)
@@ -239,8 +240,8 @@ def test_second_master_libcosim_agrees_within_the_coupling_delay():
     """libcosim (Jacobi: values move after the step) against the Gauss–Seidel reference, run 000-6:
     the one-step torque delay changes EULERINT by a fraction of a percent, nothing more."""
     pytest.importorskip("libcosimpy")
-    from scfmu.libcosim_run import run_libcosim
-    sc = scenarios.default()
+    from scfmu.engines.libcosim import run_libcosim
+    sc = scenarios.get("default")
     ref = simulate(sc, "native", log_every=0)
     lc = run_libcosim(sc)
     e_ref, e_lc = ref["eulerint_deg_s"][-1], lc["eulerint_deg_s"]

@@ -13,7 +13,7 @@ import pytest
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import fmi2Real, fmi2ValueReference
 
-from scfmu.master import Fmu
+from scfmu.fmu import Fmu
 
 OK, WARNING, DISCARD, ERROR, FATAL = 0, 1, 2, 3, 4
 

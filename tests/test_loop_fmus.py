@@ -11,8 +11,9 @@ import pytest
 from fmpy import read_model_description, simulate_fmu
 from fmpy.validation import validate_fmu
 
-from scfmu import scenarios, ssp
-from scfmu.simulate import run_reference
+from scfmu import scenario as scenarios
+from scfmu.scenario import ssp
+from scfmu.engines import run_reference
 
 LOOP_DIR = Path(__file__).resolve().parents[1] / "fmus" / "loops"
 

@@ -14,8 +14,9 @@ import scipy.linalg
 import skfuzzy as fuzz
 from fmpy.validation import validate_fmu
 
-from scfmu import CoSimulation, Fmu
-from scfmu.master import fmu_path
+from scfmu.engines.reference import CoSimulation
+from scfmu.fmu import Fmu
+from scfmu.fmu import fmu_path
 
 NEW = ["LqrController", "PolePlacementController", "MracController", "FuzzyPdController", "AdaptiveFuzzyController"]
 INERTIA = (1000.0, 500.0, 700.0)
@@ -24,7 +25,7 @@ SMALL = (math.radians(4.0), math.radians(-4.0), math.radians(-6.0))
 AX = "xyz"
 
 
-from quat_oracle import q321, qconj, qmul  # noqa: E402  (independent helpers shared by the tests)
+from quat_oracle import q321, qconj, qmul  # independent helpers shared by the tests
 
 
 def set_att(ctrl: Fmu, q, w, q_ref):

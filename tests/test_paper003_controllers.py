@@ -8,18 +8,17 @@ from __future__ import annotations
 
 import math
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 from fmpy.validation import validate_fmu
 from pyit2fls import KM_algorithm, gauss_uncert_std_lmf, gauss_uncert_std_umf
 
-from scfmu import CoSimulation, Fmu
-from scfmu.master import fmu_path
+from scfmu.engines.reference import CoSimulation
+from scfmu.fmu import Fmu
+from scfmu.fmu import fmu_path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts"))
-import paper003  # noqa: E402
+from scfmu.papers.paper003 import commands as paper003
 
 MODELS = ["SlidingModeController", "Type2FuzzySmcController"]
 AX = "xyz"
@@ -28,7 +27,7 @@ PLANT003 = paper003.PLANT
 CMD = paper003.COMMAND
 
 
-from quat_oracle import q321, qconj, qmul  # noqa: E402  (independent helpers shared by the tests)
+from quat_oracle import q321, qconj, qmul  # independent helpers shared by the tests
 
 
 def set_inputs(ctrl: Fmu, q, w, q_ref, w_ref=(0.0, 0.0, 0.0), h=(0.0, 0.0, 0.0)):
@@ -279,10 +278,10 @@ def test_unconnected_quaternion_fails_loudly():
 def test_declared_scenario_on_the_engine_equals_the_reference_path():
     """The GA fitness of one candidate and the scenario metrics, computed by the campaign engine on the
     declared scenario (native container loop, Dask worker), equal the loop written out with the reference
-    master (scripts/paper003.py simulate_reference: its own FMU set-up, name matching each step): the same
+    master (scfmu.papers.paper003.commands.simulate_reference: its own FMU set-up, name matching each step): the same
     Gauss–Seidel scheme, so bit for bit. Candidate T2F-SMC with non-default fuzzy coefficients in 003-S."""
     from scfmu import campaign
-    from scfmu import paper003 as p3
+    from scfmu.papers.paper003 import model as p3
     cand = {"k_switch": 0.004, "e_scale": 0.1, "edot_scale": 0.02, "kappa": 0.7}
     t = 4.0
     ref, _ = paper003.simulate_reference(paper003.Case("Type2FuzzySmcController", cand, p3.DISTURBANCES["S"], t_end=t))
@@ -304,7 +303,7 @@ def test_monte_carlo_on_the_engine_is_bit_reproducible_and_independent_of_worker
     """003-U through the campaign engine: the same seed list gives identical rows with 1 and 2 Dask
     workers, and each row equals the reference-path run of the plant scaled by that seed."""
     from scfmu import campaign
-    from scfmu import paper003 as p3
+    from scfmu.papers.paper003 import model as p3
     seeds = [1, 2, 3]
     c = p3.mc_campaign("T2FSMC", seeds, {}, t_end=3.0)
     t1 = campaign.run(c, tmp_path / "w1", n_workers=1, progress=False)
@@ -328,7 +327,7 @@ def test_monte_carlo_on_the_engine_is_bit_reproducible_and_independent_of_worker
 
 def _script(args, timeout=300):
     import subprocess
-    r = subprocess.run([sys.executable, str(Path(paper003.__file__)), *map(str, args)], capture_output=True, text=True,
+    r = subprocess.run([sys.executable, "-m", "scfmu", "paper", "003", *map(str, args)], capture_output=True, text=True,
                        timeout=timeout)
     assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
     return r.stdout

@@ -5,17 +5,11 @@ DCM PD between the quaternion and Euler PDs, reading 1 equals the quaternion law
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
-
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts"))
-
-from quat_oracle import qconj, qmul  # noqa: E402
-from scfmu import Fmu  # noqa: E402
+from quat_oracle import qconj, qmul
+from scfmu.fmu import Fmu
 
 K = np.array([1000.0, 500.0, 700.0])  # wn = 1: k = I
 

@@ -13,7 +13,8 @@ import pytest
 from fmpy.validation import validate_fmu
 from scipy.integrate import solve_ivp
 
-from scfmu.master import CoSimulation, Fmu, fmu_path
+from scfmu.engines.reference import CoSimulation
+from scfmu.fmu import Fmu, fmu_path
 from scfmu.metrics import settling_time
 
 MU = 3.986004418e14

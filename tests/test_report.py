@@ -1,9 +1,8 @@
 """Reproduction report: the renderer on synthetic sections (fast), the verdict rules on small synthetic
-tables, and one end-to-end --quick build of scripts/report.py whose claims table is checked."""
+tables, and one end-to-end --quick build (scfmu report) whose claims table is checked."""
 
 from __future__ import annotations
 
-import importlib.util
 import math
 import os
 import subprocess
@@ -14,17 +13,14 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "scripts"))
 
-from scfmu.report import render, rules  # noqa: E402
-from scfmu.report.types import (CONFIRMED, DEPENDS, NOT_CONFIRMED, Claim, Figure, PaperSection,  # noqa: E402
+from scfmu.report import cli as report_cli
+from scfmu.report import render, rules
+from scfmu.report.types import (CONFIRMED, DEPENDS, NOT_CONFIRMED, Claim, Figure, PaperSection,
                                 Sensitivity, Table)
 
-# The papers CI builds with --quick: one constant, scripts/report.py CI_PAPERS.
-_spec = importlib.util.spec_from_file_location("report_cli", ROOT / "scripts" / "report.py")
-report_cli = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(report_cli)
-CI_PAPERS = report_cli.CI_PAPERS
+# The papers CI builds with --quick: every paper plug-in with a report section.
+CI_PAPERS = report_cli.papers_known()
 # Every claim id of those papers (the list of the papers' conclusions).
 CLAIM_IDS = {
     "000": [f"C000-{i}" for i in range(1, 8)],
@@ -168,59 +164,6 @@ def test_rules_basic():
     assert rules.holds_at(["a", "b", "c"], [True, False, True]) == "at a, c (2 of 3)"
 
 
-def test_paper001_rules():
-    from scfmu.report import paper001 as p
-    # settling rises with the horizon, effort_abs falls (reading A), effort_sq rises (reading B)
-    h = p.horizon_rule([5, 10, 25], [10, 20, 50], {"effort_abs": [30, 20, 10], "effort_sq": [1, 2, 3]})
-    assert h["settling_rises"] and h["A:effort_abs"] and h["B:effort_sq"] and not h["A:effort_sq"]
-    assert h["verdict"] == DEPENDS
-    assert p.horizon_rule([5, 10], [10, 20], {"e": [2, 1]})["verdict"] == CONFIRMED
-    assert p.horizon_rule([5, 10], [20, 10], {"e": [2, 1]})["verdict"] == NOT_CONFIRMED
-    # settling flat from c = 25, effort 10x (abs) vs 3x (sq) from 25 to 150
-    o = p.observer_rule([5, 25, 150], [60, 50, 51], {"abs": [1, 2, 20], "sq": [1, 2, 6]})
-    assert o["settling_same"] and o["holds:abs"] and not o["holds:sq"] and o["verdict"] == DEPENDS
-    assert p.observer_rule([25, 150], [50, 70], {"abs": [1, 20]})["verdict"] == NOT_CONFIRMED
-    assert p.disturbance_rule(0.1, 40.0, 100.0, 101.0) and not p.disturbance_rule(1.0, 40.0, 100.0, 101.0)
-    assert not p.disturbance_rule(0.1, 40.0, 100.0, 110.0)
-    assert p.settled_at([5, 25, 50, 150], [80, 51, 50, 50]) == 25
-    assert p.observer_rule([25, 150], [50, 50], {"sq": [1, 8]})["verdict"] == CONFIRMED         # 8x > 6x
-    assert p.observer_rule([25, 150], [50, 50], {"sq": [1, 8]}, far=2.0)["verdict"] == NOT_CONFIRMED  # not > 12x
-    assert p.tracking_rule(0.05, 66.0, 87.7) and not p.tracking_rule(0.1, 66.0, 87.7)
-    assert not p.tracking_rule(0.0, math.nan, 87.7)
-
-
-def test_paper002_rules():
-    from scfmu.report import paper002 as p
-    fo = {"settling_s": 5.0, "overshoot_pct": 1.0, "mae_deg": 3.0}
-    it = {"settling_s": 6.0, "overshoot_pct": 1.0, "mae_deg": 3.1}
-    r = p.pair_rule(fo, it)
-    assert r["better"] == 2 and r["worse"] == 0 and r["holds"]
-    assert not p.pair_rule({**fo, "overshoot_pct": 2.0}, it)["holds"]          # worse on one metric
-    assert not p.pair_rule(it, it)["holds"]                                       # all ties
-    mae = {"PD": 3.0, "PID": 3.2, "FOPD": 2.9, "FOPID": 3.1}
-    assert p.phase_rule(mae)["holds"]
-    assert not p.phase_rule({**mae, "PID": 2.95, "FOPID": 2.9})["holds"]          # PID better than PD
-    sw = {"PD": [1, 2, 3], "PID": [1, 3, 5], "FOPD": [1, 1.4, 1.8], "FOPID": [1, 1.5, 2]}
-    assert p.spread_rule(sw)["holds"] and not p.spread_rule(sw, 0.3)["holds"]
-    b = p.sweep_better_rule({"PD": [2, 2, 2, 2], "PID": [2, 2, 2, 2], "FOPD": [1, 1, 1, 3], "FOPID": [1, 1, 1, 1]})
-    assert b["FOPD>PD"] == (3, 4) and b["holds"]
-    assert not p.sweep_better_rule({"PD": [2, 2], "PID": [2, 2], "FOPD": [1, 3], "FOPID": [1, 1]})["holds"]
-    assert p.grows_rule({"PD": [1, 1, 2], "FOPD": [0.5, 0.6, 0.7]}) and not p.grows_rule({"PD": [2, 1]})
-    wt = {"PD": [3, 2, 4], "PID": [3, 2, 4], "FOPD": [2.5, 1.9, 3], "FOPID": [2.5, 1.9, 3]}
-    ds = {"PD": [2, 3, 5], "PID": [2, 3, 5], "FOPD": [1.5, 2, 3], "FOPID": [1.5, 2, 3]}
-    assert all(p.c4_parts(wt, ds).values())
-    parts = p.c4_parts(wt, {**ds, "FOPD": [1.5, 1.4, 6]})      # fractional varies more and the error falls once
-    assert not parts["vary less, disturbance"] and not parts["error grows with disturbance"] and parts["better, wheel T"]
-
-
-def test_paper004_rules():
-    from scfmu.report import paper004 as p
-    assert p.requirement_ratio(0.005, 0.05) == pytest.approx(0.5)
-    assert p.requirement_ratio(0.02, 0.05) == pytest.approx(2.0)
-    assert p.tolerance_window(0.9, 50.0, 0.99) == (0.99, 50.0)
-
-
-# ----- end to end ----------------------------------------------------------------------------------------
 def _fmus_built() -> bool:
     need = ["RelativeOrbitPlant", "PredictivePidController", "SingleAxisPlant", "FopidController", "PidController",
             "AttitudePlant", "ReferenceCorrector", "FeedbackLinearizingController"]
@@ -231,7 +174,7 @@ def _fmus_built() -> bool:
 def test_report_quick_end_to_end(tmp_path):
     out = tmp_path / "report"
     env = dict(os.environ, PYTHONUNBUFFERED="1")
-    r = subprocess.run([sys.executable, str(ROOT / "scripts" / "report.py"), "--quick", "--workers", "2",
+    r = subprocess.run([sys.executable, "-m", "scfmu", "report", "--quick", "--workers", "2",
                         "--papers", ",".join(CI_PAPERS), "--out", str(out)], capture_output=True, text=True, env=env,
                        timeout=900)
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
@@ -250,6 +193,6 @@ def test_report_quick_end_to_end(tmp_path):
 
 
 def test_report_missing_paper_is_an_error(tmp_path):
-    r = subprocess.run([sys.executable, str(ROOT / "scripts" / "report.py"), "--papers", "999", "--out",
+    r = subprocess.run([sys.executable, "-m", "scfmu", "report", "--papers", "999", "--out",
                         str(tmp_path)], capture_output=True, text=True, timeout=120)
     assert r.returncode != 0 and "paper 999" in (r.stdout + r.stderr)

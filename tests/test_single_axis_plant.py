@@ -7,7 +7,7 @@ import math
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from scfmu.master import Fmu
+from scfmu.fmu import Fmu
 
 J, K, T = 7.7, 1.0, 0.2
 

@@ -9,9 +9,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from scfmu import scenarios, ssp
-from scfmu.lean import build_fmus, ports_of
-from scfmu.simulate import run_reference
+from scfmu import scenario as scenarios
+from scfmu.scenario import ssp
+from scfmu.engines.lean import build_fmus, ports_of
+from scfmu.engines import run_reference
 
 ROOT = Path(__file__).resolve().parents[1]
 SSP_DIR = ROOT / "fmus" / "ssp"
@@ -81,7 +82,7 @@ def test_ssp_in_libcosim_equals_libcosim_run_of_the_declaration(name, t):
     (libcosim against the Gauss–Seidel reference differs by its one-step coupling delay; that comparison
     is tests/test_campaign.py::test_second_master_libcosim_agrees_within_the_coupling_delay.)"""
     pytest.importorskip("libcosimpy")
-    from scfmu.libcosim_run import run_libcosim, run_libcosim_ssp
+    from scfmu.engines.libcosim import run_libcosim, run_libcosim_ssp
     ref = run_libcosim(scenarios.get(name, stop_time=t))
     out = run_libcosim_ssp(ssp_file(name), stop_time=t)
     assert set(out) == set(ref) - {"wall_s"}
@@ -110,7 +111,7 @@ def test_fmpy_ssd_reader_sees_components_parameters_and_connections(name):
 
 def _ports(sc):
     from fmpy import read_model_description
-    from scfmu.master import fmu_path
+    from scfmu.fmu import fmu_path
     out = {}
     for c in sc.components:
         md = read_model_description(str(fmu_path(c.model)))

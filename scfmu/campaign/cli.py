@@ -1,0 +1,150 @@
+"""Run a campaign: one standard scenario × parameter overrides (list, grid or random sample) × seeds,
+on Dask (a LocalCluster on this machine by default, or an existing cluster with --scheduler), with a
+progress bar; one metrics row per run in OUT/results.parquet (+ manifest.json), optional time series,
+and PNG figures. Re-running the same command on the same OUT resumes an interrupted campaign.
+
+Examples:
+  # 100 random (ω_n, ζ) pairs for the quaternion PD of run 000-6, 2 workers, figures
+  scfmu campaign default --random controller.wn=uniform:0.3:2 --random controller.zeta=uniform:0.5:1.5 \\
+      --samples 100 --workers 2 --timeseries alpha_deg --plot-vs controller.wn --out out/campaign/pd_random
+  # a grid and three seeds of the plant's noise generator
+  scfmu campaign paper000/000-6 --grid controller.wn=0.5,1,2 --set plant.dist_noise_std_x=1 --seeds 0:3
+  # list of override sets from a JSON file ([{"controller.wn": 1.0}, ...]) on an existing cluster
+  scfmu campaign default --list sets.json --scheduler tcp://127.0.0.1:8786
+
+Values: numbers (int if written without '.', 'e'), or strings. Random distributions: uniform:lo:hi,
+loguniform:lo:hi, normal:mean:std, int:lo:hi, choice:a,b,c. Scenarios: any registered name
+(`scfmu scenarios` lists them).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+
+from .. import campaign
+from ..run_cmd import value
+from ..scenario import get as get_scenario
+from . import plots as campaign_plots
+
+
+def parse_seeds(text: str) -> list:
+    if not text:
+        return [None]
+    if ":" in text:
+        a, b = text.split(":")
+        return list(range(int(a), int(b)))
+    return [int(x) for x in text.split(",")]
+
+
+def parse_random(items: list[str]) -> dict:
+    space = {}
+    for it in items:
+        name, _, spec = it.partition("=")
+        kind, _, rest = spec.partition(":")
+        if kind == "choice":
+            space[name] = ("choice", [value(x) for x in rest.split(",")])
+        else:
+            lo, hi = rest.split(":")
+            space[name] = (kind, value(lo), value(hi))
+    return space
+
+
+def build(args) -> campaign.Campaign:
+    kw = {}
+    if args.t_end is not None:
+        kw["stop_time"] = args.t_end
+    if args.dt is not None:
+        kw["step"] = args.dt
+    sc = get_scenario(args.scenario, **kw)
+    fixed = {}
+    for it in args.set:
+        k, _, v = it.partition("=")
+        fixed[k] = value(v)
+    if fixed:
+        sc = sc.with_overrides(fixed)
+    sets = [{}]
+    if args.list:
+        sets = json.loads(Path(args.list).read_text())
+    if args.grid:
+        axes = {}
+        for it in args.grid:
+            k, _, v = it.partition("=")
+            axes[k] = [value(x) for x in v.split(",")]
+        g = campaign.grid(axes)
+        sets = [dict(a, **b) for a in sets for b in g]
+    if args.random:
+        r = campaign.random_sample(parse_random(args.random), args.samples, args.sample_seed)
+        sets = [dict(a, **b) for a in sets for b in r]
+    ts = None
+    if args.timeseries is not None:
+        ts = [x for x in args.timeseries.split(",") if x]
+    return campaign.Campaign(sc, sets, parse_seeds(args.seeds), engine=args.engine, timeseries=ts,
+                             ts_every=args.ts_every, log_every=args.log_every)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="scfmu campaign", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("scenario", help="standard scenario name (default, paper000/000-6, paper001/a, wheel_fault, ...)")
+    ap.add_argument("--set", action="append", default=[], metavar="INST.VAR=VALUE", help="fixed override for every run")
+    ap.add_argument("--grid", action="append", default=[], metavar="INST.VAR=V1,V2,...", help="grid axis (repeatable)")
+    ap.add_argument("--random", action="append", default=[], metavar="INST.VAR=DIST:A:B", help="random axis (repeatable)")
+    ap.add_argument("--samples", type=int, default=100, help="number of random samples (with --random)")
+    ap.add_argument("--sample-seed", type=int, default=0, help="seed of the random sampler")
+    ap.add_argument("--list", help="JSON file: list of override dicts")
+    ap.add_argument("--seeds", default="", help="run seeds given to the scenario's seed parameters: 0,1,2 or 0:10")
+    ap.add_argument("--t-end", type=float, help="override the scenario's stop time [s]")
+    ap.add_argument("--dt", type=float, help="override the scenario's communication step [s]")
+    ap.add_argument("--engine", default="native", choices=["native", "lean", "reference"])
+    ap.add_argument("--timeseries", nargs="?", const="", default=None, metavar="KEYS",
+                    help="keep time series per run (comma-separated logged keys; all when empty)")
+    ap.add_argument("--ts-every", type=int, default=10, help="keep every n-th sample of the time series")
+    ap.add_argument("--log-every", type=int, default=1,
+                    help="native engine: sample the logged signals every n-th step (faster; metrics on that grid)")
+    ap.add_argument("--workers", type=int, default=None, help="LocalCluster workers (default: CPU count)")
+    ap.add_argument("--scheduler", help="address of an existing Dask scheduler (tcp://host:port)")
+    ap.add_argument("--chunk", type=int, default=None, help="runs per Dask task (default: automatic)")
+    ap.add_argument("--out", default=None, help="output folder (default out/campaign/<scenario>)")
+    ap.add_argument("--overwrite", action="store_true", help="replace a different campaign found in --out")
+    ap.add_argument("--no-progress", action="store_true")
+    ap.add_argument("--metric", default="eulerint_deg_s", help="metric of the figures")
+    ap.add_argument("--plot-vs", action="append", default=[], metavar="INST.VAR", help="metric-vs-parameter figure")
+    ap.add_argument("--no-plots", action="store_true")
+    args = ap.parse_args(argv)
+
+    c = build(args)
+    out = Path(args.out or Path("out") / "campaign" / args.scenario.replace("/", "_"))
+    print(f"campaign {c.campaign_id()}: scenario {c.scenario.name}, {len(c.overrides)} parameter set(s) × "
+          f"{len(c.seeds)} seed(s) = {len(c.overrides) * len(c.seeds)} runs, engine {c.engine} → {out}")
+    table = campaign.run(c, out, scheduler=args.scheduler, n_workers=args.workers, chunk=args.chunk,
+                         progress=not args.no_progress, overwrite=args.overwrite)
+    rows = table.to_pylist()
+    ok = [r for r in rows if r["status"] == "ok"]
+    print(f"{len(ok)} of {len(rows)} runs ok; results {out / 'results.parquet'}, manifest {out / 'manifest.json'}")
+    for r in rows:
+        if r["status"] != "ok":
+            print(f"  run {r['run']}: {r['status']}: {r['message'][:160]}")
+    import numpy as np
+    for m in ("eulerint_deg_s", "ise", "settling_s", "effort_abs", "final_error"):
+        v = np.array([r[m] for r in ok], dtype=float)
+        v = v[np.isfinite(v)]
+        if v.size:
+            print(f"  {m:16s} min {v.min():12.6g}  median {np.median(v):12.6g}  max {v.max():12.6g}  ({v.size} runs)")
+    if not args.no_plots and ok:
+        figs = [campaign_plots.hist(table, args.metric, out / f"hist_{args.metric}.png")]
+        for p in args.plot_vs:
+            figs.append(campaign_plots.metric_vs_param(table, p, args.metric,
+                                                       out / f"{args.metric}_vs_{p.replace('.', '_')}.png"))
+        if c.timeseries is not None:
+            keys = c.timeseries or [k for k in c.scenario.log]
+            for k in keys[:3]:
+                figs.append(campaign_plots.envelope(out, k, out / f"envelope_{k}.png"))
+        print("figures: " + ", ".join(str(f) for f in figs))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,208 @@
+"""Lean fixed-step Gauss–Seidel master: the same algorithm as ``master.CoSimulation``, without per-step
+Python object churn.
+
+Set-up (once per run): every FMU is instantiated and initialized through fmpy (``master.Fmu``), the
+scenario's wiring is resolved by port name to value references, and for every destination instance
+the master preallocates one ctypes ``double`` buffer for its connected inputs and the value-reference
+arrays of each source group. Per communication point t_k = t0 + k·Δ it calls, in Gauss–Seidel order,
+``fmi2GetReal`` of each source group into a slice of the destination's buffer and one ``fmi2SetReal``
+of the whole buffer; logged variables are read with one ``fmi2GetReal`` per instance straight into a
+preallocated NumPy row; then ``fmi2DoStep(t_k, Δ)`` on every instance. The FMI functions are called as
+raw ctypes function pointers taken from the FMU's shared library (arguments are plain ints: handles
+and buffer addresses), and their status codes are checked once per step.
+
+The value sequence seen by the FMUs is the one of ``master.CoSimulation`` (same reads, same writes, same
+order, same communication points), so results are bit-identical (tests/test_campaign.py checks it).
+"""
+
+from __future__ import annotations
+
+import ctypes
+from ctypes import c_double, c_int, c_size_t, c_uint, c_void_p
+
+import numpy as np
+
+from ..fmu import Fmu, fmu_path, unpacked
+from ..scenario.model import Scenario
+
+_STATUS = {0: "OK", 1: "Warning", 2: "Discard", 3: "Error", 4: "Fatal", 5: "Pending"}
+
+
+class SimulationError(RuntimeError):
+    """A run that failed: FMU error status, or a non-finite logged value. ``status`` is a short code."""
+
+    def __init__(self, status: str, message: str, time: float | None = None):
+        super().__init__(message)
+        self.status = status
+        self.time = time
+
+
+def _raw(slave, name: str, argtypes, restype=c_int):
+    f = slave.dll[name]  # a fresh function pointer: fmpy's own (cached) one keeps its argtypes
+    f.argtypes = argtypes
+    f.restype = restype
+    return f
+
+
+def build_fmus(scenario: Scenario, path_of=None, reuse: bool = False) -> dict[str, Fmu]:
+    """Instantiates and initializes every instance of the scenario (parameters in initialization mode),
+    then writes the fixed ``inputs``. Returns {instance name: Fmu} in Gauss–Seidel order. With ``reuse``
+    the FMUs are unpacked once per process (``master.unpacked``)."""
+    fmus: dict[str, Fmu] = {}
+    try:
+        for c in scenario.components:
+            p = path_of(c.model) if path_of else fmu_path(c.model)
+            # the same calls as Fmu(initialize=True), keeping the instance to report its log messages
+            f = Fmu(c.model, name=c.name, start_time=scenario.start_time, path=p, initialize=False,
+                    unpacked=unpacked(p) if reuse else None)
+            fmus[c.name] = f
+            f.slave.setupExperiment(tolerance=None, startTime=scenario.start_time, stopTime=None)
+            f.slave.enterInitializationMode()
+            for k, v in c.params.items():
+                f.set(k, v)
+            try:
+                f.slave.exitInitializationMode()
+            except Exception:
+                msgs = "; ".join(m[2] for m in f.messages if m[0] >= 2)
+                raise SimulationError("fmu_error", f"{c.name} ({c.model}): fmi2ExitInitializationMode failed"
+                                      + (f": {msgs}" if msgs else "")) from None
+        for q, value in scenario.inputs.items():
+            inst, _, var = q.partition(".")
+            fmus[inst].set(var, value)
+    except Exception:
+        for f in fmus.values():
+            f.close()
+        raise
+    return fmus
+
+
+def ports_of(fmus: dict[str, Fmu]) -> dict[str, tuple[list[str], list[str]]]:
+    return {name: (f.inputs(), f.outputs()) for name, f in fmus.items()}
+
+
+class LeanMaster:
+    """Runs a Scenario (see module docstring). Use as a context manager or call ``close()``."""
+
+    def __init__(self, scenario: Scenario, path_of=None, reuse: bool = True):
+        self.scenario = scenario
+        self.fmus = build_fmus(scenario, path_of, reuse)
+        try:
+            self._prepare()
+        except Exception:
+            self.close()
+            raise
+
+    def _prepare(self) -> None:
+        sc = self.scenario
+        fmus = self.fmus
+        links = sc.wiring(ports_of(fmus))
+        self.links = links
+        vr = {name: {v.name: v.valueReference for v in f.md.modelVariables} for name, f in fmus.items()}
+        types = {name: {v.name: v.type for v in f.md.modelVariables} for name, f in fmus.items()}
+        for d, di, s, so in links:
+            if types[d][di] != "Real" or types[s][so] != "Real":
+                raise TypeError(f"{d}.{di} <- {s}.{so}: only Real connections are supported")
+        self._keep = []  # ctypes objects that must live as long as the master
+        self._get, self._set, self._step, self._comp = {}, {}, {}, {}
+        for name, f in fmus.items():
+            sl = f.slave
+            self._comp[name] = sl.component if isinstance(sl.component, int) else ctypes.cast(sl.component, c_void_p).value
+            self._get[name] = _raw(sl, "fmi2GetReal", [c_void_p, c_void_p, c_size_t, c_void_p])
+            self._set[name] = _raw(sl, "fmi2SetReal", [c_void_p, c_void_p, c_size_t, c_void_p])
+            self._step[name] = _raw(sl, "fmi2DoStep", [c_void_p, c_double, c_double, c_int])
+
+        def vr_array(vals):
+            a = (c_uint * len(vals))(*vals)
+            self._keep.append(a)
+            return ctypes.addressof(a)
+
+        # per destination: one buffer; per (destination, source) group: a get into a slice of it
+        self._ops = []  # (get, src_comp, src_vr_addr, n, buf_addr_at_offset)... then (set, dst_comp, dst_vrs, n, buf)
+        by_dst: dict[str, list] = {}
+        for d, di, s, so in links:
+            by_dst.setdefault(d, []).append((s, so, di))
+        for d, items in by_dst.items():
+            buf = (c_double * len(items))()
+            self._keep.append(buf)
+            base = ctypes.addressof(buf)
+            i = 0
+            while i < len(items):  # consecutive items of the same source form one get
+                s = items[i][0]
+                j = i
+                while j < len(items) and items[j][0] == s:
+                    j += 1
+                self._ops.append((self._get[s], self._comp[s], vr_array([vr[s][so] for _, so, _ in items[i:j]]),
+                                  j - i, base + 8 * i))
+                i = j
+            self._ops.append((self._set[d], self._comp[d], vr_array([vr[d][di] for _, _, di in items]),
+                              len(items), base))
+        # logging: per instance one get into a row of a (n + 1, m) array
+        n = sc.n_steps
+        self.n = n
+        self._log_keys = []
+        self._log_arrays = []
+        self._log_ops = []
+        groups: dict[str, list[tuple[str, str]]] = {}
+        for key, inst, var in sc.log_items():
+            if inst not in fmus:
+                raise KeyError(f"log {key!r}: unknown instance {inst!r}")
+            if var not in vr[inst]:
+                raise KeyError(f"log {key!r}: {fmus[inst].model} has no variable {var!r}")
+            if types[inst][var] != "Real":
+                raise TypeError(f"log {key!r}: {inst}.{var} is not Real")
+            groups.setdefault(inst, []).append((key, var))
+        for inst, items in groups.items():
+            arr = np.empty((n + 1, len(items)))
+            self._log_arrays.append(arr)
+            self._log_keys.append([k for k, _ in items])
+            self._log_ops.append((self._get[inst], self._comp[inst], vr_array([vr[inst][v] for _, v in items]),
+                                  len(items), arr.ctypes.data, arr.strides[0]))
+        self._steps = [(self._step[name], self._comp[name]) for name in fmus]
+
+    # ------------------------------------------------------------------------------------------------
+    def run(self) -> dict[str, np.ndarray]:
+        """Runs from start_time to stop_time; returns {"time", log keys...} sampled at every t_k."""
+        sc = self.scenario
+        n, dt, t0 = self.n, sc.step, sc.start_time
+        ops, log_ops, steps = self._ops, self._log_ops, self._steps
+        for k in range(n + 1):
+            t = t0 + k * dt
+            st = 0
+            for fn, comp, vrs, m, buf in ops:
+                st |= fn(comp, vrs, m, buf)
+            for fn, comp, vrs, m, base, stride in log_ops:
+                st |= fn(comp, vrs, m, base + k * stride)
+            if k < n:
+                for fn, comp in steps:
+                    st |= fn(comp, t, dt, 1)
+            if st > 1:
+                self._fail(t)
+        return self._result()
+
+    def _result(self) -> dict[str, np.ndarray]:
+        sc = self.scenario
+        out = {"time": sc.start_time + np.arange(self.n + 1) * sc.step}
+        for keys, arr in zip(self._log_keys, self._log_arrays):
+            for i, key in enumerate(keys):
+                out[key] = arr[:, i].copy()
+        order = ["time"] + [k for k in sc.log]
+        return {k: out[k] for k in order}
+
+    def _fail(self, t: float):
+        msgs = []
+        for name, f in self.fmus.items():
+            for status, _cat, text in f.messages:
+                if status >= 2:
+                    msgs.append(f"{name}: {text}")
+        raise SimulationError("fmu_error", "; ".join(msgs) or f"an FMI call returned an error status at t = {t}", t)
+
+    def close(self) -> None:
+        for f in self.fmus.values():
+            f.close()
+        self.fmus = {}
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()

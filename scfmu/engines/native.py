@@ -1,0 +1,345 @@
+"""Native fast path: the whole closed loop runs inside fmpy's container FMU (a compiled co-simulation
+loop shipped with fmpy), so a run needs no Python call per communication step.
+
+How. ``build_container(scenario)`` packs the scenario's FMUs into one FMI 2.0 co-simulation FMU
+(``fmpy.container_fmu``): its configuration lists the instances, the scenario's connections (value
+references resolved by port name), and one container variable ``"<instance>.<variable>"`` for every
+parameter, calculated parameter, input and output of every instance. The container's ``fmi2DoStep(t, h)`` runs h/Δ fixed
+steps of Δ = scenario.step in compiled code; each fixed step is: ``doStep`` of every instance from
+t_k to t_k + Δ, then, connection by connection in the listed order, ``fmi2GetReal`` of the source
+outputs and ``fmi2SetReal`` of the destination inputs.
+
+Coupling. The connections are listed in the scenario's Gauss–Seidel order (grouped by destination in
+component order, exactly as ``master.CoSimulation.propagate``). Because an FMU's outputs are read only
+after its own inputs have been written at the same communication point, a controller's torque
+computed from the plant state at t_k reaches the plant at t_k, the same step: this is the reference
+master's Gauss–Seidel scheme (not the Jacobi scheme of a parallel master), and the FMUs see the same
+values at the same communication points t0 + kΔ. The container's own propagation at the end of
+``fmi2ExitInitializationMode`` happens before its instances leave initialization mode, so
+``NativeLoop`` repeats the propagation once through container variables after initialization; from
+then on, results are bit-identical to the reference master (tests/test_campaign.py).
+
+Logging. ``log_every = m`` (default 1) reads the logged variables with one container ``fmi2GetReal``
+every m communication steps (one ``fmi2DoStep(t, mΔ)`` in between); ``log_every = 0`` runs the whole
+interval in one ``fmi2DoStep`` call and returns only the initial and final samples.
+
+Containers are cached on disk by a hash of their configuration (FMU GUIDs and file SHA-256, wiring,
+step), in
+``$SCFMU_CONTAINER_DIR`` or ``~/.cache/scfmu/containers``.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import hashlib
+import json
+import os
+import shutil
+import tempfile
+import zipfile
+from ctypes import c_double, c_int, c_size_t, c_uint, c_void_p
+from pathlib import Path
+
+import numpy as np
+
+from .lean import SimulationError
+from ..fmu import Fmu, fmu_digest, fmu_path, unpacked
+from ..scenario.model import Scenario
+
+CACHE = Path(os.environ.get("SCFMU_CONTAINER_DIR", Path.home() / ".cache" / "scfmu" / "containers"))
+_KINDS = ("parameter", "calculatedParameter", "input", "output")
+LAYOUT = 3  # version of the container layout below (part of the cache key)
+
+
+def _descriptions(scenario: Scenario):
+    return {c.model: unpacked(fmu_path(c.model))[0] for c in scenario.components}
+
+
+def container_key(scenario: Scenario, starts: dict | None = None) -> tuple[str, dict]:
+    mds = _descriptions(scenario)
+    ports = {c.name: ([v.name for v in mds[c.model].modelVariables if v.causality == "input"],
+                      [v.name for v in mds[c.model].modelVariables if v.causality == "output"])
+             for c in scenario.components}
+    links = scenario.wiring(ports)
+    key = {"components": [(c.name, c.model, mds[c.model].guid, fmu_digest(fmu_path(c.model)))
+                          for c in scenario.components],
+           "links": links, "step": repr(scenario.step), "layout": LAYOUT}
+    if starts:
+        key["starts"] = sorted((k, repr(v)) for k, v in starts.items())
+    h = hashlib.sha256(json.dumps(key, sort_keys=True).encode()).hexdigest()[:20]
+    return h, {"mds": mds, "links": links}
+
+
+def scenario_starts(scenario: Scenario) -> dict:
+    """``{"instance.variable": value}`` of the scenario's parameters and fixed inputs: the start values a
+    stand-alone closed-loop FMU carries, so that it reproduces the scenario with no value set."""
+    out = {f"{c.name}.{k}": v for c in scenario.components for k, v in c.params.items()}
+    out.update(scenario.inputs)
+    return out
+
+
+def _start_text(vtype: str, value) -> str:
+    if vtype == "Real":
+        return repr(float(value))
+    if vtype == "Integer":
+        return str(int(value))
+    return "true" if value in (True, 1, "true") else "false"
+
+
+def build_container(scenario: Scenario, starts: dict | None = None) -> Path:
+    """Path of the container FMU for this scenario's structure (built once, then cached). ``starts``
+    (``"instance.variable" -> value``, e.g. :func:`scenario_starts`) replaces the nested FMUs' start
+    values of those container variables (the container applies them at instantiation)."""
+    from fmpy.container_fmu import write_configuration
+    from fmpy.container_fmu.config import Component as CComponent, Configuration, Connection
+    from fmpy.model_description import (CoSimulation, DefaultExperiment, ModelDescription, ModelVariable, Unknown,
+                                        write_model_description)
+
+    starts = dict(starts or {})
+    h, info = container_key(scenario, starts)
+    path = CACHE / f"loop_{h}.fmu"
+    if path.exists():
+        return path
+    mds, links = info["mds"], info["links"]
+    guid = "{scfmu-" + h + "}"
+    comps, cvars = {}, {}
+    container_vars = [ModelVariable(type="Real", variability="continuous", causality="independent", name="time")]
+    mappings = {}
+    cv_of = {}  # (instance, nested variable name) -> container variable
+    for c in scenario.components:
+        md = mds[c.model]
+        comp = CComponent(name=c.name, filename=fmu_path(c.model), modelDescription=md)
+        comps[c.name] = comp
+        cvars[c.name] = {v.name: v for v in md.modelVariables}
+        for v in md.modelVariables:
+            if v.causality not in _KINDS or v.type not in ("Real", "Integer", "Boolean"):
+                continue
+            if v.causality == "parameter":
+                cv = ModelVariable(type=v.type, variability="tunable" if v.variability == "tunable" else "fixed",
+                                   causality="parameter", name=f"{c.name}.{v.name}", start=v.start)
+                cv.initial = "exact"
+            elif v.causality == "calculatedParameter":
+                cv = ModelVariable(type=v.type, variability=v.variability, causality="calculatedParameter",
+                                   name=f"{c.name}.{v.name}")
+            elif v.causality == "input":
+                cv = ModelVariable(type=v.type, variability=v.variability, causality="input",
+                                   name=f"{c.name}.{v.name}", start=v.start)
+            else:
+                cv = ModelVariable(type=v.type, variability=v.variability, causality="output",
+                                   name=f"{c.name}.{v.name}")
+            cv.description = v.description
+            q = f"{c.name}.{v.name}"
+            if q in starts:
+                if v.causality not in ("parameter", "input"):
+                    raise KeyError(f"start value for {q}: not a parameter or input")
+                cv.start = _start_text(v.type, starts.pop(q))
+            container_vars.append(cv)
+            mappings[cv] = [(comp, v)]
+            cv_of[(c.name, v.name)] = cv
+    if starts:
+        raise KeyError(f"start values for unknown variables {sorted(starts)}")
+    connections = []
+    i = 0
+    while i < len(links):  # consecutive links with the same (dst, src) form one connection
+        d, _, s, _ = links[i]
+        j = i
+        while j < len(links) and links[j][0] == d and links[j][2] == s:
+            j += 1
+        connections.append(Connection(comps[s], [cvars[s][so] for _, _, _, so in links[i:j]],
+                                      comps[d], [cvars[d][di] for _, di, _, _ in links[i:j]]))
+        i = j
+    md = ModelDescription(fmiVersion="2.0", modelName=f"scfmu_loop_{h}", instantiationToken=guid,
+                          description=f"closed loop of {[c.model for c in scenario.components]} (scfmu native path)",
+                          generationTool="scfmu.native",
+                          defaultExperiment=DefaultExperiment(startTime=str(scenario.start_time),
+                                                              stopTime=str(scenario.stop_time),
+                                                              stepSize=str(scenario.step)),
+                          coSimulation=CoSimulation(modelIdentifier="container_fmu",
+                                                    fixedInternalStepSize=scenario.step,
+                                                    canHandleVariableCommunicationStepSize=True),
+                          modelVariables=container_vars)
+    # ModelStructure: a container variable reads or writes its nested variable directly (connections are
+    # propagated only inside doStep), so each container output depends on exactly the container variables
+    # its nested output depends on, at communication points and at initialization.
+    order = {id(v): i for i, v in enumerate(container_vars)}
+    for attr in ("outputs", "initialUnknowns"):
+        unknowns = []
+        for c in scenario.components:
+            for u in getattr(mds[c.model], attr):
+                cv = cv_of.get((c.name, u.variable.name))
+                if cv is None:
+                    continue
+                deps = None if u.dependencies is None else sorted(
+                    (cv_of[(c.name, d.name)] for d in u.dependencies), key=lambda x: order[id(x)])
+                unknowns.append(Unknown(variable=cv, dependencies=deps))
+        unknowns.sort(key=lambda u: order[id(u.variable)])
+        setattr(md, attr, unknowns)
+    for i, v in enumerate(md.modelVariables):
+        v.valueReference = i  # "time" is 0; container variable i maps to mappings[i - 1]
+    config = Configuration(parallelDoStep=False, modelDescription=md, components=list(comps.values()),
+                           connections=connections, variableMappings=mappings)
+    CACHE.mkdir(parents=True, exist_ok=True)
+    work = Path(tempfile.mkdtemp(prefix="scfmu_container_"))
+    try:
+        for c in comps.values():  # nested FMUs unpacked under resources/<file stem>
+            with zipfile.ZipFile(c.filename) as z:
+                z.extractall(work / "resources" / Path(c.filename).stem)
+        write_model_description(md, work / "modelDescription.xml")
+        cfg = work / "resources" / "container.json"
+        write_configuration(config, cfg)
+        data = json.loads(cfg.read_text())
+        for conn in data["connections"]:  # fmpy writes FMI 2 type names here; the container wants FMI 3 ones
+            conn["variableType"] = {"Real": "Float64", "Integer": "Int32"}.get(conn["variableType"], conn["variableType"])
+        cfg.write_text(json.dumps(data, indent=1))
+        import fmpy.container_fmu as cf
+        for tuple_, fmi2_platform, lib in (("x86_64-linux", "linux64", "container_fmu.so"),
+                                           ("x86_64-windows", "win64", "container_fmu.dll"),
+                                           ("x86_64-darwin", "darwin64", "container_fmu.dylib")):
+            src = Path(cf.__file__).parent / "binaries" / tuple_ / lib
+            if src.exists():
+                (work / "binaries" / fmi2_platform).mkdir(parents=True, exist_ok=True)
+                shutil.copyfile(src, work / "binaries" / fmi2_platform / lib)
+        tmp = CACHE / f".loop_{h}.{os.getpid()}.fmu"
+        with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as z:
+            for f in sorted(work.rglob("*")):
+                if f.is_file():
+                    z.write(f, f.relative_to(work).as_posix())
+        os.replace(tmp, path)  # atomic: concurrent workers may build the same container
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    return path
+
+
+_POOL: dict[str, list[Fmu]] = {}  # reset container instances ready for the next run, per container file
+
+
+class NativeLoop:
+    """Runs a Scenario inside its container FMU. ``log_every``: see module docstring.
+
+    With ``reuse`` (default) the container is unpacked once per process and, after a run, its instance
+    is reset (``fmi2Terminate`` + ``fmi2Reset``: every nested FMU back to its start values) and kept for
+    the next run of a scenario with the same structure, which saves the instantiation of every nested
+    FMU; an instance whose reset fails is freed. Results do not depend on reuse (tested)."""
+
+    def __init__(self, scenario: Scenario, log_every: int = 1, reuse: bool = True):
+        self.scenario = scenario
+        self.log_every = int(log_every)
+        self.reuse = reuse
+        path = build_container(scenario)
+        self._path = str(path)
+        pool = _POOL.get(self._path) if reuse else None
+        if pool:
+            self.fmu = pool.pop()
+            self.fmu.messages.clear()
+        else:
+            self.fmu = Fmu("loop", path=path, name="loop", start_time=scenario.start_time,
+                           initialize=False, unpacked=unpacked(path) if reuse else None)
+        try:
+            self._init()
+        except Exception:
+            self.close()
+            raise
+
+    def _fail(self, where: str, t: float | None = None):
+        msgs = [m[2] for m in self.fmu.messages if m[0] >= 2]
+        raise SimulationError("fmu_error", f"{where}: " + ("; ".join(msgs) or "error status"), t)
+
+    def _init(self):
+        sc, f = self.scenario, self.fmu
+        sl = f.slave
+        sl.setupExperiment(startTime=sc.start_time)
+        sl.enterInitializationMode()
+        for c in sc.components:
+            for k, v in c.params.items():
+                try:
+                    f.set(f"{c.name}.{k}", v)
+                except KeyError:
+                    raise KeyError(f"{c.model} has no parameter {k!r}") from None
+        try:
+            sl.exitInitializationMode()
+        except Exception:
+            self._fail("exitInitializationMode")
+        for q, v in sc.inputs.items():
+            f.set(q, v)
+        # repeat the Gauss–Seidel propagation now that every instance has left initialization mode
+        ports = {}
+        for c in sc.components:
+            ins = [n[len(c.name) + 1:] for n, v in f.vars.items() if n.startswith(c.name + ".") and v.causality == "input"]
+            outs = [n[len(c.name) + 1:] for n, v in f.vars.items() if n.startswith(c.name + ".") and v.causality == "output"]
+            ports[c.name] = (ins, outs)
+        vr = {n: v.valueReference for n, v in f.vars.items()}
+        for d, di, s, so in sc.wiring(ports):
+            f.slave.setReal([vr[f"{d}.{di}"]], f.slave.getReal([vr[f"{s}.{so}"]]))
+        comp = sl.component
+        self._comp = comp
+        self._get = sl.dll["fmi2GetReal"]
+        self._get.argtypes = [c_void_p, c_void_p, c_size_t, c_void_p]
+        self._get.restype = c_int
+        self._step = sl.dll["fmi2DoStep"]
+        self._step.argtypes = [c_void_p, c_double, c_double, c_int]
+        self._step.restype = c_int
+        items = sc.log_items()
+        for key, inst, var in items:
+            if f"{inst}.{var}" not in vr:
+                raise KeyError(f"log {key!r}: no variable {inst}.{var}")
+        self._log_vrs = (c_uint * len(items))(*[vr[f"{i}.{v}"] for _, i, v in items])
+        self._log_keys = [k for k, _, _ in items]
+
+    def get(self, name: str):
+        """Current value of ``"instance.variable"`` (a parameter, calculated parameter, input or output)."""
+        return self.fmu.get(name)
+
+    def run(self) -> dict[str, np.ndarray]:
+        sc = self.scenario
+        n, dt, t0 = sc.n_steps, sc.step, sc.start_time
+        m = self.log_every
+        if m <= 0:
+            ks = [0, n]
+        else:
+            ks = list(range(0, n + 1, m))
+            if ks[-1] != n:
+                ks.append(n)
+        nl = len(self._log_keys)
+        arr = np.empty((len(ks), nl))
+        base, stride = arr.ctypes.data, arr.strides[0]
+        vrs = ctypes.addressof(self._log_vrs)
+        get, step, comp = self._get, self._step, self._comp
+        prev = 0
+        for j, k in enumerate(ks):
+            if k > prev:
+                t = t0 + prev * dt
+                if step(comp, t, (k - prev) * dt, 1) > 1:
+                    self._fail(f"doStep at t = {t}", t)
+                prev = k
+            if nl and get(comp, vrs, nl, base + j * stride) > 1:
+                self._fail(f"getReal at t = {t0 + k * dt}", t0 + k * dt)
+        out = {"time": t0 + np.asarray(ks, dtype=float) * dt}
+        for i, key in enumerate(self._log_keys):
+            out[key] = arr[:, i].copy()
+        return out
+
+    def close(self):
+        f = getattr(self, "fmu", None)
+        if f is None:
+            return
+        self.fmu = None
+        if self.reuse:
+            try:
+                f.slave.terminate()
+            except Exception:
+                pass
+            try:
+                f.slave.reset()
+                pool = _POOL.setdefault(self._path, [])
+                if len(pool) < 2:
+                    pool.append(f)
+                    return
+            except Exception:
+                pass
+        f.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()

@@ -1,0 +1,42 @@
+"""Scenarios for other tools: SSP 1.0 files (``.ssp``) and loop FMUs (one container FMU per closed loop).
+
+:func:`export` writes either kind for the given scenario names (default: every scenario a plug-in marks as
+exported) and validates each file (SSP 1.0 schemas; ``fmpy.validate_fmu``); ``scfmu export ssp|loop``
+is its command line, called by ``scripts/build_fmus.sh``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..registry import REGISTRY
+from ..scenario import get
+from ..scenario.ssp import file_stem, validate_ssp, write_ssp
+from .loops import write_loop_fmu
+
+KINDS = ("ssp", "loop")
+
+
+def export(kind: str, out: str | Path, names=None, log=print) -> list[Path]:
+    """Writes ``<out>/<name with / replaced by _>.ssp`` (kind "ssp") or ``.fmu`` (kind "loop") for each
+    scenario name (a registered name, or a scenario object) and validates it; returns the paths."""
+    if kind not in KINDS:
+        raise ValueError(f"export kind {kind!r}: expected one of {KINDS}")
+    out = Path(out)
+    written = []
+    for item in (names or REGISTRY.exported_scenarios()):
+        sc = get(item) if isinstance(item, str) else item
+        if kind == "ssp":
+            p = write_ssp(sc, out / f"{file_stem(sc.name)}.ssp")
+            problems = validate_ssp(p)
+            what = "not valid SSP 1.0"
+        else:
+            from fmpy.validation import validate_fmu
+            p = write_loop_fmu(sc, out / f"{file_stem(sc.name)}.fmu")
+            problems = validate_fmu(str(p))
+            what = "fmpy validation failed"
+        if problems:
+            raise RuntimeError(f"{p}: {what}: {problems[:5]}")
+        log(f"wrote {p} ({p.stat().st_size // 1024} KiB)")
+        written.append(p)
+    return written

@@ -1,0 +1,52 @@
+"""Paper 001 scenarios: RelativePositionCommand → PredictivePidController → RelativeOrbitPlant, cases a–d
+with an optional constant disturbance (``paper001/<case>`` or ``paper001/<case>/dist<N>``)."""
+
+from __future__ import annotations
+
+from ...scenario.model import Component, Scenario
+
+PAPER001_CASES = {"a": (5.0, 5.0), "b": (25.0, 5.0), "c": (25.0, 25.0), "d": (25.0, 150.0)}
+PAPER001_REF = (50.0, 40.0, 60.0)
+
+
+def paper001(case: str = "a", dist: float = 0.0, stop_time: float = 300.0, step: float = 0.001) -> Scenario:
+    """RelativePositionCommand → PredictivePidController → RelativeOrbitPlant; step to (50, 40, 60) m,
+    T1 = 0, (T2, c) of the case, RK4 internal step = Δ, constant disturbance ``dist`` N per axis."""
+    t2, c = PAPER001_CASES[case]
+    log = {}
+    for a in "xyz":
+        log[f"pos_{a}"] = f"plant.pos_{a}"
+        log[f"pos_ref_{a}"] = f"command.pos_ref_{a}"
+        log[f"vel_{a}"] = f"plant.vel_{a}"
+        log[f"force_{a}"] = f"controller.force_{a}"
+        log[f"dist_est_{a}"] = f"controller.dist_est_{a}"
+    return Scenario(
+        name=f"paper001/{case}/dist{dist:g}",
+        components=[
+            Component("command", "RelativePositionCommand", {f"target_pos_{a}": v for a, v in zip("xyz", PAPER001_REF)}),
+            Component("controller", "PredictivePidController", {"T1": 0.0, "T2": t2, "c": c}),
+            Component("plant", "RelativeOrbitPlant", {"max_internal_step": step, "integrator": 0}),
+        ],
+        stop_time=stop_time, step=step, log=log,
+        inputs={f"plant.dist_{a}": dist for a in "xyz"},
+        metrics="formation",
+        description=f"paper 001 case {case}: T2 = {t2:g} s, c = {c:g} 1/s, dist = {dist:g} N per axis",
+    )
+
+
+
+
+def build(name: str, **kw) -> Scenario:
+    parts = name.split("/")
+    if len(parts) not in (2, 3) or parts[1] not in PAPER001_CASES:
+        raise KeyError(f"unknown scenario {name!r}: expected paper001/<a|b|c|d>[/dist<N>]")
+    dist = float(parts[2][4:]) if len(parts) == 3 else kw.pop("dist", 0.0)
+    return paper001(parts[1], dist, **kw)
+
+
+def names() -> list[tuple[str, str]]:
+    return [(f"paper001/{c}", f"paper 001 formation case {c}: T2 = {t2:g} s, c = {cc:g} 1/s, no disturbance")
+            for c, (t2, cc) in PAPER001_CASES.items()]
+
+
+EXPORTED = tuple(f"paper001/{c}" for c in PAPER001_CASES)

@@ -1,0 +1,18 @@
+"""Paper 002 [Khatoonabadi-FO]: fractional-order PID against integer PID on a single axis with a wheel lag,
+tuned by particle swarm optimisation."""
+
+from __future__ import annotations
+
+
+def register(reg) -> None:
+    from ...metrics import COMMON, EXTRA, LOGS
+    from . import model, scenarios
+    reg.scenarios("paper002", scenarios.build, scenarios.names, exported=scenarios.EXPORTED)
+    reg.metrics("paper002", model.metrics_row, [*COMMON, *EXTRA["single_axis"], *model.METRIC_COLUMNS],
+                LOGS["single_axis"])
+    reg.paper("002", "Fractional-order PID attitude control tuned by PSO",
+              commands={"tune": ("PSO tuning of PD, PID, FOPD, FOPID on the campaign engine (resumable)",
+                                 "scfmu.papers.paper002.tune:main"),
+                        "sweeps": ("runs 002-1 … 002-7 with the tuned gains: responses, MAE sweeps",
+                                   "scfmu.papers.paper002.sweeps:main")},
+              report="scfmu.papers.paper002.report:build", docs="docs/paper002.md")

@@ -1,0 +1,22 @@
+"""Paper 003 [T2FSMC-LEO]: interval type-2 fuzzy sliding-mode attitude control of a LEO satellite with
+reaction wheels, against a GA-tuned sliding-mode controller; and the ``wheel_fault`` loop on its plant."""
+
+from __future__ import annotations
+
+
+def register(reg) -> None:
+    from ...metrics import LOGS, columns
+    from . import model, wheel_fault_scenario
+    reg.scenarios("paper003", model.build, model.names, exported=("paper003/SMC/N", "paper003/T2FSMC/N"))
+    reg.scenarios("wheel_fault", lambda name, **kw: wheel_fault_scenario.wheel_fault(**kw),
+                  lambda: [("wheel_fault", "reaction-wheel saturation and an actuator fault (paper 003 plant)")],
+                  exported=("wheel_fault",))
+    reg.metrics("paper003", model.metrics, [*columns("attitude"), *model.EXTRA_COLUMNS], LOGS["attitude"])
+    reg.paper("003", "Type-2 fuzzy sliding-mode attitude control of a LEO satellite",
+              commands={"tune": ("GA tuning of the SMC gain, then the type-2 fuzzy coefficients",
+                                 "scfmu.papers.paper003.commands:main_tune"),
+                        "scenarios": ("scenarios 003-N, C, S, W and the 100-run Monte Carlo 003-U",
+                                      "scfmu.papers.paper003.commands:main_scenarios"),
+                        "wheel-fault": ("reaction-wheel saturation and an actuator fault on the paper 003 plant",
+                                        "scfmu.papers.paper003.wheel_fault:main")},
+              report="scfmu.papers.paper003.report:build", docs="docs/paper003.md")

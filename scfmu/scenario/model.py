@@ -1,0 +1,200 @@
+"""A closed-loop scenario declared once, as plain data.
+
+A :class:`Scenario` names the FMUs of a loop (instance name + model), their order for the Gauss–Seidel
+master, the parameters of each instance, the wiring, the stop time and communication step, and the
+signals to log. It holds only dataclasses, dicts, lists, strings and numbers, so the same declaration
+feeds every master of this package (the reference fmpy master, the lean master, the native container
+path), the campaign engine, and later an SSP description (``to_dict`` gives a JSON-ready form).
+
+Wiring. With ``auto_connect`` (default) every input of an instance is fed from the output of the same
+name of exactly one *other* instance. Exceptions are explicit:
+
+* ``connections``: ``{"dst_instance.input": "src_instance.output"}``, which takes precedence over the
+  name match (use it when names differ or when several instances have the output);
+* ``unconnected``: glob patterns (``fnmatch``) of inputs, bare (``"torque_dist_*"``) or qualified
+  (``"plant.torque_dist_*"``), left at their start value (or at the value given in ``inputs``).
+  ``DEFAULT_UNCONNECTED`` lists the optional inputs of the current FMUs (disturbance inputs, wheel
+  momentum, reference-rate feed-forward, leader anomaly) that the historical master left open.
+
+An input that has no source and matches no ``unconnected`` pattern is an error.
+
+Parameters are set in initialization mode (``Component.params``, name → value; integers stay
+integers). ``inputs`` are values written once after initialization into unconnected inputs (e.g. a
+constant disturbance). Overrides use qualified names ``"instance.variable"``: a parameter of an
+instance or a fixed input (see :meth:`Scenario.with_overrides`).
+"""
+
+from __future__ import annotations
+
+import copy
+import fnmatch
+import json
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+DEFAULT_UNCONNECTED = ("torque_dist_*", "dist_*", "h_wheel*", "q_ref_dot*", "q_ref_ddot*", "leader_true_anomaly")
+
+
+@dataclass
+class Component:
+    """One FMU instance: ``name`` (instance name, unique in the scenario), ``model`` (``fmus/<model>.fmu``)
+    and its parameters (set in initialization mode)."""
+
+    name: str
+    model: str
+    params: dict = field(default_factory=dict)
+
+
+@dataclass
+class Scenario:
+    name: str
+    components: list[Component]  # Gauss–Seidel order
+    stop_time: float
+    step: float
+    log: dict = field(default_factory=dict)  # key -> "instance.variable"
+    connections: dict = field(default_factory=dict)  # "dst.input" -> "src.output" (exceptions to name matching)
+    unconnected: list = field(default_factory=lambda: list(DEFAULT_UNCONNECTED))
+    inputs: dict = field(default_factory=dict)  # "instance.input" -> value, written after initialization
+    auto_connect: bool = True
+    seed_params: list = field(default_factory=list)  # "instance.param" (Integer) that receive a run's seed
+    start_time: float = 0.0
+    metrics: str = ""  # name of a metrics function in scfmu.campaign_metrics ("attitude", "formation", ...)
+    description: str = ""
+
+    # ----- access ---------------------------------------------------------------------------------------
+    def component(self, name: str) -> Component:
+        for c in self.components:
+            if c.name == name:
+                return c
+        raise KeyError(f"scenario {self.name!r} has no instance {name!r} (has {[c.name for c in self.components]})")
+
+    @property
+    def n_steps(self) -> int:
+        n = int(round((self.stop_time - self.start_time) / self.step))
+        if n <= 0 or abs(n * self.step - (self.stop_time - self.start_time)) > 1e-9 * max(1.0, abs(self.stop_time)):
+            raise ValueError(f"stop_time - start_time = {self.stop_time - self.start_time} is not a positive "
+                             f"multiple of step = {self.step}")
+        return n
+
+    def with_seed(self, seed: int | None) -> "Scenario":
+        """A copy whose ``seed_params`` are set to ``seed`` (unchanged copy when seed is None)."""
+        if seed is None:
+            return copy.deepcopy(self)
+        return self.with_overrides({p: int(seed) for p in self.seed_params})
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+    def to_json(self) -> str:
+        return json.dumps(self.to_dict(), sort_keys=True)
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "Scenario":
+        d = dict(d)
+        d["components"] = [Component(**c) for c in d["components"]]
+        return cls(**d)
+
+    # ----- variations -----------------------------------------------------------------------------------
+    def with_models(self, models: dict) -> "Scenario":
+        """A copy whose instances use other models: ``{instance: model name or path to an .fmu}``."""
+        s = copy.deepcopy(self)
+        for inst, model in models.items():
+            s.component(inst).model = str(model)
+        return s
+
+    def with_overrides(self, overrides: dict | None = None, **fields) -> "Scenario":
+        """A copy with ``overrides`` applied: ``"instance.name" -> value`` sets a parameter of that instance,
+        or, when ``instance.name`` is a key of ``inputs`` (or an unconnected input listed with ``input:``
+        prefix, ``"input:plant.torque_dist_x"``), a fixed input. Scenario fields (``stop_time``, ``step``...)
+        can be changed by keyword."""
+        s = copy.deepcopy(self)
+        for k, v in fields.items():
+            if not hasattr(s, k):
+                raise KeyError(f"Scenario has no field {k!r}")
+            setattr(s, k, v)
+        for key, value in (overrides or {}).items():
+            if key.startswith("input:"):
+                s.inputs[key[len("input:"):]] = value
+                continue
+            if key in s.inputs:
+                s.inputs[key] = value
+                continue
+            inst, sep, var = key.partition(".")
+            if not sep or not var:
+                raise KeyError(f"override {key!r}: expected 'instance.variable'")
+            s.component(inst).params[var] = value
+        return s
+
+    # ----- wiring ---------------------------------------------------------------------------------------
+    def wiring(self, ports: dict[str, tuple[list[str], list[str]]]) -> list[tuple[str, str, str, str]]:
+        """Resolves the connections given each instance's (inputs, outputs) port names (``ports[name]``).
+        Returns ``(dst_instance, dst_input, src_instance, src_output)`` in Gauss–Seidel order: grouped by
+        destination in component order, and within a destination by source (in the order sources first
+        appear among the destination's inputs), each group keeping the destination's input order: the
+        order the reference master (``master.CoSimulation``) uses."""
+        names = [c.name for c in self.components]
+        if len(set(names)) != len(names):
+            raise ValueError(f"duplicate instance names in {names}")
+        for dst, src in self.connections.items():
+            for q in (dst, src):
+                inst, _, var = q.partition(".")
+                if inst not in ports:
+                    raise KeyError(f"connection {dst} <- {src}: unknown instance {inst!r}")
+            di, _, dv = dst.partition(".")
+            si, _, sv = src.partition(".")
+            if dv not in ports[di][0]:
+                raise KeyError(f"connection {dst} <- {src}: {di} has no input {dv!r}")
+            if sv not in ports[si][1]:
+                raise KeyError(f"connection {dst} <- {src}: {si} has no output {sv!r}")
+        links = []
+        for dst in names:
+            per_src: dict[str, list[tuple[str, str]]] = {}
+            for inp in ports[dst][0]:
+                q = f"{dst}.{inp}"
+                if q in self.connections:
+                    si, _, sv = self.connections[q].partition(".")
+                    per_src.setdefault(si, []).append((inp, sv))
+                    continue
+                if q in self.inputs:
+                    continue
+                sources = [s for s in names if s != dst and inp in ports[s][1]] if self.auto_connect else []
+                if len(sources) > 1:
+                    raise ValueError(f"input {q} has several sources {sources}: add it to connections")
+                if not sources:
+                    # the unconnected patterns only name inputs that may stay open when nothing feeds them
+                    if self._is_unconnected(dst, inp):
+                        continue
+                    raise ValueError(f"input {q} has no source: add it to connections, unconnected or inputs")
+                per_src.setdefault(sources[0], []).append((inp, inp))
+            for src, pairs in per_src.items():  # sources in order of first appearance among dst's inputs
+                for inp, out in pairs:
+                    links.append((dst, inp, src, out))
+        return links
+
+    def _is_unconnected(self, inst: str, port: str) -> bool:
+        for pat in self.unconnected:
+            if "." in pat:
+                if fnmatch.fnmatchcase(f"{inst}.{port}", pat):
+                    return True
+            elif fnmatch.fnmatchcase(port, pat):
+                return True
+        return False
+
+    def log_items(self) -> list[tuple[str, str, str]]:
+        """(key, instance, variable) of every logged signal."""
+        out = []
+        for key, q in self.log.items():
+            inst, sep, var = q.partition(".")
+            if not sep:
+                raise ValueError(f"log entry {key!r}: {q!r} is not 'instance.variable'")
+            out.append((key, inst, var))
+        return out
+
+
+def log_of(instance: str, names) -> dict:
+    """``{name: "instance.name"}`` for each name: the usual way to log an instance's ports under their names."""
+    return {n: f"{instance}.{n}" for n in names}
+
+
+def load(path: str | Path) -> Scenario:
+    return Scenario.from_dict(json.loads(Path(path).read_text()))

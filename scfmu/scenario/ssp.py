@@ -1,0 +1,223 @@
+"""SSP 1.0 system files (``.ssp``) written from a :class:`~scfmu.scenario.Scenario`, and read back.
+
+One scenario declaration is the only source of the wiring: :func:`write_ssp` resolves
+it with :meth:`Scenario.wiring` (the same call the masters use) and writes
+
+* ``SystemStructure.ssd``: one ``ssd:Component`` per instance (``source="resources/<Model>.fmu"``) with a
+  connector for every input and output of its FMU, one ``ssd:Connection`` per link, a
+  ``ssd:DefaultExperiment`` (start and stop time) and, as an ``ssc:Annotation`` of type
+  ``com.github.spacecraft-fmus.scfmu``, the master settings that SSP 1.0 has no element for
+  (communication step, Gauss–Seidel order = element order, logged signals, metrics name, seed parameters);
+* ``resources/<instance>.ssv``: the instance's parameter values (SSP 1.0 parameter values, typed after the
+  FMU's modelDescription) and the constant values of its open inputs that the scenario fixes (disturbances),
+  bound to the component by an ``ssd:ParameterBinding``;
+* ``resources/<Model>.fmu``: the FMUs themselves (each model once).
+
+Inputs left open keep their FMU start value (no connection, no value). :func:`read_ssp` reads an ``.ssp``
+back into a Scenario whose FMU paths point into the unpacked archive (``path_of``), so any master of the
+package runs it; :func:`validate_ssp` checks the ``.ssd`` and ``.ssv`` files against the SSP 1.0 XML
+schemas shipped in fmpy's package data (``fmpy/ssp/schema``).
+
+Standard files: ``scfmu export ssp`` (called by ``scripts/build_fmus.sh``) writes
+``<scenario name with / replaced by _>.ssp`` for the scenarios the plug-ins mark as exported.
+"""
+
+from __future__ import annotations
+
+import json
+import tempfile
+import zipfile
+from pathlib import Path
+from xml.etree import ElementTree as ET
+
+from fmpy import read_model_description
+
+from ..fmu import fmu_path
+from .model import Component, Scenario
+
+SSD_NS = "http://ssp-standard.org/SSP1/SystemStructureDescription"
+SSC_NS = "http://ssp-standard.org/SSP1/SystemStructureCommon"
+SSV_NS = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
+ANNOTATION_TYPE = "com.github.spacecraft-fmus.scfmu"
+SCFMU_NS = "https://github.com/spacecraft-fmus/scfmu/ssp-annotation"
+NS = {"ssd": SSD_NS, "ssc": SSC_NS, "ssv": SSV_NS, "scfmu": SCFMU_NS}
+for _p, _u in NS.items():
+    ET.register_namespace(_p, _u)
+
+def file_stem(scenario_name: str) -> str:
+    return scenario_name.replace("/", "_")
+
+
+def _q(ns: str, tag: str) -> str:
+    return f"{{{NS[ns]}}}{tag}"
+
+
+def _type_elem(parent, ns: str, vtype: str, **attrs):
+    tag = {"Real": "Real", "Integer": "Integer", "Boolean": "Boolean", "Enumeration": "Integer"}[vtype]
+    return ET.SubElement(parent, _q(ns, tag), {k: v for k, v in attrs.items()})
+
+
+def _value_text(vtype: str, value) -> str:
+    if vtype == "Real":
+        return repr(float(value))  # shortest round-trip text: read back bit-identical
+    if vtype in ("Integer", "Enumeration"):
+        if float(value) != int(value):
+            raise ValueError(f"integer parameter with non-integer value {value!r}")
+        return str(int(value))
+    if vtype == "Boolean":
+        return "true" if value else "false"
+    raise ValueError(f"unsupported variable type {vtype}")
+
+
+def _ssv(values: list[tuple[str, str, object]], name: str) -> bytes:
+    root = ET.Element(_q("ssv", "ParameterSet"), {"version": "1.0", "name": name})
+    params = ET.SubElement(root, _q("ssv", "Parameters"))
+    for vname, vtype, value in values:
+        p = ET.SubElement(params, _q("ssv", "Parameter"), {"name": vname})
+        _type_elem(p, "ssv", vtype, value=_value_text(vtype, value))
+    ET.indent(root)
+    return ET.tostring(root, encoding="UTF-8", xml_declaration=True)
+
+
+def write_ssp(scenario: Scenario, path: str | Path, path_of=None) -> Path:
+    """Writes ``scenario`` as an SSP 1.0 archive at ``path``; FMUs from ``path_of(model)`` (default
+    ``fmus/<Model>.fmu``). Returns the path."""
+    path = Path(path)
+    path_of = path_of or fmu_path
+    mds = {c.model: read_model_description(str(path_of(c.model))) for c in scenario.components}
+    vars_of = {c.name: {v.name: v for v in mds[c.model].modelVariables} for c in scenario.components}
+    ports = {c.name: ([v.name for v in mds[c.model].modelVariables if v.causality == "input"],
+                      [v.name for v in mds[c.model].modelVariables if v.causality == "output"])
+             for c in scenario.components}
+    links = scenario.wiring(ports)
+    fixed = {}
+    for q, value in scenario.inputs.items():
+        inst, _, var = q.partition(".")
+        if var not in ports[inst][0]:
+            raise KeyError(f"scenario input {q}: not an input of {inst}")
+        fixed.setdefault(inst, []).append((var, value))
+
+    root = ET.Element(_q("ssd", "SystemStructureDescription"),
+                      {"version": "1.0", "name": file_stem(scenario.name), "generationTool": "scfmu.ssp",
+                       "description": scenario.description or scenario.name})
+    system = ET.SubElement(root, _q("ssd", "System"), {"name": "loop"})
+    elements = ET.SubElement(system, _q("ssd", "Elements"))
+    ssv_files = {}
+    for c in scenario.components:
+        comp = ET.SubElement(elements, _q("ssd", "Component"),
+                             {"name": c.name, "type": "application/x-fmu-sharedlibrary",
+                              "source": f"resources/{c.model}.fmu"})
+        conns = ET.SubElement(comp, _q("ssd", "Connectors"))
+        for v in mds[c.model].modelVariables:
+            if v.causality in ("input", "output"):
+                conn = ET.SubElement(conns, _q("ssd", "Connector"), {"name": v.name, "kind": v.causality})
+                _type_elem(conn, "ssc", v.type)
+        values = []
+        for k, value in c.params.items():
+            if k not in vars_of[c.name]:
+                raise KeyError(f"{c.model} has no parameter {k!r}")
+            values.append((k, vars_of[c.name][k].type, value))
+        values += [(k, vars_of[c.name][k].type, value) for k, value in fixed.get(c.name, [])]
+        if values:
+            src = f"resources/{c.name}.ssv"
+            ssv_files[src] = _ssv(values, c.name)
+            binds = ET.SubElement(comp, _q("ssd", "ParameterBindings"))
+            ET.SubElement(binds, _q("ssd", "ParameterBinding"),
+                          {"source": src, "type": "application/x-ssp-parameter-set"})
+    connections = ET.SubElement(system, _q("ssd", "Connections"))
+    for d, di, s, so in links:
+        ET.SubElement(connections, _q("ssd", "Connection"),
+                      {"startElement": s, "startConnector": so, "endElement": d, "endConnector": di})
+    exp = ET.SubElement(root, _q("ssd", "DefaultExperiment"),
+                        {"startTime": repr(float(scenario.start_time)), "stopTime": repr(float(scenario.stop_time))})
+    anns = ET.SubElement(exp, _q("ssd", "Annotations"))
+    ann = ET.SubElement(anns, _q("ssc", "Annotation"), {"type": ANNOTATION_TYPE})
+    master = ET.SubElement(ann, _q("scfmu", "Master"),
+                           {"scheme": "fixed-step Gauss-Seidel in element order", "stepSize": repr(float(scenario.step))})
+    master.text = json.dumps({"name": scenario.name, "log": scenario.log, "metrics": scenario.metrics,
+                              "seed_params": scenario.seed_params, "inputs": sorted(scenario.inputs)}, sort_keys=True)
+    ET.indent(root)
+    ssd = ET.tostring(root, encoding="UTF-8", xml_declaration=True)
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(".ssp.tmp")
+    with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as z:
+        z.writestr("SystemStructure.ssd", ssd)
+        for src, data in sorted(ssv_files.items()):
+            z.writestr(src, data)
+        for model in dict.fromkeys(c.model for c in scenario.components):
+            z.write(path_of(model), f"resources/{model}.fmu")
+    tmp.replace(path)
+    return path
+
+
+def _typed(elem, ns: str):
+    for tag, conv in (("Real", float), ("Integer", int), ("Boolean", lambda s: s in ("true", "1"))):
+        e = elem.find(f"{ns}:{tag}", NS)
+        if e is not None:
+            return conv(e.get("value"))
+    raise ValueError(f"parameter {elem.get('name')}: no Real/Integer/Boolean value")
+
+
+def read_ssp(path: str | Path, workdir: str | Path | None = None) -> tuple[Scenario, dict]:
+    """Reads an ``.ssp`` written by :func:`write_ssp` back into a Scenario: components, parameters and
+    fixed inputs from the ``.ssd``/``.ssv`` files, every connection explicit (nothing matched by name),
+    master settings from the annotation. Returns ``(scenario, fmu_files)`` where ``fmu_files[model]`` is
+    the FMU unpacked from the archive into ``workdir`` (a new temporary directory by default); pass
+    ``path_of=fmu_files.__getitem__`` to a master."""
+    workdir = Path(workdir or tempfile.mkdtemp(prefix="scfmu_ssp_"))
+    with zipfile.ZipFile(path) as z:
+        z.extractall(workdir)
+    root = ET.parse(workdir / "SystemStructure.ssd").getroot()
+    system = root.find("ssd:System", NS)
+    components, fixed, files = [], {}, {}
+    for c in system.findall("ssd:Elements/ssd:Component", NS):
+        name, source = c.get("name"), c.get("source")
+        model = Path(source).stem
+        files[model] = workdir / source
+        kinds = {k.get("name"): k.get("kind") for k in c.findall("ssd:Connectors/ssd:Connector", NS)}
+        params = {}
+        for b in c.findall("ssd:ParameterBindings/ssd:ParameterBinding", NS):
+            ps = ET.parse(workdir / b.get("source")).getroot()
+            for p in ps.findall("ssv:Parameters/ssv:Parameter", NS):
+                value = _typed(p, "ssv")
+                if kinds.get(p.get("name")) == "input":
+                    fixed[f"{name}.{p.get('name')}"] = value
+                else:
+                    params[p.get("name")] = value
+        components.append(Component(name, model, params))
+    connections = {f"{e.get('endElement')}.{e.get('endConnector')}": f"{e.get('startElement')}.{e.get('startConnector')}"
+                   for e in system.findall("ssd:Connections/ssd:Connection", NS)}
+    exp = root.find("ssd:DefaultExperiment", NS)
+    master = exp.find(f"ssd:Annotations/ssc:Annotation[@type='{ANNOTATION_TYPE}']/scfmu:Master", NS)
+    meta = json.loads(master.text)
+    sc = Scenario(name=meta["name"], components=components, start_time=float(exp.get("startTime")),
+                  stop_time=float(exp.get("stopTime")), step=float(master.get("stepSize")), log=meta["log"],
+                  connections=connections, unconnected=["*"], inputs=fixed, auto_connect=False,
+                  seed_params=meta["seed_params"], metrics=meta["metrics"], description=root.get("description", ""))
+    return sc, files
+
+
+def schema_dir() -> Path:
+    import fmpy
+    return Path(fmpy.__file__).parent / "ssp" / "schema"
+
+
+def validate_ssp(path: str | Path) -> list[str]:
+    """Problems found by validating the archive's ``.ssd`` (SSP 1.0 SystemStructureDescription.xsd) and
+    ``.ssv`` files (SystemStructureParameterValues.xsd) with lxml; empty when valid."""
+    from lxml import etree
+    schemas = {ext: etree.XMLSchema(file=str(schema_dir() / f)) for ext, f in
+               ((".ssd", "SystemStructureDescription.xsd"), (".ssv", "SystemStructureParameterValues.xsd"))}
+    problems = []
+    with zipfile.ZipFile(path) as z:
+        names = z.namelist()
+        if "SystemStructure.ssd" not in names:
+            problems.append("no SystemStructure.ssd at the archive root")
+        for n in names:
+            ext = Path(n).suffix
+            if ext in schemas:
+                doc = etree.fromstring(z.read(n))
+                if not schemas[ext].validate(doc):
+                    problems += [f"{n}:{e.line}: {e.message}" for e in schemas[ext].error_log]
+    return problems
