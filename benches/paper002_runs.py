@@ -14,7 +14,8 @@ import argparse
 import os
 import time
 
-from scfmu import paper002 as p2
+from scfmu.papers.paper002 import model as p2
+from scfmu.papers.paper002 import tuning as p2t
 
 
 def main() -> int:
@@ -26,11 +27,11 @@ def main() -> int:
     print("| controller | native engine [s/run] | direct loop [s/run] | direct / native | cost native | cost direct |")
     print("|---|---:|---:|---:|---:|---:|")
     for c in p2.CONTROLLERS:
-        p2.engine_cost(c, gains[c])  # container build / unpack
+        p2t.engine_cost(c, gains[c])  # container build / unpack
         tn, td = [], []
         for _ in range(a.repeat):
             t0 = time.perf_counter()
-            row = p2.engine_cost(c, gains[c])
+            row = p2t.engine_cost(c, gains[c])
             tn.append(time.perf_counter() - t0)
             t0 = time.perf_counter()
             d = p2.run_case(c, gains[c])

@@ -1,5 +1,5 @@
 """The container FMU of each standard closed loop (fmus/loops/, written by scripts/build_fmus.sh through
-scfmu.loops): valid for fmpy, and simulated as one FMU with ``fmpy.simulate_fmu`` and no start value set,
+`scfmu export loop`): valid for fmpy, and simulated as one FMU with ``fmpy.simulate_fmu`` and no start value set,
 it reproduces the reference run of the scenario declaration. The container steps its nested FMUs with the
 reference master's fixed-step Gauss–Seidel scheme in the same order; see each test for the expected
 difference."""
@@ -12,8 +12,12 @@ from fmpy import read_model_description, simulate_fmu
 from fmpy.validation import validate_fmu
 
 from scfmu import scenario as scenarios
+from scfmu.registry import REGISTRY
 from scfmu.scenario import ssp
+
 from scfmu.engines import run_reference
+
+STANDARD = REGISTRY.exported_scenarios()
 
 LOOP_DIR = Path(__file__).resolve().parents[1] / "fmus" / "loops"
 
@@ -25,7 +29,7 @@ def loop_file(name):
     return p
 
 
-@pytest.mark.parametrize("name", ssp.STANDARD)
+@pytest.mark.parametrize("name", STANDARD)
 def test_loop_fmu_validates_and_carries_the_scenario(name):
     p = loop_file(name)
     assert validate_fmu(str(p)) == []

@@ -1,4 +1,4 @@
-"""SSP 1.0 files of the standard scenarios (fmus/ssp/, written by scripts/build_fmus.sh through scfmu.ssp):
+"""SSP 1.0 files of the standard scenarios (fmus/ssp/, written by scripts/build_fmus.sh through `scfmu export ssp`):
 valid against the SSP 1.0 schemas in fmpy's package data, the same components, parameters and wiring as
 the scenario declaration, and, read back and run through the project's reference master (fixed-step
 Gauss–Seidel, the same scheme and order as the reference run), results bit-identical to the reference run
@@ -10,9 +10,13 @@ import numpy as np
 import pytest
 
 from scfmu import scenario as scenarios
+from scfmu.registry import REGISTRY
 from scfmu.scenario import ssp
+
 from scfmu.engines.lean import build_fmus, ports_of
 from scfmu.engines import run_reference
+
+STANDARD = REGISTRY.exported_scenarios()
 
 ROOT = Path(__file__).resolve().parents[1]
 SSP_DIR = ROOT / "fmus" / "ssp"
@@ -25,7 +29,7 @@ def ssp_file(name):
     return p
 
 
-@pytest.mark.parametrize("name", ssp.STANDARD)
+@pytest.mark.parametrize("name", STANDARD)
 def test_ssp_is_valid_ssp_1_0(name):
     assert ssp.validate_ssp(ssp_file(name)) == []
 
@@ -43,7 +47,7 @@ def test_validation_catches_an_invalid_ssd(tmp_path):
     assert problems and "kind" in problems[0]
 
 
-@pytest.mark.parametrize("name", ssp.STANDARD)
+@pytest.mark.parametrize("name", STANDARD)
 def test_ssp_reads_back_to_the_declared_scenario(name, tmp_path):
     ref = scenarios.get(name)
     sc, files = ssp.read_ssp(ssp_file(name), tmp_path)

@@ -26,13 +26,14 @@ def export(kind: str, out: str | Path, names=None, log=print) -> list[Path]:
     written = []
     for item in (names or REGISTRY.exported_scenarios()):
         sc = get(item) if isinstance(item, str) else item
+        stem = file_stem(item if isinstance(item, str) else sc.name)  # the name asked for (paper001/a, not .../dist0)
         if kind == "ssp":
-            p = write_ssp(sc, out / f"{file_stem(sc.name)}.ssp")
+            p = write_ssp(sc, out / f"{stem}.ssp")
             problems = validate_ssp(p)
             what = "not valid SSP 1.0"
         else:
             from fmpy.validation import validate_fmu
-            p = write_loop_fmu(sc, out / f"{file_stem(sc.name)}.fmu")
+            p = write_loop_fmu(sc, out / f"{stem}.fmu")
             problems = validate_fmu(str(p))
             what = "fmpy validation failed"
         if problems:

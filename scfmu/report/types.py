@@ -78,7 +78,7 @@ class Context:
     out_dir: Path             # out/report (index.html goes here)
     quick: bool               # reduced run counts/grids for CI
     workers: int              # Dask workers
-    client: object = None     # a dask.distributed Client, started once by scripts/report.py
+    client: object = None     # a dask.distributed Client, started once by `scfmu report`
 
     @property
     def figures_dir(self) -> Path:

@@ -1,4 +1,4 @@
-"""Paper 000 study (spec metrics-and-scenarios.md §2.1): PD with each kinematics option, every
+"""Paper 000 study: PD with each kinematics option, every
 controller on the large command, and the robustness runs (constant disturbance, inertia uncertainty).
 
 Setup: AttitudePlant inertia diag(1000, 500, 700) kg m², actuator_mode 0 without limits, RK4 0.01 s,
@@ -26,7 +26,8 @@ from pathlib import Path
 
 import numpy as np
 
-from scfmu import Fmu, scenarios
+from ...fmu import Fmu
+from . import scenarios
 from ...metrics import overshoot_percent, settling_time
 from ...results import write_csv
 from ...engines import simulate as run_scenario

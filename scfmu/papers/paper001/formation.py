@@ -1,4 +1,4 @@
-"""Paper 001 experiments (spec metrics-and-scenarios.md §2.2): leader-follower formation control with the
+"""Paper 001 experiments: leader-follower formation control with the
 nonlinear predictive PID.
 
 Loop (Gauss-Seidel, wired by port name): RelativePositionCommand -> PredictivePidController ->
@@ -13,7 +13,7 @@ Prints per case and axis: 2 % settling time, overshoot, peak |F_i|, ∫|F_i| dt,
 communication grid). Writes out/paper001/summary.csv, one CSV per run (decimated to --csv-every
 samples) and PNGs (tracking, error, F_z, estimated vs true disturbance; plus a four-case comparison).
 
-Usage: paper001_formation.py [--dt 0.001] [--t-end 300] [--alt] [--cases a,b,c,d]
+Usage: scfmu paper 001 formation [--dt 0.001] [--t-end 300] [--alt] [--cases a,b,c,d]
 """
 
 from __future__ import annotations
@@ -132,8 +132,8 @@ def plot_compare(path: Path, runs: dict, dist: float) -> None:
 
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--dt", type=float, default=0.001, help="communication step = RK4 step [s] (spec: 0.001)")
-    ap.add_argument("--t-end", type=float, default=300.0, help="simulated time [s] (spec: 300)")
+    ap.add_argument("--dt", type=float, default=0.001, help="communication step = RK4 step [s] (paper: 0.001)")
+    ap.add_argument("--t-end", type=float, default=300.0, help="simulated time [s] (paper: 300)")
     ap.add_argument("--alt", action="store_true", help="also run dist = 1 N (reading d = 0.01 m/s^2)")
     ap.add_argument("--cases", default="a,b,c,d")
     ap.add_argument("--csv-every", type=int, default=100, help="write every n-th sample to the per-run CSV")

@@ -1,5 +1,5 @@
 """Paper 002 experiments 002-1 … 002-6 (002-7 with --digits): the four tuned controllers (PD, PID,
-FOPD, FOPID; gains from scripts/paper002_gains.json, fixed in every sweep) on SingleAxisPlant.
+FOPD, FOPID; gains from the package data file paper002/data/gains.json, fixed in every sweep) on SingleAxisPlant.
 
 Nominal: J = 7.7 kg m², K = 1, T = 0.2 s, T_sat = 1 N m, M_d = 0.01 sin(0.1 t) + 0.0001 N m, θ_ref = 30°
 step at t = 0, explicit Euler, h = Δ = 1 ms, t_end = 20 s, full GL memory.
@@ -18,7 +18,7 @@ MAE = mean |θ_ref - θ_n| in degrees over n < N = t_end/h. Writes out/paper002/
 out/paper002/summary.csv (run, swept value, MAE per controller), and prints the summary table.
 Every run is one call of scfmu.paper002.run_case, mapped over a process pool.
 
-Usage: paper002_sweeps.py [--workers 2] [--quick] [--digits] [--gains FILE] [--out DIR]
+Usage: scfmu paper 002 sweeps [--workers 2] [--quick] [--digits] [--gains FILE] [--out DIR]
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Reaction-wheel saturation + actuator fault scenario (issue 3 demo).
 
-Paper 003 plant defaults (spec attitude-plant.md §1.8, project choice): full inertia
+Paper 003 plant defaults (project choice): full inertia
 [[4, 0.05, -0.03], [0.05, 5, 0.02], [-0.03, 0.02, 3.5]] kg m², three reaction wheels (k_t i_max = 0.05 N m,
 J_w Ω_max = 0.504 N m s) with magnetorquer momentum dumping on the 700 km, 98° circular orbit, constant
 disturbance 5e-4 N m per axis (scenario 003-C) and gravity gradient. The quaternion PdController is

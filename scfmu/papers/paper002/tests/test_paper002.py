@@ -14,6 +14,7 @@ from fmpy.validation import validate_fmu
 
 from scfmu.engines.reference import CoSimulation
 from scfmu.fmu import Fmu, fmu_path
+from scfmu.papers.paper002 import tuning as p2t
 from scfmu.papers.paper002.model import Scenario, gl_weights, pso_minimize, reference_loop, run_case
 
 H = 0.001
@@ -231,10 +232,9 @@ def test_engine_cost_equals_direct_loop_and_numpy(controller):
     (native path, scenario paper002/<controller> + gain overrides) equals the cost of the direct two-FMU
     loop of the old tuner to round-off (the engine sees θ_ref through radians → degrees) and the cost of
     the independent numpy difference equations to 1e-9."""
-    from scfmu.papers.paper002 import model as p2
 
     sc = Scenario(t_end=11.0)
-    row = p2.engine_cost(controller, ENGINE_GAINS, sc)
+    row = p2t.engine_cost(controller, ENGINE_GAINS, sc)
     direct = run_case(controller, ENGINE_GAINS, sc)
     numpy_ref = reference_loop(controller, ENGINE_GAINS, sc)
     print(f"{controller}: engine {row['cost']!r}, direct loop {direct['cost']!r}, numpy {numpy_ref['cost']!r}")
@@ -243,7 +243,7 @@ def test_engine_cost_equals_direct_loop_and_numpy(controller):
     assert abs(row["mae_deg"] - numpy_ref["mae_deg"]) < 1e-9
     assert abs(row["late_max_deg"] - numpy_ref["late_max_deg"]) < 1e-9
     assert (row["cost"] > 1000) == (numpy_ref["cost"] > 1000)
-    assert p2.row_cost({"status": "nonfinite", "cost": float("nan")}) == 1e6 + 1000
+    assert p2t.row_cost({"status": "nonfinite", "cost": float("nan")}) == 1e6 + 1000
 
 
 def test_engine_tuner_same_for_any_worker_count_and_resumes(tmp_path):
@@ -252,14 +252,13 @@ def test_engine_tuner_same_for_any_worker_count_and_resumes(tmp_path):
     second iteration and resumed from its checkpoint ends identically; the reported best cost is the
     direct loop's cost of the reported gains."""
     from scfmu import campaign
-    from scfmu.papers.paper002 import model as p2
 
     sc = Scenario(t_end=11.0)
     kw = dict(n_particles=3, max_iter=3, seed=2, progress=False)
-    serial = p2.tune(["PD", "FOPD"], sc, **kw)
+    serial = p2t.tune(["PD", "FOPD"], sc, **kw)
     client, cluster = campaign._client(None, 2)
     try:
-        dask = p2.tune(["PD", "FOPD"], sc, client=client, **kw)
+        dask = p2t.tune(["PD", "FOPD"], sc, client=client, **kw)
     finally:
         client.close()
         cluster.close()
@@ -273,7 +272,7 @@ def test_engine_tuner_same_for_any_worker_count_and_resumes(tmp_path):
 
     ck = tmp_path / "ck.json"
     with pytest.raises(Kill):
-        p2.tune(["PD", "FOPD"], sc, checkpoint=ck, on_round=kill_after_two, **kw)
+        p2t.tune(["PD", "FOPD"], sc, checkpoint=ck, on_round=kill_after_two, **kw)
     # a checkpoint from another FMU build is not resumed: the swarms start again at iteration 0
     import json
     saved = ck.read_text()
@@ -287,10 +286,10 @@ def test_engine_tuner_same_for_any_worker_count_and_resumes(tmp_path):
         raise Kill
 
     with pytest.raises(Kill):
-        p2.tune(["PD", "FOPD"], sc, checkpoint=ck, on_round=note_first_round, **kw)
+        p2t.tune(["PD", "FOPD"], sc, checkpoint=ck, on_round=note_first_round, **kw)
     assert starts == [1]  # after its first iteration, not the third
     ck.write_text(saved)
-    resumed = p2.tune(["PD", "FOPD"], sc, checkpoint=ck, **kw)
+    resumed = p2t.tune(["PD", "FOPD"], sc, checkpoint=ck, **kw)
     for c in ("PD", "FOPD"):
         print(c, serial[c]["history"], serial[c]["gains"])
         assert serial[c]["seed"] == {"PD": 2, "FOPD": 4}[c]
