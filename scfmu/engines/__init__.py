@@ -15,6 +15,7 @@ import numpy as np
 
 from .lean import LeanMaster, SimulationError, build_fmus, ports_of
 from ..scenario.model import Scenario
+from ..scenario.resolve import resolve
 from .reference import CoSimulation, _Link
 
 ENGINES = ("reference", "lean", "native")
@@ -23,6 +24,8 @@ ENGINES = ("reference", "lean", "native")
 def reference_master(scenario: Scenario, path_of=None) -> tuple[CoSimulation, dict, dict]:
     """(CoSimulation, {instance: Fmu}, log spec) for the scenario; the caller runs and closes it.
     ``path_of(model)`` gives the FMU file of a model (default ``fmus/<Model>.fmu``)."""
+    if path_of is None:
+        scenario = resolve(scenario)
     fmus = build_fmus(scenario, path_of=path_of)
     # the scenario's wiring (explicit exceptions included) replaces the master's own name matching
     sim = CoSimulation(list(fmus.values()), unconnected={n for f in fmus.values() for n in f.inputs()})

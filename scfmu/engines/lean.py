@@ -24,6 +24,7 @@ import numpy as np
 
 from ..fmu import Fmu, fmu_path, unpacked
 from ..scenario.model import Scenario
+from ..scenario.resolve import resolve
 
 _STATUS = {0: "OK", 1: "Warning", 2: "Discard", 3: "Error", 4: "Fatal", 5: "Pending"}
 
@@ -84,6 +85,7 @@ class LeanMaster:
     """Runs a Scenario (see module docstring). Use as a context manager or call ``close()``."""
 
     def __init__(self, scenario: Scenario, path_of=None, reuse: bool = True):
+        scenario = resolve(scenario)
         self.scenario = scenario
         self.fmus = build_fmus(scenario, path_of, reuse)
         try:

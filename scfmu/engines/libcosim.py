@@ -16,11 +16,13 @@ import time
 
 from ..fmu import fmu_path, unpacked
 from ..scenario.model import Scenario
+from ..scenario.resolve import resolve
 
 NS = 10**9
 
 
 def run_libcosim(scenario: Scenario) -> dict:
+    scenario = resolve(scenario)
     """Runs the scenario to its stop time; returns the final value of every logged key plus
     ``wall_s`` (the simulate_until call only)."""
     from libcosimpy.CosimExecution import CosimExecution

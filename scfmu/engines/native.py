@@ -45,6 +45,7 @@ import numpy as np
 from .lean import SimulationError
 from ..fmu import Fmu, fmu_digest, fmu_path, unpacked
 from ..scenario.model import Scenario
+from ..scenario.resolve import resolve
 
 CACHE = Path(os.environ.get("SCFMU_CONTAINER_DIR", Path.home() / ".cache" / "scfmu" / "containers"))
 _KINDS = ("parameter", "calculatedParameter", "input", "output")
@@ -222,6 +223,7 @@ class NativeLoop:
     FMU; an instance whose reset fails is freed. Results do not depend on reuse (tested)."""
 
     def __init__(self, scenario: Scenario, log_every: int = 1, reuse: bool = True):
+        scenario = resolve(scenario)
         self.scenario = scenario
         self.log_every = int(log_every)
         self.reuse = reuse

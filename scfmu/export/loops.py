@@ -18,9 +18,11 @@ from pathlib import Path
 
 from ..engines.native import build_container, scenario_starts
 from ..scenario.model import Scenario
+from ..scenario.resolve import resolve
 
 
 def write_loop_fmu(scenario: Scenario, path: str | Path) -> Path:
+    scenario = resolve(scenario)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     src = build_container(scenario, scenario_starts(scenario))

@@ -37,12 +37,23 @@ DEFAULT_UNCONNECTED = ("torque_dist_*", "dist_*", "h_wheel*", "q_ref_dot*", "q_r
 
 @dataclass
 class Component:
-    """One FMU instance: ``name`` (instance name, unique in the scenario), ``model`` (``fmus/<model>.fmu``)
-    and its parameters (set in initialization mode)."""
+    """One FMU instance in a place of the loop.
+
+    * ``name``: instance name, unique in the scenario;
+    * ``model``: a model name (``<FMU folder>/<model>.fmu``) or a path to any FMI 2.0 Co-Simulation FMU;
+    * ``params``: parameters of *that model* (set in initialization mode; an unknown name is an error).
+      They belong to the model: swapping the model (:meth:`Scenario.with_models`) drops them;
+    * ``slot``: parameters that any unit in this place is given *if it declares them* (e.g. the nominal
+      inertia an attitude controller should assume); they survive a swap;
+    * ``ports``: renames ``{"the unit's port name": "the scenario's port name"}`` for a unit whose port
+      names differ from the family's (``--map``).
+    """
 
     name: str
     model: str
     params: dict = field(default_factory=dict)
+    slot: dict = field(default_factory=dict)
+    ports: dict = field(default_factory=dict)
 
 
 @dataclass
@@ -94,12 +105,49 @@ class Scenario:
         d["components"] = [Component(**c) for c in d["components"]]
         return cls(**d)
 
+    def alias(self, inst: str, port: str) -> str:
+        """The scenario's name of ``inst``'s port ``port`` (after the component's ``ports`` renames)."""
+        return self.component(inst).ports.get(port, port)
+
+    def native_name(self, inst: str, port: str) -> str:
+        """The unit's own name of the scenario's port ``port`` of ``inst`` (inverse of :meth:`alias`)."""
+        for theirs, ours in self.component(inst).ports.items():
+            if ours == port:
+                return theirs
+        return port
+
     # ----- variations -----------------------------------------------------------------------------------
     def with_models(self, models: dict) -> "Scenario":
-        """A copy whose instances use other models: ``{instance: model name or path to an .fmu}``."""
+        """A copy whose instances use other models: ``{instance: model name or path to an .fmu}``. An
+        instance whose model changes loses the parameters of its old model (``params``; see
+        :meth:`dropped_params`) and keeps its ``slot`` parameters and wiring; set the new model's own
+        parameters with :meth:`with_overrides`."""
         s = copy.deepcopy(self)
         for inst, model in models.items():
-            s.component(inst).model = str(model)
+            c = s.component(inst)
+            if str(model) != c.model:
+                c.model = str(model)
+                c.params = {}
+                c.ports = {}
+        return s
+
+    def dropped_params(self, models: dict) -> dict:
+        """``{instance: [parameter names]}`` that :meth:`with_models` with these models would drop."""
+        out = {}
+        for inst, model in models.items():
+            c = self.component(inst)
+            if str(model) != c.model and c.params:
+                out[inst] = sorted(c.params)
+        return out
+
+    def with_port_map(self, maps: dict) -> "Scenario":
+        """A copy with port renames ``{"instance.their_name": "our_name"}`` (``--map``)."""
+        s = copy.deepcopy(self)
+        for key, ours in maps.items():
+            inst, sep, theirs = key.partition(".")
+            if not sep or not theirs or not ours:
+                raise KeyError(f"port map {key!r}={ours!r}: expected INSTANCE.THEIR_NAME=OUR_NAME")
+            s.component(inst).ports[theirs] = ours
         return s
 
     def with_overrides(self, overrides: dict | None = None, **fields) -> "Scenario":
@@ -135,6 +183,10 @@ class Scenario:
         names = [c.name for c in self.components]
         if len(set(names)) != len(names):
             raise ValueError(f"duplicate instance names in {names}")
+        # match on the scenario's names (a unit's own port names renamed by its ``ports`` map); links are
+        # returned with the units' own names
+        ports = {n: ([self.alias(n, p) for p in ports[n][0]], [self.alias(n, p) for p in ports[n][1]])
+                 for n in names}
         for dst, src in self.connections.items():
             for q in (dst, src):
                 inst, _, var = q.partition(".")
@@ -155,7 +207,7 @@ class Scenario:
                     si, _, sv = self.connections[q].partition(".")
                     per_src.setdefault(si, []).append((inp, sv))
                     continue
-                if q in self.inputs:
+                if q in self.inputs or f"{dst}.{self.native_name(dst, inp)}" in self.inputs:
                     continue
                 sources = [s for s in names if s != dst and inp in ports[s][1]] if self.auto_connect else []
                 if len(sources) > 1:
@@ -168,7 +220,7 @@ class Scenario:
                 per_src.setdefault(sources[0], []).append((inp, inp))
             for src, pairs in per_src.items():  # sources in order of first appearance among dst's inputs
                 for inp, out in pairs:
-                    links.append((dst, inp, src, out))
+                    links.append((dst, self.native_name(dst, inp), src, self.native_name(src, out)))
         return links
 
     def _is_unconnected(self, inst: str, port: str) -> bool:

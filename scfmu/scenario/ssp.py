@@ -32,15 +32,20 @@ from xml.etree import ElementTree as ET
 
 from fmpy import read_model_description
 
-from ..fmu import fmu_path
+from ..fmu import fmu_path, is_path
 from .model import Component, Scenario
+from .resolve import resolve
 
 SSD_NS = "http://ssp-standard.org/SSP1/SystemStructureDescription"
 SSC_NS = "http://ssp-standard.org/SSP1/SystemStructureCommon"
 SSV_NS = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
 ANNOTATION_TYPE = "com.github.spacecraft-fmus.scfmu"
 SCFMU_NS = "https://github.com/spacecraft-fmus/scfmu/ssp-annotation"
-NS = {"ssd": SSD_NS, "ssc": SSC_NS, "ssv": SSV_NS, "scfmu": SCFMU_NS}
+# OMSimulator reads the kind of a system and its master from its own annotation (without it, it takes the
+# system's type as "none" and refuses the file): a fixed-step master with the scenario's step
+OMS_TYPE = "org.openmodelica"
+OMS_NS = "https://raw.githubusercontent.com/OpenModelica/OMSimulator/master/schema/oms.xsd"
+NS = {"ssd": SSD_NS, "ssc": SSC_NS, "ssv": SSV_NS, "scfmu": SCFMU_NS, "oms": OMS_NS}
 for _p, _u in NS.items():
     ET.register_namespace(_p, _u)
 
@@ -79,9 +84,17 @@ def _ssv(values: list[tuple[str, str, object]], name: str) -> bytes:
     return ET.tostring(root, encoding="UTF-8", xml_declaration=True)
 
 
+def resource_name(model: str) -> str:
+    """The file name of a model's FMU inside the archive: ``<model>.fmu``, or the file's own name for a
+    model given as a path."""
+    return Path(model).name if is_path(model) else f"{model}.fmu"
+
+
 def write_ssp(scenario: Scenario, path: str | Path, path_of=None) -> Path:
     """Writes ``scenario`` as an SSP 1.0 archive at ``path``; FMUs from ``path_of(model)`` (default
-    ``fmus/<Model>.fmu``). Returns the path."""
+    ``fmus/<Model>.fmu``, or the model's own path). Returns the path."""
+    if path_of is None:
+        scenario = resolve(scenario)
     path = Path(path)
     path_of = path_of or fmu_path
     mds = {c.model: read_model_description(str(path_of(c.model))) for c in scenario.components}
@@ -106,7 +119,7 @@ def write_ssp(scenario: Scenario, path: str | Path, path_of=None) -> Path:
     for c in scenario.components:
         comp = ET.SubElement(elements, _q("ssd", "Component"),
                              {"name": c.name, "type": "application/x-fmu-sharedlibrary",
-                              "source": f"resources/{c.model}.fmu"})
+                              "source": f"resources/{resource_name(c.model)}"})
         conns = ET.SubElement(comp, _q("ssd", "Connectors"))
         for v in mds[c.model].modelVariables:
             if v.causality in ("input", "output"):
@@ -128,6 +141,11 @@ def write_ssp(scenario: Scenario, path: str | Path, path_of=None) -> Path:
     for d, di, s, so in links:
         ET.SubElement(connections, _q("ssd", "Connection"),
                       {"startElement": s, "startConnector": so, "endElement": d, "endConnector": di})
+    sys_anns = ET.SubElement(system, _q("ssd", "Annotations"))
+    oms = ET.SubElement(ET.SubElement(sys_anns, _q("ssc", "Annotation"), {"type": OMS_TYPE}), _q("oms", "Annotations"))
+    ET.SubElement(ET.SubElement(oms, _q("oms", "SimulationInformation")), _q("oms", "FixedStepMaster"),
+                  {"description": "oms-ma", "stepSize": repr(float(scenario.step)), "absoluteTolerance": "0.0001",
+                   "relativeTolerance": "0.0001"})
     exp = ET.SubElement(root, _q("ssd", "DefaultExperiment"),
                         {"startTime": repr(float(scenario.start_time)), "stopTime": repr(float(scenario.stop_time))})
     anns = ET.SubElement(exp, _q("ssd", "Annotations"))
@@ -146,7 +164,7 @@ def write_ssp(scenario: Scenario, path: str | Path, path_of=None) -> Path:
         for src, data in sorted(ssv_files.items()):
             z.writestr(src, data)
         for model in dict.fromkeys(c.model for c in scenario.components):
-            z.write(path_of(model), f"resources/{model}.fmu")
+            z.write(path_of(model), f"resources/{resource_name(model)}")
     tmp.replace(path)
     return path
 

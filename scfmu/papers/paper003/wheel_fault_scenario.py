@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 from ...scenario.model import Component, Scenario, log_of
+from ...scenario.templates import nominal_inertia
 
 D = math.radians
 WHEEL_FAULT_COMMAND = (D(30.0), D(-20.0), D(45.0))
@@ -24,8 +25,8 @@ def wheel_fault(stop_time: float = 120.0, step: float = 0.1, fault_time: float =
         components=[
             Component("command", "AttitudeCommand", {"ref_euler321_roll": c[0], "ref_euler321_pitch": c[1],
                                                      "ref_euler321_yaw": c[2]}),
-            Component("controller", "PdController", {"wn": 0.3, "zeta": 0.9, "inertia_xx": 4.0, "inertia_yy": 5.0,
-                                                     "inertia_zz": 3.5}),
+            Component("controller", "PdController", {"wn": 0.3, "zeta": 0.9},
+                      slot=nominal_inertia(I003)),
             Component("plant", "AttitudePlant", dict(I003, actuator_mode=1, mtq_enable=1, gg_enable=1,
                                                      dist_const_x=5e-4, dist_const_y=5e-4, dist_const_z=5e-4,
                                                      effectiveness_x=effectiveness_x, fault_bias_z=bias_z,

@@ -27,7 +27,9 @@ def paper004(case: str = "1", stop_time: float = 20.0, step: float = 0.01) -> Sc
         name=f"paper004/{case}",
         components=[
             Component("corrector", "ReferenceCorrector", p4.corrector_params(mode, nodes, eff, p4.INIT_DEFAULT_DEG)),
-            Component("controller", "FeedbackLinearizingController", p4.controller_params()),
+            Component("controller", "FeedbackLinearizingController",
+                      {k: v for k, v in p4.controller_params().items() if not k.startswith("inertia_")},
+                      slot={k: v for k, v in p4.controller_params().items() if k.startswith("inertia_")}),
             Component("plant", "AttitudePlant", p4.plant_params(eff, p4.INIT_DEFAULT_DEG)),
         ],
         stop_time=stop_time, step=step,

@@ -1,0 +1,158 @@
+"""Pre-flight check of a scenario before any run: every unit is an FMI 2.0 Co-Simulation FMU with a binary
+for this platform that instantiates, every parameter the scenario sets exists, and every connection joins
+an output to an input of the same type and unit.
+
+:func:`check` returns the problems found (``errors``) and what is accepted with a warning (``warnings``,
+e.g. a port without a unit); :func:`require` raises :class:`IncompatibleUnit` with every error at once.
+A unit given by path (a user's FMU) is checked the same way as ours.
+"""
+
+from __future__ import annotations
+
+import platform
+import sys
+import zipfile
+from dataclasses import dataclass, field
+
+from fmpy import read_model_description
+
+from ..fmu import fmu_path
+from .model import Scenario
+from .resolve import resolve
+
+
+class IncompatibleUnit(ValueError):
+    """A unit cannot take its place in the scenario; the message lists every reason."""
+
+
+@dataclass
+class Report:
+    errors: list = field(default_factory=list)
+    warnings: list = field(default_factory=list)
+
+    @property
+    def ok(self) -> bool:
+        return not self.errors
+
+
+def platform_folder() -> str:
+    """FMI 2.0's binaries folder for this machine (linux64, win64, darwin64, ...)."""
+    bits = "64" if sys.maxsize > 2**32 else "32"
+    return {"Linux": "linux", "Windows": "win", "Darwin": "darwin"}.get(platform.system(), platform.system().lower()) + bits
+
+
+def _unit(md, v) -> str | None:
+    """The unit of a Real variable: its own, else its declared type's (None when neither has one)."""
+    unit = getattr(v, "unit", None)
+    if unit:
+        return unit
+    dt = getattr(v, "declaredType", None)
+    return getattr(dt, "unit", None) or None
+
+
+def check_unit(model: str, instantiate: bool = True) -> tuple[object | None, list[str]]:
+    """(model description or None, errors) of one FMU: FMI 2.0, Co-Simulation, a binary for this platform,
+    and (``instantiate``) ``fmi2Instantiate`` succeeding."""
+    try:
+        path = fmu_path(model)
+    except FileNotFoundError as e:
+        return None, [str(e)]
+    try:
+        md = read_model_description(str(path), validate=False)
+    except Exception as e:  # not a zip, no modelDescription.xml, XML errors
+        return None, [f"{model}: cannot read its modelDescription.xml: {e}"]
+    errs = []
+    if md.fmiVersion != "2.0":
+        errs.append(f"{model}: FMI {md.fmiVersion}, not FMI 2.0")
+    if md.coSimulation is None:
+        errs.append(f"{model}: no Co-Simulation interface (Model Exchange only)")
+    if errs:
+        return md, errs
+    ident = md.coSimulation.modelIdentifier
+    ext = {"linux": ".so", "win": ".dll", "darwin": ".dylib"}[platform_folder().rstrip("0123456789")]
+    lib = f"binaries/{platform_folder()}/{ident}{ext}"
+    with zipfile.ZipFile(path) as z:
+        if lib not in z.namelist():
+            have = sorted({n.split("/")[1] for n in z.namelist() if n.startswith("binaries/") and n.count("/") >= 2})
+            return md, [f"{model}: no binary for this platform ({lib} missing; it has {have or 'no binaries'})"]
+    if instantiate:
+        from ..fmu import Fmu
+        try:
+            f = Fmu(str(model), path=path, name="preflight", initialize=False)
+        except Exception as e:
+            return md, [f"{model}: fmi2Instantiate failed: {e}"]
+        f.close()
+    return md, []
+
+
+def check(scenario: Scenario, instantiate: bool = True) -> Report:
+    rep = Report()
+    sc = resolve_safely(scenario, rep)
+    mds = {}
+    for c in sc.components:
+        if c.model in mds:
+            continue
+        md, errs = check_unit(c.model, instantiate)
+        rep.errors += errs
+        mds[c.model] = md if not errs else None
+    if rep.errors:
+        return rep
+    vars_of = {c.name: {v.name: v for v in mds[c.model].modelVariables} for c in sc.components}
+    for c in sc.components:
+        for k in c.params:
+            v = vars_of[c.name].get(k)
+            if v is None or v.causality != "parameter":
+                rep.errors.append(f"{c.name} ({c.model}): no parameter {k!r}")
+        for theirs in c.ports:
+            if theirs not in vars_of[c.name]:
+                rep.errors.append(f"{c.name} ({c.model}): port map names {theirs!r}, which the unit does not have")
+    ports = {c.name: ([n for n, v in vars_of[c.name].items() if v.causality == "input"],
+                      [n for n, v in vars_of[c.name].items() if v.causality == "output"]) for c in sc.components}
+    try:
+        links = sc.wiring(ports)
+    except (KeyError, ValueError) as e:
+        rep.errors.append(f"wiring: {e.args[0] if e.args else e}")
+        return rep
+    for d, di, s, so in links:
+        vd, vs = vars_of[d][di], vars_of[s][so]
+        what = f"{s}.{so} -> {d}.{di}"
+        if vd.type != "Real" or vs.type != "Real":
+            rep.errors.append(f"{what}: only Real connections are supported ({vs.type} -> {vd.type})")
+            continue
+        ud, us = _unit(mds[sc.component(d).model], vd), _unit(mds[sc.component(s).model], vs)
+        if ud and us and ud != us:
+            rep.errors.append(f"{what}: unit {us!r} does not match {ud!r}")
+        elif bool(ud) != bool(us):  # one side without a unit (both without: a dimensionless signal)
+            rep.warnings.append(f"{what}: no unit declared on {d + '.' + di if not ud else s + '.' + so} "
+                                f"(accepted; expected {us or ud or 'a unit'})")
+    for key, inst, var in sc.log_items():
+        if inst in vars_of and var not in vars_of[inst]:
+            rep.errors.append(f"logged signal {key!r}: {inst} has no variable {var!r}")
+    for q in sc.inputs:
+        inst, _, var = q.partition(".")
+        v = vars_of.get(inst, {}).get(var)
+        if v is None or v.causality != "input":
+            rep.errors.append(f"fixed input {q}: {inst} has no input {var!r}")
+    return rep
+
+
+def resolve_safely(scenario: Scenario, rep: Report) -> Scenario:
+    try:
+        return resolve(scenario)
+    except FileNotFoundError:
+        return scenario  # reported by check_unit
+    except Exception as e:
+        rep.errors.append(f"resolving the scenario: {e}")
+        return scenario
+
+
+def require(scenario: Scenario, instantiate: bool = True, warn=None) -> Report:
+    """Runs :func:`check`; raises :class:`IncompatibleUnit` listing every error; passes warnings to
+    ``warn(text)`` (default: nothing)."""
+    rep = check(scenario, instantiate)
+    if warn is not None:
+        for w in rep.warnings:
+            warn(w)
+    if rep.errors:
+        raise IncompatibleUnit(f"scenario {scenario.name!r} cannot run:\n  " + "\n  ".join(rep.errors))
+    return rep

@@ -1,0 +1,131 @@
+"""Scenarios as files: TOML (``.toml``) or JSON (``.json``) with the same fields as the Python declaration,
+validated with messages that name the field. Relative FMU paths in ``model`` are taken relative to the
+file's folder. ``scfmu scenarios --show NAME`` prints any registered scenario in this format.
+
+    name = "my_loop"
+    stop_time = 30.0
+    step = 0.01
+    metrics = "attitude"              # a registered metric set (optional)
+    [[components]]                    # in Gauss–Seidel order
+    name = "controller"
+    model = "fmus/MyController.fmu"   # a model name or a path to an FMI 2.0 Co-Simulation FMU
+    [components.params]               # parameters of this model
+    k = 2.0
+    [components.slot]                 # given to any unit in this place that declares them
+    inertia_xx = 1000.0
+    [components.ports]                # the unit's port name = the scenario's port name
+    tau_x = "torque_cmd_x"
+    [log]                             # key = "instance.variable"
+    alpha_deg = "metrics.alpha_deg"
+"""
+
+from __future__ import annotations
+
+import json
+import tomllib
+from dataclasses import fields
+from pathlib import Path
+
+from .model import Component, Scenario
+
+_FIELDS = {f.name for f in fields(Scenario)}
+_COMPONENT = {"name", "model", "params", "slot", "ports"}
+_TYPES = {"name": str, "stop_time": (int, float), "step": (int, float), "start_time": (int, float), "log": dict,
+          "connections": dict, "unconnected": list, "inputs": dict, "auto_connect": bool, "seed_params": list,
+          "metrics": str, "description": str, "components": list}
+
+
+class ScenarioFileError(ValueError):
+    pass
+
+
+def from_data(data: dict, where: str = "scenario", base: Path | None = None) -> Scenario:
+    """A Scenario from plain data (as read from TOML or JSON), validated."""
+    if not isinstance(data, dict):
+        raise ScenarioFileError(f"{where}: expected a table of fields")
+    unknown = sorted(set(data) - _FIELDS)
+    if unknown:
+        raise ScenarioFileError(f"{where}: unknown field(s) {unknown}; known: {sorted(_FIELDS)}")
+    for req in ("components", "stop_time", "step"):
+        if req not in data:
+            raise ScenarioFileError(f"{where}: missing field {req!r}")
+    for k, t in _TYPES.items():
+        if k in data and not (isinstance(data[k], t) and not (t is not bool and isinstance(data[k], bool))):
+            raise ScenarioFileError(f"{where}: field {k!r} must be {t.__name__ if isinstance(t, type) else 'a number'}, "
+                                    f"not {type(data[k]).__name__}")
+    comps = []
+    for i, c in enumerate(data["components"]):
+        w = f"{where}: components[{i}]"
+        if not isinstance(c, dict):
+            raise ScenarioFileError(f"{w}: expected a table with name and model")
+        bad = sorted(set(c) - _COMPONENT)
+        if bad:
+            raise ScenarioFileError(f"{w}: unknown field(s) {bad}; known: {sorted(_COMPONENT)}")
+        for req in ("name", "model"):
+            if not isinstance(c.get(req), str) or not c[req]:
+                raise ScenarioFileError(f"{w}: {req!r} must be a non-empty string")
+        for k in ("params", "slot", "ports"):
+            if k in c and not isinstance(c[k], dict):
+                raise ScenarioFileError(f"{w} ({c['name']}): {k!r} must be a table")
+        model = c["model"]
+        if base is not None and (model.endswith(".fmu") or "/" in model) and not Path(model).is_absolute():
+            model = str((base / model).resolve())
+        comps.append(Component(c["name"], model, dict(c.get("params", {})), dict(c.get("slot", {})),
+                               dict(c.get("ports", {}))))
+    d = {k: v for k, v in data.items() if k != "components"}
+    d.setdefault("name", where)
+    sc = Scenario(components=comps, **d)
+    try:
+        sc.n_steps
+    except ValueError as e:
+        raise ScenarioFileError(f"{where}: {e}") from None
+    for key, q in sc.log.items():
+        if not isinstance(q, str) or "." not in q:
+            raise ScenarioFileError(f"{where}: log entry {key!r} must be 'instance.variable'")
+    names = [c.name for c in comps]
+    if len(set(names)) != len(names):
+        raise ScenarioFileError(f"{where}: duplicate instance names in {names}")
+    return sc
+
+
+def load(path: str | Path) -> Scenario:
+    """Reads a scenario file (``.toml`` or ``.json``)."""
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except OSError as e:
+        raise ScenarioFileError(f"{path}: {e.strerror}") from None
+    try:
+        data = tomllib.loads(text) if path.suffix.lower() == ".toml" else json.loads(text)
+    except (tomllib.TOMLDecodeError, json.JSONDecodeError) as e:
+        raise ScenarioFileError(f"{path}: not valid {path.suffix.lstrip('.').upper() or 'JSON'}: {e}") from None
+    data.setdefault("name", path.stem)
+    return from_data(data, str(path), path.parent)
+
+
+def to_data(sc: Scenario) -> dict:
+    """Plain data of a scenario, empty optional tables left out (the form the files use)."""
+    d = sc.to_dict()
+    for c in d["components"]:
+        for k in ("params", "slot", "ports"):
+            if not c[k]:
+                del c[k]
+    for k in ("connections", "inputs", "log", "seed_params"):
+        if not d[k]:
+            del d[k]
+    comps = d.pop("components")
+    d["components"] = comps  # tables after scalars (TOML)
+    return d
+
+
+def dumps_toml(sc: Scenario) -> str:
+    import tomli_w
+    return tomli_w.dumps(to_data(sc))
+
+
+def dumps_json(sc: Scenario) -> str:
+    return json.dumps(to_data(sc), indent=1)
+
+
+def is_scenario_file(text: str) -> bool:
+    return text.lower().endswith((".toml", ".json")) and Path(text).is_file()
