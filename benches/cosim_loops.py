@@ -20,7 +20,10 @@ Only the stepping loop is timed (instantiation and initialization excluded); eac
 minimum over --repeat interleaved repetitions. With --campaign, also campaign throughput (runs/s of
 the 30 s run 000-6 on the native path, warm workers) with 1 and 2 Dask workers.
 
-Usage: .venv/bin/python benches/cosim_loops.py [--repeat 5] [--campaign] [--runs 40]
+With --run-cost, the cost of one campaign run (campaign.run_one, as a worker runs it) against the native
+stepping of the same run without logging, side by side in this process (issue 20).
+
+Usage: .venv/bin/python benches/cosim_loops.py [--repeat 5] [--campaign] [--run-cost] [--runs 40]
 """
 
 from __future__ import annotations
@@ -199,18 +202,49 @@ def campaign_throughput(n_runs: int):
     return res
 
 
+def campaign_cost(n_runs: int, repeat: int):
+    """Side by side in this process: the native stepping of run 000-6 with no Python call per step
+    (log_every=0), and one campaign run of it (``campaign.run_one``, what a worker does per run: scenario
+    from the spec, overrides, container instance from the pool, logging of the metric set's signals,
+    metrics, row); each the minimum over interleaved repetitions."""
+    from scfmu import campaign
+    sc = scenarios.get("default")
+    specs = campaign.Campaign(sc, campaign.random_sample({"controller.wn": ("uniform", 0.5, 2.0)}, n_runs, 1),
+                              seeds=[None]).runs()
+    campaign.run_one(specs[0])  # container built, unpacked, one instance pooled
+    step = run = float("inf")
+    for _ in range(repeat):
+        step = min(step, t_native(sc, 0))
+        t = time.perf_counter()
+        for s in specs:
+            row, _ = campaign.run_one(s)
+            assert row["status"] == "ok", row["message"]
+        run = min(run, (time.perf_counter() - t) / n_runs)
+    print(f"\n| run 000-6 (3,000 steps), one process | ms per run | µs per step |")
+    print("|---|---:|---:|")
+    print(f"| native stepping, log_every=0 | {step * 1e3:.2f} | {step / sc.n_steps * 1e6:.2f} |")
+    print(f"| campaign run (run_one, 1 worker's work) | {run * 1e3:.2f} ({1 / run:.1f} runs/s) | "
+          f"{run / sc.n_steps * 1e6:.2f} |")
+    print(f"| ratio campaign run / native stepping | {run / step:.2f}× | |")
+    return step, run
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--campaign", action="store_true")
     ap.add_argument("--runs", type=int, default=40)
     ap.add_argument("--no-loops", action="store_true", help="only the campaign throughput")
+    ap.add_argument("--run-cost", action="store_true",
+                    help="campaign run cost against native stepping, side by side in this process")
     args = ap.parse_args()
     load = os.getloadavg()[0]
     print(f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, {os.cpu_count()} cores, load average {load:.1f}, "
           f"Python {platform.python_version()}")
     if not args.no_loops:
         loops(args.repeat)
+    if args.run_cost:
+        campaign_cost(args.runs, args.repeat)
     if args.campaign:
         campaign_throughput(args.runs)
     return 0

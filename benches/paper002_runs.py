@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Cost of one paper 002 tuner evaluation (one 20 s closed-loop run at h = 1 ms, 20,001 samples of θ
 logged) per controller: the campaign engine's native path (``campaign.run_one`` of paper002/<controller>
-with the gains as overrides, container instance reused as in a campaign) against the direct two-FMU
-Python loop (``scfmu.papers.paper002.model.run_case``), side by side in one process. Minimum of --repeat runs each;
+with the gains as overrides, container instance reused as in a campaign) against ``run_case`` (the same
+loop scenario on the native engine through ``scfmu.simulate``, θ only logged; before issue 20 it was a
+two-FMU Python ctypes loop), side by side in one process. Minimum of --repeat runs each;
 the costs of both paths are printed too (they agree to round-off).
 
 Usage: .venv/bin/python benches/paper002_runs.py [--repeat 3]
@@ -15,7 +16,7 @@ import os
 import time
 
 from scfmu.papers.paper002 import model as p2
-from scfmu.papers.paper002 import tuning as p2t
+from scfmu.papers.paper002 import tuning
 
 
 def main() -> int:
@@ -24,14 +25,14 @@ def main() -> int:
     a = ap.parse_args()
     gains = p2.load_gains()
     print(f"load average {os.getloadavg()[0]:.1f}; min of {a.repeat} runs")
-    print("| controller | native engine [s/run] | direct loop [s/run] | direct / native | cost native | cost direct |")
+    print("| controller | campaign run [s/run] | run_case [s/run] | run_case / campaign | cost campaign | cost run_case |")
     print("|---|---:|---:|---:|---:|---:|")
     for c in p2.CONTROLLERS:
-        p2t.engine_cost(c, gains[c])  # container build / unpack
+        tuning.engine_cost(c, gains[c])  # container build / unpack
         tn, td = [], []
         for _ in range(a.repeat):
             t0 = time.perf_counter()
-            row = p2t.engine_cost(c, gains[c])
+            row = tuning.engine_cost(c, gains[c])
             tn.append(time.perf_counter() - t0)
             t0 = time.perf_counter()
             d = p2.run_case(c, gains[c])

@@ -13,6 +13,7 @@ A component's model may also be a path to any ``.fmu`` file (:func:`fmu_path`).
 
 from __future__ import annotations
 
+import functools
 import os
 import shutil
 from importlib import resources
@@ -30,6 +31,7 @@ def set_fmu_dir(path: str | Path | None) -> None:
     _FMU_DIR_OVERRIDE = None if path is None else Path(path).resolve()
 
 
+@functools.cache  # where the installed package lies does not change while it runs
 def _package_fmus() -> Path | None:
     d = resources.files("scfmu") / "fmus"
     if d.is_dir() and any(p.name.endswith(".fmu") for p in d.iterdir()):
@@ -37,6 +39,7 @@ def _package_fmus() -> Path | None:
     return None
 
 
+@functools.cache
 def _checkout_fmus() -> Path | None:
     """``fmus/`` of the source checkout that holds this package (editable install), if it is one."""
     pkg = Path(str(resources.files("scfmu")))

@@ -258,3 +258,43 @@ def test_a_worker_that_dies_gives_a_worker_error_row(tmp_path, monkeypatch):
         rows = rows_of(campaign.run(c, tmp_path, n_workers=1, chunk=2, progress=False))
     assert [r["status"] for r in rows] == ["ok", "ok", "worker_error", "ok"]
     assert rows[2]["p:controller.wn"] == 2.0 and np.isnan(rows[2]["eulerint_deg_s"])
+
+
+@pytest.mark.parametrize("name,t,overrides,seed", [("default", 3.0, {"controller.wn": 1.3}, None),
+                                                   ("paper002/FOPID", 1.5, {"controller.kp": 4.0}, None),
+                                                   ("paper001/c/dist0.01", 2.0, {}, None),
+                                                   ("paper003/T2FSMC/W", 3.0, {}, 5)])
+def test_campaign_metrics_equal_those_of_a_full_log_reference_run(name, t, overrides, seed):
+    """A campaign run logs only the signals its metric set reads; its metric columns equal, to the bit,
+    the metrics computed from every logged signal of the same scenario on the reference master."""
+    from scfmu import metrics as run_metrics
+
+    base = short(name, t)
+    spec = campaign.Campaign(base, [overrides], seeds=[seed]).runs()[0]
+    seen = []
+    real_simulate = campaign.simulate
+
+    def spy(sc, *a, **kw):
+        seen.append(dict(sc.log))
+        return real_simulate(sc, *a, **kw)
+
+    campaign.simulate = spy
+    try:
+        row, ts = campaign.run_one(spec)
+    finally:
+        campaign.simulate = real_simulate
+    assert row["status"] == "ok", row["message"]
+    assert ts is None
+    need = run_metrics.logs_needed(base.metrics)
+    assert need is not None and set(seen[0]) == set(base.log) & set(need) and len(seen[0]) <= len(base.log)
+    full = base.with_overrides(overrides)
+    if seed is not None:
+        full = full.with_seed(seed)
+    ref = simulate(full, "reference")
+    assert set(ref) == {"time", *base.log}  # every signal logged
+    want = run_metrics.compute(base.metrics, ref)
+    cols = run_metrics.columns(base.metrics)
+    assert cols
+    for k in cols:
+        a, b = row[k], float(want.get(k, np.nan))
+        assert np.array(a).view(np.int64) == np.array(b).view(np.int64) or (np.isnan(a) and np.isnan(b)), (k, a, b)

@@ -130,7 +130,10 @@ def run_one(spec: dict, fmu_dir: str | None = None) -> tuple[dict, dict | None]:
     ts = None
     metric_cols = run_metrics.columns(base.metrics)
     try:
-        sc = base.with_overrides(spec["overrides"]).with_seed(spec["seed"])
+        sc = base.with_overrides(spec["overrides"])  # a copy: the spec's scenario stays as it is
+        if spec["seed"] is not None:
+            sc = sc.with_seed(spec["seed"])
+        sc.log = _log_kept(sc, spec["timeseries"])
         kw = {"log_every": max(1, int(spec.get("log_every", 1)))} if spec["engine"] == "native" else {}
         r = simulate(sc, spec["engine"], **kw)
         m = run_metrics.compute(sc.metrics, r)
@@ -153,6 +156,17 @@ def run_one(spec: dict, fmu_dir: str | None = None) -> tuple[dict, dict | None]:
     for k in metric_cols:
         row.setdefault(k, math.nan)
     return row, ts
+
+
+def _log_kept(sc: Scenario, timeseries) -> dict:
+    """The scenario's log restricted to what the run's row and time series read: the keys of its metric
+    set (``metrics.logs_needed``; None: all) plus the time series' keys ([]: all). Fewer logged signals
+    change no value (each FMU output is read at the same points whatever else is read), only the cost."""
+    need = run_metrics.logs_needed(sc.metrics)
+    if need is None or (timeseries is not None and not list(timeseries)):
+        return sc.log
+    keep = set(need) | set(timeseries or ())
+    return {k: v for k, v in sc.log.items() if k in keep}
 
 
 def _crash_row(spec: dict, c: "Campaign", e: Exception) -> dict:

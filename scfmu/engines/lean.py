@@ -208,3 +208,73 @@ class LeanMaster:
 
     def __exit__(self, *exc):
         self.close()
+
+
+class OpenLoop:
+    """One FMU driven open loop by a table of inputs held over each communication step, every run from
+    the same initial state: instantiated and initialized once (``params`` in initialization mode), its
+    state saved (``fmi2GetFMUstate``) and restored before every run (``fmi2SetFMUstate``). The FMI calls
+    are raw ctypes calls as in :class:`LeanMaster` (value references resolved once, one ``fmi2SetReal`` of
+    all inputs per step straight from the table's row).
+
+    ``run(u, dt)``: for k < len(u), sets ``inputs`` to ``u[k]`` and steps from t0 + k·dt to t0 + (k+1)·dt;
+    returns the ``outputs`` at the end (a NumPy array). Any FMI status other than OK raises
+    :class:`SimulationError`. Use as a context manager or call ``close()``."""
+
+    def __init__(self, model: str, params: dict, inputs: list[str], outputs: list[str], start_time: float = 0.0,
+                 stop_time: float | None = None):
+        self.fmu = Fmu(model, params, start_time=start_time, stop_time=stop_time)
+        try:
+            sl = self.fmu.slave
+            self._comp = sl.component if isinstance(sl.component, int) else ctypes.cast(sl.component, c_void_p).value
+            self._get = _raw(sl, "fmi2GetReal", [c_void_p, c_void_p, c_size_t, c_void_p])
+            self._set = _raw(sl, "fmi2SetReal", [c_void_p, c_void_p, c_size_t, c_void_p])
+            self._step = _raw(sl, "fmi2DoStep", [c_void_p, c_double, c_double, c_int])
+            self.inputs, self.outputs = list(inputs), list(outputs)
+            self._vr_in = (c_uint * len(inputs))(*[self.fmu.var(n).valueReference for n in inputs])
+            self._vr_out = (c_uint * len(outputs))(*[self.fmu.var(n).valueReference for n in outputs])
+            self.t0 = start_time
+            self.state0 = sl.getFMUstate()
+        except Exception:
+            self.fmu.close()
+            raise
+        self.runs = 0
+
+    def _fail(self, what: str, t: float | None = None):
+        msgs = "; ".join(m[2] for m in self.fmu.messages[-3:])
+        raise SimulationError("fmu_error", f"{self.fmu.model}: {what}" + (f": {msgs}" if msgs else ""), t)
+
+    def run(self, u: np.ndarray, dt: float) -> np.ndarray:
+        u = np.ascontiguousarray(u, dtype=np.float64)
+        n_in = len(self.inputs)
+        if u.ndim != 2 or u.shape[1] != n_in:
+            raise ValueError(f"input table of shape {u.shape}: expected (steps, {n_in})")
+        self.fmu.slave.setFMUstate(self.state0)
+        comp, setr, step = self._comp, self._set, self._step
+        vr_in = ctypes.addressof(self._vr_in)
+        base, stride, t0 = u.ctypes.data, u.strides[0], self.t0
+        for k in range(len(u)):
+            if setr(comp, vr_in, n_in, base + k * stride) != 0:
+                self._fail(f"fmi2SetReal failed at t = {t0 + k * dt}", t0 + k * dt)
+            if step(comp, t0 + k * dt, dt, 1) != 0:
+                self._fail(f"fmi2DoStep failed at t = {t0 + k * dt}", t0 + k * dt)
+        y = np.empty(len(self.outputs))
+        if self._get(comp, ctypes.addressof(self._vr_out), len(self.outputs), y.ctypes.data) != 0:
+            self._fail("fmi2GetReal failed")
+        self.runs += 1
+        return y
+
+    def close(self) -> None:
+        if self.fmu is None:
+            return
+        try:
+            self.fmu.slave.freeFMUstate(self.state0)
+        finally:
+            self.fmu.close()
+            self.fmu = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()

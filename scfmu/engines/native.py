@@ -56,7 +56,27 @@ def _descriptions(scenario: Scenario):
     return {c.model: unpacked(fmu_path(c.model))[0] for c in scenario.components}
 
 
+_KEYS: dict = {}  # structure of a scenario (+ FMU file identities) -> (hash, info), per process
+
+
+def _structure(scenario: Scenario, starts: dict | None) -> tuple:
+    """What the container of a scenario depends on, cheaply: instances and models with their FMU files'
+    identity (path, modification time, size), wiring declaration, step and start values."""
+    files = []
+    for c in scenario.components:
+        p = fmu_path(c.model)
+        st = p.stat()
+        files.append((c.name, c.model, str(p), st.st_mtime_ns, st.st_size))
+    return (tuple(files), repr(scenario.step), tuple(sorted(scenario.connections.items())),
+            tuple(scenario.unconnected), tuple(sorted(scenario.inputs)), scenario.auto_connect,
+            tuple(sorted((k, repr(v)) for k, v in starts.items())) if starts else ())
+
+
 def container_key(scenario: Scenario, starts: dict | None = None) -> tuple[str, dict]:
+    sig = _structure(scenario, starts)
+    hit = _KEYS.get(sig)
+    if hit is not None:
+        return hit
     mds = _descriptions(scenario)
     ports = {c.name: ([v.name for v in mds[c.model].modelVariables if v.causality == "input"],
                       [v.name for v in mds[c.model].modelVariables if v.causality == "output"])
@@ -68,7 +88,8 @@ def container_key(scenario: Scenario, starts: dict | None = None) -> tuple[str, 
     if starts:
         key["starts"] = sorted((k, repr(v)) for k, v in starts.items())
     h = hashlib.sha256(json.dumps(key, sort_keys=True).encode()).hexdigest()[:20]
-    return h, {"mds": mds, "links": links}
+    _KEYS[sig] = h, {"mds": mds, "links": links}
+    return _KEYS[sig]
 
 
 def scenario_starts(scenario: Scenario) -> dict:
@@ -212,6 +233,14 @@ def build_container(scenario: Scenario, starts: dict | None = None) -> Path:
 
 
 _POOL: dict[str, list[Fmu]] = {}  # reset container instances ready for the next run, per container file
+_PLANS: dict[str, dict] = {}  # per container file: value references and the propagation's link list
+
+
+def _raw_fn(slave, name: str, argtypes, restype=c_int):
+    f = slave.dll[name]
+    f.argtypes = argtypes
+    f.restype = restype
+    return f
 
 
 class NativeLoop:
@@ -264,22 +293,33 @@ class NativeLoop:
         for q, v in sc.inputs.items():
             f.set(q, v)
         # repeat the Gauss–Seidel propagation now that every instance has left initialization mode
-        ports = {}
-        for c in sc.components:
-            ins = [n[len(c.name) + 1:] for n, v in f.vars.items() if n.startswith(c.name + ".") and v.causality == "input"]
-            outs = [n[len(c.name) + 1:] for n, v in f.vars.items() if n.startswith(c.name + ".") and v.causality == "output"]
-            ports[c.name] = (ins, outs)
-        vr = {n: v.valueReference for n, v in f.vars.items()}
-        for d, di, s, so in sc.wiring(ports):
-            f.slave.setReal([vr[f"{d}.{di}"]], f.slave.getReal([vr[f"{s}.{so}"]]))
+        plan = _PLANS.get(self._path)
+        if plan is None:  # the same for every run of this container (its key includes the wiring)
+            ports = {}
+            for c in sc.components:
+                ins = [n[len(c.name) + 1:] for n, v in f.vars.items() if n.startswith(c.name + ".") and v.causality == "input"]
+                outs = [n[len(c.name) + 1:] for n, v in f.vars.items() if n.startswith(c.name + ".") and v.causality == "output"]
+                ports[c.name] = (ins, outs)
+            vr = {n: v.valueReference for n, v in f.vars.items()}
+            pairs = [(vr[f"{s}.{so}"], vr[f"{d}.{di}"]) for d, di, s, so in sc.wiring(ports)]
+            vrs = (c_uint * (2 * len(pairs)))(*[x for p in pairs for x in p])
+            plan = _PLANS[self._path] = {"vr": vr, "pairs": vrs, "n_pairs": len(pairs)}
+        vr = plan["vr"]
+        raw = getattr(f, "_scfmu_raw", None)
+        if raw is None:  # fresh function pointers (fmpy's own keep their argtypes), kept with the instance
+            raw = f._scfmu_raw = (_raw_fn(sl, "fmi2GetReal", [c_void_p, c_void_p, c_size_t, c_void_p]),
+                                  _raw_fn(sl, "fmi2SetReal", [c_void_p, c_void_p, c_size_t, c_void_p]),
+                                  _raw_fn(sl, "fmi2DoStep", [c_void_p, c_double, c_double, c_int]))
+        get, setr, step = raw
         comp = sl.component
+        # one link at a time, in order: get the source output, set the destination input
+        one = c_double()
+        pv, addr = ctypes.addressof(plan["pairs"]), ctypes.addressof(one)
+        for i in range(plan["n_pairs"]):
+            if get(comp, pv + 8 * i, 1, addr) > 1 or setr(comp, pv + 8 * i + 4, 1, addr) > 1:
+                self._fail("propagation after initialization")
         self._comp = comp
-        self._get = sl.dll["fmi2GetReal"]
-        self._get.argtypes = [c_void_p, c_void_p, c_size_t, c_void_p]
-        self._get.restype = c_int
-        self._step = sl.dll["fmi2DoStep"]
-        self._step.argtypes = [c_void_p, c_double, c_double, c_int]
-        self._step.restype = c_int
+        self._get, self._step = get, step
         items = sc.log_items()
         for key, inst, var in items:
             if f"{inst}.{var}" not in vr:
@@ -306,8 +346,16 @@ class NativeLoop:
         base, stride = arr.ctypes.data, arr.strides[0]
         vrs = ctypes.addressof(self._log_vrs)
         get, step, comp = self._get, self._step, self._comp
-        prev = 0
-        for j, k in enumerate(ks):
+        times = t0 + np.asarray(ks, dtype=float) * dt
+        if m == 1 and nl:  # the same calls as the general loop below, with less Python per step
+            for k in range(n):
+                if get(comp, vrs, nl, base + k * stride) > 1:
+                    self._fail(f"getReal at t = {t0 + k * dt}", t0 + k * dt)
+                if step(comp, t0 + k * dt, dt, 1) > 1:
+                    self._fail(f"doStep at t = {t0 + k * dt}", t0 + k * dt)
+            ks = [n]
+        prev = ks[0]
+        for j, k in enumerate(ks, len(arr) - len(ks)):
             if k > prev:
                 t = t0 + prev * dt
                 if step(comp, t, (k - prev) * dt, 1) > 1:
@@ -315,7 +363,7 @@ class NativeLoop:
                 prev = k
             if nl and get(comp, vrs, nl, base + j * stride) > 1:
                 self._fail(f"getReal at t = {t0 + k * dt}", t0 + k * dt)
-        out = {"time": t0 + np.asarray(ks, dtype=float) * dt}
+        out = {"time": times}
         for i, key in enumerate(self._log_keys):
             out[key] = arr[:, i].copy()
         return out

@@ -11,7 +11,6 @@ controller, read u_n, set u_n on the plant, doStep both from t_n to t_n + h.
 
 from __future__ import annotations
 
-import ctypes
 import json
 import math
 import time
@@ -20,9 +19,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from fmpy.fmi1 import FMICallException
 
-from ...fmu import Fmu
+from ...engines import SimulationError, simulate
 from ...metrics import overshoot_percent, settling_time, single_axis
+from ...scenario.model import DEFAULT_UNCONNECTED, Component
+from ...scenario.model import Scenario as EngineScenario
 from .data import data_file
 
 GAINS_FILE = data_file("gains.json")
@@ -108,69 +110,43 @@ def step_metrics(t: np.ndarray, theta: np.ndarray, sc: Scenario) -> dict:
 
 
 # ----- FMU closed loop ---------------------------------------------------------------------------
-class _Raw:
-    """Direct fmi2GetReal / fmi2SetReal / fmi2DoStep calls with pre-built ctypes buffers."""
+LOG = {"theta": "plant.theta", "omega": "plant.omega", "applied_torque": "plant.applied_torque",
+       "theta_deg": "plant.theta_deg", "u": "controller.u", "theta_ref": "controller.theta_ref"}
+RECORDED = ("omega", "u", "applied_torque")
 
-    def __init__(self, fmu: Fmu, inputs: list[str], outputs: list[str]):
-        s = fmu.slave
-        self.s = s
-        self.vr_in = (ctypes.c_uint * len(inputs))(*[fmu.var(n).valueReference for n in inputs])
-        self.vr_out = (ctypes.c_uint * len(outputs))(*[fmu.var(n).valueReference for n in outputs])
-        self.buf_in = (ctypes.c_double * len(inputs))()
-        self.buf_out = (ctypes.c_double * len(outputs))()
-        self.n_in, self.n_out = len(inputs), len(outputs)
 
-    def set(self, *values):
-        for i, v in enumerate(values):
-            self.buf_in[i] = v
-        self.s.fmi2SetReal(self.s.component, self.vr_in, self.n_in, self.buf_in)
-
-    def get(self):
-        self.s.fmi2GetReal(self.s.component, self.vr_out, self.n_out, self.buf_out)
-        return self.buf_out
-
-    def step(self, t, h):
-        self.s.fmi2DoStep(self.s.component, t, h, 1)
+def loop_scenario(controller: str, gains: dict, sc: Scenario = Scenario()) -> EngineScenario:
+    """The paper 002 loop as a declared scenario (``paper002/<controller>``): the controller (PidController
+    or FopidController with `gains`) → SingleAxisPlant (explicit Euler, internal step = communication step
+    = the controller's sample time), θ_ref a fixed input, metric set ``paper002``."""
+    model, cparams = controller_params(controller, gains, sc)
+    return EngineScenario(
+        name=f"paper002/{controller}",
+        components=[Component("controller", model, cparams),
+                    Component("plant", "SingleAxisPlant", {**sc.plant, "integrator": 1, "max_internal_step": sc.h})],
+        stop_time=sc.t_end, step=sc.h, log=dict(LOG),
+        inputs={"controller.theta_ref": math.radians(sc.theta_ref_deg)},
+        unconnected=[*DEFAULT_UNCONNECTED, "torque_dist"],
+        metrics="paper002",  # single-axis step metrics + the PSO cost terms (mae_deg, late_max_deg, cost)
+        description=f"paper 002 single-axis loop, {controller}, {sc.theta_ref_deg:g} deg step")
 
 
 def run_case(controller: str, gains: dict, sc: Scenario = Scenario(), record: bool = False) -> dict:
-    """One closed-loop FMU run. Returns the cost terms (and t, theta, omega, u, applied_torque when
-    `record`). An FMU error (e.g. a non-finite value) gives the non-finite cost."""
-    model, cparams = controller_params(controller, gains, sc)
-    pparams = {**sc.plant, "integrator": 1, "max_internal_step": sc.h}
+    """One closed-loop FMU run: :func:`loop_scenario` on the native engine (Gauss–Seidel: at t_n θ_n read
+    from the plant, θ_n set on the controller, u_n read and set on the plant, both stepped), θ logged at
+    every step. Returns the cost terms (and t, theta, omega, u, applied_torque when `record`). A failing run
+    (FMU error status, non-finite value) gives the non-finite cost (and all-NaN series)."""
+    loop = loop_scenario(controller, gains, sc)
+    keys = ("theta", *RECORDED) if record else ("theta",)
+    loop.log = {k: LOG[k] for k in keys}
     n = sc.n
-    theta = np.full(n + 1, np.nan)
-    rec = {k: np.full(n + 1, np.nan) for k in ("omega", "u", "applied_torque")} if record else None
-    plant = ctrl = None
     try:
-        plant = Fmu("SingleAxisPlant", pparams, stop_time=sc.t_end)
-        ctrl = Fmu(model, cparams, stop_time=sc.t_end)
-        ref = math.radians(sc.theta_ref_deg)
-        p_out = _Raw(plant, ["u"], ["theta", "omega", "applied_torque"])
-        c_io = _Raw(ctrl, ["theta", "theta_ref"], ["u"])
-        h = sc.h
-        for k in range(n + 1):
-            t = k * h
-            y = p_out.get()
-            th = y[0]
-            theta[k] = th
-            c_io.set(th, ref)
-            u = c_io.get()[0]
-            if record:
-                rec["omega"][k], rec["applied_torque"][k], rec["u"][k] = y[1], y[2], u
-            if k < n:
-                p_out.set(u)
-                c_io.step(t, h)
-                p_out.step(t, h)
-    except Exception:  # FMU error status (fmpy raises): keep the NaN tail
-        pass
-    finally:
-        for f in (ctrl, plant):
-            if f is not None:
-                f.close()
-    out = cost_terms(theta, sc)
+        r = simulate(loop, "native")
+    except (SimulationError, FMICallException):  # an FMU error status, in initialization or stepping
+        r = {k: np.full(n + 1, np.nan) for k in keys}
+    out = cost_terms(r["theta"], sc)
     if record:
-        out.update(t=np.arange(n + 1) * sc.h, theta=theta, **rec)
+        out.update(t=np.arange(n + 1) * sc.h, **{k: r[k] for k in keys})
     return out
 
 

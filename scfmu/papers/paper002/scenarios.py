@@ -3,33 +3,22 @@
 from __future__ import annotations
 
 import json
-import math
 
-from ...scenario.model import DEFAULT_UNCONNECTED, Component, Scenario, log_of
+from ...scenario.model import Scenario
 from . import model as p2
 from .data import data_file
 
 def paper002(controller: str = "FOPID", theta_ref_deg: float = 30.0, stop_time: float = 20.0,
              step: float = 0.001) -> Scenario:
-    """Paper 002 single-axis loop: PidController or FopidController (PD, PID, FOPD, FOPID with the
-    committed PSO-tuned gains of the package data file paper002/data/gains.json) → SingleAxisPlant (explicit Euler, internal
-    step = communication step = the controller's sample time), step command theta_ref."""
+    """Paper 002 single-axis loop (:func:`model.loop_scenario`): PidController or FopidController (PD, PID,
+    FOPD, FOPID with the committed PSO-tuned gains of the package data file paper002/data/gains.json) →
+    SingleAxisPlant (explicit Euler, internal step = communication step = the controller's sample time),
+    step command theta_ref."""
     tuned = json.loads(data_file("gains.json").read_text())
-    sc = p2.Scenario(theta_ref_deg=theta_ref_deg, t_end=stop_time, h=step)
-    model, cparams = p2.controller_params(controller, tuned["controllers"][controller]["gains"], sc)
-    return Scenario(
-        name=f"paper002/{controller}",
-        components=[
-            Component("controller", model, cparams),
-            Component("plant", "SingleAxisPlant", {"integrator": 1, "max_internal_step": step}),
-        ],
-        stop_time=stop_time, step=step,
-        log=log_of("plant", ["theta", "omega", "applied_torque", "theta_deg"]) | log_of("controller", ["u", "theta_ref"]),
-        inputs={"controller.theta_ref": math.radians(theta_ref_deg)},
-        unconnected=[*DEFAULT_UNCONNECTED, "torque_dist"],
-        metrics="paper002",  # single-axis step metrics + the PSO cost terms (mae_deg, late_max_deg, cost)
-        description=f"paper 002 single-axis loop, {controller} with the tuned gains, {theta_ref_deg:g} deg step",
-    )
+    sc = p2.loop_scenario(controller, tuned["controllers"][controller]["gains"],
+                          p2.Scenario(theta_ref_deg=theta_ref_deg, t_end=stop_time, h=step))
+    sc.description = f"paper 002 single-axis loop, {controller} with the tuned gains, {theta_ref_deg:g} deg step"
+    return sc
 
 
 def build(name: str, **kw) -> Scenario:

@@ -18,7 +18,6 @@ communication points and held over each step (zero-order hold, as the master hol
 
 from __future__ import annotations
 
-import ctypes
 import math
 import time
 from dataclasses import dataclass, field
@@ -27,6 +26,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 from scipy.optimize import minimize
 
+from ...engines.lean import OpenLoop
 from ...engines.reference import CoSimulation
 from ...fmu import Fmu
 
@@ -89,51 +89,13 @@ def terminal_metrics(w_end: np.ndarray, euler_end: np.ndarray) -> dict:
             "pass": bool(wmax <= W_REQ_DEG_S and emax <= EULER_REQ_DEG)}
 
 
-class LeanPlant:
-    """The AttitudePlant FMU driven by raw FMI calls: value references resolved once, ctypes buffers
-    preallocated, the initialised state saved once and restored before every run (fmi2SetFMUstate)."""
+PLANT_OUT = ["w_x", "w_y", "w_z", "roll", "pitch", "yaw"]
 
-    OUT = ["w_x", "w_y", "w_z", "roll", "pitch", "yaw"]
 
-    def __init__(self, params: dict):
-        self.fmu = Fmu("AttitudePlant", params, stop_time=T_F)
-        s = self.fmu.slave
-        self._s = s
-        # the raw ctypes functions (fmpy's wrappers add logging and status checks on every call)
-        self._set = s._functions["fmi2SetReal"]
-        self._get = s._functions["fmi2GetReal"]
-        self._step = s._functions["fmi2DoStep"]
-        self._c = s.component
-        self._vr_in = (ctypes.c_uint * 3)(*[self.fmu.var(f"torque_cmd_{a}").valueReference for a in AXES])
-        self._vr_out = (ctypes.c_uint * 6)(*[self.fmu.var(n).valueReference for n in self.OUT])
-        self._u = (ctypes.c_double * 3)()
-        self._y = (ctypes.c_double * 6)()
-        self.state0 = s.getFMUstate()
-        self.runs = 0
-
-    def run(self, u: np.ndarray, dt: float = DT) -> np.ndarray:
-        """Holds u[k] over [k dt, (k+1) dt) for k < len(u); returns (w_x, w_y, w_z, roll, pitch, yaw)
-        at t = len(u) dt."""
-        s, c, ub, vr = self._s, self._c, self._u, self._vr_in
-        s.setFMUstate(self.state0)
-        setr, step = self._set, self._step
-        t = 0.0
-        for k in range(len(u)):
-            ub[0], ub[1], ub[2] = u[k, 0], u[k, 1], u[k, 2]
-            if setr(c, vr, 3, ub) != 0:
-                raise RuntimeError(f"fmi2SetReal failed at t = {t}: {self.fmu.messages[-3:]}")
-            if step(c, t, dt, 1) != 0:
-                raise RuntimeError(f"fmi2DoStep failed at t = {t}: {self.fmu.messages[-3:]}")
-            t = (k + 1) * dt
-        # the held input is irrelevant to these state outputs
-        if self._get(c, self._vr_out, 6, self._y) != 0:
-            raise RuntimeError(f"fmi2GetReal failed: {self.fmu.messages[-3:]}")
-        self.runs += 1
-        return np.array(self._y[:])
-
-    def close(self):
-        self._s.freeFMUstate(self.state0)
-        self.fmu.close()
+def open_loop_plant(params: dict) -> OpenLoop:
+    """The AttitudePlant driven open loop by the spline torque (``run(u, DT)`` -> w_x, w_y, w_z, roll,
+    pitch, yaw at the end), from its initialised state restored before every run."""
+    return OpenLoop("AttitudePlant", params, [f"torque_cmd_{a}" for a in AXES], PLANT_OUT, stop_time=T_F)
 
 
 class BudgetExhausted(Exception):
@@ -163,7 +125,7 @@ class SplineProblem:
         self.n = int(round(T_F / DT))
         self.times = np.arange(self.n) * DT          # held samples t_0 .. t_{n-1}
         self.basis = spline_basis(self.times)        # (n, 6)
-        self.plant = LeanPlant(plant_params(effectiveness, init_deg))
+        self.plant = open_loop_plant(plant_params(effectiveness, init_deg))
         self.budget = budget
         self.fd_step = fd_step
         self.evals = 0
@@ -189,7 +151,7 @@ class SplineProblem:
             if self.evals >= self.budget:
                 raise BudgetExhausted
             self.evals += 1
-            y = self.plant.run(self.torque(x))
+            y = self.plant.run(self.torque(x), DT)
             self._cache[key] = y
             c = self.constraints_from(y)
             self.history.append((np.array(x, float), self.objective_raw(x), float(max(0.0, -c.min()))))

@@ -298,3 +298,24 @@ def test_engine_tuner_same_for_any_worker_count_and_resumes(tmp_path):
         assert serial[c]["iterations"] == 3 and serial[c]["stop"] == "max_iter"
         direct = run_case(c, serial[c]["gains"], sc)["cost"]
         assert abs(serial[c]["cost"] - direct) <= 1e-12 * direct
+
+
+@pytest.mark.parametrize("controller,gains,sc", [
+    ("PD", {"kp": 5.0, "kd": 10.0}, Scenario(t_end=2.0)),
+    ("PID", {"kp": 3.0, "ki": 0.5, "kd": 5.0}, Scenario(t_end=2.0, history_before_start=1,
+                                                        plant={"inertia_scale": 1.2, "wheel_gain": 2.0})),
+    ("FOPD", {"kp": 5.0, "kd": 10.0, "mu": 0.8}, Scenario(t_end=2.0, theta_ref_deg=10.0)),
+    ("FOPID", {"kp": 5.0, "ki": 1.0, "kd": 10.0, "lambda": 0.9, "mu": 1.1}, Scenario(t_end=2.0, gl_memory=300)),
+])
+def test_run_case_is_the_reference_master_run_of_the_loop_scenario(controller, gains, sc):
+    """run_case (the loop scenario on the native engine) equals, bit for bit, the reference master's run
+    of the same scenario (fmpy high-level calls, the tests' oracle), plant and memory options included."""
+    from scfmu.engines import simulate
+    from scfmu.papers.paper002 import model as p2
+
+    a = run_case(controller, gains, sc, record=True)
+    ref = simulate(p2.loop_scenario(controller, gains, sc), "reference")
+    for k in ("theta", "omega", "u", "applied_torque"):
+        assert np.array_equal(a[k].view(np.int64), ref[k].view(np.int64)), k
+    assert np.array_equal(a["t"], ref["time"])
+    assert a["cost"] == p2.cost_terms(ref["theta"], sc)["cost"]

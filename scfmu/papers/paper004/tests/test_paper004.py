@@ -237,3 +237,23 @@ def test_declared_scenario_equals_the_case_runner():
     got = simulate(scenarios.get("paper004/3"), engine="lean")
     for k in ["q_w", "q_x", "w_x", "w_y", "w_z", "torque_applied_x", "torque_applied_z"]:
         assert np.array_equal(got[k], ref[k]), k
+
+
+def test_open_loop_engine_equals_the_fmpy_loop_and_restores_its_state():
+    """The optimiser's plant runs (scfmu.engines.lean.OpenLoop: raw FMI calls, initial state restored
+    by fmi2SetFMUstate) end, bit for bit, where run_open_loop's fmpy high-level loop on a fresh FMU ends,
+    run after run."""
+    rng = np.random.default_rng(4)
+    t_end = 2.0
+    n = int(round(t_end / P.DT))
+    plant = P.open_loop_plant(P.plant_params(P.A_FAULT, P.INIT_DEFAULT_DEG))
+    try:
+        for _ in range(3):
+            nodes = np.column_stack([rng.uniform(-1, 1, (3, P.N_NODES - 1)), np.zeros(3)])
+            got = plant.run(P.spline_torque(nodes, np.arange(n) * P.DT), P.DT)
+            ref = P.run_open_loop(nodes, P.A_FAULT, P.INIT_DEFAULT_DEG, t_end=t_end)
+            want = np.array([ref[k][-1] for k in P.PLANT_OUT])
+            assert np.array_equal(got.view(np.int64), want.view(np.int64)), (got, want)
+        assert plant.runs == 3
+    finally:
+        plant.close()
