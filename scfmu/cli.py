@@ -28,9 +28,21 @@ COMMANDS = {
 
 
 def _scenarios(argv) -> int:
-    ap = argparse.ArgumentParser(prog="scfmu scenarios", description="List the registered scenarios.")
+    ap = argparse.ArgumentParser(prog="scfmu scenarios", description="List the registered scenarios, or print one "
+                                 "as a scenario file (a starting point for `scfmu run my_loop.toml`).")
     ap.add_argument("pattern", nargs="?", default="*", help="glob pattern, e.g. 'paper003/*'")
+    ap.add_argument("--show", metavar="NAME", help="print scenario NAME in the scenario-file format")
+    ap.add_argument("--json", action="store_true", help="with --show: JSON instead of TOML")
     a = ap.parse_args(argv)
+    if a.show:
+        from .scenario import files
+        try:
+            sc = REGISTRY.scenario(a.show)
+        except KeyError as e:
+            print(f"scfmu scenarios: {e.args[0]}", file=sys.stderr)
+            return 2
+        print(files.dumps_json(sc) if a.json else files.dumps_toml(sc), end="")
+        return 0
     rows = REGISTRY.scenario_names(a.pattern)
     if not rows:
         print(f"no scenario matches {a.pattern!r}", file=sys.stderr)

@@ -14,33 +14,16 @@ from pathlib import Path
 
 import numpy as np
 
+import sys
+
 from . import metrics
-from .engines import ENGINES, simulate
+from .engines import ENGINES, SimulationError, simulate
 from .results import write_csv
-from .scenario import get
+from .scenario import options
+from .scenario.check import IncompatibleUnit, require
 from .scenario.ssp import file_stem
 
 ANGLES = ("roll", "pitch", "yaw")
-
-
-def value(text: str):
-    """A command-line value: int, float, or the string itself."""
-    for conv in (int, float):
-        try:
-            return conv(text)
-        except ValueError:
-            pass
-    return text
-
-
-def parse_assignments(items: list[str], what: str) -> dict:
-    out = {}
-    for it in items:
-        k, sep, v = it.partition("=")
-        if not sep or not k or not v:
-            raise SystemExit(f"{what} {it!r}: expected NAME=VALUE")
-        out[k] = v
-    return out
 
 
 def _groups(keys: list[str]) -> dict[str, list[str]]:
@@ -86,33 +69,32 @@ def plot(r: dict, path: Path, title: str) -> None:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="scfmu run", description=__doc__,
+    ap = argparse.ArgumentParser(prog="scfmu run", description=__doc__ + "\n" + options.__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("scenario", help="scenario name (`scfmu scenarios` lists them)")
+    options.add_arguments(ap)
     ap.add_argument("--engine", default="native", choices=ENGINES, help="engine (all give bit-identical results)")
-    ap.add_argument("--set", action="append", default=[], metavar="INST.VAR=VALUE", help="override (repeatable)")
-    ap.add_argument("--t-end", type=float, help="override the scenario's stop time [s]")
-    ap.add_argument("--dt", type=float, help="override the scenario's communication step [s]")
     ap.add_argument("--out", default=None, help="output folder (default out/<scenario>)")
     ap.add_argument("--no-plot", action="store_true")
     args = ap.parse_args(argv)
-    kw = {}
-    if args.t_end is not None:
-        kw["stop_time"] = args.t_end
-    if args.dt is not None:
-        kw["step"] = args.dt
-    sc = get(args.scenario, **kw)
-    ov = {k: value(v) for k, v in parse_assignments(args.set, "--set").items()}
-    if ov:
-        sc = sc.with_overrides(ov)
+    sc = options.build(args, notice=lambda t: print(t, file=sys.stderr))
+    try:
+        require(sc, warn=lambda t: print(f"warning: {t}", file=sys.stderr))
+    except IncompatibleUnit as e:
+        print(f"scfmu run: {e}", file=sys.stderr)
+        return 2
     stem = file_stem(sc.name)
     out = Path(args.out or Path("out") / stem)
     out.mkdir(parents=True, exist_ok=True)
-    r = simulate(sc, args.engine)
+    try:
+        r = simulate(sc, args.engine)
+    except SimulationError as e:
+        print(f"scfmu run: the run failed ({e.status}): {e}", file=sys.stderr)
+        return 1
     m = metrics.compute(sc.metrics, r)
     print(f"{sc.name}: {sc.description or ''}".rstrip(": "))
+    models = ", ".join(f"{c.name}={Path(c.model).name}" for c in sc.components)
     print(f"  {len(r['time']) - 1} steps of {sc.step:g} s to t = {sc.stop_time:g} s on the {args.engine} engine; "
-          f"metric set {sc.metrics or '(none)'}")
+          f"units {models}; metric set {sc.metrics or '(none)'}")
     for k, v in m.items():
         if isinstance(v, float) and math.isfinite(v):
             print(f"  {k:24s} {v:14.6g}")

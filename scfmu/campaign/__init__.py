@@ -95,31 +95,156 @@ class Campaign:
     timeseries: list | None = None  # log keys to keep per run (None: metrics only; [] : all logged keys)
     ts_every: int = 1
     log_every: int = 1  # native engine: read the logged signals every n-th step (metrics see that grid)
+    isolate: bool | None = None  # each run in a child process; None: when a unit is a foreign FMU (a path)
+    timeout: float = 600.0  # wall-time limit of an isolated run [s]; past it the run is stopped: status "timeout"
+
+    def isolated(self) -> bool:
+        if self.isolate is not None:
+            return bool(self.isolate)
+        return any(fmu_access.is_path(c.model) for c in self.scenario.components)
+
+    def foreign_files(self) -> dict:
+        """``{path: SHA-256}`` of the units given as FMU files (shipped to the workers with the runs)."""
+        return {c.model: fmu_access.fmu_digest(fmu_access.fmu_path(c.model))
+                for c in self.scenario.components if fmu_access.is_path(c.model)}
 
     def runs(self) -> list[dict]:
         sc = self.scenario.to_dict()
+        files = self.foreign_files()
+        iso = self.isolated()
         out = []
         for i, ov in enumerate(self.overrides):
             for j, seed in enumerate(self.seeds):
                 out.append({"run": i * len(self.seeds) + j, "override_index": i, "overrides": dict(ov),
                             "seed": seed, "scenario": sc, "engine": self.engine, "timeseries": self.timeseries,
-                            "ts_every": self.ts_every, "log_every": self.log_every})
+                            "ts_every": self.ts_every, "log_every": self.log_every, "fmu_files": files,
+                            "isolate": iso, "timeout": float(self.timeout)})
         return out
 
     def describe(self) -> dict:
         return {"scenario": self.scenario.to_dict(), "overrides": [dict(o) for o in self.overrides],
                 "seeds": list(self.seeds), "engine": self.engine, "timeseries": self.timeseries,
-                "ts_every": self.ts_every, **({"log_every": self.log_every} if self.log_every != 1 else {})}
+                "ts_every": self.ts_every, **({"log_every": self.log_every} if self.log_every != 1 else {}),
+                **({"isolate": self.isolate} if self.isolate is not None else {})}
 
     def campaign_id(self) -> str:
         return hashlib.sha256(json.dumps(self.describe(), sort_keys=True, default=str).encode()).hexdigest()[:16]
 
 
 # ----- one run (executes on a worker) ----------------------------------------------------------------
-def run_one(spec: dict, fmu_dir: str | None = None) -> tuple[dict, dict | None]:
-    """Simulates one run; returns (row, time series or None). Never raises for a failing simulation."""
+FMU_CACHE = Path(os.environ.get("SCFMU_FMU_CACHE", Path.home() / ".cache" / "scfmu" / "fmus"))
+
+
+def _materialize(spec: dict, blobs: dict | None) -> dict:
+    """The spec with each foreign FMU (``spec["fmu_files"]``: path -> SHA-256) pointing at a file with that
+    content on this machine: the same path when it holds those bytes, else a copy written from ``blobs``
+    (SHA-256 -> bytes, shipped by the client) into the worker's FMU cache."""
+    files = spec.get("fmu_files") or {}
+    if not files:
+        return spec
+    spec = dict(spec, scenario=json.loads(json.dumps(spec["scenario"])))
+    for comp in spec["scenario"]["components"]:
+        sha = files.get(comp["model"])
+        if sha is None:
+            continue
+        p = Path(comp["model"])
+        if p.is_file() and fmu_access.fmu_digest(p) == sha:
+            continue
+        local = FMU_CACHE / sha[:24] / p.name
+        if not local.is_file():
+            if not blobs or sha not in blobs:
+                raise FileNotFoundError(f"{comp['model']} is not on this worker and was not shipped with the runs")
+            local.parent.mkdir(parents=True, exist_ok=True)
+            tmp = local.with_suffix(f".{os.getpid()}.tmp")
+            tmp.write_bytes(blobs[sha])
+            os.replace(tmp, local)
+        comp["model"] = str(local)
+    return spec
+
+
+def run_one(spec: dict, fmu_dir: str | None = None, blobs: dict | None = None) -> tuple[dict, dict | None]:
+    """Simulates one run; returns (row, time series or None). Never raises for a failing simulation.
+    An isolated run (``spec["isolate"]``) executes in a child process with a wall-time limit, so a unit
+    that crashes or hangs costs that run only (status ``crash`` or ``timeout``)."""
     if os.environ.get("SCFMU_CRASH_TEST_RUN") == str(spec["run"]):  # test hook: a worker that dies mid-run
         os._exit(70)
+    try:
+        spec = _materialize(spec, blobs)
+    except Exception as e:
+        return _failed_row(spec, "error", f"{type(e).__name__}: {e}"), None
+    if spec.get("isolate") and hasattr(os, "fork"):
+        return _run_isolated(spec, fmu_dir)
+    return _run_body(spec, fmu_dir)
+
+
+def _failed_row(spec: dict, status: str, message: str) -> dict:
+    base = Scenario.from_dict(spec["scenario"])
+    row = {"run": spec["run"], "override_index": spec["override_index"],
+           "seed": -1 if spec["seed"] is None else int(spec["seed"]), "status": status, "message": message[:2000]}
+    for k, v in spec["overrides"].items():
+        row[f"p:{k}"] = v
+    for k in run_metrics.columns(base.metrics):
+        row[k] = math.nan
+    return row
+
+
+def _run_isolated(spec: dict, fmu_dir: str | None) -> tuple[dict, dict | None]:
+    """``_run_body`` in a forked child; the result comes back pickled through a pipe. A child that dies
+    (e.g. a segmentation fault inside an FMU) gives status ``crash`` with the signal; one that gives no
+    result within ``spec["timeout"]`` seconds is killed: status ``timeout``."""
+    import pickle
+    import select
+    import signal
+    rfd, wfd = os.pipe()
+    pid = os.fork()
+    if pid == 0:  # child: run, send, exit without running the parent's cleanup handlers
+        code = 0
+        try:
+            os.close(rfd)
+            data = pickle.dumps(_run_body(spec, fmu_dir))
+            with os.fdopen(wfd, "wb") as w:
+                w.write(data)
+        except BaseException:
+            code = 3
+        finally:
+            os._exit(code)
+    os.close(wfd)
+    chunks, deadline = [], time.monotonic() + float(spec.get("timeout", 600.0))
+    timed_out = False
+    with os.fdopen(rfd, "rb") as r:
+        while True:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                timed_out = True
+                break
+            ready, _, _ = select.select([r], [], [], min(left, 1.0))
+            if ready:
+                b = os.read(r.fileno(), 1 << 20)
+                if not b:
+                    break
+                chunks.append(b)
+    if timed_out:
+        try:
+            os.kill(pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+    _, status = os.waitpid(pid, 0)
+    if timed_out:
+        return _failed_row(spec, "timeout", f"no result within {spec.get('timeout', 600.0):g} s of wall time: "
+                                            f"the run was stopped (a unit that hangs?)"), None
+    if os.WIFSIGNALED(status):
+        sig = os.WTERMSIG(status)
+        name = signal.Signals(sig).name if sig in signal.Signals._value2member_map_ else str(sig)
+        return _failed_row(spec, "crash", f"the run's process died with {name} (a crash inside a unit's native "
+                                          f"code)"), None
+    try:
+        return pickle.loads(b"".join(chunks))
+    except Exception:
+        return _failed_row(spec, "crash", f"the run's process exited with code {os.WEXITSTATUS(status)} and no "
+                                          f"result"), None
+
+
+def _run_body(spec: dict, fmu_dir: str | None = None) -> tuple[dict, dict | None]:
     if fmu_dir:
         fmu_access.set_fmu_dir(fmu_dir)
     base = Scenario.from_dict(spec["scenario"])
@@ -180,8 +305,8 @@ def _crash_row(spec: dict, c: "Campaign", e: Exception) -> dict:
     return row
 
 
-def run_chunk(specs: list[dict], fmu_dir: str | None = None) -> list[tuple[dict, dict | None]]:
-    return [run_one(s, fmu_dir) for s in specs]
+def run_chunk(specs: list[dict], fmu_dir: str | None = None, blobs: dict | None = None) -> list[tuple[dict, dict | None]]:
+    return [run_one(s, fmu_dir, blobs) for s in specs]
 
 
 # ----- manifest, storage ------------------------------------------------------------------------------
@@ -197,11 +322,15 @@ def package_versions() -> dict:
 
 
 def fmu_versions(scenario: Scenario) -> dict:
+    """Per unit: GUID and SHA-256 (and, for a foreign FMU given by path, its model name and file)."""
     out = {}
     for c in scenario.components:
         p = fmu_access.fmu_path(c.model)
         md = fmu_access.unpacked(p)[0]
-        out[c.model] = {"guid": md.guid, "sha256": fmu_access.fmu_digest(p)}
+        entry = {"guid": md.guid, "sha256": fmu_access.fmu_digest(p)}
+        if fmu_access.is_path(c.model):
+            entry.update(model_name=md.modelName, file=str(p), instance=c.name)
+        out[c.model] = entry
     return out
 
 
@@ -360,11 +489,15 @@ def run(c: Campaign, out_dir: str | Path, scheduler: str | None = None, n_worker
             size = chunk or max(1, min(8, len(todo) // (4 * n_w)))
             chunks = [todo[i:i + size] for i in range(0, len(todo), size)]
             fmu_dir = str(fmu_access.fmu_dir().resolve())
+            # foreign FMUs travel with the runs: workers that do not share this machine's folders get the bytes
+            files = c.foreign_files()
+            blobs = (client.scatter([{sha: Path(path).read_bytes() for path, sha in files.items()}], broadcast=True)[0]
+                     if files else None)
             from dask.distributed import as_completed
             chunk_of = {}
             futures = []
             for ch in chunks:
-                f = client.submit(run_chunk, ch, fmu_dir, pure=False)
+                f = client.submit(run_chunk, ch, fmu_dir, blobs, pure=False)
                 chunk_of[f.key] = ch
                 futures.append(f)
             bar = None
@@ -395,7 +528,7 @@ def run(c: Campaign, out_dir: str | Path, scheduler: str | None = None, n_worker
                 # runs of failed tasks again, one at a time, so that only a run that kills its worker fails
                 for spec in sorted(suspects, key=lambda s: s["run"]):
                     try:
-                        results = client.submit(run_chunk, [spec], fmu_dir, pure=False).result()
+                        results = client.submit(run_chunk, [spec], fmu_dir, blobs, pure=False).result()
                     except Exception as e:
                         results = [(_crash_row(spec, c, e), None)]
                     take(results)

@@ -26,8 +26,9 @@ from pathlib import Path
 
 
 from .. import campaign
-from ..run_cmd import value
-from ..scenario import get as get_scenario
+from ..scenario import options
+from ..scenario.check import IncompatibleUnit, require
+from ..scenario.options import value
 from . import plots as campaign_plots
 
 
@@ -54,18 +55,7 @@ def parse_random(items: list[str]) -> dict:
 
 
 def build(args) -> campaign.Campaign:
-    kw = {}
-    if args.t_end is not None:
-        kw["stop_time"] = args.t_end
-    if args.dt is not None:
-        kw["step"] = args.dt
-    sc = get_scenario(args.scenario, **kw)
-    fixed = {}
-    for it in args.set:
-        k, _, v = it.partition("=")
-        fixed[k] = value(v)
-    if fixed:
-        sc = sc.with_overrides(fixed)
+    sc = options.build(args, notice=lambda t: print(t, file=sys.stderr))
     sets = [{}]
     if args.list:
         sets = json.loads(Path(args.list).read_text())
@@ -83,21 +73,23 @@ def build(args) -> campaign.Campaign:
     if args.timeseries is not None:
         ts = [x for x in args.timeseries.split(",") if x]
     return campaign.Campaign(sc, sets, parse_seeds(args.seeds), engine=args.engine, timeseries=ts,
-                             ts_every=args.ts_every, log_every=args.log_every)
+                             ts_every=args.ts_every, log_every=args.log_every,
+                             isolate=True if args.isolate else None, timeout=args.timeout)
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="scfmu campaign", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("scenario", help="standard scenario name (default, paper000/000-6, paper001/a, wheel_fault, ...)")
-    ap.add_argument("--set", action="append", default=[], metavar="INST.VAR=VALUE", help="fixed override for every run")
+    options.add_arguments(ap)
     ap.add_argument("--grid", action="append", default=[], metavar="INST.VAR=V1,V2,...", help="grid axis (repeatable)")
     ap.add_argument("--random", action="append", default=[], metavar="INST.VAR=DIST:A:B", help="random axis (repeatable)")
     ap.add_argument("--samples", type=int, default=100, help="number of random samples (with --random)")
     ap.add_argument("--sample-seed", type=int, default=0, help="seed of the random sampler")
     ap.add_argument("--list", help="JSON file: list of override dicts")
     ap.add_argument("--seeds", default="", help="run seeds given to the scenario's seed parameters: 0,1,2 or 0:10")
-    ap.add_argument("--t-end", type=float, help="override the scenario's stop time [s]")
-    ap.add_argument("--dt", type=float, help="override the scenario's communication step [s]")
+    ap.add_argument("--isolate", action="store_true",
+                    help="run each run in a child process (automatic when a unit is given as an FMU file)")
+    ap.add_argument("--timeout", type=float, default=600.0,
+                    help="wall-time limit of an isolated run [s] (default 600); past it: status timeout")
     ap.add_argument("--engine", default="native", choices=["native", "lean", "reference"])
     ap.add_argument("--timeseries", nargs="?", const="", default=None, metavar="KEYS",
                     help="keep time series per run (comma-separated logged keys; all when empty)")
@@ -116,14 +108,23 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
 
     c = build(args)
-    out = Path(args.out or Path("out") / "campaign" / args.scenario.replace("/", "_"))
+    try:
+        require(c.scenario, warn=lambda t: print(f"warning: {t}", file=sys.stderr))
+    except IncompatibleUnit as e:
+        print(f"scfmu campaign: {e}", file=sys.stderr)
+        return 2
+    out = Path(args.out or Path("out") / "campaign" / c.scenario.name.replace("/", "_"))
     print(f"campaign {c.campaign_id()}: scenario {c.scenario.name}, {len(c.overrides)} parameter set(s) × "
           f"{len(c.seeds)} seed(s) = {len(c.overrides) * len(c.seeds)} runs, engine {c.engine} → {out}")
     table = campaign.run(c, out, scheduler=args.scheduler, n_workers=args.workers, chunk=args.chunk,
                          progress=not args.no_progress, overwrite=args.overwrite)
     rows = table.to_pylist()
     ok = [r for r in rows if r["status"] == "ok"]
-    print(f"{len(ok)} of {len(rows)} runs ok; results {out / 'results.parquet'}, manifest {out / 'manifest.json'}")
+    counts: dict[str, int] = {}
+    for r in rows:
+        counts[r["status"]] = counts.get(r["status"], 0) + 1
+    print(f"{len(ok)} of {len(rows)} runs ok ({', '.join(f'{k}: {v}' for k, v in sorted(counts.items()))}); "
+          f"results {out / 'results.parquet'}, manifest {out / 'manifest.json'}")
     for r in rows:
         if r["status"] != "ok":
             print(f"  run {r['run']}: {r['status']}: {r['message'][:160]}")
@@ -143,6 +144,9 @@ def main(argv=None) -> int:
             for k in keys[:3]:
                 figs.append(campaign_plots.envelope(out, k, out / f"envelope_{k}.png"))
         print("figures: " + ", ".join(str(f) for f in figs))
+    if len(ok) < len(rows):
+        print(f"scfmu campaign: {len(rows) - len(ok)} of {len(rows)} runs failed", file=sys.stderr)
+        return 1
     return 0
 
 

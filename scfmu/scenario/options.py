@@ -17,7 +17,11 @@ from pathlib import Path
 
 from . import files
 from .model import Scenario
-from .registry_access import get
+from ..registry import REGISTRY
+
+
+def get(name: str, **kw) -> Scenario:
+    return REGISTRY.scenario(name, **kw)
 
 
 def value(text: str):
