@@ -5,6 +5,7 @@ Subcommands (each has ``--help``):
   run SCENARIO            one run: metrics, CSV and PNG           (scfmu run default)
   scenarios [PATTERN]     the registered scenarios, with descriptions
   campaign SCENARIO ...   many runs on Dask: grids, random samples, seeds; Parquet + figures
+  benchmark [FMU]         your controller beside the papers' ones on a family's scenarios (HTML + Markdown)
   export ssp|loop [NAME]  SSP 1.0 files or loop FMUs (one container FMU per closed loop)
   report [--quick]        the reproduction report of every paper (HTML + Markdown)
   paper NNN COMMAND ...   a paper's own experiments (tuning, sweeps, cases): `scfmu paper` lists them
@@ -24,6 +25,7 @@ COMMANDS = {
     "run": ("one run of a scenario: metrics, CSV and PNG", "scfmu.run_cmd:main"),
     "campaign": ("many runs of a scenario on Dask (grids, random samples, seeds)", "scfmu.campaign.cli:main"),
     "report": ("the reproduction report of the papers (HTML + Markdown)", "scfmu.report.cli:main"),
+    "benchmark": ("a controller (any FMU) beside the built-in ones on a family's scenarios", "scfmu.benchmark.cli:main"),
 }
 
 
@@ -55,16 +57,28 @@ def _scenarios(argv) -> int:
 
 def _export(argv) -> int:
     from .export import KINDS, export
+    from .scenario import options
     ap = argparse.ArgumentParser(prog="scfmu export", description="Write SSP 1.0 files or loop FMUs of scenarios "
-                                 "(default: the standard set the plug-ins export) and validate each.")
+                                 "(default: the standard set the plug-ins export) and validate each. With --fmu, "
+                                 "--map or --set, one scenario (a name or a scenario file) with those changes.")
     ap.add_argument("kind", choices=KINDS)
-    ap.add_argument("names", nargs="*", help="scenario names (default: the standard set)")
+    ap.add_argument("names", nargs="*", help="scenario names or files (default: the standard set)")
     ap.add_argument("--out", default=None, help="output folder (default fmus/ssp or fmus/loops)")
+    ap.add_argument("--fmu", action="append", default=[], metavar="INSTANCE=PATH", help="use this FMU for INSTANCE")
+    ap.add_argument("--map", action="append", default=[], metavar="INSTANCE.THEIRS=OURS", help="rename a unit's port")
+    ap.add_argument("--set", action="append", default=[], metavar="INSTANCE.VAR=VALUE", help="parameter or input")
     a = ap.parse_args(argv)
     out = a.out or ("fmus/ssp" if a.kind == "ssp" else "fmus/loops")
+    items = a.names or None
+    if a.fmu or a.map or a.set or any(n.endswith((".toml", ".json")) for n in a.names):
+        if len(a.names) != 1:
+            print("scfmu export: --fmu/--map/--set and scenario files take exactly one scenario", file=sys.stderr)
+            return 2
+        ns = argparse.Namespace(scenario=a.names[0], fmu=a.fmu, map=a.map, set=a.set, params=None, t_end=None, dt=None)
+        items = [options.build(ns, notice=lambda t: print(t, file=sys.stderr))]
     try:
-        export(a.kind, out, a.names or None)
-    except RuntimeError as e:
+        export(a.kind, out, items)
+    except (RuntimeError, KeyError, ValueError) as e:
         print(f"scfmu export: {e}", file=sys.stderr)
         return 1
     return 0
@@ -99,7 +113,7 @@ def _paper(argv) -> int:
 LOCAL = {"scenarios": ("list the registered scenarios with descriptions", _scenarios),
          "export": ("SSP 1.0 files or loop FMUs of scenarios", _export),
          "paper": ("a paper's own experiments: `scfmu paper` lists them", _paper)}
-ORDER = ("run", "scenarios", "campaign", "export", "report", "paper")
+ORDER = ("run", "scenarios", "campaign", "benchmark", "export", "report", "paper")
 
 
 def main(argv=None) -> int:

@@ -62,11 +62,40 @@ class Paper:
     plugin: str = ""
 
 
+@dataclass
+class BenchmarkCase:
+    """A scenario of a family's controller benchmark: the unit under test takes the place ``slot``;
+    ``seeds`` > 0 makes it a Monte Carlo over that many seeds (0 … seeds-1) of the scenario's seed
+    parameters; ``primary`` is the metric that ranks the controllers (lower is better)."""
+    family: str
+    scenario: str
+    label: str
+    slot: str = "controller"
+    seeds: int = 0
+    primary: str = "eulerint_deg_s"
+    signal: str = "alpha_deg"  # the logged signal the response figure overlays
+    overrides: dict = field(default_factory=dict)  # fixed overrides of the scenario for this case
+    monte_carlo: str = ""  # "module:function" (n) -> n override dicts; else `seeds` go to the seed parameters
+    plugin: str = ""
+
+
+@dataclass
+class BuiltinController:
+    """A controller of the family that the benchmark runs beside the user's: a model and its parameters."""
+    family: str
+    model: str
+    label: str
+    params: dict = field(default_factory=dict)
+    plugin: str = ""
+
+
 class Registry:
     def __init__(self):
         self.scenario_sources: dict[str, ScenarioSource] = {}
         self.metric_sets: dict[str, MetricSet] = {}
         self.papers: dict[str, Paper] = {}
+        self.benchmark_cases: list[BenchmarkCase] = []
+        self.controllers: list[BuiltinController] = []
         self._loaded = False
         self._current = ""
 
@@ -90,6 +119,21 @@ class Registry:
         if key in self.papers:
             raise ValueError(f"paper {key!r} registered twice")
         self.papers[key] = Paper(key, title, dict(commands or {}), report, docs, self._current)
+
+    def benchmark(self, family: str, scenario: str, label: str, slot: str = "controller", seeds: int = 0,
+                  primary: str = "eulerint_deg_s", signal: str = "alpha_deg", overrides: dict | None = None,
+                  monte_carlo: str = "") -> None:
+        """A scenario of ``family``'s controller benchmark (``scfmu benchmark --family``)."""
+        self.benchmark_cases.append(BenchmarkCase(family, scenario, label, slot, seeds, primary, signal,
+                                                  dict(overrides or {}), monte_carlo, self._current))
+
+    def controller(self, family: str, model: str, label: str, params: dict | None = None) -> None:
+        """A built-in controller the benchmark compares a user's unit with."""
+        self.controllers.append(BuiltinController(family, model, label, dict(params or {}), self._current))
+
+    def families(self) -> list[str]:
+        self.load()
+        return sorted({c.family for c in self.benchmark_cases})
 
     # ----- loading ----------------------------------------------------------------------------------
     def load(self) -> None:

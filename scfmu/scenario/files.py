@@ -110,7 +110,7 @@ def to_data(sc: Scenario) -> dict:
         for k in ("params", "slot", "ports"):
             if not c[k]:
                 del c[k]
-    for k in ("connections", "inputs", "log", "seed_params"):
+    for k in ("connections", "inputs", "log", "seed_params", "swapped"):
         if not d[k]:
             del d[k]
     comps = d.pop("components")

@@ -69,8 +69,9 @@ class Scenario:
     auto_connect: bool = True
     seed_params: list = field(default_factory=list)  # "instance.param" (Integer) that receive a run's seed
     start_time: float = 0.0
-    metrics: str = ""  # name of a metrics function in scfmu.campaign_metrics ("attitude", "formation", ...)
+    metrics: str = ""  # name of a registered metric set ("attitude", "formation", "paper003", ...)
     description: str = ""
+    swapped: list = field(default_factory=list)  # instances whose model was replaced (with_models)
 
     # ----- access ---------------------------------------------------------------------------------------
     def component(self, name: str) -> Component:
@@ -129,6 +130,8 @@ class Scenario:
                 c.model = str(model)
                 c.params = {}
                 c.ports = {}
+                if inst not in s.swapped:
+                    s.swapped.append(inst)
         return s
 
     def dropped_params(self, models: dict) -> dict:

@@ -19,6 +19,10 @@ def declared(model: str) -> dict:
 
 def resolve(scenario: Scenario) -> Scenario:
     s = copy.deepcopy(scenario)
+    for inst in s.swapped:  # the old model's own signals (diagnostics) are not logged from its replacement
+        names = declared(s.component(inst).model)
+        s.log = {k: q for k, q in s.log.items()
+                 if q.partition(".")[0] != inst or s.native_name(inst, q.partition(".")[2]) in names}
     for c in s.components:
         if c.slot:
             names = declared(c.model)

@@ -12,6 +12,16 @@ def register(reg) -> None:
                   lambda: [("wheel_fault", "reaction-wheel saturation and an actuator fault (paper 003 plant)")],
                   exported=("wheel_fault",))
     reg.metrics("paper003", model.metrics, [*columns("attitude"), *model.EXTRA_COLUMNS], LOGS["attitude"])
+    tuned = model.tuned_params()
+    reg.benchmark("attitude", "wheel_fault", "wheel saturation + x-wheel fault (paper 003 plant)",
+                  primary="final_error", signal="roll")
+    for case, text in (("N", "no disturbance"), ("C", "constant disturbance"), ("S", "sinusoidal disturbance"),
+                       ("W", "white-noise disturbance")):
+        reg.benchmark("attitude", f"paper003/SMC/{case}", f"003-{case}: {text} (paper 003)", primary="ise")
+    reg.benchmark("attitude", "paper003/SMC/U", "003-U: inertia uncertainty, Monte Carlo (paper 003)", primary="ise",
+                  seeds=100, monte_carlo="scfmu.papers.paper003.model:mc_draws")
+    reg.controller("attitude", "SlidingModeController", "GA-tuned SMC", tuned["SMC"])
+    reg.controller("attitude", "Type2FuzzySmcController", "type-2 fuzzy SMC", tuned["T2FSMC"])
     reg.paper("003", "Type-2 fuzzy sliding-mode attitude control of a LEO satellite",
               commands={"tune": ("GA tuning of the SMC gain, then the type-2 fuzzy coefficients",
                                  "scfmu.papers.paper003.commands:main_tune"),

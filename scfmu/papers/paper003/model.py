@@ -258,3 +258,8 @@ def build(name: str, **kw) -> Scenario:
 
 def names() -> list[tuple[str, str]]:
     return [(f"paper003/{c}/{k}", f"paper 003 case 003-{k}, {CONTROLLERS[c][0]}") for c in CONTROLLERS for k in CASES]
+
+
+def mc_draws(n: int) -> list[dict]:
+    """The 003-U Monte Carlo as n override sets (draws 1 … n of :func:`uncertainty_scales`)."""
+    return mc_overrides(range(1, n + 1))

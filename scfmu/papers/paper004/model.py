@@ -349,3 +349,25 @@ def optimise(init_deg: dict, x0: np.ndarray | None = None, effectiveness: float 
         return prob.solve(x0)
     finally:
         prob.close()
+
+
+# ----- the metric set of the paper004/<case> scenarios ---------------------------------------------
+METRIC_COLUMNS = ("w_end_max_deg_s", "euler_end_max_deg", "requirement_met")
+
+
+def metrics_row(r: dict) -> dict:
+    """Metric set ``paper004``: the attitude columns without an AttitudeMetrics instance (effort from the
+    applied torques), with the target attitude (321 angles 0, at rest) as reference: settling of the slowest
+    angle into 2 % of its initial value, final error = largest final angle [deg], and the paper's terminal
+    requirement (rates ≤ 0.01 deg/s, angles ≤ 0.1 deg at t_f)."""
+    from ...metrics import attitude_nometrics, settling_time
+    ref = {f"{a}_ref": np.zeros_like(np.asarray(r[a], dtype=float)) for a in ("roll", "pitch", "yaw")}
+    out = attitude_nometrics({**r, **ref})
+    term = terminal_metrics(np.array([r[f"w_{a}"][-1] for a in AXES]),
+                            np.array([r[a][-1] for a in ("roll", "pitch", "yaw")]))
+    out.update(w_end_max_deg_s=term["w_end_max_deg_s"], euler_end_max_deg=term["euler_end_max_deg"],
+               requirement_met=1.0 if term["pass"] else 0.0)
+    out["final_error"] = term["euler_end_max_deg"]
+    st = [settling_time(r["time"], np.asarray(r[a], dtype=float), 0.0) for a in ("roll", "pitch", "yaw")]
+    out["settling_s"] = max(st) if all(math.isfinite(x) for x in st) else math.nan
+    return out

@@ -34,7 +34,7 @@ def paper004(case: str = "1", stop_time: float = 20.0, step: float = 0.01) -> Sc
         ],
         stop_time=stop_time, step=step,
         log={**log_of("plant", names), **log_of("controller", [f"torque_cmd_{a}" for a in "xyz"])},
-        metrics="attitude_nometrics",
+        metrics="paper004",
         description=f"paper 004 case 004-{case}",
     )
 
