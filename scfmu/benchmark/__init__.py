@@ -148,8 +148,8 @@ def ranks(cases, entries: list[Entry]) -> dict:
     out = {}
     for case in cases:
         es = [e for e in entries if e.case == case.label and e.passed and math.isfinite(e.means.get(case.primary, math.nan))]
-        es.sort(key=lambda e: e.means[case.primary])
-        out[case.label] = {e.controller: i + 1 for i, e in enumerate(es)}
+        vals = [e.means[case.primary] for e in es]  # equal values share a rank (1, 2, 2, 4)
+        out[case.label] = {e.controller: 1 + sum(1 for v in vals if v < e.means[case.primary]) for e in es}
     return out
 
 

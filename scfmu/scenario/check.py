@@ -87,9 +87,8 @@ def check_unit(model: str, instantiate: bool = True) -> tuple[object | None, lis
 
 def check(scenario: Scenario, instantiate: bool = True) -> Report:
     rep = Report()
-    sc = resolve_safely(scenario, rep)
     mds = {}
-    for c in sc.components:
+    for c in scenario.components:
         if c.model in mds:
             continue
         md, errs = check_unit(c.model, instantiate)
@@ -97,6 +96,7 @@ def check(scenario: Scenario, instantiate: bool = True) -> Report:
         mds[c.model] = md if not errs else None
     if rep.errors:
         return rep
+    sc = resolve_safely(scenario, rep)
     vars_of = {c.name: {v.name: v for v in mds[c.model].modelVariables} for c in sc.components}
     for c in sc.components:
         for k in c.params:
@@ -106,6 +106,8 @@ def check(scenario: Scenario, instantiate: bool = True) -> Report:
         for theirs in c.ports:
             if theirs not in vars_of[c.name]:
                 rep.errors.append(f"{c.name} ({c.model}): port map names {theirs!r}, which the unit does not have")
+    if rep.errors:
+        return rep
     ports = {c.name: ([n for n, v in vars_of[c.name].items() if v.causality == "input"],
                       [n for n, v in vars_of[c.name].items() if v.causality == "output"]) for c in sc.components}
     try:
