@@ -56,6 +56,13 @@ def test_unit_by_path_equals_the_named_model_on_every_engine(my_pd, engine):
         assert np.array_equal(ref[k], mine[k]), k
 
 
+def test_unit_by_path_in_libcosim(my_pd):
+    from scfmu.engines.libcosim import run_libcosim
+    a = run_libcosim(short())
+    b = run_libcosim(short().with_models({"controller": str(my_pd)}).with_overrides({"controller.error_law": 0}))
+    assert a["eulerint_deg_s"] == b["eulerint_deg_s"] and a["q_w"] == b["q_w"]
+
+
 def test_swapping_drops_the_old_models_parameters_and_keeps_the_slot():
     sc = get("wheel_fault")
     assert sc.dropped_params({"controller": "LqrController"}) == {"controller": ["wn", "zeta"]}

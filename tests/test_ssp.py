@@ -12,6 +12,7 @@ import pytest
 from scfmu import scenario as scenarios
 from scfmu.registry import REGISTRY
 from scfmu.scenario import ssp
+from scfmu.scenario.resolve import resolve
 
 from scfmu.engines.lean import build_fmus, ports_of
 from scfmu.engines import run_reference
@@ -49,7 +50,7 @@ def test_validation_catches_an_invalid_ssd(tmp_path):
 
 @pytest.mark.parametrize("name", STANDARD)
 def test_ssp_reads_back_to_the_declared_scenario(name, tmp_path):
-    ref = scenarios.get(name)
+    ref = resolve(scenarios.get(name))  # an SSP file has no slots: the slot values a unit declares are its parameters
     sc, files = ssp.read_ssp(ssp_file(name), tmp_path)
     assert [(c.name, c.model) for c in sc.components] == [(c.name, c.model) for c in ref.components]
     for c, r in zip(sc.components, ref.components):
@@ -99,7 +100,7 @@ def test_fmpy_ssd_reader_sees_components_parameters_and_connections(name):
     """fmpy's SSP reader (an independent parser, schema-validating the .ssd and .ssv files) finds the
     declared instances, their parameter values and one connection per link."""
     from fmpy.ssp.ssd import read_ssd
-    ref = scenarios.get(name)
+    ref = resolve(scenarios.get(name))
     ssd = read_ssd(str(ssp_file(name)))
     comps = {e.name: e for e in ssd.system.elements}
     assert list(comps) == [c.name for c in ref.components]

@@ -22,9 +22,9 @@ NS = 10**9
 
 
 def run_libcosim(scenario: Scenario) -> dict:
-    scenario = resolve(scenario)
     """Runs the scenario to its stop time; returns the final value of every logged key plus
     ``wall_s`` (the simulate_until call only)."""
+    scenario = resolve(scenario)
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
     from libcosimpy.CosimObserver import CosimObserver
