@@ -56,6 +56,7 @@ fn derivative(orbit: &LeaderOrbit, a_ext: &Vector3<f64>, x: &State) -> Result<St
 
 impl Model for RelativeOrbitPlant {
     type Vars = RelativeOrbitPlantVars;
+    const EVOLVING: &'static [&'static str] = &["x", "stepper.h_adapt"];
     const INFO: ModelInfo = ModelInfo {
         name: "RelativeOrbitPlant",
         description: "Nonlinear leader-follower relative orbital motion in LVLH (3 translational DOF), eccentric leader orbit",
