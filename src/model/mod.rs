@@ -388,6 +388,14 @@ impl ModelEntry {
         ModelEntry { info: &M::INFO, decls: M::Vars::DECLS, create: || Box::new(Fmu::<M>::default()) }
     }
 
+    /// Every text of the model that may cite publications: description, source, equations and the
+    /// variable descriptions (read by the model description, the documentation pages and the reference list).
+    pub fn texts(&self) -> Vec<&'static str> {
+        let mut t = vec![self.info.description, self.info.source, self.info.equations_html];
+        t.extend(self.decls.iter().map(|d| d.description));
+        t
+    }
+
     pub fn decl(&self, name: &str) -> Option<&'static VarDecl> {
         self.decls.iter().find(|d| d.name == name)
     }

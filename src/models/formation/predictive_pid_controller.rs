@@ -195,7 +195,7 @@ mod tests {
 
     #[test]
     fn gains_of_the_four_cases() {
-        // spec controllers.md §2 table (m = 100 kg)
+        // gains P, D, I_g of Eqs. 41-43 worked by hand (m = 100 kg)
         for (t2, c, p, d, ig) in [
             (5.0, 5.0, 263.333, 550.0, 66.6667),
             (25.0, 5.0, 50.5333, 510.0, 2.66667),
