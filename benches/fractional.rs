@@ -7,7 +7,7 @@
 use std::hint::black_box;
 use std::time::Instant;
 
-use spacecraft_fmus::math::fractional::{FopidLaw, FopidParams, PidLaw};
+use spacecraft_fmus::models::single_axis::shared::laws::{FopidLaw, FopidParams, PidLaw};
 use spacecraft_fmus::model::{Experiment, Fmu};
 use spacecraft_fmus::models::single_axis::SingleAxisPlant;
 

@@ -407,7 +407,7 @@ pub fn documentation_html(entry: &ModelEntry) -> String {
         }
         h.push_str("</table>\n");
     }
-    let cited = crate::references::cited_in(crate::docs::model_texts(entry));
+    let cited = crate::references::cited_in(entry.texts());
     if !cited.is_empty() {
         h.push_str("<h2>References</h2>\n<ul>\n");
         for r in cited {

@@ -11,12 +11,6 @@ use crate::model::{Causality, ModelEntry, VarDecl};
 use crate::references::{self, Reference};
 use crate::registry::{Family, FAMILIES};
 
-/// Every user-visible text of a model: description, source, equations and variable descriptions.
-pub fn model_texts(e: &ModelEntry) -> Vec<&'static str> {
-    let mut t = vec![e.info.description, e.info.source, e.info.equations_html];
-    t.extend(e.decls.iter().map(|d| d.description));
-    t
-}
 
 fn cell(s: &str) -> String {
     s.replace('|', "\\|").replace('\n', " ")
@@ -89,7 +83,7 @@ pub fn family_markdown(f: &Family) -> String {
             variable_table(&mut out, title, &rows);
         }
     }
-    let cited = references::cited_in(f.fmus.iter().flat_map(model_texts).chain([f.overview]).collect::<Vec<_>>());
+    let cited = references::cited_in(f.fmus.iter().flat_map(ModelEntry::texts).chain([f.overview]).collect::<Vec<_>>());
     if !cited.is_empty() {
         out.push_str("## References\n\n");
         references_list(&mut out, &cited);
@@ -112,7 +106,7 @@ pub fn references_markdown() -> String {
         let users: Vec<String> = FAMILIES
             .iter()
             .flat_map(|f| f.fmus.iter().map(move |e| (f, e)))
-            .filter(|(_, e)| model_texts(e).iter().any(|t| t.contains(&tag)))
+            .filter(|(_, e)| e.texts().iter().any(|t| t.contains(&tag)))
             .map(|(f, e)| format!("[{0}](models/{1}.md#{2})", e.info.name, f.slug, e.info.name.to_lowercase()))
             .collect();
         if !users.is_empty() {

@@ -130,7 +130,7 @@ mod tests {
     #[test]
     fn every_model_cites_only_known_references_and_at_least_one() {
         for e in crate::registry::ALL {
-            let texts = crate::docs::model_texts(e);
+            let texts = e.texts();
             let mut cited = 0;
             for t in &texts {
                 for tag in tags_in(t) {

@@ -42,3 +42,36 @@ fn fmi_schema_reads_every_variable_back() {
         }
     }
 }
+
+/// Within a family (one `registry::FAMILIES` entry), a parameter name keeps one value reference in
+/// every FMU that declares it (calculated parameters included), so a master or a scenario can address
+/// it by reference across the family.
+#[test]
+fn every_parameter_keeps_one_value_reference_within_a_family() {
+    use spacecraft_fmus::model::Causality;
+    use std::collections::BTreeMap;
+    let mut groups: BTreeMap<&str, Vec<&spacecraft_fmus::model::ModelEntry>> = BTreeMap::new();
+    for f in registry::FAMILIES {
+        groups.entry(f.slug).or_default().extend(f.fmus.iter());
+    }
+    let mut problems = vec![];
+    let mut shared = 0;
+    for (family, fmus) in &groups {
+        let mut seen: BTreeMap<&str, (u32, &str)> = BTreeMap::new();
+        for e in fmus {
+            for d in e.decls.iter().filter(|d| matches!(d.causality, Causality::Parameter | Causality::CalculatedParameter)) {
+                match seen.get(d.name) {
+                    Some((vr, first)) if *vr != d.vr => {
+                        problems.push(format!("{family}: {} is {} in {first} but {} in {}", d.name, vr, d.vr, e.info.name))
+                    }
+                    Some(_) => shared += 1,
+                    None => {
+                        seen.insert(d.name, (d.vr, e.info.name));
+                    }
+                }
+            }
+        }
+    }
+    assert!(problems.is_empty(), "{problems:#?}");
+    assert!(shared > 20, "only {shared} parameters shared within families: the check sees too little");
+}

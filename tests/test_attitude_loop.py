@@ -17,7 +17,7 @@ I_P000 = np.diag([1000.0, 500.0, 700.0])
 LARGE = (math.radians(40.0), math.radians(-40.0), math.radians(-60.0))
 
 
-# ----- independent reference (written from the spec, not from the Rust code) -------------------
+# ----- independent reference (written from the paper's equations, not from the Rust code) -------------------
 
 def qmul(a, b):
     aw, av = a[0], a[1:]

@@ -1,4 +1,4 @@
-"""AttitudePlant verified against physics (issue 3, spec attitude-plant.md §1.7).
+"""AttitudePlant verified against physics (issue 3).
 
 Every reference here is independent of the Rust code: conservation laws, closed-form solutions
 (axisymmetric precession, gravity-gradient libration), a scipy DOP853 implementation of the full

@@ -1,4 +1,4 @@
-"""Paper 000 controller family (spec controllers.md §1) against independent references:
+"""Paper 000 controller family ([Navabi-2019]) against independent references:
 python-control / scipy (LQR, pole placement), scikit-fuzzy membership functions and centroid
 defuzzification (fuzzy PD), closed forms (reference model, double-pole response) and convergence
 properties (MRAC). The FMUs are driven through fmpy by port name."""

@@ -2,8 +2,8 @@
 
 Independent references: inertial two-body propagation (scipy DOP853) rotated into LVLH, the Jacobi
 integral, the closed-form Clohessy-Wiltshire solution, Kepler's equation, and the closed-loop
-characteristic polynomial (s + c)(s^2 + K2 s + K1) with K1 = 10/(3T^2), K2 = 5/(2T) (spec controllers.md
-section 2). Horizons and steps are shortened where the property allows; each test states its setup.
+characteristic polynomial (s + c)(s^2 + K2 s + K1) with K1 = 10/(3T^2), K2 = 5/(2T) ([NPPID-Formation]
+Eq. 25). Horizons and steps are shortened where the property allows; each test states its setup.
 """
 
 from __future__ import annotations

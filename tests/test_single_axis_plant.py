@@ -1,4 +1,4 @@
-"""SingleAxisPlant (paper 002, spec attitude-plant.md §2) against closed forms and a hand-written recursion."""
+"""SingleAxisPlant ([Khatoonabadi-FO]) against closed forms and a hand-written recursion."""
 
 from __future__ import annotations
 

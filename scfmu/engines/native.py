@@ -49,7 +49,7 @@ from ..scenario.resolve import resolve
 
 CACHE = Path(os.environ.get("SCFMU_CONTAINER_DIR", Path.home() / ".cache" / "scfmu" / "containers"))
 _KINDS = ("parameter", "calculatedParameter", "input", "output")
-LAYOUT = 3  # version of the container layout below (part of the cache key)
+LAYOUT = 4  # version of the container layout below (part of the cache key)
 
 
 def _descriptions(scenario: Scenario):
@@ -178,7 +178,9 @@ def build_container(scenario: Scenario, starts: dict | None = None) -> Path:
                                                               stepSize=str(scenario.step)),
                           coSimulation=CoSimulation(modelIdentifier="container_fmu",
                                                     fixedInternalStepSize=scenario.step,
-                                                    canHandleVariableCommunicationStepSize=True),
+                                                    # fmpy's container steps in multiples of its fixed
+                                                    # internal step only: a constant step (issue 22)
+                                                    canHandleVariableCommunicationStepSize=False),
                           modelVariables=container_vars)
     # ModelStructure: a container variable reads or writes its nested variable directly (connections are
     # propagated only inside doStep), so each container output depends on exactly the container variables

@@ -7,7 +7,7 @@ use std::ffi::{c_int, c_void, CString};
 use serde::{Deserialize, Serialize};
 
 use super::{FsmState, LoggerFn, Status, LOG_CATEGORIES};
-use crate::model::{Causality, DynModel, Experiment, ModelEntry, SlotMut, Value, VarDecl, VarKind, Variability};
+use crate::model::{Causality, DynModel, Experiment, TOLERANCE_MAX, TOLERANCE_MIN, ModelEntry, SlotMut, Value, VarDecl, VarKind, Variability};
 
 /// Failure of an FMI call: the status to return and the reason to log.
 #[derive(Debug)]
@@ -88,8 +88,10 @@ impl Run {
         if !e.start_time.is_finite() || e.tolerance.is_some_and(|t| !(t.is_finite() && t > 0.0)) || e.stop_time.is_some_and(|s| !(s.is_finite() && s >= e.start_time)) {
             return Err(format!("experiment {e:?} is not valid"));
         }
-        if matches!(self.fsm, FsmState::Fatal | FsmState::StepCanceled) {
-            return Err(format!("state machine state {:?} cannot be restored", self.fsm));
+        // only the states in which fmi2GetFMUstate can be called on this FMU (StepFailed and
+        // StepCanceled are never entered: fmi2DoStep never returns fmi2Pending or fmi2Discard)
+        if !matches!(self.fsm, FsmState::Instantiated | FsmState::InitializationMode | FsmState::StepComplete | FsmState::Terminated | FsmState::Error) {
+            return Err(format!("state machine state {:?} cannot be restored (no FMU state can be taken in it)", self.fsm));
         }
         Ok(())
     }
@@ -311,6 +313,18 @@ impl Instance {
         }
         self.run.exp = Experiment { start_time: start, tolerance, stop_time: stop };
         self.run.time = start;
+        // the adaptive integrators honour [TOLERANCE_MIN, TOLERANCE_MAX] only: say so when clamping
+        if let Some(tol) = tolerance {
+            let used = self.run.exp.tolerance_or_default();
+            if used != tol {
+                return Err(Fail {
+                    status: Status::Warning,
+                    reason: format!(
+                        "tolerance {tol:e} is outside [{TOLERANCE_MIN:e}, {TOLERANCE_MAX:e}], the range the adaptive integrators honour; {used:e} is used (the experiment is set up)"
+                    ),
+                });
+            }
+        }
         Ok(())
     }
 

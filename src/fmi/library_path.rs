@@ -20,7 +20,7 @@ pub(super) fn own_library_stem() -> Option<String> {
 fn own_library_path() -> Option<std::path::PathBuf> {
     let mut info: libc::Dl_info = unsafe { std::mem::zeroed() };
     // SAFETY: dladdr only reads the address; info is valid storage.
-    let ok = unsafe { libc::dladdr(super::abi::fmi2Instantiate as *const c_void, &mut info) };
+    let ok = unsafe { libc::dladdr(own_library_path as *const c_void, &mut info) };
     if ok == 0 || info.dli_fname.is_null() {
         return None;
     }
@@ -47,7 +47,7 @@ fn own_library_path() -> Option<std::path::PathBuf> {
     let ok = unsafe {
         GetModuleHandleExW(
             GET_MODULE_HANDLE_EX_FLAG_FROM_ADDRESS | GET_MODULE_HANDLE_EX_FLAG_UNCHANGED_REFCOUNT,
-            super::abi::fmi2Instantiate as *const u16,
+            own_library_path as *const u16,
             &mut module,
         )
     };

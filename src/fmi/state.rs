@@ -15,7 +15,7 @@ use std::sync::{Mutex, MutexGuard};
 use serde::{Deserialize, Serialize};
 
 use super::instance::{CallResult, Fail, Instance, Run};
-use super::BuildAddrHasher;
+use super::{BuildAddrHasher, FsmState};
 use crate::model::DynModel;
 
 const MAGIC: &[u8; 8] = b"SCFMUST\0";
@@ -160,7 +160,11 @@ impl Snapshot {
         if crc32fast::hash(&bytes[..HEADER + len]) != crc {
             return Err(Fail::error("serialized state is corrupted (CRC-32 mismatch)"));
         }
-        let p: Payload = postcard::from_bytes(&bytes[HEADER..HEADER + len]).map_err(|e| Fail::error(format!("serialized state does not decode: {e}")))?;
+        let (p, rest): (Payload, &[u8]) =
+            postcard::take_from_bytes(&bytes[HEADER..HEADER + len]).map_err(|e| Fail::error(format!("serialized state does not decode: {e}")))?;
+        if !rest.is_empty() {
+            return Err(Fail::error(format!("serialized state has {} trailing bytes after its payload", rest.len())));
+        }
         if p.model_name != inst.entry.info.name {
             return Err(Fail::error(format!("serialized state belongs to {}, not to {}", p.model_name, inst.entry.info.name)));
         }
@@ -170,6 +174,9 @@ impl Snapshot {
         let mut model = inst.model.clone_box();
         model.load_bytes(&p.model).map_err(Fail::error)?;
         p.run.validate().map_err(|e| Fail::error(format!("serialized state is invalid: {e}")))?;
+        if !model.is_initialized() && !matches!(p.run.fsm, FsmState::Instantiated | FsmState::InitializationMode) {
+            return Err(Fail::error(format!("serialized state is invalid: state machine state {:?} without applied parameters", p.run.fsm)));
+        }
         model.validate(&p.run.exp).map_err(|e| Fail::error(format!("serialized state is invalid: {e}")))?;
         Ok(Snapshot { model_name: inst.entry.info.name, run: p.run, model, serialized: None })
     }

@@ -130,7 +130,7 @@ pub fn dcm_from_euler213(roll: f64, pitch: f64, yaw: f64) -> Matrix3<f64> {
     rot3(yaw) * rot1(roll) * rot2(pitch)
 }
 
-/// Paper 000 Eq. 8 with the corrected sign (spec attitude-plant.md §1.3 mode 2): the angle rates
+/// Paper 000 Eq. 8 with the corrected sign (kinematics mode 2 of AttitudePlant): the angle rates
 /// (φ̇, θ̇, ψ̇) of the 213 sequence for body rates ω. Singular at cos φ = 0 (returns non-finite values).
 ///   φ̇ = ω_x cos ψ − ω_y sin ψ,  θ̇ = (ω_x sin ψ + ω_y cos ψ) / cos φ,  ψ̇ = (ω_x sin ψ + ω_y cos ψ) tan φ + ω_z
 pub fn euler213_rates(roll: f64, yaw: f64, w: &Vector3<f64>) -> Vector3<f64> {

@@ -1,4 +1,4 @@
-//! Orbit environment of the attitude plant (spec attitude-plant.md §1.5, project choice): circular
+//! Orbit environment of the attitude plant (project choice): circular
 //! orbit with right ascension of the ascending node 0, non-tilted dipole geomagnetic field, gravity
 //! gradient torque. R is the Earth-centred inertial frame.
 

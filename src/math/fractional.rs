@@ -1,5 +1,6 @@
-//! Grünwald–Letnikov (GL) fractional derivatives and integrals of a sampled signal, and the PID /
-//! fractional PI^λD^μ control laws built on them (paper 002).
+//! Grünwald–Letnikov (GL) fractional derivatives and integrals of a sampled signal: weights, direct
+//! sums and an exact online evaluation. The control laws built on them live with the single-axis
+//! controllers (`crate::models::single_axis::shared::laws`).
 //!
 //! For a signal sampled at t_k = k h (e_k = 0 for k < 0) the GL approximation of order α is
 //! ```text
@@ -21,7 +22,6 @@
 use std::sync::Arc;
 
 use rustfft::{num_complex::Complex, Fft, FftPlanner};
-use serde::{Deserialize, Serialize};
 
 /// Number of most recent weights applied directly in the fast mode (a power of two).
 pub const NEAR: usize = 64;
@@ -88,44 +88,43 @@ struct FftCache {
     levels: Vec<Option<Arc<Level>>>,
 }
 
-/// Online GL sum s_n = Σ_{j=0}^{min(n, L-1)} w_j e_{n-j} of a signal that arrives one sample per step.
-/// [`eval`](Self::eval) gives s_n for a candidate e_n without changing the state; [`push`](Self::push)
-/// appends e_n. The serialized state holds the whole history (and the pending block products), so a
-/// restored copy continues bit-identically.
-#[derive(Clone, Serialize, Deserialize)]
-pub struct GlConvolution {
+/// Online GL sum s_n = Σ_{j=0}^{min(n, L-1)} w_j e_{n-j} of a signal that arrives one sample per step,
+/// without the samples themselves: the caller owns the history e_0 … e_{n-1} and passes it to every
+/// call, so a law with several sums over one signal stores the signal once. What the kernel holds
+/// (weights, pending block products, FFT plans) is derived from the order, the memory and the history;
+/// [`rebuild`](Self::rebuild) recomputes it from a history alone, bit-identically.
+#[derive(Clone)]
+pub struct GlKernel {
     alpha: f64,
     memory: usize,
     fast: bool,
     /// w_0 … (never longer than `memory` when memory > 0)
     weights: Vec<f64>,
-    /// e_0 … e_{n-1}
-    history: Vec<f64>,
     /// far[n] = block products Σ_{j ≥ NEAR} w_j e_{n-j} accumulated so far (fast mode)
     far: Vec<f64>,
-    #[serde(skip)]
     cache: FftCache,
 }
 
-impl GlConvolution {
+impl GlKernel {
     /// Order `alpha`, memory `memory` samples (0 = full), `fast` = block-FFT evaluation.
     pub fn new(alpha: f64, memory: usize, fast: bool) -> Self {
-        let mut c = GlConvolution { alpha, memory, fast, weights: Vec::new(), history: Vec::new(), far: Vec::new(), cache: FftCache::default() };
+        let mut c = GlKernel { alpha, memory, fast, weights: Vec::new(), far: Vec::new(), cache: FftCache::default() };
         c.ensure_weights(NEAR.max(2));
+        c
+    }
+
+    /// The kernel after the samples `history` were pushed one by one (the same arithmetic in the same
+    /// order as the online pushes, so the result is bit-identical).
+    pub fn rebuild(alpha: f64, memory: usize, fast: bool, history: &[f64]) -> Self {
+        let mut c = Self::new(alpha, memory, fast);
+        for n1 in 1..=history.len() {
+            c.push(&history[..n1]);
+        }
         c
     }
 
     pub fn alpha(&self) -> f64 {
         self.alpha
-    }
-    pub fn len(&self) -> usize {
-        self.history.len()
-    }
-    pub fn is_empty(&self) -> bool {
-        self.history.is_empty()
-    }
-    pub fn history(&self) -> &[f64] {
-        &self.history
     }
 
     fn ensure_weights(&mut self, n: usize) {
@@ -142,33 +141,25 @@ impl GlConvolution {
         self.weights[j]
     }
 
-    /// Partial sum of the weights S_n = Σ_{j=0}^{min(n, L-1)} w_j.
-    pub fn weight_partial_sum(&mut self, n: usize) -> f64 {
-        let m = if self.memory == 0 { n + 1 } else { (n + 1).min(self.memory) };
-        self.ensure_weights(m);
-        self.weights[..m].iter().sum()
-    }
-
-    /// s_n with e_n = `e_now`, n = number of samples pushed so far. Does not change the state.
-    pub fn eval(&self, e_now: f64) -> f64 {
-        let n = self.history.len();
+    /// s_n with e_n = `e_now` after the samples `history` = e_0 … e_{n-1}. Does not change the state.
+    pub fn eval(&self, history: &[f64], e_now: f64) -> f64 {
+        let n = history.len();
         let m = if self.memory == 0 { n + 1 } else { (n + 1).min(self.memory) };
         if !self.fast {
             // direct: e_now * w_0 + Σ_{j=1}^{m-1} w_j e_{n-j}
-            return e_now + gl_sum_direct(&self.weights[1..m], &self.history[n + 1 - m..], 0);
+            return e_now + gl_sum_direct(&self.weights[1..m], &history[n + 1 - m..], 0);
         }
         let near = m.min(NEAR);
         let mut s = e_now;
         for j in 1..near {
-            s += self.weights[j] * self.history[n - j];
+            s += self.weights[j] * history[n - j];
         }
         s + self.far.get(n).copied().unwrap_or(0.0)
     }
 
-    /// Appends e_n (the sample of the step just taken).
-    pub fn push(&mut self, e: f64) {
-        self.history.push(e);
-        let n1 = self.history.len();
+    /// Accounts for the sample just appended: `history` ends with e_n.
+    pub fn push(&mut self, history: &[f64]) {
+        let n1 = history.len();
         // weights needed by the next eval (direct mode) or by the block levels completed now
         self.ensure_weights(if self.fast { (2 * n1).max(NEAR) } else { n1 + 1 });
         if !self.fast {
@@ -181,7 +172,7 @@ impl GlConvolution {
             if !n1.is_multiple_of(l) || (self.memory > 0 && l >= self.memory) {
                 break;
             }
-            self.add_block_product(k, l, n1);
+            self.add_block_product(history, k, l, n1);
             k += 1;
         }
     }
@@ -217,10 +208,10 @@ impl GlConvolution {
     }
 
     /// Adds the products of weight block [L, 2L) and history chunk [n1 - L, n1) to far[n1 …].
-    fn add_block_product(&mut self, k: usize, l: usize, n1: usize) {
+    fn add_block_product(&mut self, history: &[f64], k: usize, l: usize, n1: usize) {
         let lv = self.level(k, l);
         let Some(w_hat) = &lv.w_hat else { return };
-        let mut buf: Vec<Complex<f64>> = (0..2 * l).map(|i| Complex::new(if i < l { self.history[n1 - l + i] } else { 0.0 }, 0.0)).collect();
+        let mut buf: Vec<Complex<f64>> = (0..2 * l).map(|i| Complex::new(if i < l { history[n1 - l + i] } else { 0.0 }, 0.0)).collect();
         lv.fwd.process(&mut buf);
         for (b, w) in buf.iter_mut().zip(w_hat) {
             *b *= *w;
@@ -237,165 +228,17 @@ impl GlConvolution {
     }
 }
 
-/// Parameters of the PI^λD^μ law u_n = K_P e_n + K_I D^{-λ} e_n + K_D D^μ e_n (paper 002 Eqs. 16–17).
-#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
-pub struct FopidParams {
-    pub kp: f64,
-    pub ki: f64,
-    pub kd: f64,
-    pub lambda: f64,
-    pub mu: f64,
-    /// Sample time h (s).
-    pub h: f64,
-    /// GL memory in samples (0 = full memory).
-    pub memory: usize,
-    /// true: the derivative sees e_k = e_0 for k < 0 (no derivative kick); false: e_k = 0.
-    pub history_before_start: bool,
-}
 
-impl FopidParams {
-    /// Checks the values; the message names the offending parameter.
-    pub fn validate(&self) -> Result<(), String> {
-        for (n, v) in [("kp", self.kp), ("ki", self.ki), ("kd", self.kd)] {
-            if !v.is_finite() {
-                return Err(format!("parameter {n} = {v} is not finite"));
-            }
-        }
-        for (n, v) in [("lambda", self.lambda), ("mu", self.mu)] {
-            if !(v.is_finite() && (0.0..=2.0).contains(&v)) {
-                return Err(format!("parameter {n} = {v} must lie in [0, 2]"));
-            }
-        }
-        if !(self.h.is_finite() && self.h > 0.0) {
-            return Err(format!("parameter step = {} must be > 0", self.h));
-        }
-        Ok(())
-    }
-}
-
-/// Fractional PI^λD^μ law on the GL sums; the error history is the whole state.
-#[derive(Clone, Serialize, Deserialize)]
-pub struct FopidLaw {
-    p: FopidParams,
-    integral: GlConvolution,
-    derivative: GlConvolution,
-    e0: Option<f64>,
-    /// partial sums S_n = Σ_{j≤n} w_j of the derivative weights (history_before_start only)
-    wsum: Vec<f64>,
-    /// h^{λ}, h^{-μ}
-    scale_i: f64,
-    scale_d: f64,
-}
-
-impl FopidLaw {
-    pub fn new(p: FopidParams) -> Result<Self, String> {
-        Self::with_evaluation(p, true)
-    }
-
-    /// `fast` = false evaluates every GL sum directly (reference and benchmark).
-    pub fn with_evaluation(p: FopidParams, fast: bool) -> Result<Self, String> {
-        p.validate()?;
-        let mut law = FopidLaw {
-            p,
-            integral: GlConvolution::new(-p.lambda, p.memory, fast),
-            derivative: GlConvolution::new(p.mu, p.memory, fast),
-            e0: None,
-            wsum: Vec::new(),
-            scale_i: p.h.powf(p.lambda),
-            scale_d: p.h.powf(-p.mu),
-        };
-        if p.history_before_start {
-            law.extend_wsum(if p.memory > 0 { p.memory } else { 1 });
-        }
-        Ok(law)
-    }
-
-    pub fn params(&self) -> &FopidParams {
-        &self.p
-    }
-    /// Number of samples in the history.
-    pub fn len(&self) -> usize {
-        self.integral.len()
-    }
-    pub fn is_empty(&self) -> bool {
-        self.integral.is_empty()
-    }
-
-    /// D^{-λ} e_n and D^μ e_n for the current error e_n (state unchanged).
-    pub fn terms(&self, e: f64) -> (f64, f64) {
-        let i = if self.p.ki != 0.0 { self.scale_i * self.integral.eval(e) } else { 0.0 };
-        let mut d = self.derivative.eval(e);
-        if self.p.history_before_start {
-            // e_k = e_0 for k < 0 adds e_0 Σ_{j=n+1}^{L-1} w_j (full memory: Σ_{j>n} w_j = S_∞ - S_n,
-            // with S_∞ = 0 for μ > 0 and 1 for μ = 0)
-            let e0 = self.e0.unwrap_or(e);
-            d += e0 * self.tail_weight();
-        }
-        (i, self.scale_d * d)
-    }
-
-    /// Σ_{j=n+1}^{L-1} w_j for the derivative (full memory: S_∞ - S_n with S_∞ = 0 for μ > 0, 1 for μ = 0).
-    fn tail_weight(&self) -> f64 {
-        let n = self.derivative.len();
-        let s = &self.wsum;
-        let mem = self.p.memory;
-        if mem > 0 {
-            if n + 1 >= mem { 0.0 } else { s[mem - 1] - s[n] }
-        } else {
-            let s_inf = if self.p.mu == 0.0 { 1.0 } else { 0.0 };
-            s_inf - s[n]
-        }
-    }
-
-    fn extend_wsum(&mut self, len: usize) {
-        while self.wsum.len() < len {
-            let j = self.wsum.len();
-            let w = self.derivative.weight(j);
-            self.wsum.push(self.wsum.last().copied().unwrap_or(0.0) + w);
-        }
-    }
-
-    /// Control output u_n for the current error e_n (state unchanged).
-    pub fn output(&self, e: f64) -> f64 {
-        let (i, d) = self.terms(e);
-        self.p.kp * e + self.p.ki * i + self.p.kd * d
-    }
-
-    /// Appends e_n to the history (called once per step with the error of t_n).
-    pub fn push(&mut self, e: f64) {
-        self.e0.get_or_insert(e);
-        if self.p.ki != 0.0 {
-            self.integral.push(e);
-        } else {
-            // keep the sample count without paying for an unused sum
-            self.integral.history.push(e);
-        }
-        self.derivative.push(e);
-        if self.p.history_before_start {
-            let n = self.derivative.len();
-            self.extend_wsum(n + 1);
-        }
-    }
-}
-
-/// Integer PID u_n = K_P e_n + K_I h Σ_{j} e_{n-j} + K_D (e_n - e_{n-1})/h: the λ = μ = 1 case of
-/// [`FopidLaw`] written with a running sum and a backward difference (O(1) per step). With a memory
-/// L > 0 the sum covers the last L samples (short-memory principle).
-#[derive(Clone, Serialize, Deserialize)]
-pub struct PidLaw {
-    p: FopidParams,
-    /// whole error history (the integral window and the state to save)
+/// [`GlKernel`] with its own history: the GL sum of one signal, for tests and single-sum uses.
+#[derive(Clone)]
+pub struct GlConvolution {
+    kernel: GlKernel,
     history: Vec<f64>,
-    /// Σ of the samples inside the memory window
-    sum: f64,
 }
 
-impl PidLaw {
-    pub fn new(mut p: FopidParams) -> Result<Self, String> {
-        p.lambda = 1.0;
-        p.mu = 1.0;
-        p.validate()?;
-        Ok(PidLaw { p, history: Vec::new(), sum: 0.0 })
+impl GlConvolution {
+    pub fn new(alpha: f64, memory: usize, fast: bool) -> Self {
+        GlConvolution { kernel: GlKernel::new(alpha, memory, fast), history: Vec::new() }
     }
     pub fn len(&self) -> usize {
         self.history.len()
@@ -403,31 +246,17 @@ impl PidLaw {
     pub fn is_empty(&self) -> bool {
         self.history.is_empty()
     }
-
-    pub fn output(&self, e: f64) -> f64 {
-        let n = self.history.len();
-        let mem = self.p.memory;
-        // window Σ_{j=0}^{min(n, L-1)} e_{n-j}
-        let dropped = if mem > 0 && n + 1 > mem { self.history[n - mem] } else { 0.0 };
-        let window = self.sum + e - dropped;
-        let prev = match self.history.last() {
-            Some(&x) => x,
-            None if self.p.history_before_start => e,
-            None => 0.0,
-        };
-        // short memory with L = 1 drops e_{n-1} from the derivative too
-        let prev = if mem == 1 { 0.0 } else { prev };
-        self.p.kp * e + self.p.ki * (self.p.h * window) + self.p.kd * ((e - prev) / self.p.h)
+    pub fn history(&self) -> &[f64] {
+        &self.history
     }
-
+    /// s_n with e_n = `e_now`, n = number of samples pushed so far. Does not change the state.
+    pub fn eval(&self, e_now: f64) -> f64 {
+        self.kernel.eval(&self.history, e_now)
+    }
+    /// Appends e_n (the sample of the step just taken).
     pub fn push(&mut self, e: f64) {
-        let n = self.history.len();
-        let mem = self.p.memory;
-        self.sum += e;
-        if mem > 0 && n + 1 > mem {
-            self.sum -= self.history[n - mem];
-        }
         self.history.push(e);
+        self.kernel.push(&self.history);
     }
 }
 
@@ -548,75 +377,4 @@ mod tests {
         assert!((y[n] - s).abs() < 1e-14);
     }
 
-    fn params(kp: f64, ki: f64, kd: f64, lambda: f64, mu: f64) -> FopidParams {
-        FopidParams { kp, ki, kd, lambda, mu, h: 0.001, memory: 0, history_before_start: false }
-    }
-
-    #[test]
-    fn fopid_with_unit_orders_equals_pid() {
-        for hbs in [false, true] {
-            for mem in [0usize, 1, 2, 50, 3000] {
-                let p = FopidParams { memory: mem, history_before_start: hbs, ..params(2.0, 0.1, 8.0, 1.0, 1.0) };
-                let mut f = FopidLaw::new(p).unwrap();
-                let mut q = PidLaw::new(p).unwrap();
-                for (n, &e) in signal(20_000).iter().enumerate() {
-                    let (a, b) = (f.output(e), q.output(e));
-                    assert!((a - b).abs() < 1e-12 * b.abs().max(1.0), "L={mem} hbs={hbs} n={n}: {a} vs {b}");
-                    f.push(e);
-                    q.push(e);
-                }
-            }
-        }
-    }
-
-    #[test]
-    fn history_before_start_removes_derivative_kick() {
-        let e0 = 0.5;
-        for mu in [1.0, 0.7, 1.5] {
-            for mem in [0usize, 30] {
-                let p = FopidParams { memory: mem, history_before_start: true, ..params(0.0, 0.0, 1.0, 1.0, mu) };
-                let mut f = FopidLaw::new(p).unwrap();
-                // constant error that has always been there: full memory gives D^μ = 0; short memory
-                // gives the truncated sum e_0 h^{-μ} Σ_{j<L} w_j from the first sample on (no kick)
-                let expect = if mem == 0 { 0.0 } else { e0 * 1000f64.powf(mu) * gl_weights(mu, mem).iter().sum::<f64>() };
-                for _ in 0..200 {
-                    assert!((f.output(e0) - expect).abs() < 1e-9 * expect.abs().max(1.0), "μ={mu} L={mem}: {} vs {expect}", f.output(e0));
-                    f.push(e0);
-                }
-                let p0 = FopidParams { history_before_start: false, ..p };
-                let f0 = FopidLaw::new(p0).unwrap();
-                assert!((f0.output(e0) - e0 * 1000f64.powf(mu)).abs() < 1e-9);
-            }
-        }
-        // μ = 0: D^0 e = e whatever the option
-        let f = FopidLaw::new(FopidParams { history_before_start: true, ..params(0.0, 0.0, 1.0, 1.0, 0.0) }).unwrap();
-        assert!((f.output(0.3) - 0.3).abs() < 1e-15);
-    }
-
-    #[test]
-    fn bad_parameters_are_named() {
-        let e = FopidLaw::new(params(1.0, 1.0, 1.0, 2.5, 1.0)).err().unwrap();
-        assert!(e.contains("lambda"), "{e}");
-        let e = FopidLaw::new(params(1.0, 1.0, 1.0, 1.0, -0.1)).err().unwrap();
-        assert!(e.contains("mu"), "{e}");
-        let e = FopidLaw::new(params(f64::NAN, 1.0, 1.0, 1.0, 1.0)).err().unwrap();
-        assert!(e.contains("kp"), "{e}");
-    }
-
-    #[test]
-    fn serialized_state_continues_bit_identically() {
-        let p = FopidParams { ..params(2.0, 0.3, 5.0, 0.8, 1.3) };
-        let mut a = FopidLaw::new(p).unwrap();
-        let e = signal(6000);
-        for &x in &e[..2500] {
-            a.push(x);
-        }
-        let bytes = postcard::to_allocvec(&a).unwrap();
-        let mut b: FopidLaw = postcard::from_bytes(&bytes).unwrap();
-        for &x in &e[2500..] {
-            assert_eq!(a.output(x).to_bits(), b.output(x).to_bits());
-            a.push(x);
-            b.push(x);
-        }
-    }
 }

@@ -1,4 +1,4 @@
-//! Fuzzy inference of paper 000 (spec controllers.md §1.6): membership functions (triangular,
+//! Fuzzy inference of paper 000 ([Navabi-2019] §6): membership functions (triangular,
 //! Gaussian), the seven-term input partition NB … PB, product rule firing, the two 7×7 rule tables
 //! (paper 000 Tables 1–2) and defuzzification by weighted average of output-set representatives:
 //! c(S) = 0, c(B) = 1 (`Defuzz::Singleton`), or the centroids of the Gaussian output sets truncated to

@@ -35,7 +35,7 @@ mod tests {
 
     #[test]
     fn gains_match_closed_form_for_t1_zero() {
-        // T1 = 0: K1 = 10/(3T²), K2 = 5/(2T) (spec controllers.md §2)
+        // T1 = 0: K1 = 10/(3T²), K2 = 5/(2T) ([NPPID-Formation] Eq. 25 with T1 = 0)
         for t in [0.5, 5.0, 25.0, 100.0] {
             let (k1, k2) = predictive_gains(0.0, t).unwrap();
             assert!((k1 - 10.0 / (3.0 * t * t)).abs() < 1e-14 * k1, "T {t}: K1 {k1}");

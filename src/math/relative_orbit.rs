@@ -1,4 +1,4 @@
-//! Leader–follower relative orbital motion in the leader's LVLH frame (spec relative-orbit-plant.md,
+//! Leader–follower relative orbital motion in the leader's LVLH frame ([NPPID-Formation],
 //! paper 001 Eqs. 3–5 with the printed typos fixed): leader-orbit geometry θ̇(ν), θ̈(ν), R(ν), the
 //! nonlinear term G(ρ, ρ̇) of ρ̈ + G = F/m + d, and Kepler's equation for tests and references.
 //!

@@ -3,7 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{Experiment, Model, ModelInfo, ModelResult, SlotMut, Value, VarDecl, Variables};
+use super::{leaves, Causality, Experiment, Model, ModelInfo, ModelResult, SlotMut, Value, VarDecl, Variables};
 
 /// Variables + internal state of one model. The state exists once the parameters have been applied
 /// (`initialize`); before that, outputs and steps are refused with a message.
@@ -47,17 +47,40 @@ impl<M: Model> Fmu<M> {
 
     /// Checks a state restored from bytes as strictly as parameters at initialization: declared
     /// bounds, finite variables, parameter relations (a trial `initialize`), finite calculated
-    /// parameters, and the model's own invariants.
-    pub fn validate(&self, exp: &Experiment) -> ModelResult {
+    /// parameters equal to the ones the parameters give; then the internal state: every serialized
+    /// field outside [`Model::EVOLVING`] equal to a fresh `initialize`, every evolving number finite,
+    /// and the model's own invariants ([`Model::validate`]). Last, the model rebuilds what it does
+    /// not serialize ([`Model::restored`]).
+    pub fn validate(&mut self, exp: &Experiment) -> ModelResult {
         self.v.check_bounds()?;
         self.v.check_finite()?;
-        if let Some(state) = &self.state {
+        if let Some(state) = &mut self.state {
             let mut v = self.v.clone();
             let fresh = M::initialize(&mut v, exp)?;
             v.check_calculated()?;
+            for (i, d) in M::Vars::DECLS.iter().enumerate() {
+                if d.causality != Causality::CalculatedParameter {
+                    continue;
+                }
+                let (a, b) = (self.v.value(i), v.value(i));
+                let same = match (a, b) {
+                    (Some(Value::Real(x)), Some(Value::Real(y))) => x.to_bits() == y.to_bits(),
+                    _ => a == b,
+                };
+                if !same {
+                    return Err(format!("restored state: calculated parameter {} = {:?} does not match the parameters (they give {:?})", d.name, a, b));
+                }
+            }
+            leaves::check_restored(&*state, &fresh, M::EVOLVING)?;
             state.validate(&fresh)?;
+            state.restored()?;
         }
         Ok(())
+    }
+
+    /// Whether the parameters have been applied (there is an internal state).
+    pub fn is_initialized(&self) -> bool {
+        self.state.is_some()
     }
 
     /// The internal state (for tests); panics before initialization.
@@ -86,7 +109,16 @@ pub trait DynModel: Send {
     fn to_bytes(&self) -> Result<Vec<u8>, String>;
     /// Replaces `self` by the decoded state; `self` is unchanged on error.
     fn load_bytes(&mut self, bytes: &[u8]) -> ModelResult;
-    fn validate(&self, exp: &Experiment) -> ModelResult;
+    /// Checks a restored state and rebuilds its unserialized parts (see [`Fmu::validate`]).
+    fn validate(&mut self, exp: &Experiment) -> ModelResult;
+    fn is_initialized(&self) -> bool;
+    /// Test support: the internal state as JSON, a replacement decoded from JSON, the evolving paths.
+    #[cfg(test)]
+    fn state_json(&self) -> serde_json::Value;
+    #[cfg(test)]
+    fn set_state_json(&mut self, state: serde_json::Value) -> ModelResult;
+    #[cfg(test)]
+    fn evolving(&self) -> &'static [&'static str];
 }
 
 impl<M: Model> DynModel for Fmu<M> {
@@ -118,11 +150,30 @@ impl<M: Model> DynModel for Fmu<M> {
         postcard::to_stdvec(self).map_err(|e| e.to_string())
     }
     fn load_bytes(&mut self, bytes: &[u8]) -> ModelResult {
-        let decoded: Fmu<M> = postcard::from_bytes(bytes).map_err(|e| format!("model state does not decode: {e}"))?;
+        let (decoded, rest): (Fmu<M>, &[u8]) = postcard::take_from_bytes(bytes).map_err(|e| format!("model state does not decode: {e}"))?;
+        if !rest.is_empty() {
+            return Err(format!("model state has {} trailing bytes after its end", rest.len()));
+        }
         *self = decoded;
         Ok(())
     }
-    fn validate(&self, exp: &Experiment) -> ModelResult {
+    fn validate(&mut self, exp: &Experiment) -> ModelResult {
         Fmu::validate(self, exp)
+    }
+    fn is_initialized(&self) -> bool {
+        Fmu::is_initialized(self)
+    }
+    #[cfg(test)]
+    fn state_json(&self) -> serde_json::Value {
+        serde_json::to_value(&self.state).expect("state encodes as JSON")
+    }
+    #[cfg(test)]
+    fn set_state_json(&mut self, state: serde_json::Value) -> ModelResult {
+        self.state = serde_json::from_value(state).map_err(|e| e.to_string())?;
+        Ok(())
+    }
+    #[cfg(test)]
+    fn evolving(&self) -> &'static [&'static str] {
+        M::EVOLVING
     }
 }

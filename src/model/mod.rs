@@ -7,7 +7,10 @@
 mod declare;
 pub mod guid;
 mod instance;
+pub mod leaves;
 mod param;
+#[cfg(test)]
+mod restore_tests;
 
 pub use declare::{concat, no_duplicate_names, no_duplicate_vrs, total_len};
 pub use instance::{DynModel, Fmu};
@@ -301,6 +304,11 @@ impl ModelInfo {
     };
 }
 
+/// Range of relative tolerances the adaptive integrators honour (fmi2SetupExperiment clamps into it
+/// and logs a warning when it does).
+pub const TOLERANCE_MIN: f64 = 1e-14;
+pub const TOLERANCE_MAX: f64 = 0.1;
+
 /// Values from `fmi2SetupExperiment`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Experiment {
@@ -313,7 +321,7 @@ impl Experiment {
     /// Relative tolerance for adaptive integrators: the master's, clamped into [1e-14, 0.1] (a tighter
     /// value cannot be met in double precision, a looser one is meaningless), or 1e-8.
     pub fn tolerance_or_default(&self) -> f64 {
-        self.tolerance.filter(|x| *x > 0.0).map_or(1e-8, |x| x.clamp(1e-14, 0.1))
+        self.tolerance.filter(|x| *x > 0.0).map_or(1e-8, |x| x.clamp(TOLERANCE_MIN, TOLERANCE_MAX))
     }
 }
 
@@ -347,11 +355,22 @@ pub trait Model: Clone + Serialize + DeserializeOwned + Send + 'static {
     fn step(&mut self, _v: &Self::Vars, _t: f64, _h: f64) -> ModelResult {
         Ok(())
     }
-    /// Invariants of a state restored from bytes (fmi2DeSerializeFMUstate), beyond what the layer
-    /// checks itself (declared bounds, finite variables, parameter relations through `initialize`):
-    /// `fresh` is the state `initialize` builds from the same parameters, so the parts derived from
-    /// parameters must equal it and the evolving parts must be finite. Default: none.
+    /// Paths of the serialized fields that evolve with time (struct field names joined by '.', e.g.
+    /// `"law.history"`; a path covers everything below it). A state restored from bytes is checked by
+    /// the layer without model code ([`leaves::check_restored`]): every other serialized field must
+    /// equal what `initialize` gives for the restored parameters, and every number under these paths
+    /// must be finite. Required, so that no model forgets it: a field not listed here is compared with
+    /// a fresh `initialize`, which refuses any state in which it has evolved (safe by default).
+    const EVOLVING: &'static [&'static str];
+    /// Invariants of the evolving parts of a restored state beyond finiteness (ranges, buffer lengths
+    /// consistent with step counts and memory settings), checked after the layer's own checks; `fresh`
+    /// is the state `initialize` builds from the same parameters. Default: none.
     fn validate(&self, _fresh: &Self) -> ModelResult {
+        Ok(())
+    }
+    /// Rebuilds what the serialized state leaves out (`#[serde(skip)]` buffers derivable from the
+    /// parameters and the evolving fields), after a restored state passed every check. Default: nothing.
+    fn restored(&mut self) -> ModelResult {
         Ok(())
     }
 }
@@ -367,6 +386,14 @@ pub struct ModelEntry {
 impl ModelEntry {
     pub const fn of<M: Model>() -> Self {
         ModelEntry { info: &M::INFO, decls: M::Vars::DECLS, create: || Box::new(Fmu::<M>::default()) }
+    }
+
+    /// Every text of the model that may cite publications: description, source, equations and the
+    /// variable descriptions (read by the model description, the documentation pages and the reference list).
+    pub fn texts(&self) -> Vec<&'static str> {
+        let mut t = vec![self.info.description, self.info.source, self.info.equations_html];
+        t.extend(self.decls.iter().map(|d| d.description));
+        t
     }
 
     pub fn decl(&self, name: &str) -> Option<&'static VarDecl> {

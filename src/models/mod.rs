@@ -3,7 +3,8 @@
 //! laws) lives in non-FMU modules beside them (e.g. `attitude/control/shared/`), general math in
 //! `crate::math`.
 //!
-//! Value references (the same parameter has the same value reference across a family):
+//! Value references (the same parameter has the same value reference across a family; checked over the
+//! registry by `tests/model_description.rs`):
 //!
 //! | range   | what |
 //! |---------|------|
@@ -14,7 +15,8 @@
 //! Family-wide assignments:
 //! - attitude controllers: ports 0–13 in (`q` 0–3, `w` 4–6, `q_ref` 7–10, `w_ref` 11–13), 20–22 out
 //!   (`torque_cmd`); reserved 14–19 for further common inputs (e.g. wheel momentum); nominal inertia
-//!   `inertia_xx/yy/zz` 100–102; `wn` 103, `zeta` 104; `error_law` 121, `defuzz` 122; fuzzy input
+//!   `inertia_xx/yy/zz` 100–102; `wn` 103, `zeta` 104; `error_law` 121, `defuzz` 122; fuzzy output set values
+//!   `c_small` 215, `c_big` 216 (calculated); fuzzy input
 //!   scales `e_scale` 115, `edot_scale` 116, `sigma` 117, `mf_half_width` 118; MRAC block
 //!   (`shared::mrac::MracVariables`) outputs 30–44, parameters 100–110 and 120, calculated 200–205.
 //! - attitude plant: `inertia_xx/yy/zz` 100–102 as in the controllers; `integrator` 140,
@@ -24,6 +26,9 @@
 //!   `k_qdot` 163–165; the corrector's plant-copy parameters keep the plant's references
 //!   (`init_euler321_*` 110–112, `init_w` 113–115, `u_max` 120–122, `effectiveness` 123–125,
 //!   `max_internal_step` 130), `mode` 150, `node_{x,y,z}_{0..5}` 170–187, `spline_t_end` 188.
+//! - formation: the controller's leader-orbit and mass parameters keep the plant's references (`mu` 100,
+//!   `semi_major_axis` 101, `eccentricity` 102, `mass` 104); its own `T1` 114, `T2` 115, `c` 116,
+//!   `c_x/y/z` 117–119, `init_int_error` 150–152, `structure` 120.
 //! - plants of every family: `integrator` is an Integer with codes 0 RK4, 1 Euler, 2 Dormand–Prince.
 
 pub mod attitude;

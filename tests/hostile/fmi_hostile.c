@@ -8,6 +8,9 @@
  *   fmi_hostile LIB GUID hang            calls that used to run forever must return an error promptly
  *   fmi_hostile LIB GUID fuzz N SEED     serialized states with random bytes and a valid CRC
  *   fmi_hostile LIB GUID extreme         extreme parameters: errors, never infinite values with fmi2OK
+ *   fmi_hostile LIB GUID race N          deliberate misuse: two threads call ONE instance at the same time
+ *                                        (FMI forbids it); under ThreadSanitizer this must be reported, which
+ *                                        shows the detector is live (results are not checked)
  *
  * LIB must be an AttitudePlant binary (value references from modelDescription/AttitudePlant.xml).
  */
@@ -49,6 +52,16 @@ typedef struct {
     St (*serialize)(C, void *, char *, size_t);
     St (*deserialize)(C, const char *, size_t, void **);
 } Fmi;
+
+#if defined(__SANITIZE_THREAD__)
+/* A Rust library built with -Zsanitizer=thread calls __tsan_memcpy/__tsan_memmove/__tsan_memset, which
+ * LLVM's TSan runtime has and GCC 12's libtsan does not. Here they forward to the C functions, which
+ * libtsan intercepts (so the accesses are still checked); build with -rdynamic so that the dlopen'ed
+ * library finds them. */
+void *__tsan_memcpy(void *d, const void *s, size_t n) { return memcpy(d, s, n); }
+void *__tsan_memmove(void *d, const void *s, size_t n) { return memmove(d, s, n); }
+void *__tsan_memset(void *d, int c, size_t n) { return memset(d, c, n); }
+#endif
 
 /* AttitudePlant value references */
 enum { VR_TORQUE_CMD_X = 0, VR_Q_W = 10, VR_W_X = 14, VR_MAX_STEP = 130, VR_INTEGRATOR = 140, VR_ACTUATOR_MODE = 142,
@@ -197,6 +210,18 @@ static int try_state(const Fmi *f, C c, unsigned char *b, size_t n, int *accepte
     return 1;
 }
 
+/* race mode: two threads on one instance (forbidden by FMI), to check that ThreadSanitizer reports it */
+typedef struct { const Fmi *f; C c; int n; int writer; } Racer;
+static void *racer(void *arg) {
+    Racer *r = (Racer *)arg;
+    unsigned in = VR_TORQUE_CMD_X, out = VR_W_X;
+    for (int i = 0; i < r->n; i++) {
+        double v = 1e-3 * i;
+        if (r->writer) r->f->set_real(r->c, &in, 1, &v); else r->f->get_real(r->c, &out, 1, &v);
+    }
+    return NULL;
+}
+
 /* threads mode: each thread runs its own instances (with state reuse) and compares with the reference */
 typedef struct { const Fmi *f; int n; double ref; int bad; } Work;
 static void *worker(void *arg) {
@@ -242,6 +267,17 @@ int main(int argc, char **argv) {
         for (int i = 0; i < nt; i++) CHECK(w[i].bad == 0, "a thread's result differs from the single-threaded run");
         dlclose(f.lib);
         printf("ok threads %d x %d cycles, all bit-identical to the single-threaded run\n", nt, n);
+    } else if (!strcmp(mode, "race")) {
+        int n = atoi(argv[4]);
+        Fmi f = load();
+        C c = ready(&f, 0);
+        Racer r[2] = {{&f, c, n, 1}, {&f, c, n, 0}};
+        pthread_t th[2];
+        for (int i = 0; i < 2; i++) CHECK(pthread_create(&th[i], NULL, racer, &r[i]) == 0, "pthread_create");
+        for (int i = 0; i < 2; i++) pthread_join(th[i], NULL);
+        f.free_instance(c);
+        dlclose(f.lib);
+        printf("ok race %d calls per thread on one instance (misuse)\n", n);
     } else if (!strcmp(mode, "hang")) {
         Fmi f = load();
         /* 1. a tiny internal step is refused at initialization (declared range) */

@@ -27,6 +27,7 @@ pub struct AttitudeCommand;
 
 impl Model for AttitudeCommand {
     type Vars = AttitudeCommandVars;
+    const EVOLVING: &'static [&'static str] = &[];
     const INFO: ModelInfo = ModelInfo {
         name: "AttitudeCommand",
         description: "Attitude reference: a constant 321 Euler-angle command applied as a step",

@@ -42,6 +42,7 @@ fn integrands(v: &AttitudeMetricsVars) -> [f64; 4] {
 
 impl Model for AttitudeMetrics {
     type Vars = AttitudeMetricsVars;
+    const EVOLVING: &'static [&'static str] = &["integrals"];
     const INFO: ModelInfo = ModelInfo {
         name: "AttitudeMetrics",
         description: "Running attitude performance integrals: EULERINT, ISE, ISF and control effort",

@@ -86,6 +86,7 @@ fn nodes(v: &ReferenceCorrectorVars) -> [[f64; N_NODES]; 3] {
 
 impl Model for ReferenceCorrector {
     type Vars = ReferenceCorrectorVars;
+    const EVOLVING: &'static [&'static str] = &["copy.x"];
     const INFO: ModelInfo = ModelInfo {
         name: "ReferenceCorrector",
         description: "Reference corrector: attitude reference from an internal open-loop plant copy driven by a spline torque",

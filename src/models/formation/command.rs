@@ -41,6 +41,7 @@ pub struct RelativePositionCommand;
 
 impl Model for RelativePositionCommand {
     type Vars = RelativePositionCommandVars;
+    const EVOLVING: &'static [&'static str] = &[];
     const INFO: ModelInfo = ModelInfo {
         name: "RelativePositionCommand",
         description: "Relative-position reference: constant set-point step or smooth fifth-order polynomial transfer",

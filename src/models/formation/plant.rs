@@ -56,6 +56,7 @@ fn derivative(orbit: &LeaderOrbit, a_ext: &Vector3<f64>, x: &State) -> Result<St
 
 impl Model for RelativeOrbitPlant {
     type Vars = RelativeOrbitPlantVars;
+    const EVOLVING: &'static [&'static str] = &["x", "stepper.h_adapt"];
     const INFO: ModelInfo = ModelInfo {
         name: "RelativeOrbitPlant",
         description: "Nonlinear leader-follower relative orbital motion in LVLH (3 translational DOF), eccentric leader orbit",
@@ -175,7 +176,7 @@ mod tests {
 
     #[test]
     fn jacobi_integral_is_conserved_circular() {
-        // spec test 2: ρ(0) = (100, 0, 50) m, ρ̇(0) = (0, −0.2, 0.05) m/s, RK4 h = 0.1 s, one orbit
+        // ρ(0) = (100, 0, 50) m, ρ̇(0) = (0, −0.2, 0.05) m/s, RK4 h = 0.1 s, one orbit
         let mut p = plant(|v| {
             (v.init_pos.x, v.init_pos.z) = (100.0, 50.0);
             (v.init_vel.y, v.init_vel.z) = (-0.2, 0.05);
@@ -199,7 +200,7 @@ mod tests {
 
     #[test]
     fn true_anomaly_follows_kepler() {
-        // spec test 4: e = 0.1, ν(t) vs Kepler's equation with M = n t, one orbit, 1e-9 rad
+        // e = 0.1, ν(t) vs Kepler's equation with M = n t, one orbit, 1e-9 rad
         let mut p = plant(|v| {
             v.eccentricity = 0.1;
             v.max_internal_step = 0.1;

@@ -26,17 +26,17 @@ declare_variables! {
         23 => dist_est: Vec3 = [0.0; 3], Output, "N", "Estimated disturbance force m d_hat, LVLH";
         26 => int_error: Vec3 = [0.0; 3], Output, "m.s", "Integral of the position error E (structure 0)";
         // parameters
-        100 => T1: Real = 0.0, Parameter, "s", "Start of the prediction interval T1 ([NPPID-Formation]: 0)";
-        101 => T2: Real = 5.0, Parameter, "s", "End of the prediction interval T2 = prediction horizon T";
-        102 => c: Real = 5.0, Parameter, "1/s", "Disturbance-observer gain c (L = c I3), all axes unless c_* >= 0", NonNegative;
-        103 => c_x: Real = -1.0, Parameter, "1/s", "Observer gain for axis x; < 0: use c";
-        104 => c_y: Real = -1.0, Parameter, "1/s", "Observer gain for axis y; < 0: use c";
-        105 => c_z: Real = -1.0, Parameter, "1/s", "Observer gain for axis z; < 0: use c";
-        106 => mass: Real = 100.0, Parameter, "kg", "Follower mass m used by the controller ([NPPID-Formation])", Positive;
-        107 => mu: Real = 3.986004418e14, Parameter, "m3/s2", "Gravitational parameter for the feed-forward G";
-        108 => semi_major_axis: Real = 6.0e6, Parameter, "m", "Leader semi-major axis for the feed-forward G";
-        109 => eccentricity: Real = 0.0, Parameter, "", "Leader eccentricity for the feed-forward G";
-        110 => init_int_error: Vec3 = [0.0; 3], Parameter, "m.s", "Initial integral state E(0) (project addition; 0 in the paper)";
+        114 => T1: Real = 0.0, Parameter, "s", "Start of the prediction interval T1 ([NPPID-Formation]: 0)";
+        115 => T2: Real = 5.0, Parameter, "s", "End of the prediction interval T2 = prediction horizon T";
+        116 => c: Real = 5.0, Parameter, "1/s", "Disturbance-observer gain c (L = c I3), all axes unless c_* >= 0", NonNegative;
+        117 => c_x: Real = -1.0, Parameter, "1/s", "Observer gain for axis x; < 0: use c";
+        118 => c_y: Real = -1.0, Parameter, "1/s", "Observer gain for axis y; < 0: use c";
+        119 => c_z: Real = -1.0, Parameter, "1/s", "Observer gain for axis z; < 0: use c";
+        104 => mass: Real = 100.0, Parameter, "kg", "Follower mass m used by the controller ([NPPID-Formation])", Positive;
+        100 => mu: Real = 3.986004418e14, Parameter, "m3/s2", "Gravitational parameter for the feed-forward G";
+        101 => semi_major_axis: Real = 6.0e6, Parameter, "m", "Leader semi-major axis for the feed-forward G";
+        102 => eccentricity: Real = 0.0, Parameter, "", "Leader eccentricity for the feed-forward G";
+        150 => init_int_error: Vec3 = [0.0; 3], Parameter, "m.s", "Initial integral state E(0) (project addition; 0 in the paper)";
         120 => structure: Integer = 0, Parameter, "", "0 = PID form with integral state (Eq. 40); 1 = predictive law + disturbance-observer state (Eqs. 26, 28)", Choice(Structure::CODES);
         // calculated parameters
         200 => K1: Real = 0.0, CalculatedParameter, "1/s2", "Predictive gain K1 = Hbar33^-1 Hbar31";
@@ -112,6 +112,7 @@ impl PredictivePidController {
 
 impl Model for PredictivePidController {
     type Vars = PredictivePidControllerVars;
+    const EVOLVING: &'static [&'static str] = &["int_e", "z"];
     const INFO: ModelInfo = ModelInfo {
         name: "PredictivePidController",
         description: "Nonlinear predictive PID (predictive law + disturbance observer) for leader-follower formation control",
@@ -194,7 +195,7 @@ mod tests {
 
     #[test]
     fn gains_of_the_four_cases() {
-        // spec controllers.md §2 table (m = 100 kg)
+        // gains P, D, I_g of Eqs. 41-43 worked by hand (m = 100 kg)
         for (t2, c, p, d, ig) in [
             (5.0, 5.0, 263.333, 550.0, 66.6667),
             (25.0, 5.0, 50.5333, 510.0, 2.66667),

@@ -1,12 +1,12 @@
 //! `FopidController` (paper 002): fractional PI^λD^μ law u = K_P e + K_I D^{-λ} e + K_D D^μ e on the
 //! error e = θ_ref − θ, with Grünwald–Letnikov operators over the sampled error history
-//! (`crate::math::fractional`).
+//! (`crate::math::fractional`, law in `shared::laws`).
 
 use serde::{Deserialize, Serialize};
 
 use super::shared::{law_params, sampled_output, sampled_step};
 use crate::declare_variables;
-use crate::math::fractional::FopidLaw;
+use super::shared::laws::FopidLaw;
 use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult, SWITCH};
 
 declare_variables! {
@@ -20,8 +20,8 @@ declare_variables! {
         102 => kd: Real = 8.0, Parameter, "", "Derivative gain K_D (per rad s^-mu; project default)";
         103 => lambda: Real = 1.0, Parameter, "", "Integral order lambda", Range(0.0, 2.0);
         104 => mu: Real = 1.0, Parameter, "", "Derivative order mu", Range(0.0, 2.0);
-        105 => step: Real = 0.001, Parameter, "s", "Sample time h; every communication step must equal it", Positive;
-        120 => gl_memory: Integer = 0, Parameter, "", "Grunwald-Letnikov memory in samples (0 = full memory; L > 0 keeps the last L samples)", NonNegative;
+        105 => step: Real = 0.001, Parameter, "s", "Sample time h; every communication step must be an integer multiple of it", Positive;
+        120 => gl_memory: Integer = 0, Parameter, "", "Grunwald-Letnikov memory in samples (0 = full memory; L > 0 keeps the last L samples)", Range(0.0, 1e7);
         121 => history_before_start: Integer = 0, Parameter, "", "0: e_k = 0 for k < 0 (derivative kick at t = 0); 1: the derivative sees e_k = e_0 for k < 0", Choice(SWITCH);
     }
 }
@@ -34,6 +34,7 @@ pub struct FopidController {
 
 impl Model for FopidController {
     type Vars = FopidControllerVars;
+    const EVOLVING: &'static [&'static str] = &["law.history"];
     const INFO: ModelInfo = ModelInfo {
         name: "FopidController",
         description: "Fractional-order PI^lambda D^mu controller with Grunwald-Letnikov operators ([Khatoonabadi-FO])",
@@ -43,15 +44,15 @@ u_n = K_P e_n + K_I D^(-lambda) e_n + K_D D^(mu) e_n\n\
 D^alpha e(t_n) = h^(-alpha) sum_{j=0}^{min(n, L-1)} w_j e_(n-j),  w_0 = 1,  w_j = (1 - (alpha + 1)/j) w_(j-1)\n\
 alpha = -lambda (integral), alpha = mu (derivative); e_k = 0 for k &lt; 0; L = gl_memory (0 = full memory)</pre>\n\
 <p>The error of t_n is appended to the history in doStep(t_n, h); the output read at t_n uses the inputs just set, so \
-u depends directly on theta and theta_ref. Every communication step must equal the parameter step (h); any other \
-step is an error. With history_before_start = 1 the derivative term sees a constant past e_k = e_0 (no derivative \
+u depends directly on theta and theta_ref. A communication step must be an integer multiple k of the parameter step (h): the inputs are \
+held over it and the law takes k samples of the same error; any other step is an error. With history_before_start = 1 the derivative term sees a constant past e_k = e_0 (no derivative \
 kick at t = 0); the integral always starts at t = 0. lambda = mu = 1 is the integer PID (PidController). \
 The sums are evaluated exactly (to round-off) in O(log^2 n) amortised time per step: the 64 newest samples \
 directly, older ones in FFT blocks. The FMU state holds the whole history.</p>",
         feedthrough: Feedthrough::AllInputs,
         default_stop_time: 20.0,
         default_step: 0.001,
-        variable_step: false,
+        variable_step: false, // a constant step, any integer multiple of `step`
     };
 
     fn initialize(v: &mut FopidControllerVars, _exp: &Experiment) -> Result<Self, String> {
@@ -102,8 +103,20 @@ mod tests {
         c.outputs(0.0).unwrap();
         assert_eq!(u0.to_bits(), c.v.u.to_bits());
         c.step(0.0, 0.001).unwrap();
-        let e = c.step(0.001, 0.002).unwrap_err();
-        assert!(e.contains("step"), "{e}");
+        let e = c.step(0.001, 0.0015).unwrap_err();
+        assert!(e.contains("integer multiple") && e.contains("step = 0.001"), "{e}");
+        assert!(c.step(0.001, 1e4).unwrap_err().contains("at most"));
+        // a step of k sample times takes k samples of the held error: the same as k single steps
+        let mut d = ctrl(|v| (v.theta_ref, v.lambda, v.mu) = (0.5, 0.6, 1.4)).unwrap();
+        d.step(0.0, 0.001).unwrap();
+        for k in 0..3 {
+            d.step(0.001 + k as f64 * 0.001, 0.001).unwrap();
+        }
+        c.step(0.001, 0.003).unwrap();
+        assert_eq!(c.model().law.history(), d.model().law.history());
+        c.outputs(0.004).unwrap();
+        d.outputs(0.004).unwrap();
+        assert_eq!(c.v.u.to_bits(), d.v.u.to_bits());
         // u_0 = K_P e + K_I h^λ e + K_D h^-μ e with e = 0.5
         let expect = 0.5 * (2.0 + 0.1 * 0.001f64.powf(0.6) + 8.0 * 0.001f64.powf(-1.4));
         assert!((u0 - expect).abs() < 1e-12 * expect, "{u0} vs {expect}");

@@ -1,12 +1,12 @@
 //! `PidController` (paper 002): integer PID u = K_P e + K_I h Σ e_j + K_D (e_n − e_{n−1})/h on the error
 //! e = θ_ref − θ: the λ = μ = 1 case of `FopidController`, written with a running sum and a backward
-//! difference (`crate::math::fractional::PidLaw`).
+//! difference (`super::shared::laws::PidLaw`).
 
 use serde::{Deserialize, Serialize};
 
 use super::shared::{law_params, sampled_output, sampled_step};
 use crate::declare_variables;
-use crate::math::fractional::PidLaw;
+use super::shared::laws::PidLaw;
 use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult, SWITCH};
 
 declare_variables! {
@@ -18,8 +18,8 @@ declare_variables! {
         100 => kp: Real = 2.0, Parameter, "", "Proportional gain K_P (per rad; project default)";
         101 => ki: Real = 0.1, Parameter, "1/s", "Integral gain K_I (per rad s; project default)";
         102 => kd: Real = 8.0, Parameter, "s", "Derivative gain K_D (s per rad; project default)";
-        105 => step: Real = 0.001, Parameter, "s", "Sample time h; every communication step must equal it", Positive;
-        120 => gl_memory: Integer = 0, Parameter, "", "Memory in samples (0 = full; L > 0: the integral sums the last L samples)", NonNegative;
+        105 => step: Real = 0.001, Parameter, "s", "Sample time h; every communication step must be an integer multiple of it", Positive;
+        120 => gl_memory: Integer = 0, Parameter, "", "Memory in samples (0 = full; L > 0: the integral sums the last L samples)", Range(0.0, 1e7);
         121 => history_before_start: Integer = 0, Parameter, "", "0: e_(-1) = 0 (derivative kick at t = 0); 1: e_(-1) = e_0", Choice(SWITCH);
     }
 }
@@ -32,6 +32,7 @@ pub struct PidController {
 
 impl Model for PidController {
     type Vars = PidControllerVars;
+    const EVOLVING: &'static [&'static str] = &["law.history"];
     const INFO: ModelInfo = ModelInfo {
         name: "PidController",
         description: "Discrete PID controller, the lambda = mu = 1 case of FopidController ([Khatoonabadi-FO])",
@@ -40,14 +41,14 @@ impl Model for PidController {
 u_n = K_P e_n + K_I h sum_{j=0}^{min(n, L-1)} e_(n-j) + K_D (e_n - e_(n-1)) / h\n\
 e_k = 0 for k &lt; 0; L = gl_memory (0 = full memory)</pre>\n\
 <p>The error of t_n is appended to the history in doStep(t_n, h); the output read at t_n uses the inputs just set, so \
-u depends directly on theta and theta_ref. Every communication step must equal the parameter step (h); any other \
-step is an error. With history_before_start = 1 the derivative uses e_(-1) = e_0 (no derivative kick at t = 0); \
+u depends directly on theta and theta_ref. A communication step must be an integer multiple k of the parameter step (h): the inputs are \
+held over it and the law takes k samples of the same error; any other step is an error. With history_before_start = 1 the derivative uses e_(-1) = e_0 (no derivative kick at t = 0); \
 the integral always starts at t = 0. The same law as FopidController with lambda = mu = 1, written with a running \
 sum (O(1) per step). The FMU state holds the whole history.</p>",
         feedthrough: Feedthrough::AllInputs,
         default_stop_time: 20.0,
         default_step: 0.001,
-        variable_step: false,
+        variable_step: false, // a constant step, any integer multiple of `step`
     };
 
     fn initialize(v: &mut PidControllerVars, _exp: &Experiment) -> Result<Self, String> {

@@ -56,6 +56,7 @@ impl SingleAxisPlant {
 
 impl Model for SingleAxisPlant {
     type Vars = SingleAxisPlantVars;
+    const EVOLVING: &'static [&'static str] = &["x", "stepper.h_adapt"];
     const INFO: ModelInfo = ModelInfo {
         name: "SingleAxisPlant",
         description: "Single-axis spacecraft with first-order reaction-wheel lag, torque saturation and sinusoidal disturbance ([Khatoonabadi-FO])",

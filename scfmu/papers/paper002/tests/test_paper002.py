@@ -153,13 +153,16 @@ def test_bad_parameters_are_fmi_errors_with_message(model, params, name):
 
 
 @pytest.mark.parametrize("model", ["PidController", "FopidController"])
-def test_step_other_than_sample_time_is_an_error(model):
+def test_step_not_a_multiple_of_the_sample_time_is_an_error(model):
+    """A step of k sample times is k samples with the inputs held (0.002 s = 2 samples of 0.001 s);
+    a step that is no integer multiple is refused with a message naming the sample time."""
     f = Fmu(model, {"step": 0.001})
     try:
         f.do_step(0.0, 0.001)
+        f.do_step(0.001, 0.002)
         with pytest.raises(Exception):
-            f.do_step(0.001, 0.002)
-        assert any("step" in m[2] for m in f.messages), f.messages
+            f.do_step(0.003, 0.0015)
+        assert any("integer multiple" in m[2] and "step = 0.001" in m[2] for m in f.messages), f.messages
     finally:
         f.close()
 

@@ -25,8 +25,8 @@ declare_variables! {
         117 => sigma: Real = 0.25, Parameter, "", "Width of the Gaussian output sets Small and Big", Positive;
         118 => mf_half_width: Real = 0.3333333333333333, Parameter, "", "Half-width of the seven triangular input sets (>= 1/3)";
         122 => defuzz: Integer = 0, Parameter, "", "Defuzzification: 0 = c(S) = 0, c(B) = 1; 1 = truncated-centroid representatives", Choice(Defuzz::CODES);
-        206 => c_small: Real = 0.0, CalculatedParameter, "", "Representative value c(S) of the output set Small";
-        207 => c_big: Real = 0.0, CalculatedParameter, "", "Representative value c(B) of the output set Big";
+        215 => c_small: Real = 0.0, CalculatedParameter, "", "Representative value c(S) of the output set Small";
+        216 => c_big: Real = 0.0, CalculatedParameter, "", "Representative value c(B) of the output set Big";
     }
 }
 
@@ -35,6 +35,7 @@ pub struct AdaptiveFuzzyController(Mrac);
 
 impl Model for AdaptiveFuzzyController {
     type Vars = AdaptiveFuzzyControllerVars;
+    const EVOLVING: &'static [&'static str] = &["st"];
     const INFO: ModelInfo = ModelInfo {
         name: "AdaptiveFuzzyController",
         description: "Adaptive-fuzzy attitude controller: MRAC whose reference-model lambda1, lambda2 are fuzzy-scheduled",

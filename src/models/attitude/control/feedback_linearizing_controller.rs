@@ -26,6 +26,7 @@ pub struct FeedbackLinearizingController;
 
 impl Model for FeedbackLinearizingController {
     type Vars = FeedbackLinearizingControllerVars;
+    const EVOLVING: &'static [&'static str] = &[];
     const INFO: ModelInfo = ModelInfo {
         name: "FeedbackLinearizingController",
         description: "Feedback-linearising quaternion attitude law with reference-derivative inputs",

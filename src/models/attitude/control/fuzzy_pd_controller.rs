@@ -45,6 +45,7 @@ pub struct FuzzyPdController {
 
 impl Model for FuzzyPdController {
     type Vars = FuzzyPdControllerVars;
+    const EVOLVING: &'static [&'static str] = &[];
     const INFO: ModelInfo = ModelInfo {
         name: "FuzzyPdController",
         description: "Quaternion PD attitude controller with gains scheduled by a 7x7-rule fuzzy system",

@@ -31,6 +31,7 @@ pub struct LqrController {
 
 impl Model for LqrController {
     type Vars = LqrControllerVars;
+    const EVOLVING: &'static [&'static str] = &[];
     const INFO: ModelInfo = ModelInfo {
         name: "LqrController",
         description: "Per-axis LQR attitude controller; gains from the Riccati equation solved at initialization",

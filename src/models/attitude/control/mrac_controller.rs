@@ -23,6 +23,7 @@ pub struct MracController(Mrac);
 
 impl Model for MracController {
     type Vars = MracControllerVars;
+    const EVOLVING: &'static [&'static str] = &["st"];
     const INFO: ModelInfo = ModelInfo {
         name: "MracController",
         description: "Model-reference adaptive attitude controller (Slotine-Li adaptation of the inertia per axis)",

@@ -32,6 +32,7 @@ pub struct PdController {
 
 impl Model for PdController {
     type Vars = PdControllerVars;
+    const EVOLVING: &'static [&'static str] = &[];
     const INFO: ModelInfo = ModelInfo {
         name: "PdController",
         description: "PD attitude controller with quaternion, DCM or Euler-angle error law",

@@ -37,6 +37,7 @@ pub struct PolePlacementController {
 
 impl Model for PolePlacementController {
     type Vars = PolePlacementControllerVars;
+    const EVOLVING: &'static [&'static str] = &[];
     const INFO: ModelInfo = ModelInfo {
         name: "PolePlacementController",
         description: "Per-axis pole-placement attitude controller; gains by Ackermann's formula at initialization",

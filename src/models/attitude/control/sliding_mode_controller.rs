@@ -25,6 +25,7 @@ pub struct SlidingModeController {
 
 impl Model for SlidingModeController {
     type Vars = SlidingModeControllerVars;
+    const EVOLVING: &'static [&'static str] = &[];
     const INFO: ModelInfo = ModelInfo {
         name: "SlidingModeController",
         description: "Quaternion sliding-mode attitude controller (equivalent control + boundary-layer switching, K = (k, k, k))",

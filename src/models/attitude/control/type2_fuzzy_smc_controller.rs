@@ -35,6 +35,7 @@ pub struct Type2FuzzySmcController {
 
 impl Model for Type2FuzzySmcController {
     type Vars = Type2FuzzySmcControllerVars;
+    const EVOLVING: &'static [&'static str] = &[];
     const INFO: ModelInfo = ModelInfo {
         name: "Type2FuzzySmcController",
         description: "Quaternion sliding-mode attitude controller with the switching gain scheduled by an interval type-2 fuzzy system",

@@ -80,6 +80,7 @@ impl AttitudePlant {
 
 impl Model for AttitudePlant {
     type Vars = AttitudePlantVars;
+    const EVOLVING: &'static [&'static str] = &["x", "stepper.h_adapt", "q_dcm"];
     const INFO: ModelInfo = ModelInfo {
         name: "AttitudePlant",
         description: "Three-axis rigid spacecraft (gyrostat) with full inertia, selectable kinematics, saturating fault-prone torque actuators or reaction wheels with magnetorquers, disturbance generator and gravity gradient",

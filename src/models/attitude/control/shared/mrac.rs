@@ -179,7 +179,7 @@ pub struct Signals {
     pub v: Vector3<f64>,
 }
 
-/// The Slotine–Li adaptive law per axis with a reference model (spec controllers.md §1.5).
+/// The Slotine–Li adaptive law per axis with a reference model ([Navabi-2019] Eqs. 37-43).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct MracCore {
     pub coordinates: MracCoordinates,

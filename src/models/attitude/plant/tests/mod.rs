@@ -53,7 +53,7 @@ pub(super) fn full_inertia(v: &mut AttitudePlantVars) {
 
 #[test]
 fn dcm_mode_matches_quaternion_mode() {
-    // spec §1.7 test 3: same q(t) within 1e-6 over 30 s for the same torque history
+    // same q(t) within 1e-6 over 30 s for the same torque history
     let mut a = plant(full_inertia);
     let mut b = plant(|v| {
         full_inertia(v);
@@ -141,7 +141,7 @@ fn euler_mode_reproduces_213_kinematics_read_as_321() {
 
 #[test]
 fn small_angle_modes_agree_to_first_order() {
-    // spec §1.7 test 3: modes 2 and 3 agree to first order for angles below 1e-3 rad
+    // modes 2 and 3 agree to first order for angles below 1e-3 rad
     let tiny = |v: &mut AttitudePlantVars| {
         (v.inertia.x, v.inertia.y, v.inertia.z) = (1000.0, 500.0, 700.0);
         v.init_euler321_roll = 2e-4;
@@ -234,7 +234,7 @@ fn free_run(p: &mut P, t_end: f64, dt: f64) -> (f64, f64) {
 
 #[test]
 fn torque_free_conservation_rk4() {
-    // spec §1.7 test 1: relative drift < 1e-9 over 100 s, RK4 0.01 s, full inertia, |ω| ≈ 0.1 rad/s
+    // relative drift < 1e-9 over 100 s, RK4 0.01 s, full inertia, |ω| ≈ 0.1 rad/s
     let mut p = plant(tumbling);
     let (dh, de) = free_run(&mut p, 100.0, 0.1);
     println!("torque-free RK4 0.01 s, 100 s: momentum drift {dh:.3e}, energy drift {de:.3e}");

@@ -23,7 +23,7 @@ fn restored_states_are_validated() {
     // a stored internal step that no longer matches the parameter (e.g. crafted bytes) is refused
     let mut bad = p.clone();
     bad.model_mut().stepper.max_step = 1e-22;
-    assert!(bad.validate(&Experiment::default()).unwrap_err().contains("integrator state"));
+    assert!(bad.validate(&Experiment::default()).unwrap_err().contains("stepper.max_step"));
     let mut bad = p.clone();
     bad.model_mut().x[W] = f64::NAN;
     assert!(bad.validate(&Experiment::default()).unwrap_err().contains("not finite"));

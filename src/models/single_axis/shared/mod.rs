@@ -1,7 +1,9 @@
-//! What the single-axis PID and PI^λD^μ controllers share: the law parameters from their declared
-//! variables, the sample-time rule, and what each call does with the law.
+//! What the single-axis PID and PI^λD^μ controllers share: the laws (`laws`), the law parameters
+//! from their declared variables, the sample-time rule, and what each call does with the law.
 
-use crate::math::fractional::{FopidLaw, FopidParams, PidLaw};
+pub mod laws;
+
+use laws::{FopidLaw, FopidParams, PidLaw};
 
 /// Law parameters from the declared variables (the bounds were checked by the FMI layer).
 #[allow(clippy::too_many_arguments)]
@@ -9,12 +11,23 @@ pub fn law_params(kp: f64, ki: f64, kd: f64, lambda: f64, mu: f64, step: f64, gl
     FopidParams { kp, ki, kd, lambda, mu, h: step, memory: gl_memory.max(0) as usize, history_before_start: history_before_start == 1 }
 }
 
-/// The GL history is sampled at `step`: any other communication step is an error.
-pub fn check_step(h: f64, step: f64) -> Result<(), String> {
-    if (h - step).abs() > 1e-9 * step {
-        return Err(format!("communication step {h} s differs from the sample time parameter step = {step} s (the error history is sampled at step)"));
+/// Most samples one communication step may take (as the plants' internal steps): bounds the work
+/// and the history growth of one fmi2DoStep.
+pub const MAX_SAMPLES_PER_STEP: usize = 1_000_000;
+
+/// The GL history is sampled at `step`: a communication step must be an integer multiple k >= 1 of
+/// it (to 1e-9 relative), and then takes k samples; any other step is an error.
+pub fn samples_in_step(h: f64, step: f64) -> Result<usize, String> {
+    let k = (h / step).round();
+    if !(k >= 1.0 && (h - k * step).abs() <= 1e-9 * h) {
+        return Err(format!(
+            "communication step {h} s is not an integer multiple of the sample time parameter step = {step} s (the error history is sampled at step)"
+        ));
     }
-    Ok(())
+    if k > MAX_SAMPLES_PER_STEP as f64 {
+        return Err(format!("communication step {h} s would take {k} samples of step = {step} s (at most {MAX_SAMPLES_PER_STEP} per doStep)"));
+    }
+    Ok(k as usize)
 }
 
 /// The two laws as the FMUs use them: the output for the current error, and the error of t_n appended
@@ -52,9 +65,13 @@ pub fn sampled_output(law: &impl SampledLaw, theta_ref: f64, theta: f64) -> Resu
     Ok((u, e))
 }
 
-/// One sample: the step must equal the sample time, then the error of t_n joins the history.
+/// One communication step of k samples (see [`samples_in_step`]): the inputs are held over the step,
+/// so the error of t_n joins the history k times (the law is sampled at t_n, t_n + step, …).
 pub fn sampled_step(law: &mut impl SampledLaw, h: f64, step: f64, theta_ref: f64, theta: f64) -> Result<(), String> {
-    check_step(h, step)?;
-    law.push(theta_ref - theta);
+    let k = samples_in_step(h, step)?;
+    let e = theta_ref - theta;
+    for _ in 0..k {
+        law.push(e);
+    }
     Ok(())
 }

@@ -1,0 +1,394 @@
+//! The single-axis controllers' laws: the fractional PI^λD^μ law on Grünwald–Letnikov sums
+//! (`crate::math::fractional`) and the integer PID written with a running sum ([Khatoonabadi-FO]
+//! Eqs. 16–17).
+//!
+//! Both store the error history once and nothing else that evolves: what the GL sums keep besides it
+//! (weights, pending block products, partial sums of weights, the PID's running sum) is rebuilt from
+//! the history when a state is decoded, with the same arithmetic in the same order as the online
+//! pushes, so a restored law continues bit-identically. The serialized form is the parameters and
+//! the history (8 bytes per sample).
+
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+use crate::math::fractional::GlKernel;
+
+/// Longest GL memory in samples (80 MB of history): bounds what a parameter or a decoded state can
+/// make the law allocate.
+pub const MAX_MEMORY: usize = 10_000_000;
+
+/// Parameters of the PI^λD^μ law u_n = K_P e_n + K_I D^{-λ} e_n + K_D D^μ e_n ([Khatoonabadi-FO] Eqs. 16–17).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FopidParams {
+    pub kp: f64,
+    pub ki: f64,
+    pub kd: f64,
+    pub lambda: f64,
+    pub mu: f64,
+    /// Sample time h (s).
+    pub h: f64,
+    /// GL memory in samples (0 = full memory).
+    pub memory: usize,
+    /// true: the derivative sees e_k = e_0 for k < 0 (no derivative kick); false: e_k = 0.
+    pub history_before_start: bool,
+}
+
+impl FopidParams {
+    /// Checks the values; the message names the offending parameter.
+    pub fn validate(&self) -> Result<(), String> {
+        for (n, v) in [("kp", self.kp), ("ki", self.ki), ("kd", self.kd)] {
+            if !v.is_finite() {
+                return Err(format!("parameter {n} = {v} is not finite"));
+            }
+        }
+        for (n, v) in [("lambda", self.lambda), ("mu", self.mu)] {
+            if !(v.is_finite() && (0.0..=2.0).contains(&v)) {
+                return Err(format!("parameter {n} = {v} must lie in [0, 2]"));
+            }
+        }
+        if !(self.h.is_finite() && self.h > 0.0) {
+            return Err(format!("parameter step = {} must be > 0", self.h));
+        }
+        if self.memory > MAX_MEMORY {
+            return Err(format!("parameter gl_memory = {} must lie in [0, {MAX_MEMORY}]", self.memory));
+        }
+        Ok(())
+    }
+}
+
+/// What a law's state is on the wire: its parameters and the error history.
+#[derive(Serialize)]
+struct StoredRef<'a> {
+    p: &'a FopidParams,
+    fast: bool,
+    history: &'a [f64],
+}
+
+#[derive(Deserialize)]
+struct Stored {
+    p: FopidParams,
+    fast: bool,
+    history: Vec<f64>,
+}
+
+/// Fractional PI^λD^μ law on the GL sums; the error history is the whole state.
+#[derive(Clone)]
+pub struct FopidLaw {
+    p: FopidParams,
+    fast: bool,
+    /// e_0 … e_{n-1}
+    history: Vec<f64>,
+    // derived from p and the history (never serialized)
+    integral: GlKernel,
+    derivative: GlKernel,
+    /// partial sums S_n = Σ_{j≤n} w_j of the derivative weights (history_before_start only)
+    wsum: Vec<f64>,
+    /// h^{λ}, h^{-μ}
+    scale_i: f64,
+    scale_d: f64,
+}
+
+impl Serialize for FopidLaw {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        StoredRef { p: &self.p, fast: self.fast, history: &self.history }.serialize(s)
+    }
+}
+
+impl<'de> Deserialize<'de> for FopidLaw {
+    /// Checks the parameters (so that nothing is allocated from absurd ones), then rebuilds the
+    /// derived buffers from the history.
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let s = Stored::deserialize(d)?;
+        FopidLaw::from_history(s.p, s.fast, s.history).map_err(serde::de::Error::custom)
+    }
+}
+
+impl FopidLaw {
+    pub fn new(p: FopidParams) -> Result<Self, String> {
+        Self::with_evaluation(p, true)
+    }
+
+    /// `fast` = false evaluates every GL sum directly (reference and benchmark).
+    pub fn with_evaluation(p: FopidParams, fast: bool) -> Result<Self, String> {
+        Self::from_history(p, fast, Vec::new())
+    }
+
+    /// The law after the samples `history` were pushed one by one (bit-identical to the online pushes).
+    pub fn from_history(p: FopidParams, fast: bool, history: Vec<f64>) -> Result<Self, String> {
+        p.validate()?;
+        let integral = if p.ki != 0.0 { GlKernel::rebuild(-p.lambda, p.memory, fast, &history) } else { GlKernel::new(-p.lambda, p.memory, fast) };
+        let derivative = GlKernel::rebuild(p.mu, p.memory, fast, &history);
+        let mut law = FopidLaw { p, fast, history, integral, derivative, wsum: Vec::new(), scale_i: p.h.powf(p.lambda), scale_d: p.h.powf(-p.mu) };
+        if p.history_before_start {
+            law.extend_wsum(if p.memory > 0 { p.memory } else { 1 });
+            law.extend_wsum(law.history.len() + 1);
+        }
+        Ok(law)
+    }
+
+    pub fn params(&self) -> &FopidParams {
+        &self.p
+    }
+    /// Number of samples in the history.
+    pub fn len(&self) -> usize {
+        self.history.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.history.is_empty()
+    }
+    pub fn history(&self) -> &[f64] {
+        &self.history
+    }
+
+    /// D^{-λ} e_n and D^μ e_n for the current error e_n (state unchanged).
+    pub fn terms(&self, e: f64) -> (f64, f64) {
+        let i = if self.p.ki != 0.0 { self.scale_i * self.integral.eval(&self.history, e) } else { 0.0 };
+        let mut d = self.derivative.eval(&self.history, e);
+        if self.p.history_before_start {
+            // e_k = e_0 for k < 0 adds e_0 Σ_{j=n+1}^{L-1} w_j (full memory: Σ_{j>n} w_j = S_∞ - S_n,
+            // with S_∞ = 0 for μ > 0 and 1 for μ = 0)
+            let e0 = self.history.first().copied().unwrap_or(e);
+            d += e0 * self.tail_weight();
+        }
+        (i, self.scale_d * d)
+    }
+
+    /// Σ_{j=n+1}^{L-1} w_j for the derivative (full memory: S_∞ - S_n with S_∞ = 0 for μ > 0, 1 for μ = 0).
+    fn tail_weight(&self) -> f64 {
+        let n = self.history.len();
+        let s = &self.wsum;
+        let mem = self.p.memory;
+        if mem > 0 {
+            if n + 1 >= mem { 0.0 } else { s[mem - 1] - s[n] }
+        } else {
+            let s_inf = if self.p.mu == 0.0 { 1.0 } else { 0.0 };
+            s_inf - s[n]
+        }
+    }
+
+    fn extend_wsum(&mut self, len: usize) {
+        while self.wsum.len() < len {
+            let j = self.wsum.len();
+            let w = self.derivative.weight(j);
+            self.wsum.push(self.wsum.last().copied().unwrap_or(0.0) + w);
+        }
+    }
+
+    /// Control output u_n for the current error e_n (state unchanged).
+    pub fn output(&self, e: f64) -> f64 {
+        let (i, d) = self.terms(e);
+        self.p.kp * e + self.p.ki * i + self.p.kd * d
+    }
+
+    /// Appends e_n to the history (called once per sample with the error of t_n).
+    pub fn push(&mut self, e: f64) {
+        self.history.push(e);
+        if self.p.ki != 0.0 {
+            self.integral.push(&self.history);
+        }
+        self.derivative.push(&self.history);
+        if self.p.history_before_start {
+            let n = self.history.len();
+            self.extend_wsum(n + 1);
+        }
+    }
+}
+
+/// Integer PID u_n = K_P e_n + K_I h Σ_{j} e_{n-j} + K_D (e_n - e_{n-1})/h: the λ = μ = 1 case of
+/// [`FopidLaw`] written with a running sum and a backward difference (O(1) per step). With a memory
+/// L > 0 the sum covers the last L samples (short-memory principle).
+#[derive(Clone)]
+pub struct PidLaw {
+    p: FopidParams,
+    /// whole error history (the integral window and the state to save)
+    history: Vec<f64>,
+    /// Σ of the samples inside the memory window (derived from the history, never serialized)
+    sum: f64,
+}
+
+impl Serialize for PidLaw {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        StoredRef { p: &self.p, fast: true, history: &self.history }.serialize(s)
+    }
+}
+
+impl<'de> Deserialize<'de> for PidLaw {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let s = Stored::deserialize(d)?;
+        // the PID is the λ = μ = 1 law with the exact running sum: anything else is not its state
+        if !s.fast || s.p.lambda != 1.0 || s.p.mu != 1.0 {
+            return Err(serde::de::Error::custom("PID law state with orders other than 1 or without fast = true"));
+        }
+        PidLaw::from_history(s.p, s.history).map_err(serde::de::Error::custom)
+    }
+}
+
+impl PidLaw {
+    pub fn new(p: FopidParams) -> Result<Self, String> {
+        Self::from_history(p, Vec::new())
+    }
+
+    /// The law after the samples `history` were pushed one by one (bit-identical running sum).
+    pub fn from_history(mut p: FopidParams, history: Vec<f64>) -> Result<Self, String> {
+        p.lambda = 1.0;
+        p.mu = 1.0;
+        p.validate()?;
+        let mut law = PidLaw { p, history: Vec::with_capacity(history.len()), sum: 0.0 };
+        for e in history {
+            law.push(e);
+        }
+        Ok(law)
+    }
+
+    pub fn len(&self) -> usize {
+        self.history.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.history.is_empty()
+    }
+    pub fn history(&self) -> &[f64] {
+        &self.history
+    }
+
+    pub fn output(&self, e: f64) -> f64 {
+        let n = self.history.len();
+        let mem = self.p.memory;
+        // window Σ_{j=0}^{min(n, L-1)} e_{n-j}
+        let dropped = if mem > 0 && n + 1 > mem { self.history[n - mem] } else { 0.0 };
+        let window = self.sum + e - dropped;
+        let prev = match self.history.last() {
+            Some(&x) => x,
+            None if self.p.history_before_start => e,
+            None => 0.0,
+        };
+        // short memory with L = 1 drops e_{n-1} from the derivative too
+        let prev = if mem == 1 { 0.0 } else { prev };
+        self.p.kp * e + self.p.ki * (self.p.h * window) + self.p.kd * ((e - prev) / self.p.h)
+    }
+
+    pub fn push(&mut self, e: f64) {
+        let n = self.history.len();
+        let mem = self.p.memory;
+        self.sum += e;
+        if mem > 0 && n + 1 > mem {
+            self.sum -= self.history[n - mem];
+        }
+        self.history.push(e);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::fractional::gl_weights;
+
+    fn signal(n: usize) -> Vec<f64> {
+        (0..n).map(|k| (0.013 * k as f64).sin() + 0.3 * (0.0071 * k as f64 * k as f64 % 7.0).cos() - 0.2).collect()
+    }
+
+    fn params(kp: f64, ki: f64, kd: f64, lambda: f64, mu: f64) -> FopidParams {
+        FopidParams { kp, ki, kd, lambda, mu, h: 0.001, memory: 0, history_before_start: false }
+    }
+
+    #[test]
+    fn fopid_with_unit_orders_equals_pid() {
+        for hbs in [false, true] {
+            for mem in [0usize, 1, 2, 50, 3000] {
+                let p = FopidParams { memory: mem, history_before_start: hbs, ..params(2.0, 0.1, 8.0, 1.0, 1.0) };
+                let mut f = FopidLaw::new(p).unwrap();
+                let mut q = PidLaw::new(p).unwrap();
+                for (n, &e) in signal(20_000).iter().enumerate() {
+                    let (a, b) = (f.output(e), q.output(e));
+                    assert!((a - b).abs() < 1e-12 * b.abs().max(1.0), "L={mem} hbs={hbs} n={n}: {a} vs {b}");
+                    f.push(e);
+                    q.push(e);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn history_before_start_removes_derivative_kick() {
+        let e0 = 0.5;
+        for mu in [1.0, 0.7, 1.5] {
+            for mem in [0usize, 30] {
+                let p = FopidParams { memory: mem, history_before_start: true, ..params(0.0, 0.0, 1.0, 1.0, mu) };
+                let mut f = FopidLaw::new(p).unwrap();
+                // constant error that has always been there: full memory gives D^μ = 0; short memory
+                // gives the truncated sum e_0 h^{-μ} Σ_{j<L} w_j from the first sample on (no kick)
+                let expect = if mem == 0 { 0.0 } else { e0 * 1000f64.powf(mu) * gl_weights(mu, mem).iter().sum::<f64>() };
+                for _ in 0..200 {
+                    assert!((f.output(e0) - expect).abs() < 1e-9 * expect.abs().max(1.0), "μ={mu} L={mem}: {} vs {expect}", f.output(e0));
+                    f.push(e0);
+                }
+                let p0 = FopidParams { history_before_start: false, ..p };
+                let f0 = FopidLaw::new(p0).unwrap();
+                assert!((f0.output(e0) - e0 * 1000f64.powf(mu)).abs() < 1e-9);
+            }
+        }
+        // μ = 0: D^0 e = e whatever the option
+        let f = FopidLaw::new(FopidParams { history_before_start: true, ..params(0.0, 0.0, 1.0, 1.0, 0.0) }).unwrap();
+        assert!((f.output(0.3) - 0.3).abs() < 1e-15);
+    }
+
+    #[test]
+    fn bad_parameters_are_named() {
+        let e = FopidLaw::new(params(1.0, 1.0, 1.0, 2.5, 1.0)).err().unwrap();
+        assert!(e.contains("lambda"), "{e}");
+        let e = FopidLaw::new(params(1.0, 1.0, 1.0, 1.0, -0.1)).err().unwrap();
+        assert!(e.contains("mu"), "{e}");
+        let e = FopidLaw::new(params(f64::NAN, 1.0, 1.0, 1.0, 1.0)).err().unwrap();
+        assert!(e.contains("kp"), "{e}");
+    }
+
+    #[test]
+    fn serialized_state_continues_bit_identically() {
+        let p = FopidParams { ..params(2.0, 0.3, 5.0, 0.8, 1.3) };
+        let mut a = FopidLaw::new(p).unwrap();
+        let e = signal(6000);
+        for &x in &e[..2500] {
+            a.push(x);
+        }
+        let bytes = postcard::to_allocvec(&a).unwrap();
+        let mut b: FopidLaw = postcard::from_bytes(&bytes).unwrap();
+        for &x in &e[2500..] {
+            assert_eq!(a.output(x).to_bits(), b.output(x).to_bits());
+            a.push(x);
+            b.push(x);
+        }
+    }
+
+    #[test]
+    fn state_is_the_history_once_and_restores_bit_identically() {
+        let e = signal(20_000);
+        for (hbs, mem, ki) in [(false, 0usize, 0.3), (true, 0, 0.3), (true, 300, 0.0), (false, 5000, 0.2)] {
+            let p = FopidParams { memory: mem, history_before_start: hbs, ..params(2.0, ki, 5.0, 0.8, 1.3) };
+            let mut a = FopidLaw::new(p).unwrap();
+            let mut q = PidLaw::new(p).unwrap();
+            for &x in &e[..12_345] {
+                a.push(x);
+                q.push(x);
+            }
+            let bytes = postcard::to_allocvec(&a).unwrap();
+            // 8 bytes per sample plus the parameters
+            assert!(bytes.len() <= 8 * 12_345 + 80, "{} bytes for 12,345 samples", bytes.len());
+            let mut b: FopidLaw = postcard::from_bytes(&bytes).unwrap();
+            let qb = postcard::to_allocvec(&q).unwrap();
+            assert!(qb.len() <= 8 * 12_345 + 80);
+            let mut r: PidLaw = postcard::from_bytes(&qb).unwrap();
+            for &x in &e[12_345..] {
+                assert_eq!(a.output(x).to_bits(), b.output(x).to_bits(), "hbs={hbs} L={mem}");
+                assert_eq!(q.output(x).to_bits(), r.output(x).to_bits(), "hbs={hbs} L={mem}");
+                a.push(x);
+                b.push(x);
+                q.push(x);
+                r.push(x);
+            }
+        }
+        // absurd parameters in a decoded state are refused before anything is allocated
+        let p = FopidParams { memory: usize::MAX / 2, history_before_start: true, ..params(1.0, 1.0, 1.0, 0.5, 0.5) };
+        let bytes = postcard::to_allocvec(&StoredRef { p: &p, fast: true, history: &[0.1, 0.2] }).unwrap();
+        let err = postcard::from_bytes::<FopidLaw>(&bytes).err().unwrap();
+        let _ = err;
+        assert!(FopidLaw::new(p).err().unwrap().contains("gl_memory"));
+    }
+}
