@@ -80,7 +80,7 @@ impl LeaderOrbit {
         Ok(Vector3::new(self.mu * num_x / (r * r * rf3), -self.mu * rho.y / rf3, -self.mu * rho.z / rf3))
     }
 
-    /// G(ρ, ρ̇) of ρ̈ + G = F/m + d (relative-orbit-plant.md; third row μ z/ρ_f³):
+    /// G(ρ, ρ̇) of ρ̈ + G = F/m + d (the relative-orbit equations of the formation family; third row μ z/ρ_f³):
     /// G = [−2θ̇ẏ − θ̈y − θ̇²x + μ(R+x)/ρ_f³ − μ/R² ; 2θ̇ẋ + θ̈x − θ̇²y + μy/ρ_f³ ; μz/ρ_f³].
     pub fn g_term(&self, nu: f64, rho: &Vector3<f64>, rho_dot: &Vector3<f64>) -> Result<Vector3<f64>, String> {
         let td = self.theta_dot(nu);
