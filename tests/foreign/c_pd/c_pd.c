@@ -60,7 +60,11 @@ static void logmsg(Instance *c, fmi2Status status, const char *category, const c
     va_start(ap, fmt);
     vsnprintf(buf, sizeof buf, fmt, ap);
     va_end(ap);
-    c->cb.logger(c->cb.componentEnvironment, c->name, status, category, "%s", buf);
+    /* the message goes as the format string with no arguments: masters such as fmpy cannot expand C
+     * varargs. A '%' would be read as a conversion by the masters that do, so none is passed on. */
+    for (char *p = buf; *p; p++)
+        if (*p == '%') *p = '#';
+    c->cb.logger(c->cb.componentEnvironment, c->name, status, category, buf);
 }
 
 static void set_defaults(Instance *c) {
@@ -127,9 +131,9 @@ FMI2_Export fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuT
     if (fmuType != fmi2CoSimulation || !fmuGUID || strcmp(fmuGUID, MODEL_GUID) != 0) {
         if (functions->logger)
             functions->logger(functions->componentEnvironment, instanceName ? instanceName : "?", fmi2Error,
-                              "logStatusError", "fmi2Instantiate: %s",
-                              fmuType != fmi2CoSimulation ? "only Co-Simulation is supported"
-                                                          : "GUID does not match the modelDescription");
+                              "logStatusError",
+                              fmuType != fmi2CoSimulation ? "fmi2Instantiate: only Co-Simulation is supported"
+                                                          : "fmi2Instantiate: GUID does not match the modelDescription");
         return NULL;
     }
     Instance *c = calloc(1, sizeof *c);
