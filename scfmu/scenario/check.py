@@ -110,11 +110,11 @@ def check(scenario: Scenario, instantiate: bool = True) -> Report:
         return rep
     ports = {c.name: ([n for n, v in vars_of[c.name].items() if v.causality == "input"],
                       [n for n, v in vars_of[c.name].items() if v.causality == "output"]) for c in sc.components}
-    try:
-        links = sc.wiring(ports)
-    except (KeyError, ValueError) as e:
-        rep.errors.append(f"wiring: {e.args[0] if e.args else e}")
+    problems = sc.wiring_problems(ports)
+    if problems:
+        rep.errors += [f"wiring: {x}" for x in problems]
         return rep
+    links = sc.wiring(ports)
     for d, di, s, so in links:
         vd, vs = vars_of[d][di], vars_of[s][so]
         what = f"{s}.{so} -> {d}.{di}"

@@ -226,6 +226,36 @@ class Scenario:
                     links.append((dst, self.native_name(dst, inp), src, self.native_name(src, out)))
         return links
 
+    def wiring_problems(self, ports: dict[str, tuple[list[str], list[str]]]) -> list[str]:
+        """Every reason :meth:`wiring` would refuse, not only the first (inputs without a source or with
+        several, explicit connections naming unknown ports)."""
+        try:
+            self.wiring(ports)
+            return []
+        except (KeyError, ValueError):
+            pass
+        out = []
+        names = [c.name for c in self.components]
+        ours = {n: ([self.alias(n, p) for p in ports[n][0]], [self.alias(n, p) for p in ports[n][1]]) for n in names}
+        for dst, src in self.connections.items():
+            di, _, dv = dst.partition(".")
+            si, _, sv = src.partition(".")
+            if di not in ours or dv not in ours[di][0]:
+                out.append(f"connection {dst} <- {src}: no input {dst}")
+            if si not in ours or sv not in ours[si][1]:
+                out.append(f"connection {dst} <- {src}: no output {src}")
+        for dst in names:
+            for inp in ours[dst][0]:
+                q = f"{dst}.{inp}"
+                if q in self.connections or q in self.inputs:
+                    continue
+                sources = [s for s in names if s != dst and inp in ours[s][1]] if self.auto_connect else []
+                if len(sources) > 1:
+                    out.append(f"input {q} has several sources {sources}")
+                elif not sources and not self._is_unconnected(dst, inp):
+                    out.append(f"input {q} has no source")
+        return out
+
     def _is_unconnected(self, inst: str, port: str) -> bool:
         for pat in self.unconnected:
             if "." in pat:
