@@ -133,6 +133,9 @@ def formation(r: dict) -> dict:
         out[f"settling_{a}_s"] = s
         out[f"overshoot_{a}_pct"] = overshoot_percent(r[f"pos_{a}"], ref)
         out[f"final_error_{a}_m"] = float(e[i, -1])
+        out[f"sse_{a}_m"] = steady_state_error(r[f"pos_{a}"], ref)
+        out[f"peak_force_{a}"] = float(np.max(np.abs(f[i])))
+        out[f"effort_abs_{a}"] = float(np.sum(np.abs(f[i, :-1]) * dt))
         out[f"dist_est_end_{a}"] = _last(r, f"dist_est_{a}")
         st.append(s)
     out["settling_s"] = max(st) if not any(math.isnan(x) for x in st) else math.nan
@@ -165,7 +168,8 @@ EXTRA = {
     "attitude": _ANGLE_COLS,
     "attitude_nometrics": _ANGLE_COLS,
     "formation": [f"{k}_{a}{u}" for a in "xyz" for k, u in (("settling", "_s"), ("overshoot", "_pct"),
-                                                           ("final_error", "_m"), ("dist_est_end", ""))] + ["peak_force"],
+                                                           ("final_error", "_m"), ("sse", "_m"), ("peak_force", ""),
+                                                           ("effort_abs", ""), ("dist_est_end", ""))] + ["peak_force"],
     "single_axis": ["overshoot_pct", "peak_torque"],
 }
 _ATT_LOGS = ("alpha_deg", "eulerint_deg_s", "ise", "isf", "effort_abs", "effort_sq", "roll", "pitch", "yaw",

@@ -28,7 +28,7 @@ import numpy as np
 
 from ...fmu import Fmu
 from . import scenarios
-from ...metrics import overshoot_percent, settling_time
+from ...metrics import attitude as attitude_metrics
 from ...results import write_csv
 from ...engines import simulate as run_scenario
 
@@ -58,14 +58,14 @@ def simulate(run: Run, t_end: float, dt: float) -> dict:
 
 
 def summarize(run: Run, r: dict) -> dict:
-    t = r["time"]
-    cmd = COMMANDS[run.command]
+    """The study's row, from the ``attitude`` metric set (the function the campaigns and the report use)."""
+    m = attitude_metrics(r)
     row = {"run": run.run_id, "controller": run.controller, "label": run.label, "kinematics": run.kinematics,
-           "command": run.command, "eulerint_deg_s": r["eulerint_deg_s"][-1], "effort_abs_Nms": r["effort_abs"][-1],
-           "effort_sq_N2m2s": r["effort_sq"][-1], "alpha_end_deg": r["alpha_deg"][-1]}
-    for i, ang in enumerate(ANGLES):
-        row[f"ts_{ang}_s"] = settling_time(t, r[ang], cmd[i])
-        row[f"os_{ang}_pct"] = overshoot_percent(r[ang], cmd[i])
+           "command": run.command, "eulerint_deg_s": m["eulerint_deg_s"], "effort_abs_Nms": m["effort_abs"],
+           "effort_sq_N2m2s": m["effort_sq"], "alpha_end_deg": m["final_error"]}
+    for ang in ANGLES:
+        row[f"ts_{ang}_s"] = m[f"settling_{ang}_s"]
+        row[f"os_{ang}_pct"] = m[f"overshoot_{ang}_pct"]
     return row
 
 

@@ -27,7 +27,7 @@ import numpy as np
 
 from . import scenarios
 from ...engines.native import NativeLoop
-from ...metrics import overshoot_percent, settling_time, steady_state_error
+from ...metrics import formation as formation_metrics
 from ...results import write_csv
 
 AX = "xyz"
@@ -48,19 +48,19 @@ def run_case(t2: float, c: float, dist: float, dt: float, t_end: float) -> dict[
 
 
 def metrics(out: dict, dist: float, dt: float) -> dict:
-    t = out["time"]
+    """The per-axis and per-run numbers this command prints, taken from the ``formation`` metric set (the
+    same function the campaigns and the report use), under this command's column names."""
     m = {}
-    f = np.stack([out[f"force_{a}"] for a in AX], axis=1)
-    for i, a in enumerate(AX):
-        y, r = out[f"pos_{a}"], REF[i]
-        m[f"settling_{a}"] = settling_time(t, y, r)
-        m[f"overshoot_{a}"] = overshoot_percent(y, r)
-        m[f"peak_F_{a}"] = float(np.max(np.abs(f[:, i])))
-        m[f"int_abs_F_{a}"] = float(np.sum(np.abs(f[:-1, i])) * dt)
-        m[f"sse_{a}"] = steady_state_error(y, r)
-        m[f"dist_est_end_{a}"] = float(out[f"dist_est_{a}"][-1])
-    m["int_sum_abs_F"] = float(np.sum(np.abs(f[:-1])) * dt)
-    m["int_F2"] = float(np.sum(f[:-1] ** 2) * dt)
+    f = formation_metrics(out)
+    for a in AX:
+        m[f"settling_{a}"] = f[f"settling_{a}_s"]
+        m[f"overshoot_{a}"] = f[f"overshoot_{a}_pct"]
+        m[f"peak_F_{a}"] = f[f"peak_force_{a}"]
+        m[f"int_abs_F_{a}"] = f[f"effort_abs_{a}"]
+        m[f"sse_{a}"] = f[f"sse_{a}_m"]
+        m[f"dist_est_end_{a}"] = f[f"dist_est_end_{a}"]
+    m["int_sum_abs_F"] = f["effort_abs"]
+    m["int_F2"] = f["effort_sq"]
     m["dist"] = dist
     return m
 
