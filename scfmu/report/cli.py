@@ -137,6 +137,7 @@ def main(argv=None) -> int:
                      "give, which we had to choose). Sensitivity blocks show the values tried and where the claim "
                      "holds."}
     html_path, md_path = render.render(sections, args.out, meta)
+    print("\n" + render.numbers_text(sections))
     print("\n" + render.claims_text(sections))
     print(f"\nreport: {html_path.resolve()}\nmarkdown: {md_path.resolve()}\n"
           f"total {time.time() - t_all:.1f} s, runs per paper: {dict(ctx.runs)}")
