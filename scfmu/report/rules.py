@@ -227,11 +227,12 @@ def tally(verdicts: Iterable[str]) -> dict:
 def combine_faithful(nominal: bool, readings: dict) -> tuple[str, list[str], list[str]]:
     """Like ``combine`` for readings ``{name: (holds, moves_away)}``, where ``moves_away`` says that the
     reading moves our values of the paper's own reported numbers further from them. Such a reading is never
-    support: where the claim holds only under it, it counts as failing. Returns (verdict, names of readings
-    that support the claim, names of readings under which it holds only by moving away from the paper)."""
+    support (nor a counter-example): it is left out of the verdict and listed. Returns (verdict, names of
+    readings that support the claim, names of readings under which it holds only by moving away from the
+    paper)."""
     support = [n for n, (h, away) in readings.items() if h and not away]
     away = [n for n, (h, a) in readings.items() if h and a]
-    vals = [bool(nominal)] + [bool(h) and not a for h, a in readings.values()]
+    vals = [bool(nominal)] + [bool(h) for h, a in readings.values() if not a]
     if all(vals):
         v = CONFIRMED
     elif not any(vals):
