@@ -444,3 +444,63 @@ def write_verdicts(sections: list[PaperSection], path: Path, meta: dict | None =
     d = {"quick": bool((meta or {}).get("quick")), **verdicts_of(sections)}
     path.write_text(json.dumps(d, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
     return path
+
+
+# ----- the docs pages' "paper vs ours" tables -------------------------------------------------------------
+DOC_BEGIN = "<!-- numbers:begin (written by `scfmu report --docs docs`; do not edit by hand) -->"
+DOC_END = "<!-- numbers:end -->"
+
+
+def read_numbers_csv(path: Path) -> list[dict]:
+    with open(path, newline="", encoding="utf-8") as f:
+        return list(csv.DictReader(f))
+
+
+def _g4(text: str) -> str:
+    """A CSV number with 4 significant digits (text that is not a number unchanged)."""
+    try:
+        return f"{float(text):.4g}"
+    except ValueError:
+        return text
+
+
+def docs_table(rows: list[dict], paper: str) -> str:
+    """The Markdown table a docs/paperNNN.md page opens with, from numbers.csv rows of one paper."""
+    out = [DOC_BEGIN, "", "| item | unit | paper | ours | difference | verdict | calibration |", "|---|---|---:|---:|---:|---|---|"]
+    for r in rows:
+        if r["paper"] != paper:
+            continue
+        rd = r["relative difference"]
+        rd = f"{100 * float(rd):+.1f} %" if rd else "–"
+        out.append("| " + " | ".join(_md(x) for x in (r["item"], r["unit"], r["paper value"] or "–",
+                                                      _g4(r["our value"]) or "–", rd, r["verdict"],
+                                                      r["used for calibration"])) + " |")
+    n = [r for r in rows if r["paper"] == paper]
+    counts = {v: sum(1 for r in n if r["verdict"] == v) for v in NUMBER_VERDICTS}
+    out += ["", "Counts: " + ", ".join(f"{v} {k}" for v, k in counts.items())
+            + f"; independent checks {sum(1 for r in n if r['used for calibration'] == 'no' and r['verdict'] != NOT_CHECKABLE)}"
+            f" of {len(n)}.", "", DOC_END]
+    return "\n".join(out)
+
+
+def doc_block(text: str) -> str | None:
+    """The generated block of a docs page (None when the page has none)."""
+    i, j = text.find(DOC_BEGIN), text.find(DOC_END)
+    return None if i < 0 or j < i else text[i:j + len(DOC_END)]
+
+
+def update_docs(docs_dir: Path, csv_path: Path) -> list[Path]:
+    """Rewrites the generated block of every docs/paperNNN.md that has one (papers present in the CSV)."""
+    rows = read_numbers_csv(csv_path)
+    done = []
+    for paper in sorted({r["paper"] for r in rows}):
+        p = Path(docs_dir) / f"paper{paper}.md"
+        if not p.exists():
+            continue
+        text = p.read_text(encoding="utf-8")
+        old = doc_block(text)
+        if old is None:
+            continue
+        p.write_text(text.replace(old, docs_table(rows, paper)), encoding="utf-8")
+        done.append(p)
+    return done

@@ -141,6 +141,8 @@ def rule_c7(m: dict, commands=("L2",)) -> tuple[bool, str]:
             ok &= better and best == "AdaptFuzzy"
             parts.append(f"{case}-{cmd}: AF OS {_os(af):.1f} % vs PD {_os(pd):.1f} %, ts {_ts(af):.1f} vs {_ts(pd):.1f} s, "
                          f"best EULERINT {ROBUST_CTRL[best]}")
+    if not parts:
+        return False, "no robustness run for the command(s) " + ", ".join(commands)
     return ok, "; ".join(parts)
 
 
@@ -238,7 +240,7 @@ def sweeps(quick: bool) -> list[dict]:
                       [scenarios.T_R_UNCONSTRAINED, scenarios.T_R_CALIBRATED, 45.0]),
              default=scenarios.T_R_CALIBRATED, runs=fuzzy_runs, claims=main),
         dict(param="AdaptiveFuzzyController λ-range scale s", key="lam_scale", unit="",
-             values=g(sorted(geo(0.5, 16.0, 24) + [1.0]), [1.0, 4.0, 12.0]), default=1.0, runs=af_runs, claims=main),
+             values=g(sorted(geo(0.5, 16.0, 24) + [1.0]), [1.0, 1.3, 4.0, 12.0]), default=1.0, runs=af_runs, claims=main),
         dict(param="AdaptiveFuzzyController.e_scale", key="controller.e_scale", unit="",
              values=g(geo(0.1, 4.0, 20), [0.25, 3.0]), default=1.0, runs=af_runs, claims=main),
         dict(param="AdaptiveFuzzyController.edot_scale", key="controller.edot_scale", unit="1/s",
