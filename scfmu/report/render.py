@@ -41,6 +41,7 @@ h3{margin-top:1.6em}
 table{border-collapse:collapse;margin:.6em 0 1.2em 0;font-size:.92em}
 th,td{border:1px solid #d0d7de;padding:.3em .6em;text-align:left;vertical-align:top}
 th{background:#f6f8fa}
+#glance td,#glance th{padding:.2em .45em;font-size:.9em}
 td.num{text-align:right;font-variant-numeric:tabular-nums;white-space:nowrap}
 caption{caption-side:top;text-align:left;font-weight:600;padding:.2em 0}
 .badge{display:inline-block;border-radius:1em;padding:.05em .7em;font-size:.85em;font-weight:600;white-space:nowrap}
@@ -254,7 +255,9 @@ def summary_html(sections: list[PaperSection]) -> str:
     rows = []
     for s in sections:
         d = paper_summary(s)
-        rows.append(f"<tr><td><a href=\"#paper{_e(s.paper)}\">{_e(s.paper)}</a></td><td>{_e(s.title)}</td>"
+        short = s.title if len(s.title) <= 48 else s.title[:47].rstrip() + "…"
+        rows.append(f"<tr><td><a href=\"#paper{_e(s.paper)}\">{_e(s.paper)}</a></td>"
+                    f"<td title=\"{_e(s.title)}\">{_e(short)}</td>"
                     + "".join(f"<td class=\"num\">{d[v]}</td>" for v in NUMBER_VERDICTS)
                     + f"<td class=\"num\"><a href=\"#numbers{_e(s.paper)}\">{d['independent']} of {d['numbers']}</a></td>"
                     + "".join(f"<td class=\"num\">{d[v]}</td>" for v in (CONFIRMED, DEPENDS, NOT_CONFIRMED))
