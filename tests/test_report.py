@@ -16,8 +16,12 @@ ROOT = Path(__file__).resolve().parents[1]
 
 from scfmu.report import cli as report_cli
 from scfmu.report import render, rules
-from scfmu.report.types import (CONFIRMED, DEPENDS, NOT_CONFIRMED, Claim, Figure, PaperSection,
-                                Sensitivity, Table)
+from scfmu.report.types import (CONFIRMED, DEPENDS, NOT_CHECKABLE, NOT_CONFIRMED, NOT_REPRODUCED, REPRODUCED,
+                                SAME_ORDERING, Claim, Figure, NumberRow, PaperSection, Sensitivity, Table)
+
+# The verdicts of the last full build (`scfmu report --workers 2`), claims and reported numbers: the quick
+# build must reach every one of them (it may run fewer points, never another set-up).
+FULL_VERDICTS = ROOT / "tests" / "data" / "report_full_verdicts.json"
 
 # The papers CI builds with --quick: every paper plug-in with a report section.
 CI_PAPERS = report_cli.papers_known()
@@ -164,6 +168,120 @@ def test_rules_basic():
     assert rules.holds_at(["a", "b", "c"], [True, False, True]) == "at a, c (2 of 3)"
 
 
+# ----- reported numbers: verdict rules on synthetic values (expected outcomes worked out by hand) ---------
+def test_number_rules():
+    assert rules.rel_diff(105.0, 100.0) == pytest.approx(0.05) and math.isnan(rules.rel_diff(1.0, 0.0))
+    assert rules.printed_precision("156.1") == pytest.approx(0.05)
+    assert rules.printed_precision("≈ 0.01") == pytest.approx(0.005)
+    assert rules.printed_precision("2954") == pytest.approx(0.5) and math.isnan(rules.printed_precision("–"))
+    # 5 % of the paper's value …
+    assert rules.number_verdict(104.9, 100.0) == REPRODUCED
+    assert rules.number_verdict(105.2, 100.0) == NOT_REPRODUCED
+    # … or the printed precision when larger: "≈ 0.01" stands for [0.005, 0.015]
+    assert rules.number_verdict(0.0122, 0.01, precision=0.005) == REPRODUCED
+    assert rules.number_verdict(0.0152, 0.01, precision=0.005) == NOT_REPRODUCED
+    assert rules.number_verdict(0.0152, 0.01, precision=0.005, ordering=True) == SAME_ORDERING
+    assert rules.number_verdict(None, 1.0) == NOT_CHECKABLE and rules.number_verdict(1.0, None) == NOT_CHECKABLE
+    assert rules.number_verdict(math.nan, 1.0, ordering=True) == NOT_CHECKABLE
+    # 6.4 times is not "more than 50 times"
+    assert rules.bound_verdict(6.4, 50.0) == NOT_REPRODUCED and rules.bound_verdict(51.0, 50.0) == REPRODUCED
+
+
+def test_same_ordering():
+    paper = [275.7, 156.1, 161.5, 156.1]          # Euler > DCM > quaternion = LQR
+    assert rules.same_ordering(0, [300, 100, 120, 100], paper)
+    assert rules.same_ordering(2, [300, 100, 120, 100], paper)
+    assert not rules.same_ordering(2, [300, 100, 90, 100], paper)   # DCM below quaternion: order broken
+    assert not rules.same_ordering(1, [300, 100, 120, 110], paper)  # the paper's tie is broken
+    assert not rules.same_ordering(0, [300], [275.7])                # nothing to rank against
+
+
+def test_nearest_candidate():
+    best, rd = rules.nearest(3.5, [1.44, 3.44, 5.44])
+    assert best == 3.44 and rd == pytest.approx(0.06 / 3.44)
+    assert math.isnan(rules.nearest(1.0, [])[0])
+
+
+def test_combine_faithful_never_counts_moving_away_as_support():
+    # holds at the default and at a faithful reading: confirmed
+    assert rules.combine_faithful(True, {"a": (True, False)})[0] == CONFIRMED
+    # fails at the default, holds only at a reading that moves the paper's numbers away: not confirmed
+    v, support, away = rules.combine_faithful(False, {"dcm 4": (True, True), "dcm 1": (False, False)})
+    assert v == NOT_CONFIRMED and support == [] and away == ["dcm 4"]
+    # the same reading without moving away would make it depend on the reading
+    assert rules.combine_faithful(False, {"dcm 4": (True, False)})[0] == DEPENDS
+    # a reading that breaks the claim only by moving away is no counter-example either
+    assert rules.combine_faithful(True, {"x": (False, True)})[0] == CONFIRMED
+
+
+def test_number_row_validates_and_computes_difference():
+    r = NumberRow("9", "x", "s", 100.0, 93.0, NOT_REPRODUCED)
+    assert r.rel_diff == pytest.approx(-0.07) and r.independent
+    assert not NumberRow("9", "y", "s", 1.0, 1.0, REPRODUCED, calibration=True).independent
+    assert not NumberRow("9", "z", "s", None, None, NOT_CHECKABLE).independent
+    with pytest.raises(ValueError):
+        NumberRow("9", "x", "s", 1.0, 1.0, CONFIRMED)     # a claim verdict is no number verdict
+
+
+def test_numbers_csv_summary_and_docs_table(tmp_path):
+    secs = synthetic_sections(tmp_path)
+    secs[0].numbers = [NumberRow("901", "EULERINT <a>", "deg·s", 156.1, 156.4, REPRODUCED, paper_text="156.1"),
+                       NumberRow("901", "effort", "N·m·s", 2954.0, 772.1, SAME_ORDERING),
+                       NumberRow("901", "fitted", "deg", 0.7, 0.7455, REPRODUCED, calibration=True)]
+    secs[1].numbers = [NumberRow("902", "lost", "–", None, None, NOT_CHECKABLE, note="no table survives")]
+    h, _ = render.render(secs, tmp_path, {"quick": False})
+    import csv as csv_
+    with open(tmp_path / "numbers.csv", newline="", encoding="utf-8") as f:
+        rows = list(csv_.reader(f))
+    assert rows[0][:8] == ["paper", "item", "unit", "paper value", "our value", "relative difference", "verdict",
+                           "used for calibration"]
+    assert rows[1][:8] == ["901", "EULERINT <a>", "deg·s", "156.1", "156.4", f"{0.3 / 156.1:.6g}", REPRODUCED, "no"]
+    assert rows[3][6:8] == [REPRODUCED, "yes"] and rows[4][3:8] == ["", "", "", NOT_CHECKABLE, "no"]
+    text = h.read_text(encoding="utf-8")
+    assert "EULERINT &lt;a&gt;" in text and 'id="glance"' in text and 'href="#numbers901"' in text
+    # the first page's counts per paper: 901 has 2 reproduced, 1 same ordering, 2 independent checks of 3
+    glance = text[text.index('id="glance"'):text.index("</table>", text.index('id="glance"'))]
+    row901 = glance[glance.index(">901<"):glance.index("</tr>", glance.index(">901<"))]
+    assert [c.split(">")[-1] for c in row901.split("</td>") if 'class="num"' in c][:4] == ["2", "1", "0", "0"]
+    assert "2 of 3</a>" in row901
+    import json
+    v = json.loads((tmp_path / "verdicts.json").read_text())
+    assert v["numbers"]["901/effort"] == SAME_ORDERING and v["claims"]["C901-1"] == CONFIRMED
+    # the docs block written from the CSV
+    doc = tmp_path / "paper901.md"
+    doc.write_text(f"# Paper 901\n\n{render.DOC_BEGIN}\nstale\n{render.DOC_END}\n\nrest\n", encoding="utf-8")
+    render.update_docs(tmp_path, tmp_path / "numbers.csv")
+    block = render.doc_block(doc.read_text(encoding="utf-8"))
+    assert "stale" not in block and "| EULERINT <a> | deg·s | 156.1 | 156.4 | +0.2 % | reproduced | no |" in block
+    assert "independent checks 2 of 3" in block and doc.read_text().endswith("rest\n")
+
+
+def test_quick_never_changes_the_physical_setup():
+    """Quick builds may run fewer points, never another horizon, step or start: every quick sweep point is a
+    point of the full grid and the horizons agree."""
+    from scfmu.papers.paper000 import report as r0
+    from scfmu.papers.paper001 import report as r1
+    from scfmu.papers.paper002 import report as r2
+    from scfmu.papers.paper004 import report as r4
+    q, f = r1.plan(True), r1.plan(False)
+    assert q["t_end"] == f["t_end"] and set(q["T2"]) <= set(f["T2"]) and set(q["c"]) <= set(f["c"])
+    assert 25.0 in q["c"] and 150.0 in q["c"]                          # the paper's L = 25 → 150
+    q, f = r2.plan(True), r2.plan(False)
+    assert q["t_end"] == f["t_end"]
+    for k in ("inertia_scale", "wheel_time_constant", "disturbance_factor", "theta_ref_deg", "digits"):
+        assert set(q[k]) <= set(f[k]), k
+    q, f = r4.plan(True), r4.plan(False)
+    for k in ("scales", "opt_scales", "eff", "fault_time", "margins"):
+        assert set(q[k]) <= set(f[k]), k
+    sq, sf = r0.sweeps(True), r0.sweeps(False)
+    assert [s["param"] for s in sq] == [s["param"] for s in sf]
+    for a, b in zip(sq, sf):
+        assert set(a["values"]) <= set(b["values"]) and a["default"] == b["default"] and a["runs"] == b["runs"], a["param"]
+    import inspect
+    from scfmu.papers.paper003 import report as r3
+    assert "40.0 if quick" not in inspect.getsource(r3.build)
+
+
 def _fmus_built() -> bool:
     need = ["RelativeOrbitPlant", "PredictivePidController", "SingleAxisPlant", "FopidController", "PidController",
             "AttitudePlant", "ReferenceCorrector", "FeedbackLinearizingController"]
@@ -190,6 +308,20 @@ def test_report_quick_end_to_end(tmp_path):
         assert f"| {cid} |" in md
     for cid in want:                                              # the terminal table lists every claim
         assert cid in r.stdout
+    # every reported number has a row; quick agrees with the last full build on every verdict
+    import json
+    quick = json.loads((out / "verdicts.json").read_text(encoding="utf-8"))
+    full = json.loads(FULL_VERDICTS.read_text(encoding="utf-8"))
+    assert quick["quick"] and not full["quick"]
+    papers_full = {k: v for k, v in full["claims"].items() if k.split("-")[0][1:] in CI_PAPERS}
+    assert quick["claims"] == papers_full
+    assert quick["numbers"] == {k: v for k, v in full["numbers"].items() if k.split("/")[0] in CI_PAPERS}
+    # the docs pages open with the table this build computes (quick and full compute the same numbers)
+    rows = render.read_numbers_csv(out / "numbers.csv")
+    for p in CI_PAPERS:
+        page = (ROOT / "docs" / f"paper{p}.md").read_text(encoding="utf-8")
+        assert 0 <= page.find(render.DOC_BEGIN) < 1000, f"docs/paper{p}.md does not open with its numbers table"
+        assert render.doc_block(page) == render.docs_table(rows, p), f"docs/paper{p}.md: table is stale"
 
 
 def test_report_missing_paper_is_an_error(tmp_path):

@@ -97,6 +97,8 @@ def main(argv=None) -> int:
     ap.add_argument("--workers", type=int, default=2, help="Dask LocalCluster workers (default 2)")
     ap.add_argument("--papers", default=None, help="comma-separated paper numbers (default: every paper with a report section)")
     ap.add_argument("--out", type=Path, default=Path("out") / "report", help="output folder (index.html goes here)")
+    ap.add_argument("--docs", type=Path, default=None,
+                    help="also rewrite the 'paper vs ours' table that opens each DOCS/paperNNN.md from numbers.csv")
     args = ap.parse_args(argv)
 
     papers = parse_papers(args.papers)
@@ -131,12 +133,19 @@ def main(argv=None) -> int:
             "built": time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime()), "commit": git_commit(),
             "quick": args.quick, "workers": args.workers, "runs": dict(ctx.runs),
             "runtime_s": time.time() - t_all,
-            "intro": "Each claim below is one of the papers' stated conclusions, in our words. The verdict is decided "
-                     "by an explicit rule in the code of the paper's section (stated with the evidence): confirmed, "
-                     "not confirmed, or depends on a reading (the outcome changes with a value the paper does not "
-                     "give, which we had to choose). Sensitivity blocks show the values tried and where the claim "
-                     "holds."}
+            "intro": "Each paper section opens with the paper's reported numbers beside ours (verdicts: reproduced, "
+                     "same ordering only, not reproduced, not checkable; calibrated numbers are marked and are no "
+                     "independent check). Each claim below is one of the papers' stated conclusions, in our words. "
+                     "Its verdict is decided by an explicit rule in the code of the paper's section (stated with the "
+                     "evidence): confirmed (holds with today's set-up and every other plausible reading checked), "
+                     "not confirmed, or depends on a reading (named). A reading under which a claim holds only by "
+                     "moving the paper's own numbers further away is listed and never counted as support. "
+                     "Sensitivity blocks show the values tried and where the claim holds."}
     html_path, md_path = render.render(sections, args.out, meta)
+    if args.docs is not None:
+        for p in render.update_docs(args.docs, args.out / "numbers.csv"):
+            print(f"updated {p}")
+    print("\n" + render.numbers_text(sections))
     print("\n" + render.claims_text(sections))
     print(f"\nreport: {html_path.resolve()}\nmarkdown: {md_path.resolve()}\n"
           f"total {time.time() - t_all:.1f} s, runs per paper: {dict(ctx.runs)}")

@@ -68,3 +68,11 @@ def sweep_panels(path: Path, x, panels: list[tuple[str, dict]], xlabel: str, tit
 
 def arr(rs: list[dict], key: str) -> np.ndarray:
     return np.array([r.get(key, math.nan) for r in rs], dtype=float)
+
+
+def reported(package: str, name: str = "reported.json") -> dict:
+    """A paper's reported numbers, shipped as data of its plug-in (``<package>/data/reported.json``, read
+    through importlib.resources)."""
+    import json
+    from importlib import resources
+    return json.loads((resources.files(package) / "data" / name).read_text(encoding="utf-8"))

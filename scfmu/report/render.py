@@ -17,10 +17,20 @@ import html
 import math
 from pathlib import Path
 
-from .types import CONFIRMED, DEPENDS, NOT_CONFIRMED, Claim, PaperSection, Sensitivity, Table
+import csv
+import json
+
+from .types import (CONFIRMED, DEPENDS, NOT_CHECKABLE, NOT_CONFIRMED, NOT_REPRODUCED, NUMBER_VERDICTS, REPRODUCED,
+                    SAME_ORDERING, Claim, NumberRow, PaperSection, Sensitivity, Table)
 
 BADGE = {CONFIRMED: ("#1a7f37", "#ffffff"), NOT_CONFIRMED: ("#cf222e", "#ffffff"), DEPENDS: ("#bf8700", "#ffffff")}
+BADGE.update({REPRODUCED: ("#1a7f37", "#ffffff"), SAME_ORDERING: ("#bf8700", "#ffffff"),
+              NOT_REPRODUCED: ("#cf222e", "#ffffff"), NOT_CHECKABLE: ("#57606a", "#ffffff")})
 MD_MARK = {CONFIRMED: "✅ confirmed", NOT_CONFIRMED: "❌ not confirmed", DEPENDS: "⚠️ depends on a reading"}
+
+# numbers.csv: one row per reported number (the same table as the report's "paper vs ours" tables)
+CSV_COLUMNS = ["paper", "item", "unit", "paper value", "our value", "relative difference", "verdict",
+               "used for calibration", "note"]
 
 CSS = """
 body{font-family:-apple-system,Segoe UI,Helvetica,Arial,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;
@@ -31,6 +41,7 @@ h3{margin-top:1.6em}
 table{border-collapse:collapse;margin:.6em 0 1.2em 0;font-size:.92em}
 th,td{border:1px solid #d0d7de;padding:.3em .6em;text-align:left;vertical-align:top}
 th{background:#f6f8fa}
+#glance td,#glance th{padding:.2em .45em;font-size:.9em}
 td.num{text-align:right;font-variant-numeric:tabular-nums;white-space:nowrap}
 caption{caption-side:top;text-align:left;font-weight:600;padding:.2em 0}
 .badge{display:inline-block;border-radius:1em;padding:.05em .7em;font-size:.85em;font-weight:600;white-space:nowrap}
@@ -82,6 +93,85 @@ def badge(verdict: str) -> str:
 def _paras(text: str) -> str:
     parts = [p.strip() for p in str(text).split("\n\n") if p.strip()]
     return "".join(f"<p>{_e(p)}</p>" for p in parts)
+
+
+# ----- the papers' numbers beside ours -----------------------------------------------------------------
+def fmt_num(v, digits: int = 4) -> str:
+    if v is None:
+        return "–"
+    return fmt_cell(float(v), digits) if _is_num(v) else str(v)
+
+
+def fmt_rel(x: float) -> str:
+    """Relative difference as a signed percentage ("+0.7 %"), "–" when undefined."""
+    if x is None or not isinstance(x, float) or math.isnan(x):
+        return "–"
+    return f"{100 * x:+.1f} %"
+
+
+def number_cells(n: NumberRow) -> list[str]:
+    """[item, unit, paper value, our value, relative difference, verdict, calibration, note] as plain text."""
+    paper = n.paper_text or fmt_num(n.paper_value)
+    return [n.item, n.unit, paper, fmt_num(n.ours), fmt_rel(n.rel_diff), n.verdict,
+            "yes" if n.calibration else "no", n.note]
+
+
+def number_counts(numbers: list[NumberRow]) -> dict:
+    """{verdict: count} over NUMBER_VERDICTS (zeros included)."""
+    return {v: sum(1 for n in numbers if n.verdict == v) for v in NUMBER_VERDICTS}
+
+
+def numbers_csv_rows(sections: list[PaperSection]) -> list[list[str]]:
+    """The rows of numbers.csv (CSV_COLUMNS), every section's numbers in order. Numbers are written with
+    6 significant digits, the relative difference as a fraction (empty when undefined)."""
+    out = []
+    for s in sections:
+        for n in s.numbers:
+            rd = n.rel_diff
+            out.append([s.paper, n.item, n.unit,
+                        n.paper_text or ("" if n.paper_value is None else f"{float(n.paper_value):.6g}"),
+                        "" if n.ours is None else (f"{float(n.ours):.6g}" if _is_num(n.ours) else str(n.ours)),
+                        "" if math.isnan(rd) else f"{rd:.6g}", n.verdict, "yes" if n.calibration else "no", n.note])
+    return out
+
+
+def write_numbers_csv(sections: list[PaperSection], path: Path) -> Path:
+    with open(path, "w", newline="", encoding="utf-8") as f:
+        w = csv.writer(f)
+        w.writerow(CSV_COLUMNS)
+        w.writerows(numbers_csv_rows(sections))
+    return path
+
+
+def numbers_md(numbers: list[NumberRow], digits: int = 4) -> list[str]:
+    """The paper-vs-ours table in Markdown (the docs pages open with it)."""
+    out = ["| item | unit | paper | ours | difference | verdict | calibration | note |",
+           "|---|---|---:|---:|---:|---|---|---|"]
+    for n in numbers:
+        out.append("| " + " | ".join(_md(c) for c in number_cells(n)) + " |")
+    return out
+
+
+def numbers_html(sec: PaperSection) -> str:
+    if not sec.numbers:
+        return ""
+    rows = []
+    for n in sec.numbers:
+        c = number_cells(n)
+        rows.append(f"<tr><td>{_e(c[0])}</td><td>{_e(c[1])}</td><td class=\"num\">{_e(c[2])}</td>"
+                    f"<td class=\"num\">{_e(c[3])}</td><td class=\"num\">{_e(c[4])}</td><td>{badge(n.verdict)}</td>"
+                    f"<td>{_e(c[6])}</td><td>{_e(c[7])}</td></tr>")
+    counts = number_counts(sec.numbers)
+    indep = [n for n in sec.numbers if n.independent]
+    cal = [n.item for n in sec.numbers if n.calibration]
+    head = (f"<h3 id=\"numbers{_e(sec.paper)}\">The paper's numbers beside ours</h3><p>"
+            + " · ".join(f"{badge(v)} {k}" for v, k in counts.items())
+            + f"</p><p>Independent checks (not used for a calibration, and checkable): {len(indep)} of "
+              f"{len(sec.numbers)}" + (f"; used for a calibration: {_e(', '.join(cal))}" if cal else "") + ".</p>")
+    cal_txt = _paras(sec.calibrations) if sec.calibrations else ""
+    return (head + "<table class=\"numbers\"><thead><tr><th>item</th><th>unit</th><th>paper</th><th>ours</th>"
+            "<th>difference</th><th>verdict</th><th>used for calibration</th><th>note</th></tr></thead><tbody>"
+            + "".join(rows) + "</tbody></table>" + cal_txt)
 
 
 # ----- HTML pieces ------------------------------------------------------------------------------------
@@ -147,6 +237,42 @@ def summary_rows(sections: list[PaperSection]) -> list[tuple[str, str, str, str,
             for s in sections for c in s.claims]
 
 
+def paper_summary(sec: PaperSection) -> dict:
+    """Counts of the first page for one paper: the number verdicts, the independent checks and the claim
+    verdicts."""
+    d = number_counts(sec.numbers)
+    d["numbers"] = len(sec.numbers)
+    d["independent"] = sum(1 for n in sec.numbers if n.independent)
+    d["calibration"] = sum(1 for n in sec.numbers if n.calibration)
+    for v in (CONFIRMED, DEPENDS, NOT_CONFIRMED):
+        d[v] = sum(1 for c in sec.claims if c.verdict == v)
+    return d
+
+
+def summary_html(sections: list[PaperSection]) -> str:
+    """The one-screen summary that opens the page: per paper the counts of its reported numbers per verdict
+    and of its claims per verdict, with links to the paper's numbers table and section."""
+    rows = []
+    for s in sections:
+        d = paper_summary(s)
+        short = s.title if len(s.title) <= 48 else s.title[:47].rstrip() + "…"
+        rows.append(f"<tr><td><a href=\"#paper{_e(s.paper)}\">{_e(s.paper)}</a></td>"
+                    f"<td title=\"{_e(s.title)}\">{_e(short)}</td>"
+                    + "".join(f"<td class=\"num\">{d[v]}</td>" for v in NUMBER_VERDICTS)
+                    + f"<td class=\"num\"><a href=\"#numbers{_e(s.paper)}\">{d['independent']} of {d['numbers']}</a></td>"
+                    + "".join(f"<td class=\"num\">{d[v]}</td>" for v in (CONFIRMED, DEPENDS, NOT_CONFIRMED))
+                    + "</tr>")
+    return ("<h2 id=\"at-a-glance\">At a glance</h2><table id=\"glance\"><thead><tr><th>paper</th><th>title</th>"
+            + "".join(f"<th>{badge(v)}</th>" for v in NUMBER_VERDICTS)
+            + "<th>independent checks</th>"
+            + "".join(f"<th>claims {badge(v)}</th>" for v in (CONFIRMED, DEPENDS, NOT_CONFIRMED))
+            + "</tr></thead><tbody>" + "".join(rows) + "</tbody></table>"
+            + "<p class=\"meta\">Reported numbers: reproduced = within 5 % of the paper's value (or its printed "
+              "precision); same ordering only = off, but ranked among the paper's numbers as the paper ranks it; "
+              "not checkable = the paper lacks what is needed. A number used for a calibration is no independent "
+              "check. The full table is <a href=\"numbers.csv\">numbers.csv</a>.</p>")
+
+
 def render_html(sections: list[PaperSection], out_dir: Path, meta: dict) -> str:
     mode = "quick (reduced grids, CI)" if meta.get("quick") else "full"
     head = [f"<!DOCTYPE html><html lang=\"en\"><head><meta charset=\"utf-8\">",
@@ -156,6 +282,7 @@ def render_html(sections: list[PaperSection], out_dir: Path, meta: dict) -> str:
             f"<p class=\"meta\">Built {_e(meta.get('built', '?'))} · git commit {_e(meta.get('commit', '?'))} · "
             f"mode: {_e(mode)} · Dask workers: {_e(meta.get('workers', '?'))} · total runtime "
             f"{_e(fmt_cell(float(meta.get('runtime_s', 0.0)), 4))} s</p>"]
+    head.append(summary_html(sections))
     if meta.get("intro"):
         head.append(_paras(meta["intro"]))
     counts = {v: sum(1 for r in summary_rows(sections) if r[3] == v) for v in (CONFIRMED, NOT_CONFIRMED, DEPENDS)}
@@ -176,6 +303,7 @@ def render_html(sections: list[PaperSection], out_dir: Path, meta: dict) -> str:
     for s in sections:
         body.append(f"<h2 id=\"paper{_e(s.paper)}\">Paper {_e(s.paper)}: {_e(s.title)}</h2>")
         body.append(f"<p class=\"meta\">{_e(_paper_meta(s, meta))}</p>")
+        body.append(numbers_html(s))
         body.append("<h3>Setup</h3>" + _paras(s.setup))
         for c in s.claims:
             body.append(claim_html(c, out_dir))
@@ -211,6 +339,13 @@ def render_md(sections: list[PaperSection], out_dir: Path, meta: dict) -> str:
     out = [f"# {meta.get('title', 'Reproduction report')}", "",
            f"Built {meta.get('built', '?')} · git commit {meta.get('commit', '?')} · mode: {mode} · Dask workers: "
            f"{meta.get('workers', '?')} · total runtime {fmt_cell(float(meta.get('runtime_s', 0.0)), 4)} s", ""]
+    out += ["## At a glance", "", "| paper | " + " | ".join(NUMBER_VERDICTS) + " | independent checks | claims "
+            "confirmed | depends | not confirmed |", "|---|" + "---:|" * (len(NUMBER_VERDICTS) + 4)]
+    for s in sections:
+        d = paper_summary(s)
+        out.append(f"| [{s.paper}](#paper-{s.paper}) | " + " | ".join(str(d[v]) for v in NUMBER_VERDICTS)
+                   + f" | {d['independent']} of {d['numbers']} | {d[CONFIRMED]} | {d[DEPENDS]} | {d[NOT_CONFIRMED]} |")
+    out.append("")
     if meta.get("intro"):
         out += [meta["intro"], ""]
     out += ["## Summary of the claims", "", "| claim | statement | verdict | readings examined |", "|---|---|---|---|"]
@@ -222,7 +357,12 @@ def render_md(sections: list[PaperSection], out_dir: Path, meta: dict) -> str:
                    f"{fmt_cell(float(s.runtime_s), 3)} |")
     out.append("")
     for s in sections:
-        out += [f"## Paper {s.paper}: {s.title}", "", f"*{_paper_meta(s, meta)}*", "", "### Setup", "", s.setup, ""]
+        out += [f"## Paper {s.paper}: {s.title}", "", f"*{_paper_meta(s, meta)}*", ""]
+        if s.numbers:
+            out += ["### The paper's numbers beside ours", ""] + numbers_md(s.numbers) + [""]
+            if s.calibrations:
+                out += [s.calibrations, ""]
+        out += ["### Setup", "", s.setup, ""]
         for c in s.claims:
             out += [f"### {c.id}: {MD_MARK.get(c.verdict, c.verdict)}", "", f"**Claim:** {c.statement}", "",
                     f"**Evidence:** {c.evidence}", ""]
@@ -251,6 +391,23 @@ def render_md(sections: list[PaperSection], out_dir: Path, meta: dict) -> str:
     return "\n".join(out) + "\n"
 
 
+def numbers_text(sections: list[PaperSection]) -> str:
+    """The paper-vs-ours rows and the per-paper counts as plain text for the terminal."""
+    lines = [f"{'paper':5s} {'item':44s} {'paper':>14s} {'ours':>11s} {'diff':>9s} verdict"]
+    for s in sections:
+        for n in s.numbers:
+            c = number_cells(n)
+            item = c[0] if len(c[0]) <= 44 else c[0][:43] + "…"
+            lines.append(f"{s.paper:5s} {item:44s} {c[2][:14]:>14s} {c[3]:>11s} {c[4]:>9s} {n.verdict}"
+                         + (" (calibration)" if n.calibration else ""))
+    lines.append("")
+    for s in sections:
+        d = paper_summary(s)
+        lines.append(f"paper {s.paper}: " + ", ".join(f"{v} {d[v]}" for v in NUMBER_VERDICTS)
+                     + f"; independent checks {d['independent']} of {d['numbers']}")
+    return "\n".join(lines)
+
+
 def claims_text(sections: list[PaperSection], width: int = 70) -> str:
     """The summary table as plain text for the terminal."""
     rows = summary_rows(sections)
@@ -274,4 +431,79 @@ def render(sections: list[PaperSection], out_dir: str | Path, meta: dict | None 
     m = out_dir / "report.md"
     h.write_text(render_html(sections, out_dir, meta), encoding="utf-8")
     m.write_text(render_md(sections, out_dir, meta), encoding="utf-8")
+    write_numbers_csv(sections, out_dir / "numbers.csv")
+    write_verdicts(sections, out_dir / "verdicts.json", meta)
     return h, m
+
+
+def verdicts_of(sections: list[PaperSection]) -> dict:
+    """{"claims": {claim id: verdict}, "numbers": {"paper/item": verdict}}: what quick and full builds must
+    agree on."""
+    return {"claims": {c.id: c.verdict for s in sections for c in s.claims},
+            "numbers": {f"{s.paper}/{n.item}": n.verdict for s in sections for n in s.numbers}}
+
+
+def write_verdicts(sections: list[PaperSection], path: Path, meta: dict | None = None) -> Path:
+    d = {"quick": bool((meta or {}).get("quick")), **verdicts_of(sections)}
+    path.write_text(json.dumps(d, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
+    return path
+
+
+# ----- the docs pages' "paper vs ours" tables -------------------------------------------------------------
+DOC_BEGIN = "<!-- numbers:begin (written by `scfmu report --docs docs`; do not edit by hand) -->"
+DOC_END = "<!-- numbers:end -->"
+
+
+def read_numbers_csv(path: Path) -> list[dict]:
+    with open(path, newline="", encoding="utf-8") as f:
+        return list(csv.DictReader(f))
+
+
+def _g4(text: str) -> str:
+    """A CSV number with 4 significant digits (text that is not a number unchanged)."""
+    try:
+        return f"{float(text):.4g}"
+    except ValueError:
+        return text
+
+
+def docs_table(rows: list[dict], paper: str) -> str:
+    """The Markdown table a docs/paperNNN.md page opens with, from numbers.csv rows of one paper."""
+    out = [DOC_BEGIN, "", "| item | unit | paper | ours | difference | verdict | calibration |", "|---|---|---:|---:|---:|---|---|"]
+    for r in rows:
+        if r["paper"] != paper:
+            continue
+        rd = r["relative difference"]
+        rd = f"{100 * float(rd):+.1f} %" if rd else "–"
+        out.append("| " + " | ".join(_md(x) for x in (r["item"], r["unit"], r["paper value"] or "–",
+                                                      _g4(r["our value"]) or "–", rd, r["verdict"],
+                                                      r["used for calibration"])) + " |")
+    n = [r for r in rows if r["paper"] == paper]
+    counts = {v: sum(1 for r in n if r["verdict"] == v) for v in NUMBER_VERDICTS}
+    out += ["", "Counts: " + ", ".join(f"{v} {k}" for v, k in counts.items())
+            + f"; independent checks {sum(1 for r in n if r['used for calibration'] == 'no' and r['verdict'] != NOT_CHECKABLE)}"
+            f" of {len(n)}.", "", DOC_END]
+    return "\n".join(out)
+
+
+def doc_block(text: str) -> str | None:
+    """The generated block of a docs page (None when the page has none)."""
+    i, j = text.find(DOC_BEGIN), text.find(DOC_END)
+    return None if i < 0 or j < i else text[i:j + len(DOC_END)]
+
+
+def update_docs(docs_dir: Path, csv_path: Path) -> list[Path]:
+    """Rewrites the generated block of every docs/paperNNN.md that has one (papers present in the CSV)."""
+    rows = read_numbers_csv(csv_path)
+    done = []
+    for paper in sorted({r["paper"] for r in rows}):
+        p = Path(docs_dir) / f"paper{paper}.md"
+        if not p.exists():
+            continue
+        text = p.read_text(encoding="utf-8")
+        old = doc_block(text)
+        if old is None:
+            continue
+        p.write_text(text.replace(old, docs_table(rows, paper)), encoding="utf-8")
+        done.append(p)
+    return done

@@ -11,7 +11,10 @@ from __future__ import annotations
 import math
 from typing import Iterable, Sequence
 
-from .types import CONFIRMED, DEPENDS, NOT_CONFIRMED
+from .types import (CONFIRMED, DEPENDS, NOT_CHECKABLE, NOT_CONFIRMED, NOT_REPRODUCED, NUMBER_VERDICTS, REPRODUCED,
+                    SAME_ORDERING)
+
+REL_TOL = 0.05   # "reproduced": within 5 % of the paper's value (or within its printed precision, if larger)
 
 
 def finite(x) -> bool:
@@ -134,3 +137,106 @@ def holds_at(labels: Sequence[str], holds: Sequence[bool]) -> str:
     if not any(holds):
         return "nowhere tried"
     return "at " + ", ".join(str(x) for x, h in zip(labels, holds) if h) + f" ({sum(map(bool, holds))} of {len(holds)})"
+
+
+# ----- the papers' reported numbers beside ours -----------------------------------------------------------
+def rel_diff(ours, paper) -> float:
+    """(ours − paper)/|paper| (NaN when either is missing or non-finite, or the paper's value is 0)."""
+    if not (finite(ours) and finite(paper)) or paper == 0:
+        return math.nan
+    return (ours - paper) / abs(paper)
+
+
+def printed_precision(text: str) -> float:
+    """Half a unit of the last printed digit of a decimal number as printed ("0.01" → 0.005, "156.1" →
+    0.05, "2954" → 0.5); the precision a value printed that way stands for. Leading "≈", "~" and signs
+    are ignored; NaN when the text holds no number."""
+    t = str(text).strip().lstrip("≈~<>=± ").replace("−", "-").lstrip("+-")
+    num = ""
+    for ch in t:
+        if ch.isdigit() or ch == ".":
+            num += ch
+        else:
+            break
+    if not num or not any(c.isdigit() for c in num):
+        return math.nan
+    decimals = len(num.split(".")[1]) if "." in num else 0
+    return 0.5 * 10.0 ** (-decimals)
+
+
+def within(ours, paper, rel: float = REL_TOL, precision: float = 0.0) -> bool:
+    """|ours − paper| ≤ max(rel·|paper|, precision) (False when either is missing)."""
+    if not (finite(ours) and finite(paper)):
+        return False
+    prec = precision if finite(precision) else 0.0
+    return abs(ours - paper) <= max(rel * abs(paper), prec) + 1e-12 * abs(paper)
+
+
+def same_ordering(i: int, ours: Sequence, paper: Sequence, tie: float = 0.005) -> bool:
+    """Item i sits among the others as the paper has it: for every other item j with both values, the sign
+    of ours[i] − ours[j] equals that of paper[i] − paper[j], where differences within ``tie`` (relative to
+    the larger magnitude) count as a tie (sign 0). False when item i lacks a value or has no partner."""
+    if len(ours) != len(paper):
+        raise ValueError("same_ordering: lengths differ")
+
+    def sign(a, b):
+        if abs(a - b) <= tie * max(abs(a), abs(b)):
+            return 0
+        return 1 if a > b else -1
+
+    if not (finite(ours[i]) and finite(paper[i])):
+        return False
+    pairs = [j for j in range(len(ours)) if j != i and finite(ours[j]) and finite(paper[j])]
+    return bool(pairs) and all(sign(ours[i], ours[j]) == sign(paper[i], paper[j]) for j in pairs)
+
+
+def number_verdict(ours, paper, precision: float = 0.0, ordering: bool | None = None, rel: float = REL_TOL) -> str:
+    """The verdict of one reported number: not checkable when either value is missing; reproduced when
+    ``within(ours, paper, rel, precision)``; otherwise "same ordering only" when ``ordering`` is True (the
+    item ranks among the paper's other numbers as in the paper), else not reproduced."""
+    if not (finite(ours) and finite(paper)):
+        return NOT_CHECKABLE
+    if within(ours, paper, rel, precision):
+        return REPRODUCED
+    return SAME_ORDERING if ordering else NOT_REPRODUCED
+
+
+def bound_verdict(ours, bound, above: bool = True) -> str:
+    """A number the paper states as a bound ("more than 50 times"): reproduced when ours is beyond it."""
+    if not (finite(ours) and finite(bound)):
+        return NOT_CHECKABLE
+    return REPRODUCED if ((ours > bound) if above else (ours < bound)) else NOT_REPRODUCED
+
+
+def nearest(ours, candidates: Sequence[float]) -> tuple[float, float]:
+    """(candidate closest to ours, its relative difference) among the paper's candidate readings of a damaged
+    number; (NaN, NaN) when there is nothing to compare."""
+    c = [x for x in candidates if finite(x)]
+    if not c or not finite(ours):
+        return math.nan, math.nan
+    best = min(c, key=lambda x: abs(ours - x))
+    return best, rel_diff(ours, best)
+
+
+def tally(verdicts: Iterable[str]) -> dict:
+    """{number verdict: count} in the order of NUMBER_VERDICTS (zeros included)."""
+    v = list(verdicts)
+    return {k: sum(1 for x in v if x == k) for k in NUMBER_VERDICTS}
+
+
+def combine_faithful(nominal: bool, readings: dict) -> tuple[str, list[str], list[str]]:
+    """Like ``combine`` for readings ``{name: (holds, moves_away)}``, where ``moves_away`` says that the
+    reading moves our values of the paper's own reported numbers further from them. Such a reading is never
+    support (nor a counter-example): it is left out of the verdict and listed. Returns (verdict, names of
+    readings that support the claim, names of readings under which it holds only by moving away from the
+    paper)."""
+    support = [n for n, (h, away) in readings.items() if h and not away]
+    away = [n for n, (h, a) in readings.items() if h and a]
+    vals = [bool(nominal)] + [bool(h) for h, a in readings.values() if not a]
+    if all(vals):
+        v = CONFIRMED
+    elif not any(vals):
+        v = NOT_CONFIRMED
+    else:
+        v = DEPENDS
+    return v, support, away

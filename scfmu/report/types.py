@@ -16,6 +16,13 @@ NOT_CONFIRMED = "not confirmed"
 DEPENDS = "depends on a reading"
 VERDICTS = (CONFIRMED, NOT_CONFIRMED, DEPENDS)
 
+# verdicts of a paper's reported number set beside ours (``NumberRow``)
+REPRODUCED = "reproduced"            # within 5 % of the paper's value, or within its printed precision
+SAME_ORDERING = "same ordering only"  # off, but ranked among the paper's other numbers as the paper ranks it
+NOT_REPRODUCED = "not reproduced"
+NOT_CHECKABLE = "not checkable"       # the paper lacks what is needed to compute ours (the row says what)
+NUMBER_VERDICTS = (REPRODUCED, SAME_ORDERING, NOT_REPRODUCED, NOT_CHECKABLE)
+
 
 @dataclass
 class Figure:
@@ -61,6 +68,46 @@ class Claim:
 
 
 @dataclass
+class NumberRow:
+    """One reported number of a paper beside ours.
+
+    ``paper_value`` is the number as printed (None when the paper prints none, e.g. a lost table);
+    ``paper_text`` how it is printed ("≈ 0.16", "> 50×", "1.44 / 3.44 / 5.44"); ``ours`` our value under the
+    paper's stated set-up (None when it cannot be computed); ``calibration`` is True when the number was used
+    to fit a value the paper does not give (it is then no independent check); ``note`` says what was
+    compared, which reading, or what is missing."""
+    paper: str
+    item: str
+    unit: str
+    paper_value: float | None
+    ours: float | None
+    verdict: str
+    calibration: bool = False
+    note: str = ""
+    paper_text: str = ""
+
+    def __post_init__(self):
+        if self.verdict not in NUMBER_VERDICTS:
+            raise ValueError(f"{self.item}: number verdict {self.verdict!r} is not one of {NUMBER_VERDICTS}")
+
+    @property
+    def rel_diff(self) -> float:
+        """(ours − paper) / |paper|; NaN when either is missing or the paper's value is 0."""
+        import math
+        if self.paper_value is None or self.ours is None or self.paper_value == 0:
+            return math.nan
+        try:
+            return (float(self.ours) - float(self.paper_value)) / abs(float(self.paper_value))
+        except (TypeError, ValueError):
+            return math.nan
+
+    @property
+    def independent(self) -> bool:
+        """An independent check: not used for a calibration and something to compare."""
+        return not self.calibration and self.verdict != NOT_CHECKABLE
+
+
+@dataclass
 class PaperSection:
     paper: str                # "000" … "004"
     title: str                # the paper's title
@@ -70,6 +117,8 @@ class PaperSection:
     tables: list[Table] = field(default_factory=list)
     notes: str = ""           # readings, deviations, what differs in --quick
     runtime_s: float = 0.0
+    numbers: list[NumberRow] = field(default_factory=list)   # the paper's reported numbers beside ours
+    calibrations: str = ""    # which values were fitted to which reported number (plain text)
 
 
 @dataclass
