@@ -98,7 +98,7 @@ def main(argv=None) -> int:
     ap.add_argument("--seeds", default="", help="run seeds given to the scenario's seed parameters: 0,1,2 or 0:10")
     ap.add_argument("--t-end", type=float, help="override the scenario's stop time [s]")
     ap.add_argument("--dt", type=float, help="override the scenario's communication step [s]")
-    ap.add_argument("--engine", default="native", choices=["native", "lean", "reference"])
+    ap.add_argument("--engine", default="auto", choices=["auto", "compiled", "native", "lean", "reference"])
     ap.add_argument("--timeseries", nargs="?", const="", default=None, metavar="KEYS",
                     help="keep time series per run (comma-separated logged keys; all when empty)")
     ap.add_argument("--ts-every", type=int, default=10, help="keep every n-th sample of the time series")
