@@ -29,6 +29,7 @@ from __future__ import annotations
 import ctypes
 import platform
 import sys
+from importlib import resources
 from ctypes import POINTER, c_double, c_int, c_int64, c_size_t, c_uint, c_uint32, c_void_p
 from pathlib import Path
 
@@ -64,11 +65,11 @@ def library_path() -> Path | None:
     p = _platform()
     if p is None:
         return None
-    here = Path(__file__).resolve().parent
-    shipped = here / "native_loop" / "bin" / p[0] / p[1]
+    pkg = Path(str(resources.files("scfmu")))
+    shipped = pkg / "engines" / "native_loop" / "bin" / p[0] / p[1]
     if shipped.is_file():
         return shipped
-    root = here.parents[1]
+    root = pkg.parent  # the source checkout holding this package (editable install), if it is one
     built = root / "target" / "release" / p[1]
     if (root / "Cargo.toml").is_file() and built.is_file():
         return built
