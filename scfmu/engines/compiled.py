@@ -15,8 +15,8 @@ status above fmi2Warning, so results are bit-identical to the lean and reference
 
 Reuse. With ``reuse`` (default), after a successful run every FMU is reset (``fmi2Terminate`` +
 ``fmi2Reset``) and the instances are kept (up to two sets per structure: components, models and FMU
-files) for the next run, which only sets them up and initializes them again; results do not depend on
-it (tested). Instances of a failed run are freed.
+files with their modification times and sizes) for the next run, which only sets them up and
+initializes them again; results do not depend on it (tested). Instances of a failed run are freed.
 
 The library: :func:`library_path` (the package's shipped binary, else a source checkout's
 ``target/release``); :func:`available` says whether it can be loaded. ``simulate(..., "auto")`` and
@@ -111,6 +111,11 @@ def available() -> bool:
 _POOL: dict[tuple, list[dict]] = {}  # reset FMU instance sets ready for the next run, per structure
 
 
+def _identity(name: str, model: str, path: Path) -> tuple:
+    st = path.stat()  # a rebuilt FMU file is another structure: its old instances are not reused
+    return name, model, str(path.resolve()), st.st_mtime_ns, st.st_size
+
+
 class CompiledLoop(LeanMaster):
     """Runs a Scenario in the compiled loop (see module docstring). Use as a context manager or call
     ``close()``. ``run()`` returns what ``LeanMaster.run`` returns."""
@@ -125,7 +130,7 @@ class CompiledLoop(LeanMaster):
         self.scenario = scenario
         self.reuse = reuse
         self._ok = False
-        self._key = tuple((c.name, c.model, str(path_of(c.model) if path_of else fmu_path(c.model)))
+        self._key = tuple(_identity(c.name, c.model, Path(path_of(c.model) if path_of else fmu_path(c.model)))
                           for c in scenario.components)
         pool = _POOL.get(self._key) if reuse else None
         if pool:
