@@ -20,8 +20,12 @@ Only the stepping loop is timed (instantiation and initialization excluded); eac
 minimum over --repeat interleaved repetitions. With --campaign, also campaign throughput (runs/s of
 the 30 s run 000-6 on the native path, warm workers) with 1 and 2 Dask workers.
 
-With --run-cost, the cost of one campaign run (campaign.run_one, as a worker runs it) against the native
-stepping of the same run without logging, side by side in this process (issue 20).
+* compiled: scfmu.engines.compiled.CompiledLoop, the lean master's plan with logging of every step run
+  by the Rust library scfmu/engines/native_loop (cargo build --release);
+
+With --run-cost, the cost of one campaign run (campaign.run_one, as a worker runs it, on the compiled and
+on the native engine) against the native stepping of the same run without logging, side by side in this
+process (issue 20).
 
 Usage: .venv/bin/python benches/cosim_loops.py [--repeat 5] [--campaign] [--run-cost] [--runs 40]
 """
@@ -146,10 +150,19 @@ def t_native(sc, log_every):
         return time.perf_counter() - t
 
 
+def t_compiled(sc):
+    from scfmu.engines.compiled import CompiledLoop
+    with CompiledLoop(sc) as m:
+        t = time.perf_counter()
+        m.run()
+        return time.perf_counter() - t
+
+
 METHODS = [("reference master (fmpy, CoSimulation)", t_reference), ("lean master, logging", t_lean),
            ("lean master, no logging", lambda sc: t_lean(sc, False)), ("minimal ctypes loop (unrolled)", t_minimal),
            ("native container, logging every step", lambda sc: t_native(sc, 1)),
            ("native container, no Python per step", lambda sc: t_native(sc, 0)),
+           ("compiled loop (scfmu/engines/native_loop), logging every step", t_compiled),
            ("C floor (same FMI calls from C)", t_floor),
            ("libcosim (libcosimpy; Jacobi coupling)", lambda sc: run_libcosim(sc)["wall_s"])]
 
@@ -205,27 +218,41 @@ def campaign_throughput(n_runs: int):
 def campaign_cost(n_runs: int, repeat: int):
     """Side by side in this process: the native stepping of run 000-6 with no Python call per step
     (log_every=0), and one campaign run of it (``campaign.run_one``, what a worker does per run: scenario
-    from the spec, overrides, container instance from the pool, logging of the metric set's signals,
-    metrics, row); each the minimum over interleaved repetitions."""
+    from the spec, overrides, instances from the pool, logging of the metric set's signals, metrics, row)
+    on the compiled engine (the campaigns' default "auto" when its library is available) and on the
+    native engine; each the minimum over interleaved repetitions."""
     from scfmu import campaign
+    from scfmu.engines import compiled
     sc = scenarios.get("default")
-    specs = campaign.Campaign(sc, campaign.random_sample({"controller.wn": ("uniform", 0.5, 2.0)}, n_runs, 1),
-                              seeds=[None]).runs()
-    campaign.run_one(specs[0])  # container built, unpacked, one instance pooled
-    step = run = float("inf")
+    sets = campaign.random_sample({"controller.wn": ("uniform", 0.5, 2.0)}, n_runs, 1)
+    engines = ["compiled", "native"] if compiled.available() else ["native"]
+    specs = {e: campaign.Campaign(sc, sets, seeds=[None], engine=e).runs() for e in engines}
+    for e in engines:
+        campaign.run_one(specs[e][0])  # container built, unpacked, instances pooled
+    step = float("inf")
+    run = dict.fromkeys(engines, float("inf"))
+    stepc = float("inf")
     for _ in range(repeat):
         step = min(step, t_native(sc, 0))
-        t = time.perf_counter()
-        for s in specs:
-            row, _ = campaign.run_one(s)
-            assert row["status"] == "ok", row["message"]
-        run = min(run, (time.perf_counter() - t) / n_runs)
+        if compiled.available():
+            stepc = min(stepc, t_compiled(sc))
+        for e in engines:
+            t = time.perf_counter()
+            for s in specs[e]:
+                row, _ = campaign.run_one(s)
+                assert row["status"] == "ok", row["message"]
+            run[e] = min(run[e], (time.perf_counter() - t) / n_runs)
     print(f"\n| run 000-6 (3,000 steps), one process | ms per run | µs per step |")
     print("|---|---:|---:|")
     print(f"| native stepping, log_every=0 | {step * 1e3:.2f} | {step / sc.n_steps * 1e6:.2f} |")
-    print(f"| campaign run (run_one, 1 worker's work) | {run * 1e3:.2f} ({1 / run:.1f} runs/s) | "
-          f"{run / sc.n_steps * 1e6:.2f} |")
-    print(f"| ratio campaign run / native stepping | {run / step:.2f}× | |")
+    if compiled.available():
+        print(f"| compiled loop alone, all 22 signals logged every step | {stepc * 1e3:.2f} | "
+              f"{stepc / sc.n_steps * 1e6:.2f} |")
+    for e in engines:
+        print(f"| campaign run on the {e} engine (run_one, 1 worker's work) | {run[e] * 1e3:.2f} "
+              f"({1 / run[e]:.1f} runs/s) | {run[e] / sc.n_steps * 1e6:.2f} |")
+    for e in engines:
+        print(f"| ratio campaign run ({e}) / native stepping | {run[e] / step:.2f}× | |")
     return step, run
 
 

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Builds the release cdylib and writes modelDescription/<Model>.xml and fmus/<Model>.fmu, then the
+# Builds the release cdylibs (the FMUs' one and the compiled engine's loop, scfmu/engines/native_loop: the
+# workspace's default members) and writes modelDescription/<Model>.xml and fmus/<Model>.fmu, then the
 # scenario files for other tools: fmus/ssp/<scenario>.ssp (SSP 1.0) and fmus/loops/<scenario>.fmu (one
 # container FMU per standard closed loop). The last two need the Python venv (scripts/setup.sh); without
 # it they are skipped with a message. When the Windows cross toolchain is installed (scripts/setup.sh

@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
-# Cross-builds the cdylib for Windows x86-64 on Linux: target/win64/x86_64-win7-windows-gnu/release/
-# spacecraft_fmus.dll. Uses Debian's Rust (rustc-web, cargo-web, rust-web-src: /usr/bin/rustc,
-# /usr/bin/cargo and the std sources in /usr/lib/rustlib/src) to build std for the target itself
+# Cross-builds the cdylibs of the workspace's default members for Windows x86-64 on Linux:
+# target/win64/x86_64-win7-windows-gnu/release/spacecraft_fmus.dll (the FMUs' binary) and
+# scfmu_native_loop.dll (the compiled engine's loop, shipped in the wheel by scripts/build_wheel.sh).
+# Uses Debian's Rust (rustc-web, cargo-web, rust-web-src: /usr/bin/rustc, /usr/bin/cargo and the std
+# sources in /usr/lib/rustlib/src) to build std for the target itself
 # (-Z build-std, allowed on a stable compiler by RUSTC_BOOTSTRAP=1) and the MinGW-w64 linker
 # (gcc-mingw-w64-x86-64). scripts/setup.sh installs these packages. Why the win7 target: docs/tools.md.
 #
-#   scripts/build_win64.sh            build; prints the DLL path on the last line
+#   scripts/build_win64.sh            build; prints the FMUs' DLL path on the last line
 #   scripts/build_win64.sh --check    exit 0 when the cross toolchain is installed, 1 (with the reason) if not
 set -euo pipefail
 cd "$(dirname "$0")/.."

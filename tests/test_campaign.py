@@ -71,10 +71,138 @@ def test_native_full_run_000_6_eulerint_matches_reference():
 
 def test_failing_runs_raise_simulation_error():
     from scfmu.engines.lean import SimulationError
-    for engine in ("lean", "native"):
+    for engine in ("lean", "native", "compiled"):
         with pytest.raises((SimulationError, Exception)) as e:
             simulate(short().with_overrides({"controller.wn": -1.0}), engine)
         assert "wn" in str(e.value)
+
+
+# ----- compiled engine (scfmu/engines/native_loop) ------------------------------------------------------
+def need_compiled():
+    from scfmu.engines import compiled
+    if not compiled.available():
+        pytest.fail(f"compiled loop library not found ({compiled.library_path()}): cargo build --release")
+
+
+@pytest.mark.parametrize("name,t", [("default", 3.0), ("paper000/000-9L", 2.0), ("wheel_fault", 20.0),
+                                    ("paper001/c/dist0.01", 2.0), ("paper003/T2FSMC/W", 3.0)])
+def test_compiled_bit_identical_to_reference_master(name, t):
+    need_compiled()
+    sc = short(name, t)
+    ref = simulate(sc, "reference")
+    for kw in ({"reuse": False}, {}, {}):  # fresh instances, then instances from the pool
+        got = simulate(sc, "compiled", **kw)
+        assert list(got) == list(ref)
+        for k in ref:
+            assert np.array_equal(ref[k], got[k]), (k, kw)
+
+
+def test_compiled_fmu_error_status_raises_with_the_fmus_messages():
+    """A doStep error at the second step (the plant's state overflows) stops the compiled loop there:
+    SimulationError at that time with the FMU's message, as on the reference and lean masters. When
+    several FMUs would fail at one point, the compiled loop stops at the first failing call (its message
+    is the first of the lean master's, which makes the remaining calls of the step)."""
+    from scfmu.engines.lean import SimulationError
+    need_compiled()
+    sc = short(t=0.5).with_overrides({"controller.gain_mode": 1, "controller.kp_x": 1e160})
+    errs = {}
+    for engine in ("reference", "lean", "compiled"):
+        with pytest.raises(SimulationError) as e:
+            simulate(sc, engine)
+        errs[engine] = e.value
+    assert errs["compiled"].status == "fmu_error" and errs["compiled"].time == 0.01 == errs["lean"].time
+    assert str(errs["compiled"]) == str(errs["lean"]) == str(errs["reference"])
+    assert "plant: fmi2DoStep: step from t = 0.01 failed" in str(errs["compiled"])
+    sc = short(t=0.5).with_overrides({"controller.wn": 1e80})
+    with pytest.raises(SimulationError) as lean:
+        simulate(sc, "lean")
+    with pytest.raises(SimulationError) as comp:
+        simulate(sc, "compiled")
+    assert comp.value.time == lean.value.time == 0.01
+    assert str(lean.value).startswith(str(comp.value) + "; ") and str(comp.value).startswith("controller: ")
+    # the pool is not given the instances of a failed run, and a good run afterwards is unchanged
+    assert np.array_equal(simulate(short(t=1.0), "compiled")["q_x"], simulate(short(t=1.0), "reference")["q_x"])
+
+
+def test_compiled_nonfinite_logged_value_raises(monkeypatch):
+    """The FMUs refuse non-finite values themselves, so one is injected: the metrics FMU's fmi2GetReal (its outputs are only logged) returns
+    NaN for its first value from its 40th call on (a ctypes callback around the real function). The
+    compiled loop logs it like the lean master, and the run fails with status ``nonfinite`` at the same time."""
+    import ctypes
+    from ctypes import CFUNCTYPE, c_double, c_int, c_size_t, c_void_p
+    from scfmu.engines import lean
+    from scfmu.engines.lean import SimulationError
+    need_compiled()
+    real_raw = lean._raw
+    proto = CFUNCTYPE(c_int, c_void_p, c_void_p, c_size_t, c_void_p)
+    keep = []
+
+    def raw(slave, name, argtypes, restype=c_int):
+        f = real_raw(slave, name, argtypes, restype)
+        if name != "fmi2GetReal" or slave.instanceName != "metrics":
+            return f
+        calls = [0]
+
+        def get(c, vr, n, v):
+            st = f(c, vr, n, v)
+            calls[0] += 1
+            if calls[0] >= 40:
+                c_double.from_address(v).value = float("nan")
+            return st
+
+        cb = proto(get)
+        keep.append(cb)
+        return cb
+
+    monkeypatch.setattr(lean, "_raw", raw)
+    errs = {}
+    for engine in ("lean", "compiled"):
+        with pytest.raises(SimulationError) as e:
+            simulate(short(t=1.0), engine, reuse=False)
+        errs[engine] = e.value
+    assert errs["compiled"].status == errs["lean"].status == "nonfinite"
+    assert errs["compiled"].time == errs["lean"].time and 0 < errs["compiled"].time < 1.0
+    assert str(errs["compiled"]) == str(errs["lean"])
+
+
+def test_compiled_instance_reuse_after_reset_gives_fresh_results():
+    """Instances reset after a run and initialized again give the fresh-instance results (also after a
+    run that failed, whose instances are freed)."""
+    from scfmu.engines import compiled
+    from scfmu.engines.lean import SimulationError
+    need_compiled()
+    a = short(t=2.0).with_overrides({"controller.wn": 1.7, "plant.dist_noise_std_x": 0.5}).with_seed(7)
+    b = short(t=2.0).with_overrides({"controller.wn": 0.6}).with_seed(1)
+    fresh_a = simulate(a, "reference")
+    fresh_b = simulate(b, "reference")
+    compiled._POOL.clear()
+    sets = []
+    for sc, ref in ((a, fresh_a), (b, fresh_b), (a, fresh_a), (None, None), (b, fresh_b)):
+        if sc is None:  # a run that fails at initialization takes the pooled set, which is then freed
+            with pytest.raises(SimulationError):
+                simulate(short(t=2.0).with_overrides({"controller.wn": -1.0}), "compiled")
+            assert sum(len(v) for v in compiled._POOL.values()) == 0
+            continue
+        r = simulate(sc, "compiled")
+        assert all(np.array_equal(r[k], ref[k]) for k in ref)
+        (pool,) = compiled._POOL.values()
+        sets.append(pool[-1])
+    assert sets[0] is sets[1] is sets[2] and sets[3] is not sets[0]  # the same instances, reset, until freed
+
+
+def test_auto_engine_is_compiled_when_available_else_native(monkeypatch):
+    """Campaigns run on "auto": the compiled engine in this checkout; without its library the native
+    engine, with no error and the same row."""
+    from scfmu.engines import compiled, resolve_engine
+    need_compiled()
+    assert resolve_engine("auto") == "compiled" and campaign.Campaign(short()).engine == "auto"
+    spec = campaign.Campaign(short(t=2.0), [{"controller.wn": 1.3}], seeds=[None]).runs()[0]
+    row_c, _ = campaign.run_one(spec)
+    monkeypatch.setattr(compiled, "_LIB", [None])
+    assert not compiled.available() and resolve_engine("auto") == "native"
+    row_n, _ = campaign.run_one(spec)
+    assert row_c["status"] == row_n["status"] == "ok"
+    same_rows([row_c], [row_n])
 
 
 # ----- campaigns ---------------------------------------------------------------------------------------

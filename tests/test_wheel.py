@@ -53,6 +53,19 @@ def test_wheel_carries_every_fmu_and_the_data(installed):
                  "scfmu/papers/paper004/data/nodes.json"):
         assert data in names
     assert not [n for n in names if "/tests/" in n], "the package's tests are not shipped"
+    # the compiled engine's loop library (cargo build --release), for this platform
+    assert "scfmu/engines/native_loop/bin/linux64/libscfmu_native_loop.so" in names
+
+
+def test_installed_wheel_uses_its_compiled_loop(installed, tmp_path):
+    env_dir, _ = installed
+    r = subprocess.run([str(env_dir / "bin" / "python"), "-c",
+                        "from scfmu.engines import compiled, resolve_engine; "
+                        "print(compiled.library_path()); print(resolve_engine('auto'))"],
+                       cwd=tmp_path, env=_clean_env(env_dir), capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr[-2000:]
+    path, engine = r.stdout.split()
+    assert Path(path).is_relative_to(env_dir) and engine == "compiled"
 
 
 def test_installed_wheel_runs_default_outside_the_repository(installed, tmp_path):

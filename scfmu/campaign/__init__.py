@@ -14,7 +14,8 @@ campaign goes on.
 
 Output folder:
 
-* ``manifest.json``: scenario (plain data), overrides, seeds, engine, FMU GUIDs and SHA-256, package
+* ``manifest.json``: scenario (plain data), overrides, seeds, engine (``"auto"``, the default: the
+  compiled engine where its library is available, else the native one, with the same rows), FMU GUIDs and SHA-256, package
   versions, and a hash of the scenario, overrides, seeds and engine (``campaign_id``);
 * ``parts/rows-*.parquet``: rows as they complete (written every ``flush_every`` rows), so an
   interrupted campaign resumes: ``run()`` on the same folder skips the runs already written (a folder
@@ -47,7 +48,7 @@ import numpy as np
 
 from .. import fmu as fmu_access
 from .. import metrics as run_metrics
-from ..engines import SimulationError, simulate
+from ..engines import SimulationError, resolve_engine, simulate
 from ..scenario.model import Scenario
 
 ROW_FIXED = ("run", "override_index", "seed", "status", "message")
@@ -91,7 +92,7 @@ class Campaign:
     scenario: Scenario
     overrides: list = field(default_factory=lambda: [{}])
     seeds: list = field(default_factory=lambda: [None])
-    engine: str = "native"  # "native", "lean" or "reference"
+    engine: str = "auto"  # "auto" (compiled if available, else native: same rows), "compiled", "native", "lean", "reference"
     timeseries: list | None = None  # log keys to keep per run (None: metrics only; [] : all logged keys)
     ts_every: int = 1
     log_every: int = 1  # native engine: read the logged signals every n-th step (metrics see that grid)
@@ -259,8 +260,12 @@ def _run_body(spec: dict, fmu_dir: str | None = None) -> tuple[dict, dict | None
         if spec["seed"] is not None:
             sc = sc.with_seed(spec["seed"])
         sc.log = _log_kept(sc, spec["timeseries"])
-        kw = {"log_every": max(1, int(spec.get("log_every", 1)))} if spec["engine"] == "native" else {}
-        r = simulate(sc, spec["engine"], **kw)
+        every = max(1, int(spec.get("log_every", 1)))
+        engine = spec["engine"]
+        if engine == "auto":  # the compiled loop logs every step; a coarser log grid is the native engine's
+            engine = resolve_engine("auto") if every == 1 else "native"
+        kw = {"log_every": every} if engine == "native" else {}
+        r = simulate(sc, engine, **kw)
         m = run_metrics.compute(sc.metrics, r)
         for k in metric_cols:
             row[k] = float(m.get(k, math.nan))
@@ -461,6 +466,7 @@ def run(c: Campaign, out_dir: str | Path, scheduler: str | None = None, n_worker
             (out_dir / "results.parquet").unlink(missing_ok=True)
     specs = c.runs()
     manifest = {"campaign_id": cid, **c.describe(), "n_runs": len(specs), "fmus": fmus,
+                "engine_used": ("native" if c.log_every != 1 else resolve_engine("auto")) if c.engine == "auto" else c.engine,
                 "packages": package_versions(), "created": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
                 "row_columns": _row_columns(c)}
     if man_path.exists():

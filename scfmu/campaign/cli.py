@@ -90,7 +90,8 @@ def main(argv=None) -> int:
                     help="run each run in a child process (automatic when a unit is given as an FMU file)")
     ap.add_argument("--timeout", type=float, default=600.0,
                     help="wall-time limit of an isolated run [s] (default 600); past it: status timeout")
-    ap.add_argument("--engine", default="native", choices=["native", "lean", "reference"])
+    ap.add_argument("--engine", default="auto", choices=["auto", "compiled", "native", "lean", "reference"],
+                    help="auto (default): the compiled loop when its library is present, else native")
     ap.add_argument("--timeseries", nargs="?", const="", default=None, metavar="KEYS",
                     help="keep time series per run (comma-separated logged keys; all when empty)")
     ap.add_argument("--ts-every", type=int, default=10, help="keep every n-th sample of the time series")

@@ -4,6 +4,11 @@
   Python per step when ``log_every`` is 0); same coupling as the reference master, bit-identical;
 * ``"reference"``: ``reference.CoSimulation`` (fmpy high-level calls, name-based), the tests' oracle;
 * ``"lean"``: ``lean.LeanMaster``, same Gauss–Seidel algorithm, bit-identical results, much less overhead;
+* ``"compiled"``: ``compiled.CompiledLoop``, the lean master's plan run, logging of every step included,
+  by a small compiled library (``scfmu/engines/native_loop``, Rust): no Python per step, bit-identical;
+  available when the library is (``compiled.available()``: shipped in the wheel, or built by
+  ``cargo build --release`` in a source checkout);
+* ``"auto"`` (the campaigns' default): ``"compiled"`` when available, else ``"native"``.
 
 A run that fails (FMU error status, non-finite logged value) raises ``SimulationError`` with a status
 code and the FMUs' log messages.
@@ -18,7 +23,16 @@ from ..scenario.model import Scenario
 from ..scenario.resolve import resolve
 from .reference import CoSimulation, _Link
 
-ENGINES = ("reference", "lean", "native")
+ENGINES = ("reference", "lean", "native", "compiled")
+
+
+def resolve_engine(engine: str) -> str:
+    """The engine that runs for ``engine``: ``"auto"`` is ``"compiled"`` when its library is available,
+    else ``"native"`` (the same results either way); any other name is returned as is."""
+    if engine == "auto":
+        from .compiled import available
+        return "compiled" if available() else "native"
+    return engine
 
 
 def reference_master(scenario: Scenario, path_of=None) -> tuple[CoSimulation, dict, dict]:
@@ -71,7 +85,8 @@ class Result(dict):
 def simulate(scenario, engine: str = "native", *, fmus: dict | None = None, overrides: dict | None = None,
              seed: int | None = None, **kw) -> Result:
     """Runs a scenario (a :class:`~scfmu.scenario.Scenario` or a registered name such as ``"default"``) on
-    one of the engines (``"native"``, default; ``"lean"``; ``"reference"``) and returns the logged signals.
+    one of the engines (``"native"``, default; ``"compiled"``; ``"auto"``; ``"lean"``; ``"reference"``) and
+    returns the logged signals.
 
     ``fmus``: ``{instance: model name or path to an .fmu}`` replaces components' models; ``overrides``:
     ``{"instance.parameter": value}``; ``seed``: sets the scenario's seed parameters. Engine options
@@ -86,6 +101,7 @@ def simulate(scenario, engine: str = "native", *, fmus: dict | None = None, over
         scenario = scenario.with_overrides(overrides)
     if seed is not None:
         scenario = scenario.with_seed(seed)
+    engine = resolve_engine(engine)
     if engine == "reference":
         out = run_reference(scenario)
     elif engine == "lean":
@@ -95,8 +111,12 @@ def simulate(scenario, engine: str = "native", *, fmus: dict | None = None, over
         from .native import NativeLoop
         with NativeLoop(scenario, **kw) as m:
             out = m.run()
+    elif engine == "compiled":
+        from .compiled import CompiledLoop
+        with CompiledLoop(scenario, **kw) as m:
+            out = m.run()
     else:
-        raise ValueError(f"engine {engine!r}: expected one of {ENGINES}")
+        raise ValueError(f"engine {engine!r}: expected one of {ENGINES} or 'auto'")
     for k, v in out.items():
         if not np.all(np.isfinite(v)):
             i = int(np.argmin(np.isfinite(v)))

@@ -54,27 +54,34 @@ def build_fmus(scenario: Scenario, path_of=None, reuse: bool = False) -> dict[st
         for c in scenario.components:
             p = path_of(c.model) if path_of else fmu_path(c.model)
             # the same calls as Fmu(initialize=True), keeping the instance to report its log messages
-            f = Fmu(c.model, name=c.name, start_time=scenario.start_time, path=p, initialize=False,
-                    unpacked=unpacked(p) if reuse else None)
-            fmus[c.name] = f
-            f.slave.setupExperiment(tolerance=None, startTime=scenario.start_time, stopTime=None)
-            f.slave.enterInitializationMode()
-            for k, v in c.params.items():
-                f.set(k, v)
-            try:
-                f.slave.exitInitializationMode()
-            except Exception:
-                msgs = "; ".join(m[2] for m in f.messages if m[0] >= 2)
-                raise SimulationError("fmu_error", f"{c.name} ({c.model}): fmi2ExitInitializationMode failed"
-                                      + (f": {msgs}" if msgs else "")) from None
-        for q, value in scenario.inputs.items():
-            inst, _, var = q.partition(".")
-            fmus[inst].set(var, value)
+            fmus[c.name] = Fmu(c.model, name=c.name, start_time=scenario.start_time, path=p, initialize=False,
+                               unpacked=unpacked(p) if reuse else None)
+        initialize_fmus(fmus, scenario)
     except Exception:
         for f in fmus.values():
             f.close()
         raise
     return fmus
+
+
+def initialize_fmus(fmus: dict[str, Fmu], scenario: Scenario) -> None:
+    """Initializes instantiated (or reset) FMUs for the scenario: set-up, parameters in initialization
+    mode, then the fixed ``inputs``. Raises SimulationError when an FMU refuses to initialize."""
+    for c in scenario.components:
+        f = fmus[c.name]
+        f.slave.setupExperiment(tolerance=None, startTime=scenario.start_time, stopTime=None)
+        f.slave.enterInitializationMode()
+        for k, v in c.params.items():
+            f.set(k, v)
+        try:
+            f.slave.exitInitializationMode()
+        except Exception:
+            msgs = "; ".join(m[2] for m in f.messages if m[0] >= 2)
+            raise SimulationError("fmu_error", f"{c.name} ({c.model}): fmi2ExitInitializationMode failed"
+                                  + (f": {msgs}" if msgs else "")) from None
+    for q, value in scenario.inputs.items():
+        inst, _, var = q.partition(".")
+        fmus[inst].set(var, value)
 
 
 def ports_of(fmus: dict[str, Fmu]) -> dict[str, tuple[list[str], list[str]]]:
@@ -112,38 +119,27 @@ class LeanMaster:
             self._get[name] = _raw(sl, "fmi2GetReal", [c_void_p, c_void_p, c_size_t, c_void_p])
             self._set[name] = _raw(sl, "fmi2SetReal", [c_void_p, c_void_p, c_size_t, c_void_p])
             self._step[name] = _raw(sl, "fmi2DoStep", [c_void_p, c_double, c_double, c_int])
-
-        def vr_array(vals):
-            a = (c_uint * len(vals))(*vals)
-            self._keep.append(a)
-            return ctypes.addressof(a)
-
-        # per destination: one buffer; per (destination, source) group: a get into a slice of it
-        self._ops = []  # (get, src_comp, src_vr_addr, n, buf_addr_at_offset)... then (set, dst_comp, dst_vrs, n, buf)
+        # The plan, by instance name (also executed by the compiled engine, scfmu/engines/compiled.py):
+        # per destination one buffer; per (destination, source) group a get into a slice of it, in
+        # Gauss–Seidel order; then the set of the whole buffer.
+        self.plan_ops = []  # ("get", source, [vr], buffer index, offset) / ("set", destination, [vr], buffer index, 0)
+        self.plan_buffers = []  # buffer sizes
         by_dst: dict[str, list] = {}
         for d, di, s, so in links:
             by_dst.setdefault(d, []).append((s, so, di))
         for d, items in by_dst.items():
-            buf = (c_double * len(items))()
-            self._keep.append(buf)
-            base = ctypes.addressof(buf)
+            b = len(self.plan_buffers)
+            self.plan_buffers.append(len(items))
             i = 0
             while i < len(items):  # consecutive items of the same source form one get
                 s = items[i][0]
                 j = i
                 while j < len(items) and items[j][0] == s:
                     j += 1
-                self._ops.append((self._get[s], self._comp[s], vr_array([vr[s][so] for _, so, _ in items[i:j]]),
-                                  j - i, base + 8 * i))
+                self.plan_ops.append(("get", s, [vr[s][so] for _, so, _ in items[i:j]], b, i))
                 i = j
-            self._ops.append((self._set[d], self._comp[d], vr_array([vr[d][di] for _, _, di in items]),
-                              len(items), base))
+            self.plan_ops.append(("set", d, [vr[d][di] for _, _, di in items], b, 0))
         # logging: per instance one get into a row of a (n + 1, m) array
-        n = sc.n_steps
-        self.n = n
-        self._log_keys = []
-        self._log_arrays = []
-        self._log_ops = []
         groups: dict[str, list[tuple[str, str]]] = {}
         for key, inst, var in sc.log_items():
             if inst not in fmus:
@@ -153,13 +149,34 @@ class LeanMaster:
             if types[inst][var] != "Real":
                 raise TypeError(f"log {key!r}: {inst}.{var} is not Real")
             groups.setdefault(inst, []).append((key, var))
-        for inst, items in groups.items():
-            arr = np.empty((n + 1, len(items)))
+        self.plan_log = [(inst, [k for k, _ in items], [vr[inst][v] for _, v in items]) for inst, items in groups.items()]
+        self.n = sc.n_steps
+        self._build_calls()
+
+    def _build_calls(self) -> None:
+        """The plan as ctypes calls for :meth:`run`."""
+        bufs = [(c_double * m)() for m in self.plan_buffers]
+        self._keep.extend(bufs)
+
+        def vr_array(vals):
+            a = (c_uint * len(vals))(*vals)
+            self._keep.append(a)
+            return ctypes.addressof(a)
+
+        self._ops = []  # (fn, component, vr array address, n, buffer address at the offset)
+        for kind, inst, vrs, b, off in self.plan_ops:
+            fn = self._get[inst] if kind == "get" else self._set[inst]
+            self._ops.append((fn, self._comp[inst], vr_array(vrs), len(vrs), ctypes.addressof(bufs[b]) + 8 * off))
+        self._log_keys = []
+        self._log_arrays = []
+        self._log_ops = []
+        for inst, keys, vrs in self.plan_log:
+            arr = np.empty((self.n + 1, len(keys)))
             self._log_arrays.append(arr)
-            self._log_keys.append([k for k, _ in items])
-            self._log_ops.append((self._get[inst], self._comp[inst], vr_array([vr[inst][v] for _, v in items]),
-                                  len(items), arr.ctypes.data, arr.strides[0]))
-        self._steps = [(self._step[name], self._comp[name]) for name in fmus]
+            self._log_keys.append(keys)
+            self._log_ops.append((self._get[inst], self._comp[inst], vr_array(vrs), len(vrs), arr.ctypes.data,
+                                  arr.strides[0]))
+        self._steps = [(self._step[name], self._comp[name]) for name in self.fmus]
 
     # ------------------------------------------------------------------------------------------------
     def run(self) -> dict[str, np.ndarray]:
