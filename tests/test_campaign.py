@@ -128,7 +128,6 @@ def test_compiled_nonfinite_logged_value_raises(monkeypatch):
     """The FMUs refuse non-finite values themselves, so one is injected: the metrics FMU's fmi2GetReal (its outputs are only logged) returns
     NaN for its first value from its 40th call on (a ctypes callback around the real function). The
     compiled loop logs it like the lean master, and the run fails with status ``nonfinite`` at the same time."""
-    import ctypes
     from ctypes import CFUNCTYPE, c_double, c_int, c_size_t, c_void_p
     from scfmu.engines import lean
     from scfmu.engines.lean import SimulationError
