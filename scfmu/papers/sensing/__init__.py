@@ -18,5 +18,7 @@ def register(reg) -> None:
     reg.paper("sensing", "Sensors in the loop: do the papers' controller rankings survive realistic sensing?",
               commands={"rankings": ("paper 000's large slew and paper 003's cases with and without sensors, "
                                      "a Monte Carlo over sensor seeds; rankings in CSV + PNG",
-                                     "scfmu.papers.sensing.rankings:main")},
+                                     "scfmu.papers.sensing.rankings:main"),
+                        "slew": ("paper 000's large slew with and without sensors: large_slew.png",
+                                 "scfmu.papers.sensing.rankings:main_slew")},
               docs="docs/sensing.md")
