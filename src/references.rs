@@ -66,6 +66,33 @@ pub const ALL: &[Reference] = &[
         used_for: "loss-of-effectiveness actuator faults; feedback-linearising quaternion law; reference \
                    correction from an optimised open-loop spline torque",
     },
+    Reference {
+        key: "Markley-Crassidis-2014",
+        authors: "F. L. Markley, J. L. Crassidis",
+        title: "Fundamentals of Spacecraft Attitude Determination and Control",
+        venue: "Springer, 2014",
+        subject: "",
+        used_for: "sensor error models: gyro angle and rate random walk, star-tracker error rotation, sun-sensor \
+                   and magnetometer measurements",
+    },
+    Reference {
+        key: "IEEE-952",
+        authors: "IEEE Aerospace and Electronic Systems Society",
+        title: "IEEE Standard Specification Format Guide and Test Procedure for Single-Axis Interferometric \
+                Fiber Optic Gyros",
+        venue: "IEEE Std 952-1997 (R2008), Annex C: Allan variance",
+        subject: "",
+        used_for: "gyro noise terms by their Allan deviation: angle random walk N, bias instability B, rate \
+                   random walk K",
+    },
+    Reference {
+        key: "Franklin-Powell-Workman-1998",
+        authors: "G. F. Franklin, J. D. Powell, M. Workman",
+        title: "Digital Control of Dynamic Systems",
+        venue: "3rd ed., Addison-Wesley, 1998",
+        subject: "",
+        used_for: "sampled-data timing: zero-order hold and computation delay",
+    },
 ];
 
 /// The references whose `[key]` occurs in any of `texts`, in the order of [`ALL`].

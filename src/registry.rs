@@ -3,7 +3,7 @@
 //! tests all iterate over [`ALL`].
 
 use crate::model::{concat, total_len, ModelEntry};
-use crate::models::{attitude, formation, single_axis};
+use crate::models::{attitude, formation, sensors, single_axis};
 
 /// A family of FMUs (one folder under `src/models/`) and its documentation page `docs/models/<slug>.md`.
 pub struct Family {
@@ -39,9 +39,15 @@ pub const FAMILIES: &[Family] = &[
         overview: include_str!("models/formation/README.md"),
         fmus: formation::FMUS,
     },
+    Family {
+        slug: "sensors",
+        title: "Sensors and timing: gyro, star tracker, sun sensor, magnetometer, sample-and-hold",
+        overview: include_str!("models/sensors/README.md"),
+        fmus: sensors::FMUS,
+    },
 ];
 
-const LISTS: [&[ModelEntry]; 4] = [FAMILIES[0].fmus, FAMILIES[1].fmus, FAMILIES[2].fmus, FAMILIES[3].fmus];
+const LISTS: [&[ModelEntry]; 5] = [FAMILIES[0].fmus, FAMILIES[1].fmus, FAMILIES[2].fmus, FAMILIES[3].fmus, FAMILIES[4].fmus];
 const _: () = assert!(FAMILIES.len() == LISTS.len(), "every family goes into the registry");
 
 const LIST: [ModelEntry; total_len(&LISTS)] = concat(&LISTS, LISTS[0][0]);

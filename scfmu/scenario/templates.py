@@ -3,9 +3,17 @@
 ``attitude_loop``: AttitudeCommand → <controller> → AttitudePlant → AttitudeMetrics, the standard
 three-axis closed loop (plant defaults: inertia diag(1000, 500, 700) kg·m², no torque limit, RK4 with
 internal step 0.01 s).
+
+``with_sensors``: the same loop with the controller fed by sensors instead of the plant's truth, and run
+by a flight computer: AttitudePlant → Gyro, StarTracker → <controller> → SampleHold → AttitudePlant
+(issue 26). The sensors read the plant's ``q_*``, ``w_*`` by name; explicit connections feed the
+controller's ``q_*`` ← ``star_tracker.q_meas_*``, ``w_*`` ← ``gyro.w_meas_*`` and pass its ``torque_cmd_*``
+through the hold (``u_1…3`` → ``y_1…3``) to the plant. The metrics still read the true attitude.
 """
 
 from __future__ import annotations
+
+import copy
 
 from .model import Component, Scenario, log_of
 
@@ -49,3 +57,55 @@ def attitude_loop(name: str, controller: str, command, ctrl_params: dict | None 
         seed_params=["plant.dist_noise_seed"],
         description=description,
     )
+
+
+# ----- sensors in the loop (issue 26) ---------------------------------------------------------------------
+# Project choice, a small-satellite sensor suite: gyro 100 Hz, ARW 0.15 deg/sqrt(h), bias instability
+# 1 deg/h (tau_c 300 s), turn-on bias (5, -3, 2) deg/h; star tracker 5 Hz, 5 / 41 arcsec (cross / about
+# boresight), 0.1 s latency, 30 deg sun exclusion; flight computer 10 Hz with a 0.05 s computation delay.
+_DEG_H = 3.141592653589793 / 180.0 / 3600.0
+GYRO_DEFAULT = {"sample_period": 0.01, "bias_const_x": 5 * _DEG_H, "bias_const_y": -3 * _DEG_H,
+                "bias_const_z": 2 * _DEG_H}
+STAR_TRACKER_DEFAULT = {"sample_period": 0.2, "latency": 0.1}
+HOLD_DEFAULT = {"sample_period": 0.1, "delay": 0.05}
+SENSOR_LOG = {**{f"w_meas_{a}": f"gyro.w_meas_{a}" for a in "xyz"},
+              **{f"q_meas_{a}": f"star_tracker.q_meas_{a}" for a in ("w", "x", "y", "z")},
+              "st_valid": "star_tracker.valid",
+              **{f"torque_cmd_{a}": f"hold.y_{i}" for i, a in enumerate("xyz", 1)}}
+
+
+def with_sensors(sc: Scenario, name: str | None = None, gyro: dict | None = None, star_tracker: dict | None = None,
+                 hold: dict | None = None, description: str = "") -> Scenario:
+    """``sc`` (an attitude loop with instances ``controller`` and ``plant``) with a Gyro and a StarTracker
+    between the plant and the controller and a SampleHold between the controller and the plant.
+    ``gyro``, ``star_tracker``, ``hold``: parameters over the defaults above. The sensors' seeds join the
+    scenario's seed parameters, so a campaign over seeds is a Monte Carlo over sensor noise."""
+    s = copy.deepcopy(sc)
+    names = [c.name for c in s.components]
+    if "controller" not in names or "plant" not in names:
+        raise KeyError(f"with_sensors: scenario {sc.name!r} needs instances 'controller' and 'plant' (has {names})")
+    if s.component("plant").model != "AttitudePlant":
+        raise KeyError(f"with_sensors: scenario {sc.name!r} is not a three-axis attitude loop "
+                       f"(its plant is {s.component('plant').model!r}, not AttitudePlant)")
+    sun = {k: v for k, v in s.component("plant").params.items() if k == "sun_ecliptic_longitude"}
+    comps = []
+    for c in s.components:
+        if c.name == "controller":
+            comps.append(Component("gyro", "Gyro", {**GYRO_DEFAULT, **(gyro or {})}))
+            comps.append(Component("star_tracker", "StarTracker", {**STAR_TRACKER_DEFAULT, **sun, **(star_tracker or {})}))
+            comps.append(c)
+            comps.append(Component("hold", "SampleHold", {**HOLD_DEFAULT, **(hold or {})}))
+        else:
+            comps.append(c)
+    s.components = comps
+    s.connections = {**s.connections,
+                     **{f"controller.q_{a}": f"star_tracker.q_meas_{a}" for a in ("w", "x", "y", "z")},
+                     **{f"controller.w_{a}": f"gyro.w_meas_{a}" for a in "xyz"},
+                     **{f"hold.u_{i}": f"controller.torque_cmd_{a}" for i, a in enumerate("xyz", 1)},
+                     **{f"plant.torque_cmd_{a}": f"hold.y_{i}" for i, a in enumerate("xyz", 1)}}
+    s.unconnected = [*s.unconnected, "hold.u_*"]
+    s.seed_params = [*s.seed_params, "gyro.seed", "star_tracker.seed"]
+    s.log = {**s.log, **SENSOR_LOG}
+    s.name = name or f"sensing/{sc.name}"
+    s.description = description or f"{sc.description} — with gyro, star tracker and a 10 Hz flight computer"
+    return s

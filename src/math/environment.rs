@@ -1,6 +1,7 @@
 //! Orbit environment of the attitude plant (project choice): circular
 //! orbit with right ascension of the ascending node 0, non-tilted dipole geomagnetic field, gravity
-//! gradient torque. R is the Earth-centred inertial frame.
+//! gradient torque; for the sensors, the sun direction on the ecliptic and the Earth's cylindrical
+//! shadow. R is the Earth-centred inertial frame (equatorial).
 
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
@@ -40,6 +41,27 @@ impl CircularOrbit {
     }
 }
 
+/// Obliquity of the ecliptic ε (rad), 23.439 281° (J2000).
+pub const OBLIQUITY: f64 = 0.409_092_627_750_149;
+/// Mean motion of the sun on the ecliptic (rad/s): 2π per sidereal year of 365.256 363 days.
+pub const SUN_RATE: f64 = 2.0 * std::f64::consts::PI / (365.256_363 * 86_400.0);
+/// Equatorial Earth radius R_E (m), the radius of the shadow cylinder.
+pub const EARTH_RADIUS: f64 = 6_378_137.0;
+
+/// Unit vector Earth → sun in R: ŝ = [cos λ, sin λ cos ε, sin λ sin ε], ecliptic longitude
+/// λ = λ0 + n_sun t (circular apparent solar orbit, obliquity ε).
+pub fn sun_ref(lambda0: f64, t: f64) -> Vector3<f64> {
+    let (sl, cl) = (lambda0 + SUN_RATE * t).sin_cos();
+    let (se, ce) = OBLIQUITY.sin_cos();
+    Vector3::new(cl, sl * ce, sl * se)
+}
+
+/// Cylindrical Earth shadow: the spacecraft at r r̂ is in eclipse when it is behind the Earth
+/// (r̂·ŝ < 0) and within the shadow cylinder (r |r̂ × ŝ| < R_E).
+pub fn in_eclipse(r_hat: &Vector3<f64>, radius: f64, sun: &Vector3<f64>) -> bool {
+    r_hat.dot(sun) < 0.0 && radius * r_hat.cross(sun).norm() < EARTH_RADIUS
+}
+
 /// Gravity-gradient torque 3 n² r̂_b × (I r̂_b) with n² = μ / r³ and r̂_b the orbit radius direction
 /// in body axes.
 pub fn gravity_gradient(n2: f64, r_hat_b: &Vector3<f64>, inertia: &Matrix3<f64>) -> Vector3<f64> {
@@ -77,6 +99,29 @@ mod tests {
         o.arg_lat0 = std::f64::consts::FRAC_PI_2;
         let bp = o.field_ref(0.0);
         assert!((bp.z + 2.0 * o.dipole / o.radius.powi(3)).abs() < 1e-18);
+    }
+
+    #[test]
+    fn sun_direction_and_shadow() {
+        // λ = 0: vernal equinox direction x; λ = 90°: summer solstice, declination = ε
+        assert!((sun_ref(0.0, 0.0) - Vector3::x()).norm() < 1e-15);
+        let s = sun_ref(std::f64::consts::FRAC_PI_2, 0.0);
+        assert!((s.z.asin() - 23.439281f64.to_radians()).abs() < 1e-12 && s.x.abs() < 1e-15);
+        // one sidereal year later the sun is back; a quarter year moves it by 90°
+        let year = 365.256363 * 86400.0;
+        assert!((sun_ref(0.3, year) - sun_ref(0.3, 0.0)).norm() < 1e-12);
+        assert!((sun_ref(0.0, year / 4.0).dot(&Vector3::x())).abs() < 1e-12);
+        // 700 km orbit: behind the Earth on the sun line in shadow, beside it not; shadow half-angle
+        // asin(R_E / r) = 64.3° about the anti-sun direction
+        let r = 7078137.0;
+        let sun = Vector3::x();
+        assert!(in_eclipse(&-Vector3::x(), r, &sun));
+        assert!(!in_eclipse(&Vector3::x(), r, &sun));
+        let half = (EARTH_RADIUS / r).asin();
+        for (off, inside) in [(half - 1e-6, true), (half + 1e-6, false)] {
+            let rh = Vector3::new(-off.cos(), off.sin(), 0.0);
+            assert_eq!(in_eclipse(&rh, r, &sun), inside, "{off}");
+        }
     }
 
     #[test]

@@ -29,8 +29,13 @@
 //! - formation: the controller's leader-orbit and mass parameters keep the plant's references (`mu` 100,
 //!   `semi_major_axis` 101, `eccentricity` 102, `mass` 104); its own `T1` 114, `T2` 115, `c` 116,
 //!   `c_x/y/z` 117–119, `init_int_error` 150–152, `structure` 120.
+//! - sensors: truth inputs `q` 0–3 (the plant's attitude), `w` 4–6 (the plant's rate); measured outputs
+//!   from 20 (`w_meas`, `q_meas` + `valid` 24, `sun_meas` + `valid` 23, `b_meas`; `SampleHold` `y_1…8`
+//!   20–27 from `u_1…8` 0–7), diagnostics from 30; `sample_period` 100, `seed` 140, the plant's orbit
+//!   parameters with the plant's references (`mu` 160 … `earth_dipole` 164), `sun_ecliptic_longitude` 165.
 //! - plants of every family: `integrator` is an Integer with codes 0 RK4, 1 Euler, 2 Dormand–Prince.
 
 pub mod attitude;
 pub mod formation;
+pub mod sensors;
 pub mod single_axis;

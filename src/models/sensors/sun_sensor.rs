@@ -1,0 +1,193 @@
+//! `SunSensor`: body-frame sun direction with noise and a fixed bias rotation, a field of view and the
+//! Earth's shadow, sampled at its own rate, seeded.
+
+use nalgebra::{Matrix3, Quaternion, Vector3};
+use serde::{Deserialize, Serialize};
+
+use super::shared::{check_unit, rotation, DelayLine, OrbitParams, SunParams, TrueAttitude};
+use crate::declare_variables;
+use crate::math::attitude::attitude_matrix;
+use crate::math::environment::{in_eclipse, sun_ref, CircularOrbit};
+use crate::math::random::{hold_index, normal};
+use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult, SWITCH};
+
+declare_variables! {
+    pub struct SunSensorVars {
+        truth: TrueAttitude;
+        orbit: OrbitParams;
+        sun: SunParams;
+        20 => sun_meas: Vec3 = [0.0, 0.0, 1.0], Output, "", "Measured unit sun direction, body axes (the last valid one while valid = 0)";
+        23 => valid: Real = 0.0, Output, "", "1 = sun in the field of view and not in the Earth's shadow; 0 = sun_meas held";
+        100 => sample_period: Real = 0.1, Parameter, "s", "Sample period T", Range(1e-6, 1e4);
+        103 => noise: Real = 1.745e-3, Parameter, "rad", "1-sigma angular noise about each axis perpendicular to the sun line (default 0.1 deg)", NonNegative;
+        110 => bias: Vec3 = [0.0; 3], Parameter, "rad", "Bias: fixed rotation vector applied to the measured direction, body axes", Range(-0.5, 0.5);
+        106 => mount: Vec3 = [0.0; 3], Parameter, "rad", "Mounting: rotation vector of the sensor axes relative to the body axes (boresight = sensor z)", Range(-4.0, 4.0);
+        113 => fov: Real = 1.0471975511965976, Parameter, "rad", "Field-of-view half-angle about the boresight (pi = whole sky; default 60 deg)", Range(0.0, 3.141592653589793);
+        140 => seed: Integer = 1, Parameter, "", "Seed of the counter-based noise generator";
+        141 => eclipse: Integer = 1, Parameter, "", "1 = no measurement in the Earth's cylindrical shadow, 0 = shadow ignored", Choice(SWITCH);
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SunSample {
+    s: [f64; 3],
+    valid: bool,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+struct Derived {
+    period: f64,
+    k0: i64,
+    seed: i64,
+    orbit: CircularOrbit,
+    sun_lambda0: f64,
+    boresight: Vector3<f64>,
+    cos_fov: f64,
+    bias: Vector3<f64>,
+    noise: f64,
+    eclipse: bool,
+}
+
+#[derive(Clone, Serialize, Deserialize)]
+pub struct SunSensor {
+    d: Derived,
+    line: DelayLine<SunSample>,
+}
+
+impl SunSensor {
+    /// Sample k: s_B = A(q) ŝ(t_k), measured R(bias + σ n_k) s_B; valid if in the field of view and lit.
+    fn sample(&self, k: i64, q: &Quaternion<f64>) -> SunSample {
+        let d = &self.d;
+        let t = k as f64 * d.period;
+        let s_ref = sun_ref(d.sun_lambda0, t);
+        let s_b = attitude_matrix(q) * s_ref;
+        let n = Vector3::from_fn(|i, _| d.noise * normal(d.seed, k, i as u64));
+        let m: Matrix3<f64> = rotation(&(d.bias + n));
+        let meas = (m * s_b).normalize();
+        let lit = !d.eclipse || !in_eclipse(&d.orbit.r_hat(t), d.orbit.radius, &s_ref);
+        SunSample { s: [meas.x, meas.y, meas.z], valid: lit && s_b.dot(&d.boresight) >= d.cos_fov }
+    }
+}
+
+impl Model for SunSensor {
+    type Vars = SunSensorVars;
+    const EVOLVING: &'static [&'static str] = &["line"];
+    const INFO: ModelInfo = ModelInfo {
+        name: "SunSensor",
+        description: "Sun sensor: body-frame sun direction with angular noise and bias, field of view and Earth shadow, sampled at its own rate, seeded",
+        source: "sun-sensor measurement model of [Markley-Crassidis-2014] Sec. 4.4 (unit-vector measurement with small-angle noise); sun on the ecliptic and cylindrical shadow: project choice",
+        equations_html: "<pre>samples at t_k = k T, held until the next sample:\n\
+s_R(t)   = [cos l, sin l cos eps, sin l sin eps],  l = l_0 + n_sun t,  eps = 23.439 deg,  n_sun = 2 pi / 365.256 d\n\
+s_B      = A(q(t_k)) s_R(t_k)\n\
+s_meas,k = R(b + sigma n_k) s_B,   n_k,i = N(seed, k, i) of math::random, R(.) the rotation of a rotation vector\n\
+valid_k  = s_B . boresight_B >= cos(fov)  and not in shadow (eclipse = 1): r_hat . s_R < 0 and r |r_hat x s_R| < R_E\n\
+           r_hat(t) = the plant's circular orbit (same parameters, value references 160-164)\n\
+while not valid: the last valid sample, valid = 0 (before any: (0, 0, 1))</pre>\n\
+<p>The angular error about each axis perpendicular to the sun line has standard deviation sigma (the component \
+of the noise along the sun line does not move the direction), so the angle between measured and true direction \
+is Rayleigh-distributed with mean square 2 sigma^2.</p>",
+        feedthrough: Feedthrough::AllInputs,
+        ..ModelInfo::DEFAULT
+    };
+
+    fn initialize(v: &mut SunSensorVars, exp: &Experiment) -> Result<Self, String> {
+        let k0 = hold_index(exp.start_time, v.sample_period);
+        let d = Derived {
+            period: v.sample_period,
+            k0,
+            seed: v.seed as i64,
+            orbit: v.orbit.orbit(),
+            sun_lambda0: v.sun.sun_ecliptic_longitude,
+            boresight: rotation(&v.mount).column(2).into_owned(),
+            cos_fov: v.fov.cos(),
+            bias: v.bias,
+            noise: v.noise,
+            eclipse: v.eclipse == 1,
+        };
+        Ok(SunSensor { d, line: DelayLine::new(SunSample { s: [0.0, 0.0, 1.0], valid: false }, k0) })
+    }
+
+    fn outputs(&self, v: &mut SunSensorVars, t: f64) -> ModelResult {
+        check_unit("q", &v.truth.q)?;
+        let q = v.truth.q;
+        let (s, ok) = self.line.at(t, self.d.period, 0.0, |k| self.sample(k, &q), |s| s.valid);
+        v.sun_meas = Vector3::from(s.s);
+        v.valid = if ok { 1.0 } else { 0.0 };
+        Ok(())
+    }
+
+    fn step(&mut self, v: &SunSensorVars, t: f64, h: f64) -> ModelResult {
+        check_unit("q", &v.truth.q)?;
+        let q = v.truth.q;
+        let mut line = self.line.clone();
+        line.advance(t, h, self.d.period, 0.0, |k| self.sample(k, &q), |s| s.valid)?;
+        self.line = line;
+        Ok(())
+    }
+
+    fn validate(&self, _fresh: &Self) -> ModelResult {
+        self.line.check(super::shared::max_queue(self.d.period, 0.0), self.d.k0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::attitude::quat_from_euler321;
+    use crate::model::Fmu;
+
+    #[test]
+    fn direction_noise_bias_and_shadow() {
+        // noise-free with a bias of 0.01 rad about body x: the measured direction is R(b) A(q) s_R
+        let mut s = Fmu::<SunSensor>::default();
+        (s.v.noise, s.v.fov, s.v.eclipse) = (0.0, std::f64::consts::PI, 0);
+        s.v.bias = Vector3::new(0.01, 0.0, 0.0);
+        s.initialize(&Experiment::default()).unwrap();
+        let q = quat_from_euler321(0.2, 0.5, -1.0);
+        s.v.truth.q = q;
+        s.outputs(0.0).unwrap();
+        // independent: rotate s_R = x (λ0 = 0) by hand: A(q) = R1(0.2) R2(0.5) R3(-1.0) for the 321 sequence
+        let r1 = |a: f64| Matrix3::new(1.0, 0.0, 0.0, 0.0, a.cos(), a.sin(), 0.0, -a.sin(), a.cos());
+        let r2 = |a: f64| Matrix3::new(a.cos(), 0.0, -a.sin(), 0.0, 1.0, 0.0, a.sin(), 0.0, a.cos());
+        let r3 = |a: f64| Matrix3::new(a.cos(), a.sin(), 0.0, -a.sin(), a.cos(), 0.0, 0.0, 0.0, 1.0);
+        let sb = r1(0.2) * r2(0.5) * r3(-1.0) * Vector3::x();
+        // active rotation by +0.01 about x: (x, y c - z s, y s + z c)
+        let (sn, c) = 0.01f64.sin_cos();
+        let want = Vector3::new(sb.x, sb.y * c - sb.z * sn, sb.y * sn + sb.z * c);
+        assert!((s.v.sun_meas - want).norm() < 1e-14, "{} vs {want}", s.v.sun_meas);
+        assert_eq!(s.v.valid, 1.0);
+
+        // noise: mean square angle 2 σ² (Rayleigh), over 20 000 samples
+        let mut s = Fmu::<SunSensor>::default();
+        (s.v.noise, s.v.fov, s.v.eclipse) = (1e-3, std::f64::consts::PI, 0);
+        s.initialize(&Experiment::default()).unwrap();
+        s.v.truth.q = q;
+        let (n, h) = (20_000, s.v.sample_period);
+        let mut ms = 0.0;
+        for i in 0..n {
+            let t = i as f64 * h;
+            s.outputs(t).unwrap();
+            let truth = attitude_matrix(&q) * sun_ref(0.0, t);
+            ms += s.v.sun_meas.angle(&truth).powi(2);
+            s.step(t, h).unwrap();
+        }
+        let ms = ms / n as f64;
+        // the squared angle is exponential with mean 2σ²: relative standard error 1/sqrt(n)
+        assert!((ms / 2e-6 - 1.0).abs() < 4.0 / (n as f64).sqrt(), "{ms}");
+
+        // shadow: argument of latitude 180° with the sun at λ0 = 0 and the equatorial... orbit inclination 0
+        let mut s = Fmu::<SunSensor>::default();
+        s.v.orbit.orbit_inclination = 0.0;
+        s.v.orbit.orbit_arg_lat0 = std::f64::consts::PI;
+        s.v.fov = std::f64::consts::PI;
+        s.initialize(&Experiment::default()).unwrap();
+        s.outputs(0.0).unwrap();
+        assert_eq!((s.v.valid, s.v.sun_meas), (0.0, Vector3::new(0.0, 0.0, 1.0)));
+        // field of view: the boresight body z at identity is 90° from the sun: outside a 60° cone
+        s.v.orbit.orbit_arg_lat0 = 0.0;
+        s.v.fov = 1.0;
+        s.initialize(&Experiment::default()).unwrap();
+        s.outputs(0.0).unwrap();
+        assert_eq!(s.v.valid, 0.0);
+    }
+}
