@@ -101,7 +101,7 @@ fn abi_instance() -> *mut std::ffi::c_void {
         step_finished: None,
         component_environment: std::ptr::null_mut(),
     }));
-    let c = fmi2Instantiate(name.as_ptr(), 1, g.as_ptr(), std::ptr::null(), cb, 0, 0);
+    let c = fmi2Instantiate(spacecraft_fmus::registry::ALL, name.as_ptr(), 1, g.as_ptr(), std::ptr::null(), cb, 0, 0);
     assert!(!c.is_null());
     assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), 0);
     assert_eq!(fmi2EnterInitializationMode(c), 0);

@@ -1,15 +1,22 @@
 #!/usr/bin/env bash
-# Cross-builds the cdylibs of the workspace's default members for Windows x86-64 on Linux:
-# target/win64/x86_64-win7-windows-gnu/release/spacecraft_fmus.dll (the FMUs' binary) and
+# Cross-builds cdylibs for Windows x86-64 on Linux. Without arguments: the workspace's default members,
+# giving target/win64/x86_64-win7-windows-gnu/release/spacecraft_fmus_cdylib.dll (the FMUs' binary) and
 # scfmu_native_loop.dll (the compiled engine's loop, shipped in the wheel by scripts/build_wheel.sh).
+# With --manifest-path PATH: that package (a user's model crate; fmu-package calls this), into
+# <its target folder>/win64.
 # Uses Debian's Rust (rustc-web, cargo-web, rust-web-src: /usr/bin/rustc, /usr/bin/cargo and the std
 # sources in /usr/lib/rustlib/src) to build std for the target itself
 # (-Z build-std, allowed on a stable compiler by RUSTC_BOOTSTRAP=1) and the MinGW-w64 linker
 # (gcc-mingw-w64-x86-64). scripts/setup.sh installs these packages. Why the win7 target: docs/tools.md.
 #
-#   scripts/build_win64.sh            build; prints the FMUs' DLL path on the last line
-#   scripts/build_win64.sh --check    exit 0 when the cross toolchain is installed, 1 (with the reason) if not
+#   scripts/build_win64.sh                         build; prints the FMUs' DLL path on the last line
+#   scripts/build_win64.sh --manifest-path PATH    build that package; prints its release folder on the last line
+#   scripts/build_win64.sh --check                 exit 0 when the cross toolchain is installed, 1 (with the reason) if not
 set -euo pipefail
+manifest=""
+if [ "${1:-}" = "--manifest-path" ]; then
+    manifest=$(realpath "${2:?--manifest-path needs a path}")
+fi
 cd "$(dirname "$0")/.."
 
 TARGET=x86_64-win7-windows-gnu
@@ -37,10 +44,21 @@ fi
 
 # The Debian compiler is used for everything of this build (RUSTC), never the rustup one: std is
 # compiled from the sources that match it exactly. Separate target dir: the Linux build is untouched.
+if [ -n "$manifest" ]; then
+    # the package's own target folder (its workspace's), win64 below it
+    target_dir=$("$CARGO_DEB" metadata --no-deps --format-version 1 --manifest-path "$manifest" |
+        python3 -c 'import json, sys; print(json.load(sys.stdin)["target_directory"])')/win64
+    RUSTC_BOOTSTRAP=1 RUSTC="$RUSTC_DEB" RUSTDOC=/usr/bin/rustdoc \
+    CARGO_TARGET_X86_64_WIN7_WINDOWS_GNU_LINKER="$LINKER" \
+        "$CARGO_DEB" build --release --lib -Z build-std=std,panic_unwind \
+        --manifest-path "$manifest" --target "$TARGET" --target-dir "$target_dir" >&2
+    echo "$target_dir/$TARGET/release"
+    exit 0
+fi
 RUSTC_BOOTSTRAP=1 RUSTC="$RUSTC_DEB" RUSTDOC=/usr/bin/rustdoc \
 CARGO_TARGET_X86_64_WIN7_WINDOWS_GNU_LINKER="$LINKER" \
     "$CARGO_DEB" build --release --locked --lib -Z build-std=std,panic_unwind \
     --target "$TARGET" --target-dir target/win64 >&2
-dll=target/win64/$TARGET/release/spacecraft_fmus.dll
+dll=target/win64/$TARGET/release/spacecraft_fmus_cdylib.dll
 [ -f "$dll" ] || { echo "build_win64: $dll was not produced" >&2; exit 1; }
 echo "$dll"

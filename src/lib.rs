@@ -1,20 +1,29 @@
-//! Spacecraft guidance and control units as FMI 2.0 Co-Simulation FMUs.
+//! Spacecraft guidance and control units as FMI 2.0 Co-Simulation FMUs, and the runtime that exports
+//! them — ours and anyone's.
 //!
-//! - `fmi`: the FMI 2.0 CS C ABI, state machine, logging and FMU state, written once.
+//! - `export`: the public export API in one place — the model contract, the declaration macros,
+//!   [`export_fmus!`] (which generates a shared library's FMI entry points) and the catalogue the
+//!   packaging tool reads back. Start there (docs/export.md walks through a model of your own).
+//! - `fmi`: the FMI 2.0 CS C functions, state machine, logging and FMU state, written once; exported by
+//!   `export_fmus!` in the crate that builds the shared library, never by this one (an rlib).
 //! - `model`: what a model is (declared variables + init/outputs/step), the declaration macro, GUIDs.
-//! - `models`: the FMUs, one folder per family; `registry` lists them.
-//! - `description`: modelDescription.xml and documentation generated from the declarations (packaging).
+//! - `models`: the project's FMUs, one folder per family; `registry` lists them.
 //! - `math`: shared math (attitude conventions, integrators, ...), unit-tested on its own.
-//! - `docs`, `references`: the generated model pages under docs/ and the publications they cite.
-//! - `package`: writes `fmus/<Model>.fmu` and `modelDescription/<Model>.xml`.
+//! - `units`: the unit table every declared unit must come from.
+//!
+//! Workspace members next to this crate: `src/cdylib` (the shared library of the project's FMUs: one
+//! `export_fmus!` line over the registry, like a user's crate) and `src/package` (the packaging tool
+//! `fmu-package`: modelDescription.xml, documentation, `.fmu` archives and the generated model pages;
+//! the only code that links an XML writer and `zip`).
 
-pub mod description;
-pub mod docs;
+pub mod export;
 pub mod fmi;
 pub mod math;
 pub mod model;
 pub mod models;
-pub mod package;
-pub mod references;
 pub mod registry;
 pub mod units;
+
+/// The linear-algebra crate of the declarations (`Vec3`, `Diag3`, `Quat` fields), re-exported so that
+/// a model crate uses the same version.
+pub use nalgebra;

@@ -59,6 +59,22 @@ pub const UNITS: &[(&str, BaseUnit, &[(&str, f64)])] = &[
     ("T.m3", u(1, 3, -2, -1, 0), &[]),
 ];
 
+/// Whether `name` is "" (dimensionless) or a unit of the table; usable in constants (the declaration
+/// macro checks every unit at compile time with it).
+pub const fn is_defined(name: &str) -> bool {
+    if name.is_empty() {
+        return true;
+    }
+    let mut i = 0;
+    while i < UNITS.len() {
+        if crate::model::same_str(UNITS[i].0, name) {
+            return true;
+        }
+        i += 1;
+    }
+    false
+}
+
 pub fn lookup(name: &str) -> Option<&'static (&'static str, BaseUnit, &'static [(&'static str, f64)])> {
     UNITS.iter().find(|(n, _, _)| *n == name)
 }

@@ -1,6 +1,12 @@
-//! The exported FMI 2.0 Co-Simulation C functions. Each one: checks pointers, finds the instance
-//! among the live ones, checks the state machine, runs the call inside `catch_unwind`, and turns
-//! every failure into a status plus a logger message naming the function and the reason.
+//! The FMI 2.0 Co-Simulation C functions, written once for every model. Each one: checks pointers,
+//! finds the instance among the live ones, checks the state machine, runs the call inside
+//! `catch_unwind`, and turns every failure into a status plus a logger message naming the function
+//! and the reason.
+//!
+//! Nothing here is exported by itself: [`export_fmus!`](crate::export_fmus) expands, in the crate
+//! that builds the shared library (ours or a user's), to `#[no_mangle]` functions with the standard
+//! names that call these, and passes its list of models to [`fmi2Instantiate`]. A library that only
+//! depends on this crate (an rlib) therefore exports no FMI symbol of its own.
 #![allow(non_snake_case, clippy::missing_safety_doc, clippy::not_unsafe_ptr_arg_deref)]
 
 use std::cell::{Cell, RefCell};
@@ -14,7 +20,6 @@ use super::state::Snapshot;
 use super::{mask, status_kind, BuildAddrHasher, CallbackFunctions, FsmState, LiveSet, Status};
 use crate::model::guid::guid;
 use crate::model::{ModelEntry, Value, VarKind};
-use crate::registry;
 
 type Component = *mut c_void;
 
@@ -139,8 +144,7 @@ fn out_ptr<'a, T>(p: *mut T, what: &str) -> CallResult<&'a mut T> {
 
 // ----- model lookup for fmi2Instantiate ------------------------------------------------------------
 
-fn find_model(requested: &str) -> Result<&'static ModelEntry, String> {
-    let all = registry::ALL;
+fn find_model(all: &'static [ModelEntry], requested: &str) -> Result<&'static ModelEntry, String> {
     if let Some(expected) = super::library_path::own_library_stem().and_then(|stem| all.iter().find(|e| e.info.name == stem)) {
         let want = guid(expected);
         return if requested == want {
@@ -162,20 +166,20 @@ fn log_without_instance(functions: &CallbackFunctions, name: &CStr, message: &st
 
 // ----- platform ------------------------------------------------------------------------------------
 
-#[no_mangle]
 pub extern "C" fn fmi2GetTypesPlatform() -> *const c_char {
     TYPES_PLATFORM.as_ptr()
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2GetVersion() -> *const c_char {
     VERSION.as_ptr()
 }
 
 // ----- life cycle ----------------------------------------------------------------------------------
 
-#[no_mangle]
-pub extern "C" fn fmi2Instantiate(
+/// `fmi2Instantiate` for a library holding `models`: the model is the one whose name is the library's
+/// file name (`binaries/<platform>/<Model>.<ext>`) if there is one, else the one with the requested GUID.
+pub fn fmi2Instantiate(
+    models: &'static [ModelEntry],
     instance_name: *const c_char,
     fmu_type: c_int,
     fmu_guid: *const c_char,
@@ -206,7 +210,7 @@ pub extern "C" fn fmi2Instantiate(
         }
         // SAFETY: non-null C string from the master.
         let requested = unsafe { CStr::from_ptr(fmu_guid) }.to_string_lossy();
-        let entry = find_model(&requested)?;
+        let entry = find_model(models, &requested)?;
         let inst = Box::new(Instance::new(name.to_owned(), entry, functions.logger, functions.component_environment, logging_on != 0));
         inst.trace(|| format!("fmi2Instantiate: {} instance of {}", inst.name.to_string_lossy(), entry.info.name));
         let p = Box::into_raw(inst) as Component;
@@ -231,7 +235,6 @@ pub extern "C" fn fmi2Instantiate(
     }
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2FreeInstance(c: Component) {
     if c.is_null() || !live_instances().remove(&(c as usize)) {
         return; // null or not ours: nothing to free, nothing to log to
@@ -249,7 +252,6 @@ pub extern "C" fn fmi2FreeInstance(c: Component) {
     }
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2SetDebugLogging(c: Component, logging_on: c_int, n: usize, categories: *const *const c_char) -> c_int {
     call(c, "fmi2SetDebugLogging", mask::SET_DEBUG_LOGGING, |inst| {
         let ptrs = unsafe { slice(categories, n, "categories[]")? };
@@ -265,7 +267,6 @@ pub extern "C" fn fmi2SetDebugLogging(c: Component, logging_on: c_int, n: usize,
     })
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2SetupExperiment(c: Component, tol_defined: c_int, tol: f64, start: f64, stop_defined: c_int, stop: f64) -> c_int {
     call(c, "fmi2SetupExperiment", mask::SETUP_EXPERIMENT, |inst| {
         inst.trace(|| format!("fmi2SetupExperiment(toleranceDefined={tol_defined}, tolerance={tol}, startTime={start}, stopTimeDefined={stop_defined}, stopTime={stop})"));
@@ -273,17 +274,14 @@ pub extern "C" fn fmi2SetupExperiment(c: Component, tol_defined: c_int, tol: f64
     })
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2EnterInitializationMode(c: Component) -> c_int {
     call(c, "fmi2EnterInitializationMode", mask::ENTER_INITIALIZATION_MODE, |inst| inst.enter_initialization_mode())
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2ExitInitializationMode(c: Component) -> c_int {
     call(c, "fmi2ExitInitializationMode", mask::EXIT_INITIALIZATION_MODE, |inst| inst.exit_initialization_mode())
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2Terminate(c: Component) -> c_int {
     call(c, "fmi2Terminate", mask::TERMINATE, |inst| {
         inst.run.fsm = FsmState::Terminated;
@@ -291,7 +289,6 @@ pub extern "C" fn fmi2Terminate(c: Component) -> c_int {
     })
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2Reset(c: Component) -> c_int {
     call(c, "fmi2Reset", mask::RESET, |inst| {
         inst.reset();
@@ -325,22 +322,18 @@ fn set_typed<T: Copy>(c: Component, func: &str, kind: VarKind, vr: *const u32, n
     })
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2GetReal(c: Component, vr: *const u32, n: usize, value: *mut f64) -> c_int {
     get_typed(c, "fmi2GetReal", VarKind::Real, vr, n, value, |v| if let Value::Real(x) = v { x } else { f64::NAN })
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2GetInteger(c: Component, vr: *const u32, n: usize, value: *mut c_int) -> c_int {
     get_typed(c, "fmi2GetInteger", VarKind::Integer, vr, n, value, |v| if let Value::Integer(x) = v { x } else { 0 })
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2GetBoolean(c: Component, vr: *const u32, n: usize, value: *mut c_int) -> c_int {
     get_typed(c, "fmi2GetBoolean", VarKind::Boolean, vr, n, value, |v| matches!(v, Value::Boolean(true)) as c_int)
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2GetString(c: Component, vr: *const u32, n: usize, value: *mut *const c_char) -> c_int {
     call(c, "fmi2GetString", mask::GET, |_inst| {
         let vrs = unsafe { slice(vr, n, "vr[]")? };
@@ -352,22 +345,18 @@ pub extern "C" fn fmi2GetString(c: Component, vr: *const u32, n: usize, value: *
     })
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2SetReal(c: Component, vr: *const u32, n: usize, value: *const f64) -> c_int {
     set_typed(c, "fmi2SetReal", VarKind::Real, vr, n, value, Value::Real)
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2SetInteger(c: Component, vr: *const u32, n: usize, value: *const c_int) -> c_int {
     set_typed(c, "fmi2SetInteger", VarKind::Integer, vr, n, value, Value::Integer)
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2SetBoolean(c: Component, vr: *const u32, n: usize, value: *const c_int) -> c_int {
     set_typed(c, "fmi2SetBoolean", VarKind::Boolean, vr, n, value, |b| Value::Boolean(b != 0))
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2SetString(c: Component, vr: *const u32, n: usize, value: *const *const c_char) -> c_int {
     call(c, "fmi2SetString", mask::SET, |_inst| {
         let vrs = unsafe { slice(vr, n, "vr[]")? };
@@ -381,7 +370,6 @@ pub extern "C" fn fmi2SetString(c: Component, vr: *const u32, n: usize, value: *
 
 // ----- FMU state -----------------------------------------------------------------------------------
 
-#[no_mangle]
 pub extern "C" fn fmi2GetFMUstate(c: Component, state: *mut *mut c_void) -> c_int {
     call(c, "fmi2GetFMUstate", mask::FMU_STATE, |inst| {
         let slot = out_ptr(state, "FMUstate")?;
@@ -399,14 +387,12 @@ pub extern "C" fn fmi2GetFMUstate(c: Component, state: *mut *mut c_void) -> c_in
     })
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2SetFMUstate(c: Component, state: *mut c_void) -> c_int {
     call(c, "fmi2SetFMUstate", mask::FMU_STATE, |inst| {
         Snapshot::with_handle(state as *mut Snapshot, |snap| snap.restore_into(inst))
     })
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2FreeFMUstate(c: Component, state: *mut *mut c_void) -> c_int {
     call(c, "fmi2FreeFMUstate", mask::FMU_STATE, |_inst| {
         let slot = out_ptr(state, "FMUstate")?;
@@ -419,7 +405,6 @@ pub extern "C" fn fmi2FreeFMUstate(c: Component, state: *mut *mut c_void) -> c_i
     })
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2SerializedFMUstateSize(c: Component, state: *mut c_void, size: *mut usize) -> c_int {
     call(c, "fmi2SerializedFMUstateSize", mask::FMU_STATE, |inst| {
         let out = out_ptr(size, "size")?;
@@ -432,7 +417,6 @@ pub extern "C" fn fmi2SerializedFMUstateSize(c: Component, state: *mut c_void, s
     })
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2SerializeFMUstate(c: Component, state: *mut c_void, buffer: *mut c_char, size: usize) -> c_int {
     call(c, "fmi2SerializeFMUstate", mask::FMU_STATE, |inst| {
         Snapshot::with_handle(state as *mut Snapshot, |snap| {
@@ -450,7 +434,6 @@ pub extern "C" fn fmi2SerializeFMUstate(c: Component, state: *mut c_void, buffer
     })
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2DeSerializeFMUstate(c: Component, buffer: *const c_char, size: usize, state: *mut *mut c_void) -> c_int {
     call(c, "fmi2DeSerializeFMUstate", mask::FMU_STATE, |inst| {
         let slot = out_ptr(state, "FMUstate")?;
@@ -470,7 +453,6 @@ pub extern "C" fn fmi2DeSerializeFMUstate(c: Component, buffer: *const c_char, s
 
 // ----- derivatives ---------------------------------------------------------------------------------
 
-#[no_mangle]
 pub extern "C" fn fmi2GetDirectionalDerivative(
     c: Component,
     v_unknown: *const u32,
@@ -491,14 +473,12 @@ pub extern "C" fn fmi2GetDirectionalDerivative(
     })
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2SetRealInputDerivatives(c: Component, _vr: *const u32, _n: usize, _order: *const c_int, _value: *const f64) -> c_int {
     call(c, "fmi2SetRealInputDerivatives", mask::SET_INPUT_DERIVATIVES, |_| {
         Err(Fail::error("not supported: canInterpolateInputs = false, inputs are held constant over a step"))
     })
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2GetRealOutputDerivatives(c: Component, _vr: *const u32, _n: usize, _order: *const c_int, _value: *mut f64) -> c_int {
     call(c, "fmi2GetRealOutputDerivatives", mask::GET_OUTPUT_DERIVATIVES, |_| {
         Err(Fail::error("not supported: maxOutputDerivativeOrder = 0"))
@@ -507,7 +487,6 @@ pub extern "C" fn fmi2GetRealOutputDerivatives(c: Component, _vr: *const u32, _n
 
 // ----- stepping ------------------------------------------------------------------------------------
 
-#[no_mangle]
 pub extern "C" fn fmi2DoStep(c: Component, t: f64, h: f64, _no_set_prior: c_int) -> c_int {
     call(c, "fmi2DoStep", mask::DO_STEP, |inst| {
         inst.trace(|| format!("fmi2DoStep(currentCommunicationPoint={t}, communicationStepSize={h})"));
@@ -515,7 +494,6 @@ pub extern "C" fn fmi2DoStep(c: Component, t: f64, h: f64, _no_set_prior: c_int)
     })
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2CancelStep(c: Component) -> c_int {
     // Never allowed: fmi2DoStep is synchronous and never returns fmi2Pending.
     call(c, "fmi2CancelStep", mask::CANCEL_STEP, |_| Ok(()))
@@ -525,7 +503,6 @@ fn status_query(c: Component, func: &str, f: impl FnOnce(&mut Instance) -> CallR
     call(c, func, mask::GET_STATUS, f)
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2GetStatus(c: Component, kind: c_int, value: *mut c_int) -> c_int {
     status_query(c, "fmi2GetStatus", |_| {
         out_ptr(value, "value")?;
@@ -533,7 +510,6 @@ pub extern "C" fn fmi2GetStatus(c: Component, kind: c_int, value: *mut c_int) ->
     })
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2GetRealStatus(c: Component, kind: c_int, value: *mut f64) -> c_int {
     status_query(c, "fmi2GetRealStatus", |inst| {
         let out = out_ptr(value, "value")?;
@@ -546,7 +522,6 @@ pub extern "C" fn fmi2GetRealStatus(c: Component, kind: c_int, value: *mut f64) 
     })
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2GetIntegerStatus(c: Component, kind: c_int, value: *mut c_int) -> c_int {
     status_query(c, "fmi2GetIntegerStatus", |_| {
         out_ptr(value, "value")?;
@@ -554,7 +529,6 @@ pub extern "C" fn fmi2GetIntegerStatus(c: Component, kind: c_int, value: *mut c_
     })
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2GetBooleanStatus(c: Component, kind: c_int, value: *mut c_int) -> c_int {
     status_query(c, "fmi2GetBooleanStatus", |inst| {
         let out = out_ptr(value, "value")?;
@@ -567,7 +541,6 @@ pub extern "C" fn fmi2GetBooleanStatus(c: Component, kind: c_int, value: *mut c_
     })
 }
 
-#[no_mangle]
 pub extern "C" fn fmi2GetStringStatus(c: Component, kind: c_int, value: *mut *const c_char) -> c_int {
     status_query(c, "fmi2GetStringStatus", |_| {
         out_ptr(value, "value")?;
@@ -602,9 +575,9 @@ mod tests {
             step_finished: None,
             component_environment: &*log as *const Log as *mut c_void,
         };
-        let entry = registry::find("AttitudeMetrics").unwrap();
+        let entry = crate::registry::find("AttitudeMetrics").unwrap();
         let g = CString::new(guid(entry)).unwrap();
-        let c = fmi2Instantiate(c"p".as_ptr(), 1, g.as_ptr(), std::ptr::null(), &cb, 0, 0);
+        let c = fmi2Instantiate(crate::registry::ALL, c"p".as_ptr(), 1, g.as_ptr(), std::ptr::null(), &cb, 0, 0);
         assert!(!c.is_null());
         let st = call(c, "fmi2Probe", mask::SETUP_EXPERIMENT, |_| panic!("deliberate test panic"));
         assert_eq!(st, Status::Fatal as c_int);

@@ -67,7 +67,7 @@ pub const fn no_duplicate_vrs(d: &[VarDecl]) -> bool {
     true
 }
 
-const fn same_str(a: &str, b: &str) -> bool {
+pub const fn same_str(a: &str, b: &str) -> bool {
     let (a, b) = (a.as_bytes(), b.as_bytes());
     if a.len() != b.len() {
         return false;
@@ -80,6 +80,54 @@ const fn same_str(a: &str, b: &str) -> bool {
         i += 1;
     }
     true
+}
+
+/// What is wrong with the declarations of one field (the `width` variables from value reference `vr`:
+/// 1 for scalars, 3 for `Vec3`/`Diag3`, 4 for `Quat`) within the whole table `d`, as a code for the
+/// compile-time assertions `declare_variables!` generates (each names the field):
+/// 0 nothing; 1 a value reference used by another variable; 2 a name used by another variable;
+/// 3 a unit not in `crate::units`; 4 a unit on a non-Real; 5 a parameter start value outside its bound;
+/// 6 a bound on a variable that is not a parameter; 7 an empty description; 8 a non-finite start value.
+pub const fn field_problem(d: &[VarDecl], vr: u32, width: u32) -> u8 {
+    let mut i = 0;
+    while i < d.len() {
+        let a = &d[i];
+        if a.vr >= vr && a.vr < vr + width {
+            let mut j = 0;
+            while j < d.len() {
+                if j != i && d[j].vr == a.vr {
+                    return 1;
+                }
+                if j != i && same_str(d[j].name, a.name) {
+                    return 2;
+                }
+                j += 1;
+            }
+            if !crate::units::is_defined(a.unit) {
+                return 3;
+            }
+            if !a.unit.is_empty() && !matches!(a.kind, super::VarKind::Real) {
+                return 4;
+            }
+            if let super::Start::Real(x) = a.start {
+                if !x.is_finite() {
+                    return 8;
+                }
+            }
+            if matches!(a.causality, super::Causality::Parameter) {
+                if !a.bound.admits(a.start) {
+                    return 5;
+                }
+            } else if !matches!(a.bound, super::Bound::Any) {
+                return 6;
+            }
+            if a.description.is_empty() {
+                return 7;
+            }
+        }
+        i += 1;
+    }
+    0
 }
 
 pub const fn no_duplicate_names(d: &[VarDecl]) -> bool {
@@ -133,8 +181,9 @@ macro_rules! declare_variables {
                 $crate::model::concat($Name::PARTS, $crate::model::VarDecl::PLACEHOLDER);
         }
 
-        const _: () = assert!($crate::model::no_duplicate_vrs(&$Name::ALL_DECLS), concat!("duplicate value reference in ", stringify!($Name)));
-        const _: () = assert!($crate::model::no_duplicate_names(&$Name::ALL_DECLS), concat!("duplicate variable name in ", stringify!($Name)));
+        $( $crate::declare_variables!(@check $Name, $vr, $field, $kind, $unit); )*
+        const _: () = assert!($crate::model::no_duplicate_vrs(&$Name::ALL_DECLS), concat!("duplicate value reference in ", stringify!($Name), " (between its embedded blocks)"));
+        const _: () = assert!($crate::model::no_duplicate_names(&$Name::ALL_DECLS), concat!("duplicate variable name in ", stringify!($Name), " (between its embedded blocks)"));
 
         impl $crate::model::Variables for $Name {
             const DECLS: &'static [$crate::model::VarDecl] = &$Name::ALL_DECLS;
@@ -171,21 +220,42 @@ macro_rules! declare_variables {
         }
     };
 
+    // compile-time checks of one field, each message naming the field (see `field_problem`)
+    (@check $Name:ident, $vr:literal, $field:ident, $kind:ident, $unit:literal) => {
+        const _: () = {
+            const P: u8 = $crate::model::field_problem(&$Name::ALL_DECLS, $vr, $crate::declare_variables!(@width $kind));
+            assert!(P != 1, concat!("declare_variables! ", stringify!($Name), ".", stringify!($field), " (vr ", stringify!($vr), "): its value reference is used by another variable"));
+            assert!(P != 2, concat!("declare_variables! ", stringify!($Name), ".", stringify!($field), " (vr ", stringify!($vr), "): its name is used by another variable"));
+            assert!(P != 3, concat!("declare_variables! ", stringify!($Name), ".", stringify!($field), " (vr ", stringify!($vr), "): unit \"", $unit, "\" is not in spacecraft_fmus::units (\"\" = dimensionless)"));
+            assert!(P != 4, concat!("declare_variables! ", stringify!($Name), ".", stringify!($field), " (vr ", stringify!($vr), "): only Real variables carry a unit"));
+            assert!(P != 5, concat!("declare_variables! ", stringify!($Name), ".", stringify!($field), " (vr ", stringify!($vr), "): the start value lies outside the declared bound"));
+            assert!(P != 6, concat!("declare_variables! ", stringify!($Name), ".", stringify!($field), " (vr ", stringify!($vr), "): only parameters have bounds"));
+            assert!(P != 7, concat!("declare_variables! ", stringify!($Name), ".", stringify!($field), " (vr ", stringify!($vr), "): the description is empty"));
+            assert!(P != 8, concat!("declare_variables! ", stringify!($Name), ".", stringify!($field), " (vr ", stringify!($vr), "): the start value is not finite"));
+        };
+    };
+    (@width Real) => { 1 };
+    (@width Integer) => { 1 };
+    (@width Boolean) => { 1 };
+    (@width Vec3) => { 3 };
+    (@width Diag3) => { 3 };
+    (@width Quat) => { 4 };
+
     (@type Real) => { f64 };
     (@type Integer) => { i32 };
     (@type Boolean) => { bool };
-    (@type Vec3) => { nalgebra::Vector3<f64> };
-    (@type Diag3) => { nalgebra::Vector3<f64> };
-    (@type Quat) => { nalgebra::Quaternion<f64> };
+    (@type Vec3) => { $crate::nalgebra::Vector3<f64> };
+    (@type Diag3) => { $crate::nalgebra::Vector3<f64> };
+    (@type Quat) => { $crate::nalgebra::Quaternion<f64> };
 
     (@default Real $s:expr) => { $s };
     (@default Integer $s:expr) => { $s };
     (@default Boolean $s:expr) => { $s };
-    (@default Vec3 $s:expr) => { nalgebra::Vector3::from($s) };
-    (@default Diag3 $s:expr) => { nalgebra::Vector3::from($s) };
+    (@default Vec3 $s:expr) => { $crate::nalgebra::Vector3::from($s) };
+    (@default Diag3 $s:expr) => { $crate::nalgebra::Vector3::from($s) };
     (@default Quat $s:expr) => {{
         let s: [f64; 4] = $s;
-        nalgebra::Quaternion::new(s[0], s[1], s[2], s[3])
+        $crate::nalgebra::Quaternion::new(s[0], s[1], s[2], s[3])
     }};
 
     (@bound) => { $crate::model::Bound::Any };

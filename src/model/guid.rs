@@ -1,13 +1,13 @@
 //! The GUID of a model: a name-based UUID (v5) of its declarations — name, flags, default
 //! experiment, feed-through, every variable with its unit definition and bounds — and the package
 //! version. It changes exactly when the interface (or the release) changes. Both the runtime
-//! (`fmi2Instantiate`, FMU-state payloads) and the modelDescription writer use it; nothing here renders XML.
+//! (`fmi2Instantiate`, FMU-state payloads) and the packaging tool (through the catalogue a binary
+//! exports, `crate::export`) use it; nothing here renders XML.
 
 use std::fmt::Write;
-use std::sync::OnceLock;
+use std::sync::Mutex;
 
 use super::{Feedthrough, ModelEntry, Start};
-use crate::registry;
 
 /// Namespace of the project's name-based GUIDs (a fixed random UUID).
 const GUID_NAMESPACE: uuid::Uuid = uuid::Uuid::from_u128(0x6f1d_2b7e_3c4a_4e55_9a61_0d2f_8c3b_71a4);
@@ -47,6 +47,11 @@ impl super::ModelInfo {
     }
 }
 
+/// The GUID computed afresh (uncached), e.g. to check one read from a catalogue.
+pub fn compute_fresh(entry: &ModelEntry) -> String {
+    String::from_utf8(compute(entry).to_vec()).expect("hyphenated UUID is ASCII")
+}
+
 fn compute(entry: &ModelEntry) -> [u8; GUID_LEN] {
     let uuid = uuid::Uuid::new_v5(&GUID_NAMESPACE, fingerprint(entry).as_bytes());
     let mut out = [0u8; GUID_LEN];
@@ -56,12 +61,18 @@ fn compute(entry: &ModelEntry) -> [u8; GUID_LEN] {
     out
 }
 
-/// GUID of a registered model, computed once per process (kept in fixed-size static storage, no heap).
+/// GUID of a model, computed once per process and model name (the strings are kept for the life of
+/// the process: one per model of the binary, a few dozen bytes each).
 pub fn guid(entry: &ModelEntry) -> &'static str {
-    static CACHE: OnceLock<[[u8; GUID_LEN]; registry::COUNT]> = OnceLock::new();
-    let cache = CACHE.get_or_init(|| std::array::from_fn(|i| compute(&registry::ALL[i])));
-    let i = registry::ALL.iter().position(|e| e.info.name == entry.info.name).expect("model is registered");
-    std::str::from_utf8(&cache[i]).expect("hyphenated UUID is ASCII")
+    static CACHE: Mutex<Vec<(&'static str, &'static str)>> = Mutex::new(Vec::new());
+    let mut cache = CACHE.lock().unwrap_or_else(|p| p.into_inner());
+    if let Some((_, g)) = cache.iter().find(|(n, _)| *n == entry.info.name) {
+        return g;
+    }
+    let text = std::str::from_utf8(&compute(entry)).expect("hyphenated UUID is ASCII").to_owned();
+    let g: &'static str = Box::leak(text.into_boxed_str());
+    cache.push((entry.info.name, g));
+    g
 }
 
 #[cfg(test)]
@@ -70,7 +81,7 @@ mod tests {
 
     #[test]
     fn guids_are_distinct_stable_and_braced() {
-        let all = registry::ALL;
+        let all = crate::registry::ALL;
         for (i, a) in all.iter().enumerate() {
             let g = guid(a);
             assert_eq!(g.as_bytes(), &compute(a)[..]);

@@ -12,14 +12,14 @@ mod param;
 #[cfg(test)]
 mod restore_tests;
 
-pub use declare::{concat, no_duplicate_names, no_duplicate_vrs, total_len};
+pub use declare::{concat, field_problem, no_duplicate_names, no_duplicate_vrs, same_str, total_len};
 pub use instance::{DynModel, Fmu};
 pub use param::ParamEnum;
 
 use serde::{de::DeserializeOwned, Serialize};
 
 /// FMI 2.0 causality of a variable.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Causality {
     Parameter,
     CalculatedParameter,
@@ -29,7 +29,7 @@ pub enum Causality {
 }
 
 /// FMI 2.0 variability of a variable.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Variability {
     Constant,
     Fixed,
@@ -59,7 +59,7 @@ pub enum Initial {
 }
 
 /// Base type of a variable.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum VarKind {
     Real,
     Integer,
@@ -67,7 +67,7 @@ pub enum VarKind {
 }
 
 /// A start value of the declared kind.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Start {
     Real(f64),
     Integer(i32),
@@ -126,6 +126,39 @@ impl Bound {
             Bound::Positive if v <= 0 => Err(format!("parameter {name} = {v} must be > 0")),
             Bound::NonNegative | Bound::Limit if v < 0 => Err(format!("parameter {name} = {v} must be >= 0")),
             _ => Ok(()),
+        }
+    }
+
+    /// Whether a start value of the declared kind satisfies the bound (const: checked at compile time
+    /// for every parameter by `declare_variables!`).
+    pub const fn admits(self, start: Start) -> bool {
+        match start {
+            Start::Boolean(_) => true,
+            Start::Real(v) => {
+                v.is_finite()
+                    && match self {
+                        Bound::Any | Bound::Choice(_) => true,
+                        Bound::Positive => v > 0.0,
+                        Bound::NonNegative | Bound::Limit => v >= 0.0,
+                        Bound::Range(lo, hi) => v >= lo && v <= hi,
+                    }
+            }
+            Start::Integer(v) => match self {
+                Bound::Choice(codes) => {
+                    let mut i = 0;
+                    while i < codes.len() {
+                        if codes[i] == v {
+                            return true;
+                        }
+                        i += 1;
+                    }
+                    false
+                }
+                Bound::Range(lo, hi) => (v as f64) >= lo && (v as f64) <= hi,
+                Bound::Positive => v > 0,
+                Bound::NonNegative | Bound::Limit => v >= 0,
+                Bound::Any => true,
+            },
         }
     }
 

@@ -56,7 +56,7 @@ impl TestFmu {
         });
         let name = CString::new(format!("test_{model}")).unwrap();
         let g = CString::new(guid).unwrap();
-        let c = fmi2Instantiate(name.as_ptr(), 1, g.as_ptr(), std::ptr::null(), &*callbacks, 0, 0);
+        let c = fmi2Instantiate(registry::ALL, name.as_ptr(), 1, g.as_ptr(), std::ptr::null(), &*callbacks, 0, 0);
         TestFmu { c, model, log, callbacks }
     }
 

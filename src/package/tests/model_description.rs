@@ -4,21 +4,27 @@
 use std::path::Path;
 use std::str::FromStr;
 
-use spacecraft_fmus::description::model_description;
-use spacecraft_fmus::package::stale_model_descriptions;
 use spacecraft_fmus::registry;
+use spacecraft_fmus_package::description::model_description;
+use spacecraft_fmus_package::{stale_model_descriptions, Unit};
+
+fn xml(e: &spacecraft_fmus::model::ModelEntry) -> String {
+    let u = Unit::registered(e);
+    model_description(e, u.guid, u.package)
+}
 
 #[test]
 fn committed_model_descriptions_are_not_stale() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("modelDescription");
-    let stale = stale_model_descriptions(&dir);
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../modelDescription");
+    let units: Vec<Unit> = registry::ALL.iter().map(Unit::registered).collect();
+    let stale = stale_model_descriptions(&units, &dir);
     assert!(stale.is_empty(), "stale modelDescription/ for {stale:?}: run scripts/build_fmus.sh and commit");
 }
 
 #[test]
 fn fmi_rs_validation_finds_no_problem() {
     for e in registry::ALL {
-        let xml = model_description(e);
+        let xml = xml(e);
         let md = fmi_rs::model_description::fmi2::ModelDescription::from_string(&xml)
             .unwrap_or_else(|err| panic!("{}: fmi-rs cannot read the description: {err}", e.info.name));
         let problems: Vec<String> = md.validate().into_iter().map(|p| p.message).collect();
@@ -29,7 +35,7 @@ fn fmi_rs_validation_finds_no_problem() {
 #[test]
 fn fmi_schema_reads_every_variable_back() {
     for e in registry::ALL {
-        let xml = model_description(e);
+        let xml = xml(e);
         let md = fmi_schema::fmi2::Fmi2ModelDescription::from_str(&xml).unwrap_or_else(|err| panic!("{}: {err}", e.info.name));
         assert_eq!(md.model_name, e.info.name);
         assert_eq!(md.num_variables(), e.decls.len());

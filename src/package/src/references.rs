@@ -156,7 +156,7 @@ mod tests {
 
     #[test]
     fn every_model_cites_only_known_references_and_at_least_one() {
-        for e in crate::registry::ALL {
+        for e in spacecraft_fmus::registry::ALL {
             let texts = e.texts();
             let mut cited = 0;
             for t in &texts {

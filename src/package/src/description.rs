@@ -1,5 +1,6 @@
-//! Generates `modelDescription.xml` and `documentation/index.html` from a model's declarations
-//! (packaging only: the runtime never renders XML; it shares the GUID module `crate::model::guid`).
+//! Generates `modelDescription.xml` and `documentation/index.html` from a model's declarations, as the
+//! runtime exports them (the packaging tool reads them from a built library's catalogue; the project's
+//! own pages and tests read the registry directly). The runtime never renders XML.
 //!
 //! XML is written with quick-xml. (fmi-schema's FMI 2 types were the first choice, but their `<Real>`
 //! has no `unit` attribute and an empty `dependencies=""` list, which says "no direct feed-through",
@@ -10,12 +11,12 @@ use std::io::Cursor;
 use quick_xml::events::{BytesDecl, BytesEnd, BytesStart, BytesText, Event};
 use quick_xml::Writer;
 
-use crate::fmi::LOG_CATEGORIES;
-use crate::model::guid::guid;
-use crate::model::{Bound, Causality, Feedthrough, Initial, ModelEntry, Start, VarDecl, VarKind, Variability};
-use crate::units;
+use spacecraft_fmus::export::PackageInfo;
+use spacecraft_fmus::fmi::LOG_CATEGORIES;
+use spacecraft_fmus::model::{Bound, Causality, Feedthrough, Initial, ModelEntry, Start, VarDecl, VarKind, Variability};
+use spacecraft_fmus::units;
 
-pub const GENERATION_TOOL: &str = concat!("spacecraft_fmus ", env!("CARGO_PKG_VERSION"));
+pub const GENERATION_TOOL: &str = concat!("spacecraft_fmus fmu-package ", env!("CARGO_PKG_VERSION"));
 
 fn causality_str(c: Causality) -> &'static str {
     match c {
@@ -188,7 +189,7 @@ fn elem<'a>(name: &'a str, attrs: &[(&'a str, String)]) -> BytesStart<'a> {
 }
 
 /// Writes the complete model description with the given GUID.
-fn write_xml(entry: &ModelEntry, guid: &str) -> String {
+fn write_xml(entry: &ModelEntry, guid: &str, package: &PackageInfo) -> String {
     let info = entry.info;
     let mut w = Writer::new_with_indent(Cursor::new(Vec::new()), b' ', 2);
     let empty = |w: &mut Writer<Cursor<Vec<u8>>>, name: &str, attrs: &[(&str, String)]| {
@@ -210,9 +211,9 @@ fn write_xml(entry: &ModelEntry, guid: &str) -> String {
             ("modelName", info.name.into()),
             ("guid", guid.into()),
             ("description", info.description.into()),
-            ("author", "spacecraft_fmus contributors".into()),
-            ("version", env!("CARGO_PKG_VERSION").into()),
-            ("license", "BSD-2-Clause".into()),
+            ("author", package.author()),
+            ("version", package.version.clone()),
+            ("license", package.license.clone()),
             ("generationTool", GENERATION_TOOL.into()),
             ("variableNamingConvention", "flat".into()),
             ("numberOfEventIndicators", "0".into()),
@@ -343,9 +344,31 @@ fn write_xml(entry: &ModelEntry, guid: &str) -> String {
     s
 }
 
-/// The complete modelDescription.xml of a registered model.
-pub fn model_description(entry: &ModelEntry) -> String {
-    write_xml(entry, guid(entry))
+/// The complete modelDescription.xml of a model whose binary accepts `guid`, exported by `package`.
+pub fn model_description(entry: &ModelEntry, guid: &str, package: &PackageInfo) -> String {
+    write_xml(entry, guid, package)
+}
+
+/// `author`, `version` and `license` of the project's own models (the metadata of `src/cdylib`, whose
+/// catalogue says the same; `fmu-package --check` compares the two outputs).
+pub fn project_package() -> PackageInfo {
+    PackageInfo {
+        name: "spacecraft_fmus_cdylib".into(),
+        version: "0.1.0".into(),
+        authors: "spacecraft_fmus contributors".into(),
+        license: "BSD-2-Clause".into(),
+    }
+}
+
+/// Cargo's colon-separated authors as one `author` attribute (the package name when there are none).
+trait Author {
+    fn author(&self) -> String;
+}
+
+impl Author for PackageInfo {
+    fn author(&self) -> String {
+        if self.authors.trim().is_empty() { format!("{} authors", self.name) } else { self.authors.split(':').collect::<Vec<_>>().join(", ") }
+    }
 }
 
 pub(crate) fn bound_text(b: Bound) -> String {
@@ -364,7 +387,7 @@ pub(crate) fn html_escape(s: &str) -> String {
 }
 
 /// documentation/index.html: purpose, source, equations, variable tables.
-pub fn documentation_html(entry: &ModelEntry) -> String {
+pub fn documentation_html(entry: &ModelEntry, guid: &str) -> String {
     let info = entry.info;
     let mut h = String::new();
     h.push_str("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n");
@@ -372,7 +395,7 @@ pub fn documentation_html(entry: &ModelEntry) -> String {
     h.push_str("<style>body{font-family:sans-serif;max-width:60em;margin:2em auto;line-height:1.4}table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:2px 6px;text-align:left;vertical-align:top}pre{background:#f4f4f4;padding:0.5em;overflow-x:auto}code{background:#f4f4f4}</style>\n</head>\n<body>\n");
     h.push_str(&format!("<h1>{}</h1>\n<p>{}</p>\n", info.name, html_escape(info.description)));
     h.push_str(&format!("<p><b>Source:</b> {}</p>\n", html_escape(info.source)));
-    h.push_str(&format!("<p><b>GUID:</b> <code>{}</code> &middot; <b>Generated by:</b> {}</p>\n", guid(entry), GENERATION_TOOL));
+    h.push_str(&format!("<p><b>GUID:</b> <code>{}</code> &middot; <b>Generated by:</b> {}</p>\n", guid, GENERATION_TOOL));
     h.push_str("<h2>Equations</h2>\n");
     h.push_str(info.equations_html);
     h.push_str("\n<h2>Conventions</h2>\n<ul><li>SI units on every port; degrees only where the name ends in <code>_deg</code>.</li>");
@@ -425,7 +448,7 @@ mod tests {
 
     #[test]
     fn every_registered_model_has_consistent_declarations() {
-        for e in crate::registry::ALL {
+        for e in spacecraft_fmus::registry::ALL {
             check_declarations(e).unwrap();
         }
     }

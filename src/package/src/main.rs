@@ -1,0 +1,163 @@
+//! `fmu-package`: builds a model crate and packages every model it exports as an FMU.
+//!
+//! ```text
+//! fmu-package [--crate DIR | --lib PATH] [--out DIR] [--xml DIR] [--win64 auto|yes|no]
+//!             [--add-lib PLATFORM=PATH]... [--locked] [--check]
+//! ```
+//! - `--crate DIR`: the model crate (a `cdylib` calling `spacecraft_fmus::export_fmus!`); it is built
+//!   with `cargo build --release --lib`. Default: this project's `src/cdylib` (all registered models).
+//! - `--lib PATH`: package an already built host library instead of building a crate.
+//! - `--out DIR`: where `<Model>.fmu` go (default `DIR/fmus`; for the project, `fmus/`).
+//! - `--xml DIR`: also write `<Model>.xml` there (the project: `modelDescription/`, always).
+//! - `--win64`: add `binaries/win64/<Model>.dll` from `scripts/build_win64.sh`: `auto` (default) when
+//!   the cross toolchain is installed, `yes` requires it, `no` skips it (also `SCFMU_NO_WIN64=1`).
+//! - `--add-lib PLATFORM=PATH`: store another platform's build of the same crate (linux64, win64, darwin64).
+//! - `--check`: write nothing; exit 1 if the XML folder (and, for the project, the generated pages under
+//!   docs/) differ from what the declarations generate.
+//!
+//! For the project it also writes the model pages `docs/models/<family>.md` and `docs/references.md`.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use spacecraft_fmus_package::build::{cargo_build, win64_available, win64_build};
+use spacecraft_fmus_package::{platform_lib_ext, stale_model_descriptions, units_of_library, write_fmu, write_model_descriptions, Binary, PLATFORM};
+
+struct Args {
+    krate: Option<PathBuf>,
+    lib: Option<PathBuf>,
+    out: Option<PathBuf>,
+    xml: Option<PathBuf>,
+    win64: String,
+    extra: Vec<(String, PathBuf)>,
+    locked: bool,
+    check: bool,
+}
+
+fn parse() -> Result<Args, String> {
+    let mut a = Args { krate: None, lib: None, out: None, xml: None, win64: "auto".into(), extra: vec![], locked: false, check: false };
+    let mut args = std::env::args().skip(1);
+    while let Some(arg) = args.next() {
+        let mut value = |name: &str| args.next().ok_or_else(|| format!("{name} needs a value"));
+        match arg.as_str() {
+            "--crate" => a.krate = Some(PathBuf::from(value("--crate")?)),
+            "--lib" => a.lib = Some(PathBuf::from(value("--lib")?)),
+            "--out" | "--fmus" => a.out = Some(PathBuf::from(value("--out")?)),
+            "--xml" => a.xml = Some(PathBuf::from(value("--xml")?)),
+            "--win64" => {
+                a.win64 = value("--win64")?;
+                if !["auto", "yes", "no"].contains(&a.win64.as_str()) {
+                    return Err(format!("--win64 takes auto, yes or no, not {:?}", a.win64));
+                }
+            }
+            "--add-lib" => {
+                let spec = value("--add-lib")?;
+                match spec.split_once('=') {
+                    Some((platform, path)) if platform_lib_ext(platform).is_some() && !path.is_empty() => a.extra.push((platform.into(), PathBuf::from(path))),
+                    _ => return Err(format!("--add-lib wants PLATFORM=PATH with PLATFORM linux64, win64 or darwin64, got {spec:?}")),
+                }
+            }
+            "--locked" => a.locked = true,
+            "--check" => a.check = true,
+            "-h" | "--help" => {
+                println!("{}", include_str!("main.rs").lines().take_while(|l| l.starts_with("//!")).map(|l| l.trim_start_matches("//!").strip_prefix(' ').unwrap_or("")).collect::<Vec<_>>().join("\n"));
+                std::process::exit(0);
+            }
+            other => return Err(format!("unknown argument {other} (see --help)")),
+        }
+    }
+    if a.krate.is_some() && a.lib.is_some() {
+        return Err("give --crate or --lib, not both".into());
+    }
+    Ok(a)
+}
+
+fn main() -> ExitCode {
+    match run() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("fmu-package: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run() -> Result<(), String> {
+    let args = parse()?;
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").canonicalize().map_err(|e| format!("the project folder: {e}"))?;
+    let project_crate = root.join("src/cdylib");
+    let krate = args.krate.clone().or_else(|| args.lib.is_none().then(|| project_crate.clone()));
+    let is_project = match &krate {
+        Some(k) => k.canonicalize().ok() == project_crate.canonicalize().ok(),
+        None => false,
+    };
+    let manifest = krate.as_ref().map(|k| k.join("Cargo.toml"));
+    if let Some(m) = &manifest {
+        if !m.is_file() {
+            return Err(format!("{} not found: --crate wants the folder of a Cargo package", m.display()));
+        }
+    }
+    let lib = match (&args.lib, &manifest) {
+        (Some(l), _) => l.clone(),
+        (None, Some(m)) => cargo_build(m, args.locked)?,
+        (None, None) => unreachable!("a crate or a library is always given"),
+    };
+    let units = units_of_library(&lib)?;
+    let xml = args.xml.clone().or_else(|| is_project.then(|| root.join("modelDescription")));
+    let docs = is_project.then(|| root.join("docs"));
+
+    if args.check {
+        let mut stale = vec![];
+        if let Some(x) = &xml {
+            stale.extend(stale_model_descriptions(&units, x));
+        }
+        if let Some(d) = &docs {
+            stale.extend(spacecraft_fmus_package::docs::stale_pages(d));
+        }
+        if stale.is_empty() {
+            println!("model descriptions{} are up to date ({} models)", if docs.is_some() { " and docs/" } else { "" }, units.len());
+            return Ok(());
+        }
+        return Err(format!("stale generated files: {}", stale.join(", ")));
+    }
+
+    let host = std::fs::read(&lib).map_err(|e| format!("cannot read {} ({e})", lib.display()))?;
+    let mut extra: Vec<(String, Vec<u8>)> = vec![];
+    for (platform, path) in &args.extra {
+        let bytes = std::fs::read(path).map_err(|e| format!("cannot read the {platform} library {} ({e})", path.display()))?;
+        extra.push((platform.clone(), bytes));
+    }
+    let no_win64 = args.win64 == "no" || std::env::var("SCFMU_NO_WIN64").as_deref() == Ok("1");
+    if !no_win64 && !extra.iter().any(|(p, _)| p == "win64") {
+        match (&manifest, win64_available()) {
+            (Some(m), Ok(())) => {
+                let dll = win64_build(m, &lib)?;
+                extra.push(("win64".into(), std::fs::read(&dll).map_err(|e| format!("cannot read {} ({e})", dll.display()))?));
+            }
+            (_, Err(why)) if args.win64 == "yes" => return Err(format!("--win64 yes, but the cross toolchain is not usable: {why}")),
+            (None, Ok(())) if args.win64 == "yes" => return Err("--win64 yes needs --crate (the crate is cross-built)".into()),
+            (_, Err(why)) => eprintln!("fmu-package: no Windows binaries ({why}); packaging {PLATFORM} only"),
+            (None, Ok(())) => {}
+        }
+    }
+    let mut binaries = vec![Binary::host(&host)];
+    for (platform, bytes) in &extra {
+        if binaries.iter().any(|b| b.platform == platform) {
+            return Err(format!("two binaries for {platform}"));
+        }
+        binaries.push(Binary { platform, ext: platform_lib_ext(platform).unwrap_or("so"), bytes });
+    }
+
+    if let Some(x) = &xml {
+        write_model_descriptions(&units, x).map_err(|e| format!("cannot write model descriptions to {}: {e}", x.display()))?;
+    }
+    if let Some(d) = &docs {
+        spacecraft_fmus_package::docs::write_pages(d).map_err(|e| format!("cannot write docs/models and docs/references.md: {e}"))?;
+    }
+    let out = args.out.clone().unwrap_or_else(|| if is_project { root.join("fmus") } else { krate.clone().unwrap_or_default().join("fmus") });
+    for u in &units {
+        let p = write_fmu(u, &binaries, &out).map_err(|e| format!("{}: {e}", u.name()))?;
+        println!("wrote {} ({})", p.display(), binaries.iter().map(|b| b.platform).collect::<Vec<_>>().join(" + "));
+    }
+    Ok(())
+}
