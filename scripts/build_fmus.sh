@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Builds the release cdylibs (the FMUs' one and the compiled engine's loop, scfmu/engines/native_loop: the
-# workspace's default members) and writes modelDescription/<Model>.xml and fmus/<Model>.fmu, then the
+# Builds the workspace's default members in release mode (the FMUs' shared library src/cdylib, the
+# packaging tool fmu-package and the compiled engine's loop scfmu/engines/native_loop), then packages
+# with fmu-package exactly as a user's model crate is packaged: modelDescription/<Model>.xml,
+# fmus/<Model>.fmu and the generated pages docs/models/*.md and docs/references.md. Then the
 # scenario files for other tools: fmus/ssp/<scenario>.ssp (SSP 1.0) and fmus/loops/<scenario>.fmu (one
 # container FMU per standard closed loop). The last two need the Python venv (scripts/setup.sh); without
 # it they are skipped with a message. When the Windows cross toolchain is installed (scripts/setup.sh
@@ -9,20 +11,21 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --release --locked
-package_args=()
+package_args=(--locked)
 if [ "${SCFMU_NO_WIN64:-0}" = 1 ]; then
     echo "build_fmus: SCFMU_NO_WIN64=1: packaging linux64 binaries only (no binaries/win64)" >&2
 elif scripts/build_win64.sh --check; then
     dll=$(scripts/build_win64.sh | tail -n 1)
     package_args+=(--add-lib "win64=$dll")
 else
+    package_args+=(--win64 no)
     echo "build_fmus: Windows cross toolchain not installed: packaging linux64 binaries only (no binaries/win64)" >&2
 fi
 # A macOS build made elsewhere (see .github/workflows/macos.yml, untested) joins as darwin64.
 if [ -n "${SCFMU_DARWIN64_LIB:-}" ]; then
     package_args+=(--add-lib "darwin64=$SCFMU_DARWIN64_LIB")
 fi
-./target/release/package "${package_args[@]}"
+./target/release/fmu-package "${package_args[@]}"
 if [ -x .venv/bin/python ]; then
     .venv/bin/scfmu export ssp --out fmus/ssp
     .venv/bin/scfmu export loop --out fmus/loops

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Builds the cdylib instrumented with ThreadSanitizer: target/tsan/x86_64-unknown-linux-gnu/release/
-# libspacecraft_fmus.so. TSan needs a standard library built with the same instrumentation; Debian's
+# Builds the FMUs' cdylib instrumented with ThreadSanitizer: target/tsan/x86_64-unknown-linux-gnu/release/
+# libspacecraft_fmus_cdylib.so. TSan needs a standard library built with the same instrumentation; Debian's
 # Rust (rustc-web, cargo-web, rust-web-src: /usr/bin/rustc, /usr/bin/cargo and the std sources, which
 # scripts/setup.sh installs for the Windows build) builds it with -Z build-std, allowed on this stable
 # compiler by RUSTC_BOOTSTRAP=1: no nightly toolchain is needed. Separate target dir, so the normal
@@ -33,6 +33,6 @@ fi
 RUSTC_BOOTSTRAP=1 RUSTC="$RUSTC_DEB" RUSTDOC=/usr/bin/rustdoc RUSTFLAGS="-Zsanitizer=thread" \
     "$CARGO_DEB" build --release --locked --lib -Z build-std=std,panic_unwind \
     --target "$TARGET" --target-dir target/tsan >&2
-lib=target/tsan/$TARGET/release/libspacecraft_fmus.so
+lib=target/tsan/$TARGET/release/libspacecraft_fmus_cdylib.so
 [ -f "$lib" ] || { echo "build_tsan: $lib was not produced" >&2; exit 1; }
 echo "$lib"

@@ -1,6 +1,8 @@
 //! `declare_variables!`: the one declaration of a model's variables, and the const helpers it uses.
 //!
-//! ```ignore
+//! ```
+//! use spacecraft_fmus::export::*;
+//!
 //! declare_variables! {
 //!     /// Variables of a controller.
 //!     pub struct MyControllerVars {
@@ -11,6 +13,12 @@
 //!         120 => mode: Integer = 0,                  Parameter, "", "0 = a, 1 = b", Choice(&[0, 1]);
 //!     }
 //! }
+//!
+//! // one row of a Vec3 is three FMI variables; the embedded block's variables come first
+//! let names: Vec<&str> = MyControllerVars::DECLS.iter().map(|d| d.name).collect();
+//! assert_eq!(&names[names.len() - 5..], ["wn", "kp_x", "kp_y", "kp_z", "mode"]);
+//! assert_eq!(MyControllerVars::DECLS.iter().find(|d| d.name == "kp_y").unwrap().vr, 106);
+//! assert_eq!(MyControllerVars::default().kp, Vector3::new(1000.0, 500.0, 700.0));
 //! ```
 //!
 //! Kinds: `Real` (f64), `Integer` (i32), `Boolean` (bool), `Vec3` (`nalgebra::Vector3`, FMI names

@@ -1,7 +1,7 @@
 //! What a model is. A model declares its variables once (`declare_variables!`, one row per port or
 //! parameter, vectors and quaternions as one row) and implements [`Model`]: build its internal state
 //! from the parameters, compute outputs, advance a step. The FMI layer (`crate::fmi`) and the
-//! model-description writer (`crate::description`) see models only through this module, so a model
+//! packaging tool (`src/package`, through the catalogue of `crate::export`) see models only through this module, so a model
 //! never touches C types or XML.
 
 mod declare;

@@ -16,11 +16,23 @@ pub trait ParamEnum: Sized + Copy {
 
 /// Declares an enum selected by an Integer parameter and its codes:
 ///
-/// ```ignore
+/// ```
+/// use spacecraft_fmus::export::*;
+///
 /// param_enum! {
 ///     /// Kinematics option.
 ///     pub enum Kinematics { Quaternion = 0, Dcm = 1 }
 /// }
+///
+/// declare_variables! {
+///     pub struct Vars {
+///         // the codes are the parameter's bound: any other value is refused before initialize
+///         140 => kinematics: Integer = 0, Parameter, "", "0 = quaternion, 1 = DCM", Choice(Kinematics::CODES);
+///     }
+/// }
+///
+/// assert_eq!(Kinematics::from_param("kinematics", 1), Ok(Kinematics::Dcm));
+/// assert_eq!(Kinematics::from_param("kinematics", 7).unwrap_err(), "parameter kinematics = 7 is not one of [0, 1]");
 /// ```
 #[macro_export]
 macro_rules! param_enum {

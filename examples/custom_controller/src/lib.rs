@@ -23,11 +23,11 @@ declare_variables! {
         100 => inertia: Diag3 = [1000.0, 500.0, 700.0], Parameter, "kg.m2", "Controller's nominal inertia", Positive;
         103 => wn: Real = 1.0, Parameter, "rad/s", "Natural frequency omega_n of the per-axis closed loop", Positive;
         104 => zeta: Real = 1.0, Parameter, "", "Damping ratio of the per-axis closed loop", NonNegative;
-        130 => error_kind: Integer = 0, Parameter, "", "Error signal: 0 = 2 q_E,w q_E,v (sin(alpha) n); 1 = 2 sign(q_E,w) q_E,v (2 sin(alpha/2) n)", Choice(SWITCH);
-        131 => torque_limit: Real = 1e30, Parameter, "N.m", "Largest commanded torque per axis; larger commands are scaled down keeping their direction (1e30 = no limit)", Limit;
+        123 => error_kind: Integer = 0, Parameter, "", "Error signal: 0 = 2 q_E,w q_E,v (sin(alpha) n); 1 = 2 sign(q_E,w) q_E,v (2 sin(alpha/2) n)", Choice(SWITCH);
+        111 => torque_limit: Real = 1e30, Parameter, "N.m", "Largest commanded torque per axis; larger commands are scaled down keeping their direction (1e30 = no limit)", Limit;
         200 => k: Vec3 = [0.0; 3], CalculatedParameter, "N.m/rad", "Proportional gain in use";
         203 => k_d: Vec3 = [0.0; 3], CalculatedParameter, "N.m.s/rad", "Rate gain in use (negative)";
-        300 => scale: Real = 1.0, Output, "", "Scale s applied to the PD command (1 = not limited)";
+        30 => scale: Real = 1.0, Output, "", "Scale s applied to the PD command (1 = not limited)";
     }
 }
 
