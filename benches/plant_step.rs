@@ -90,7 +90,7 @@ fn direct_model() -> Fmu<AttitudePlant> {
 
 fn abi_instance() -> *mut std::ffi::c_void {
     let entry = registry::find("AttitudePlant").unwrap();
-    let g = CString::new(guid(entry)).unwrap();
+    let g = CString::new(guid(entry).as_str()).unwrap();
     let name = CString::new("bench").unwrap();
     // The logger is never called on the success path; NULL avoids defining a C-variadic function,
     // which stable Rust cannot do.

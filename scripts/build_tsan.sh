@@ -31,7 +31,7 @@ if [ "${1:-}" = "--check" ]; then
 fi
 
 RUSTC_BOOTSTRAP=1 RUSTC="$RUSTC_DEB" RUSTDOC=/usr/bin/rustdoc RUSTFLAGS="-Zsanitizer=thread" \
-    "$CARGO_DEB" build --release --locked --lib -Z build-std=std,panic_unwind \
+    "$CARGO_DEB" build --release --locked --lib -p spacecraft_fmus_cdylib -Z build-std=std,panic_unwind \
     --target "$TARGET" --target-dir target/tsan >&2
 lib=target/tsan/$TARGET/release/libspacecraft_fmus_cdylib.so
 [ -f "$lib" ] || { echo "build_tsan: $lib was not produced" >&2; exit 1; }

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Cross-builds cdylibs for Windows x86-64 on Linux. Without arguments: the workspace's default members,
-# giving target/win64/x86_64-win7-windows-gnu/release/spacecraft_fmus_cdylib.dll (the FMUs' binary) and
+# Cross-builds cdylibs for Windows x86-64 on Linux. Without arguments: the two shared libraries of the
+# workspace, giving target/win64/x86_64-win7-windows-gnu/release/spacecraft_fmus_cdylib.dll (the FMUs' binary) and
 # scfmu_native_loop.dll (the compiled engine's loop, shipped in the wheel by scripts/build_wheel.sh).
 # With --manifest-path PATH: that package (a user's model crate; fmu-package calls this), into
 # <its target folder>/win64.
@@ -57,7 +57,7 @@ if [ -n "$manifest" ]; then
 fi
 RUSTC_BOOTSTRAP=1 RUSTC="$RUSTC_DEB" RUSTDOC=/usr/bin/rustdoc \
 CARGO_TARGET_X86_64_WIN7_WINDOWS_GNU_LINKER="$LINKER" \
-    "$CARGO_DEB" build --release --locked --lib -Z build-std=std,panic_unwind \
+    "$CARGO_DEB" build --release --locked --lib -p spacecraft_fmus_cdylib -p scfmu_native_loop -Z build-std=std,panic_unwind \
     --target "$TARGET" --target-dir target/win64 >&2
 dll=target/win64/$TARGET/release/spacecraft_fmus_cdylib.dll
 [ -f "$dll" ] || { echo "build_win64: $dll was not produced" >&2; exit 1; }

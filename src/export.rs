@@ -163,7 +163,7 @@ impl ModelDescription {
             default_stop_time: i.default_stop_time,
             default_step: i.default_step,
             variable_step: i.variable_step,
-            guid: crate::model::guid::guid(e).into(),
+            guid: crate::model::guid::guid(e).as_str().into(),
             variables: e
                 .decls
                 .iter()
@@ -385,7 +385,7 @@ mod tests {
             let guid = m.guid.clone();
             let back = m.into_entry();
             assert_eq!(crate::model::guid::compute_fresh(&back), guid, "{}", e.info.name);
-            assert_eq!(guid, crate::model::guid::guid(e));
+            assert_eq!(guid, crate::model::guid::guid(e).as_str());
             assert_eq!(back.decls.len(), e.decls.len());
             for (a, b) in back.decls.iter().zip(e.decls) {
                 assert_eq!((a.vr, a.name, a.unit, a.bound, a.start), (b.vr, b.name, b.unit, b.bound, b.start));

@@ -3,8 +3,9 @@ the repository gives a valid FMU that carries only its own model and swaps into 
 place of PdController with the same trajectory; bad declarations fail at compile time or packaging time
 with messages that name the variable.
 
-Cargo runs here with the repository's own target folder (CARGO_TARGET_DIR), so the registry crates are
-compiled once for the build and these tests; the copies of this project's crates compile afresh."""
+Cargo builds here go to target/export-test (CARGO_TARGET_DIR), one folder shared by these tests and kept
+between runs, never the repository's own target/release: the clean copy's packaging tool would replace
+target/release/fmu-package with one that points at the copy."""
 
 from __future__ import annotations
 
@@ -29,10 +30,11 @@ from scfmu.scenario.check import check
 ROOT = Path(__file__).resolve().parents[1]
 TARGET = ROOT / "target"
 TOOL = TARGET / "release" / "fmu-package"
+BUILDS = TARGET / "export-test"
 
 
 def _env(**extra) -> dict:
-    env = dict(os.environ, CARGO_TARGET_DIR=str(TARGET), CARGO_TERM_COLOR="never")
+    env = dict(os.environ, CARGO_TARGET_DIR=str(BUILDS), CARGO_TERM_COLOR="never")
     env.update(extra)
     return env
 

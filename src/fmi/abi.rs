@@ -147,13 +147,13 @@ fn out_ptr<'a, T>(p: *mut T, what: &str) -> CallResult<&'a mut T> {
 fn find_model(all: &'static [ModelEntry], requested: &str) -> Result<&'static ModelEntry, String> {
     if let Some(expected) = super::library_path::own_library_stem().and_then(|stem| all.iter().find(|e| e.info.name == stem)) {
         let want = guid(expected);
-        return if requested == want {
+        return if requested == want.as_str() {
             Ok(expected)
         } else {
             Err(format!("fmuGUID {requested} does not match {}'s GUID {want} (modelDescription.xml and binary are from different builds)", expected.info.name))
         };
     }
-    all.iter().find(|e| guid(e) == requested).ok_or_else(|| format!("fmuGUID {requested} matches no model in this binary"))
+    all.iter().find(|e| guid(e).as_str() == requested).ok_or_else(|| format!("fmuGUID {requested} matches no model in this binary"))
 }
 
 fn log_without_instance(functions: &CallbackFunctions, name: &CStr, message: &str) {
@@ -409,7 +409,7 @@ pub extern "C" fn fmi2SerializedFMUstateSize(c: Component, state: *mut c_void, s
     call(c, "fmi2SerializedFMUstateSize", mask::FMU_STATE, |inst| {
         let out = out_ptr(size, "size")?;
         Snapshot::with_handle(state as *mut Snapshot, |snap| {
-            let bytes = snap.to_bytes(guid(inst.entry))?;
+            let bytes = snap.to_bytes(&guid(inst.entry))?;
             *out = bytes.len();
             snap.serialized = Some(bytes);
             Ok(())
@@ -422,7 +422,7 @@ pub extern "C" fn fmi2SerializeFMUstate(c: Component, state: *mut c_void, buffer
         Snapshot::with_handle(state as *mut Snapshot, |snap| {
             let bytes = match snap.serialized.take() {
                 Some(b) => b,
-                None => snap.to_bytes(guid(inst.entry))?,
+                None => snap.to_bytes(&guid(inst.entry))?,
             };
             if size != bytes.len() {
                 return Err(Fail::error(format!("size {size} differs from fmi2SerializedFMUstateSize = {}", bytes.len())));
@@ -438,7 +438,7 @@ pub extern "C" fn fmi2DeSerializeFMUstate(c: Component, buffer: *const c_char, s
     call(c, "fmi2DeSerializeFMUstate", mask::FMU_STATE, |inst| {
         let slot = out_ptr(state, "FMUstate")?;
         let bytes = unsafe { slice(buffer as *const u8, size, "serializedState[]")? };
-        let snap = Snapshot::from_bytes(bytes, inst, guid(inst.entry))?;
+        let snap = Snapshot::from_bytes(bytes, inst, &guid(inst.entry))?;
         if slot.is_null() {
             *slot = snap.into_handle(c as usize) as *mut c_void;
             Ok(())
@@ -576,7 +576,7 @@ mod tests {
             component_environment: &*log as *const Log as *mut c_void,
         };
         let entry = crate::registry::find("AttitudeMetrics").unwrap();
-        let g = CString::new(guid(entry)).unwrap();
+        let g = CString::new(guid(entry).as_str()).unwrap();
         let c = fmi2Instantiate(crate::registry::ALL, c"p".as_ptr(), 1, g.as_ptr(), std::ptr::null(), &cb, 0, 0);
         assert!(!c.is_null());
         let st = call(c, "fmi2Probe", mask::SETUP_EXPERIMENT, |_| panic!("deliberate test panic"));

@@ -5,7 +5,6 @@
 //! exports, `crate::export`) use it; nothing here renders XML.
 
 use std::fmt::Write;
-use std::sync::Mutex;
 
 use super::{Feedthrough, ModelEntry, Start};
 
@@ -61,18 +60,40 @@ fn compute(entry: &ModelEntry) -> [u8; GUID_LEN] {
     out
 }
 
-/// GUID of a model, computed once per process and model name (the strings are kept for the life of
-/// the process: one per model of the binary, a few dozen bytes each).
-pub fn guid(entry: &ModelEntry) -> &'static str {
-    static CACHE: Mutex<Vec<(&'static str, &'static str)>> = Mutex::new(Vec::new());
-    let mut cache = CACHE.lock().unwrap_or_else(|p| p.into_inner());
-    if let Some((_, g)) = cache.iter().find(|(n, _)| *n == entry.info.name) {
-        return g;
+/// A GUID as text, "{xxxxxxxx-xxxx-xxxx-xxxx-xxxxxxxxxxxx}", held inline (no heap).
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub struct Guid([u8; GUID_LEN]);
+
+impl Guid {
+    pub fn as_str(&self) -> &str {
+        std::str::from_utf8(&self.0).expect("hyphenated UUID is ASCII")
     }
-    let text = std::str::from_utf8(&compute(entry)).expect("hyphenated UUID is ASCII").to_owned();
-    let g: &'static str = Box::leak(text.into_boxed_str());
-    cache.push((entry.info.name, g));
-    g
+}
+
+impl std::ops::Deref for Guid {
+    type Target = str;
+    fn deref(&self) -> &str {
+        self.as_str()
+    }
+}
+
+impl std::fmt::Display for Guid {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl std::fmt::Debug for Guid {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// GUID of a model, computed when asked (a few microseconds, at fmi2Instantiate and when a state is
+/// serialized). Nothing is cached: a library whose last instance is freed holds no heap memory, so a
+/// master that loads and unloads it per run does not grow.
+pub fn guid(entry: &ModelEntry) -> Guid {
+    Guid(compute(entry))
 }
 
 #[cfg(test)]
@@ -85,6 +106,7 @@ mod tests {
         for (i, a) in all.iter().enumerate() {
             let g = guid(a);
             assert_eq!(g.as_bytes(), &compute(a)[..]);
+            assert_eq!(g.as_str(), compute_fresh(a));
             assert!(g.starts_with('{') && g.ends_with('}') && g.len() == GUID_LEN);
             for b in &all[i + 1..] {
                 assert_ne!(g, guid(b));

@@ -42,7 +42,7 @@ impl TestFmu {
     /// Instantiates `model` (in Co-Simulation mode) with its GUID.
     pub fn new(model: &'static str) -> Self {
         let entry = registry::find(model).expect("registered");
-        Self::with_guid(model, guid(entry))
+        Self::with_guid(model, &guid(entry))
     }
 
     pub fn with_guid(model: &'static str, guid: &str) -> Self {

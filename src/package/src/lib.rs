@@ -37,7 +37,7 @@ impl Unit {
     /// A model of this process's registry (the project's own models, for pages and tests).
     pub fn registered(entry: &ModelEntry) -> Unit {
         static PROJECT: std::sync::OnceLock<PackageInfo> = std::sync::OnceLock::new();
-        Unit { entry: *entry, guid: spacecraft_fmus::model::guid::guid(entry), package: PROJECT.get_or_init(description::project_package) }
+        Unit { entry: *entry, guid: Box::leak(spacecraft_fmus::model::guid::guid(entry).as_str().into()), package: PROJECT.get_or_init(description::project_package) }
     }
 
     pub fn name(&self) -> &'static str {

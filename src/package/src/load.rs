@@ -2,9 +2,12 @@
 //! `spacecraft_fmus_catalogue` function that `export_fmus!` generates, and copies the bytes. Unix hosts
 //! (the library of the host platform); a Windows build of the same crate is packaged next to it.
 
-use std::ffi::{c_void, CStr, CString};
 use std::path::Path;
 
+#[cfg(unix)]
+use std::ffi::{c_void, CStr, CString};
+
+#[cfg(unix)]
 const SYMBOL: &CStr = c"spacecraft_fmus_catalogue";
 
 #[cfg(unix)]
