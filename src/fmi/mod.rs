@@ -5,6 +5,8 @@
 pub mod abi;
 pub mod fmi3;
 pub mod fmi3_more;
+#[cfg(test)]
+mod fmi3_tests;
 pub mod instance;
 mod library_path;
 pub mod state;
