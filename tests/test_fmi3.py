@@ -33,6 +33,41 @@ def fmu2(model: str) -> str:
     return str(ROOT / "fmus" / f"{model}.fmu")
 
 
+# The FMI 3.0 functions (fmi3Functions.h of the standard, all interfaces: importers such as fmpy resolve
+# every one when they load a binary), written out here rather than read from our own binary.
+FMI3_FUNCTIONS = {
+    "fmi3GetVersion", "fmi3SetDebugLogging", "fmi3InstantiateModelExchange", "fmi3InstantiateCoSimulation",
+    "fmi3InstantiateScheduledExecution", "fmi3FreeInstance", "fmi3EnterInitializationMode", "fmi3ExitInitializationMode",
+    "fmi3EnterEventMode", "fmi3Terminate", "fmi3Reset",
+    *(f"fmi3{gs}{t}" for gs in ("Get", "Set") for t in ("Float32", "Float64", "Int8", "UInt8", "Int16", "UInt16", "Int32",
+                                                        "UInt32", "Int64", "UInt64", "Boolean", "String", "Binary", "Clock")),
+    "fmi3GetNumberOfVariableDependencies", "fmi3GetVariableDependencies", "fmi3GetFMUState", "fmi3SetFMUState",
+    "fmi3FreeFMUState", "fmi3SerializedFMUStateSize", "fmi3SerializeFMUState", "fmi3DeserializeFMUState",
+    "fmi3GetDirectionalDerivative", "fmi3GetAdjointDerivative", "fmi3EnterConfigurationMode", "fmi3ExitConfigurationMode",
+    "fmi3GetIntervalDecimal", "fmi3GetIntervalFraction", "fmi3GetShiftDecimal", "fmi3GetShiftFraction",
+    "fmi3SetIntervalDecimal", "fmi3SetIntervalFraction", "fmi3SetShiftDecimal", "fmi3SetShiftFraction",
+    "fmi3EvaluateDiscreteStates", "fmi3UpdateDiscreteStates",
+    "fmi3EnterContinuousTimeMode", "fmi3CompletedIntegratorStep", "fmi3SetTime", "fmi3SetContinuousStates",
+    "fmi3GetContinuousStateDerivatives", "fmi3GetEventIndicators", "fmi3GetContinuousStates",
+    "fmi3GetNominalsOfContinuousStates", "fmi3GetNumberOfEventIndicators", "fmi3GetNumberOfContinuousStates",
+    "fmi3EnterStepMode", "fmi3GetOutputDerivatives", "fmi3DoStep", "fmi3ActivateModelPartition",
+}
+
+
+def test_the_binary_exports_every_fmi3_function_and_fmpy_needs_no_other():
+    import inspect
+    import subprocess
+
+    assert len(FMI3_FUNCTIONS) == 75
+    with zipfile.ZipFile(fmu3("AttitudePlant")) as z, __import__("tempfile").TemporaryDirectory() as d:
+        so = Path(d) / "AttitudePlant.so"
+        so.write_bytes(z.read("binaries/x86_64-linux/AttitudePlant.so"))
+        nm = subprocess.run(["nm", "-D", "--defined-only", str(so)], capture_output=True, text=True, check=True).stdout
+    exported = {line.split()[-1] for line in nm.splitlines() if line.split()[-1].startswith("fmi3")}
+    assert exported == FMI3_FUNCTIONS
+    assert {n for n, _ in inspect.getmembers(FMU3Slave) if n.startswith("fmi3")} <= exported
+
+
 def test_every_model_has_an_fmi3_description_and_fmu():
     fmi2_models = sorted(p.stem for p in (ROOT / "modelDescription").glob("*.xml"))
     assert MODELS == fmi2_models and len(MODELS) == 24

@@ -215,7 +215,7 @@ pub extern "C" fn fmi3EvaluateDiscreteStates(c: Instance3) -> c_int {
     refuse(c, "fmi3EvaluateDiscreteStates", mask3::ANY, "this Co-Simulation FMU has no Event Mode")
 }
 
-pub extern "C" fn fmi3UpdateDiscreteStates(c: Instance3, _a: *mut u8, _b: *mut u8, _c: *mut u8, _d: *mut u8, _e: *mut u8, _t: *mut f64) -> c_int {
+pub extern "C" fn fmi3UpdateDiscreteStates(c: Instance3, _a: *mut u8, _b: *mut u8, _nominals_changed: *mut u8, _d: *mut u8, _e: *mut u8, _t: *mut f64) -> c_int {
     refuse(c, "fmi3UpdateDiscreteStates", mask3::ANY, "this Co-Simulation FMU has no Event Mode")
 }
 
@@ -274,7 +274,7 @@ pub extern "C" fn fmi3GetIntervalDecimal(c: Instance3, vr: *const u32, n: usize,
     no_such_type(c, "fmi3GetIntervalDecimal", mask3::ANY, "Clock", vr, n)
 }
 
-pub extern "C" fn fmi3GetIntervalFraction(c: Instance3, vr: *const u32, n: usize, _c: *mut u64, _r: *mut u64, _q: *mut c_int) -> c_int {
+pub extern "C" fn fmi3GetIntervalFraction(c: Instance3, vr: *const u32, n: usize, _counters: *mut u64, _r: *mut u64, _q: *mut c_int) -> c_int {
     no_such_type(c, "fmi3GetIntervalFraction", mask3::ANY, "Clock", vr, n)
 }
 
@@ -282,7 +282,7 @@ pub extern "C" fn fmi3GetShiftDecimal(c: Instance3, vr: *const u32, n: usize, _s
     no_such_type(c, "fmi3GetShiftDecimal", mask3::ANY, "Clock", vr, n)
 }
 
-pub extern "C" fn fmi3GetShiftFraction(c: Instance3, vr: *const u32, n: usize, _c: *mut u64, _r: *mut u64) -> c_int {
+pub extern "C" fn fmi3GetShiftFraction(c: Instance3, vr: *const u32, n: usize, _counters: *mut u64, _r: *mut u64) -> c_int {
     no_such_type(c, "fmi3GetShiftFraction", mask3::ANY, "Clock", vr, n)
 }
 
@@ -290,7 +290,7 @@ pub extern "C" fn fmi3SetIntervalDecimal(c: Instance3, vr: *const u32, n: usize,
     no_such_type(c, "fmi3SetIntervalDecimal", mask3::ANY, "Clock", vr, n)
 }
 
-pub extern "C" fn fmi3SetIntervalFraction(c: Instance3, vr: *const u32, n: usize, _c: *const u64, _r: *const u64) -> c_int {
+pub extern "C" fn fmi3SetIntervalFraction(c: Instance3, vr: *const u32, n: usize, _counters: *const u64, _r: *const u64) -> c_int {
     no_such_type(c, "fmi3SetIntervalFraction", mask3::ANY, "Clock", vr, n)
 }
 
@@ -298,7 +298,7 @@ pub extern "C" fn fmi3SetShiftDecimal(c: Instance3, vr: *const u32, n: usize, _s
     no_such_type(c, "fmi3SetShiftDecimal", mask3::ANY, "Clock", vr, n)
 }
 
-pub extern "C" fn fmi3SetShiftFraction(c: Instance3, vr: *const u32, n: usize, _c: *const u64, _r: *const u64) -> c_int {
+pub extern "C" fn fmi3SetShiftFraction(c: Instance3, vr: *const u32, n: usize, _counters: *const u64, _r: *const u64) -> c_int {
     no_such_type(c, "fmi3SetShiftFraction", mask3::ANY, "Clock", vr, n)
 }
 
