@@ -59,6 +59,11 @@ pub(super) fn call3(c: Instance3, func: &str, allowed: u16, f: impl FnOnce(&mut 
     let Some(inst) = instance_of(c, true) else {
         return Status::Error as c_int;
     };
+    if inst.run.fsm == FsmState::Error {
+        // FMI 2.0's error state (a step or output failure inside the shared Instance code, or an FMU
+        // state serialized by an FMI 2.0 instance) is FMI 3.0's Terminated
+        inst.run.fsm = FsmState::Terminated;
+    }
     let result = if allowed & inst.run.fsm.bit() == 0 {
         let status = if inst.run.fsm == FsmState::Fatal { Status::Fatal } else { Status::Error };
         Err(Fail { status, reason: format!("not allowed in state {} (illegal call sequence)", state_name(inst.run.fsm)) })
