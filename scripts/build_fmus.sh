@@ -22,7 +22,7 @@ fi
 if [ -n "${SCFMU_DARWIN64_LIB:-}" ]; then
     package_args+=(--add-lib "darwin64=$SCFMU_DARWIN64_LIB")
 fi
-./target/release/package "${package_args[@]}"
+./target/release/fmu-package "${package_args[@]}"
 if [ -x .venv/bin/python ]; then
     .venv/bin/scfmu export ssp --out fmus/ssp
     .venv/bin/scfmu export loop --out fmus/loops
