@@ -138,6 +138,9 @@ pub fn check_declarations(entry: &ModelEntry) -> Result<(), String> {
                 return Err(format!("{name}: {} and {} share value reference {}", a.name, b.name, a.vr));
             }
         }
+        if a.vr == spacecraft_fmus::fmi::fmi3::TIME_VR {
+            return Err(format!("{name}: {} uses value reference {}, reserved for time in FMI 3.0", a.name, a.vr));
+        }
         if !a.unit.is_empty() && units::lookup(a.unit).is_none() {
             return Err(format!("{name}: variable {} uses undefined unit {}", a.name, a.unit));
         }
@@ -466,6 +469,15 @@ mod tests {
         for e in spacecraft_fmus::registry::ALL {
             check_declarations(e).unwrap();
         }
+    }
+
+    #[test]
+    fn the_fmi3_time_value_reference_is_reserved() {
+        let e = spacecraft_fmus::registry::find("PdController").unwrap();
+        let mut decls = e.decls.to_vec();
+        decls[0].vr = spacecraft_fmus::fmi::fmi3::TIME_VR;
+        let bad = ModelEntry { decls: Box::leak(decls.into_boxed_slice()), ..*e };
+        assert!(check_declarations(&bad).unwrap_err().contains("reserved for time in FMI 3.0"));
     }
 
     #[test]
