@@ -270,7 +270,7 @@ pub fn read_catalogue(bytes: &[u8]) -> Result<Catalogue, String> {
     postcard::from_bytes(body).map_err(|e| format!("catalogue unreadable: {e}"))
 }
 
-/// Generates the FMI 2.0 Co-Simulation entry points of a shared library for the given models, plus
+/// Generates the FMI 2.0 and FMI 3.0 Co-Simulation entry points of a shared library for the given models, plus
 /// `spacecraft_fmus_catalogue` (the declarations, for the packaging tool). Use it once, at the root of a
 /// `cdylib` crate:
 ///
@@ -281,7 +281,7 @@ pub fn read_catalogue(bytes: &[u8]) -> Result<Catalogue, String> {
 ///
 /// One library may hold several models: each FMU carries the same binary under its own name
 /// (`binaries/<platform>/<Model>.<ext>`), and `fmi2Instantiate` picks the model by that file name and
-/// checks the GUID. Every function goes through the layer in `spacecraft_fmus::fmi::abi` (state machine,
+/// checks the GUID (`fmi3InstantiateCoSimulation`: the instantiationToken, the same GUID). Every function goes through the layer in `spacecraft_fmus::fmi::abi` (state machine,
 /// status and logging, panics caught, validated FMU states).
 #[macro_export]
 macro_rules! export_fmus {
@@ -362,6 +362,8 @@ macro_rules! export_fmus {
             #[no_mangle] pub extern "C" fn fmi2GetIntegerStatus(c: Component, k: c_int, v: *mut c_int) -> c_int { abi::fmi2GetIntegerStatus(c, k, v) }
             #[no_mangle] pub extern "C" fn fmi2GetBooleanStatus(c: Component, k: c_int, v: *mut c_int) -> c_int { abi::fmi2GetBooleanStatus(c, k, v) }
             #[no_mangle] pub extern "C" fn fmi2GetStringStatus(c: Component, k: c_int, v: *mut *const c_char) -> c_int { abi::fmi2GetStringStatus(c, k, v) }
+            // FMI 3.0 Co-Simulation: the same instances and models (src/export3.rs)
+            $crate::__export_fmi3!(MODELS);
         };
     };
     ($($Model:ty),+ $(,)?) => {

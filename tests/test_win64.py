@@ -156,6 +156,19 @@ def test_dll_exports_the_fmi2_functions_and_imports_only_system_dlls(loop_dir):
     assert "bcryptprimitives.dll" not in lower
 
 
+def test_fmi3_fmus_carry_the_same_dll_which_exports_the_fmi3_functions_of_the_so(fmus_with_win64, loop_dir):
+    """fmus/fmi3/<Model>.fmu stores the same DLL under the FMI 3.0 platform tuple x86_64-windows, and it
+    exports the same fmi3* functions as the Linux build."""
+    d, _ = loop_dir
+    for n in fmus_with_win64:
+        with zipfile.ZipFile(FMUS / "fmi3" / f"{n}.fmu") as z3, zipfile.ZipFile(FMUS / f"{n}.fmu") as z2:
+            assert z3.read(f"binaries/x86_64-windows/{n}.dll") == z2.read(f"binaries/win64/{n}.dll")
+    _, exports = pe_imports_exports(d / "AttitudePlant.dll")
+    nm = subprocess.run(["nm", "-D", "--defined-only", str(d / "AttitudePlant.so")], capture_output=True, text=True, check=True).stdout
+    linux = {line.split()[-1] for line in nm.splitlines() if line.split()[-1].startswith("fmi3")}
+    assert len(linux) == 75 and {e for e in exports if e.startswith("fmi3")} == linux
+
+
 def test_dll_finds_its_own_file_name_under_wine(loop_dir):
     """fmi2Instantiate of AttitudePlant.dll with PdController's GUID must be refused and name
     AttitudePlant: the DLL found its own file name (GetModuleHandleExW + GetModuleFileNameW) instead of

@@ -15,7 +15,7 @@ use std::ffi::{c_char, c_int, c_void, CStr, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::MutexGuard;
 
-use super::instance::{CallResult, Fail, Instance};
+use super::instance::{CallResult, Fail, Instance, Logger};
 use super::state::Snapshot;
 use super::{mask, status_kind, BuildAddrHasher, CallbackFunctions, FsmState, LiveSet, Status};
 use crate::model::guid::guid;
@@ -36,11 +36,31 @@ fn live_instances() -> MutexGuard<'static, HashSet<usize, BuildAddrHasher>> {
 /// The instance behind a component pointer, if it is one of ours and not freed. A null, foreign or
 /// freed pointer gives None (and the call returns fmi2Error: there is no logger to tell).
 fn instance<'a>(c: Component) -> Option<&'a mut Instance> {
+    instance_of(c, false)
+}
+
+/// The instance behind a pointer if it is live and was created through the FMI version asked for
+/// (`fmi3`: by `fmi3InstantiateCoSimulation`); an FMI 2.0 instance is foreign to the FMI 3.0
+/// functions and the other way round.
+pub(super) fn instance_of<'a>(c: Component, fmi3: bool) -> Option<&'a mut Instance> {
     if c.is_null() || !live_instances().contains(&(c as usize)) {
         return None;
     }
-    // SAFETY: the address is registered by fmi2Instantiate and removed by fmi2FreeInstance.
-    Some(unsafe { &mut *(c as *mut Instance) })
+    // SAFETY: the address is registered by fmi2Instantiate / fmi3InstantiateCoSimulation and removed
+    // by fmi2FreeInstance / fmi3FreeInstance.
+    let inst = unsafe { &mut *(c as *mut Instance) };
+    (inst.fmi3 == fmi3).then_some(inst)
+}
+
+/// Registers a new instance (installing the panic hook with the first one).
+pub(super) fn register(inst: Box<Instance>) -> Component {
+    let p = Box::into_raw(inst) as Component;
+    let mut live = live_instances();
+    if live.is_empty() {
+        install_panic_hook();
+    }
+    live.insert(p as usize);
+    p
 }
 
 // ----- panics ------------------------------------------------------------------------------------
@@ -72,7 +92,7 @@ fn install_panic_hook() {
     }));
 }
 
-fn guarded<T>(f: impl FnOnce() -> T) -> Result<T, String> {
+pub(super) fn guarded<T>(f: impl FnOnce() -> T) -> Result<T, String> {
     let was = IN_FFI.with(|x| x.replace(true));
     let r = catch_unwind(AssertUnwindSafe(f));
     IN_FFI.with(|x| x.set(was));
@@ -106,7 +126,7 @@ fn call(c: Component, func: &str, allowed: u16, f: impl FnOnce(&mut Instance) ->
 // ----- pointer helpers ---------------------------------------------------------------------------
 
 /// Borrows a C array; `n == 0` needs no pointer. Null with n > 0 is an error naming the argument.
-unsafe fn slice<'a, T>(p: *const T, n: usize, what: &str) -> CallResult<&'a [T]> {
+pub(super) unsafe fn slice<'a, T>(p: *const T, n: usize, what: &str) -> CallResult<&'a [T]> {
     if n == 0 {
         return Ok(&[]);
     }
@@ -120,7 +140,7 @@ unsafe fn slice<'a, T>(p: *const T, n: usize, what: &str) -> CallResult<&'a [T]>
     Ok(unsafe { std::slice::from_raw_parts(p, n) })
 }
 
-unsafe fn slice_mut<'a, T>(p: *mut T, n: usize, what: &str) -> CallResult<&'a mut [T]> {
+pub(super) unsafe fn slice_mut<'a, T>(p: *mut T, n: usize, what: &str) -> CallResult<&'a mut [T]> {
     if n == 0 {
         return Ok(&mut []);
     }
@@ -134,7 +154,7 @@ unsafe fn slice_mut<'a, T>(p: *mut T, n: usize, what: &str) -> CallResult<&'a mu
     Ok(unsafe { std::slice::from_raw_parts_mut(p, n) })
 }
 
-fn out_ptr<'a, T>(p: *mut T, what: &str) -> CallResult<&'a mut T> {
+pub(super) fn out_ptr<'a, T>(p: *mut T, what: &str) -> CallResult<&'a mut T> {
     if p.is_null() {
         return Err(Fail::error(format!("{what} is NULL")));
     }
@@ -144,7 +164,7 @@ fn out_ptr<'a, T>(p: *mut T, what: &str) -> CallResult<&'a mut T> {
 
 // ----- model lookup for fmi2Instantiate ------------------------------------------------------------
 
-fn find_model(all: &'static [ModelEntry], requested: &str) -> Result<&'static ModelEntry, String> {
+pub(super) fn find_model(all: &'static [ModelEntry], requested: &str) -> Result<&'static ModelEntry, String> {
     if let Some(expected) = super::library_path::own_library_stem().and_then(|stem| all.iter().find(|e| e.info.name == stem)) {
         let want = guid(expected);
         return if requested == want.as_str() {
@@ -211,15 +231,9 @@ pub fn fmi2Instantiate(
         // SAFETY: non-null C string from the master.
         let requested = unsafe { CStr::from_ptr(fmu_guid) }.to_string_lossy();
         let entry = find_model(models, &requested)?;
-        let inst = Box::new(Instance::new(name.to_owned(), entry, functions.logger, functions.component_environment, logging_on != 0));
+        let inst = Box::new(Instance::new(name.to_owned(), entry, functions.logger.map_or(Logger::None, Logger::Fmi2), functions.component_environment, logging_on != 0));
         inst.trace(|| format!("fmi2Instantiate: {} instance of {}", inst.name.to_string_lossy(), entry.info.name));
-        let p = Box::into_raw(inst) as Component;
-        let mut live = live_instances();
-        if live.is_empty() {
-            install_panic_hook();
-        }
-        live.insert(p as usize);
-        Ok(p)
+        Ok(register(inst))
     });
     let name = if instance_name.is_null() { c"?" } else { unsafe { CStr::from_ptr(instance_name) } };
     match result {
@@ -236,8 +250,13 @@ pub fn fmi2Instantiate(
 }
 
 pub extern "C" fn fmi2FreeInstance(c: Component) {
-    if c.is_null() || !live_instances().remove(&(c as usize)) {
-        return; // null or not ours: nothing to free, nothing to log to
+    free_instance(c, false)
+}
+
+/// Frees an instance of the given FMI version (and its FMU states); anything else is ignored.
+pub(super) fn free_instance(c: Component, fmi3: bool) {
+    if instance_of(c, fmi3).is_none() || !live_instances().remove(&(c as usize)) {
+        return; // null, not ours or of the other FMI version: nothing to free, nothing to log to
     }
     let _ = guarded(|| {
         Snapshot::free_all_of(c as usize);

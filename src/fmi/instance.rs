@@ -2,11 +2,22 @@
 //! initialization and stepping. Called only from `abi`, after null/state checks.
 
 use std::collections::HashSet;
-use std::ffi::{c_int, c_void, CString};
+use std::ffi::{c_char, c_int, c_void, CString};
 
 use serde::{Deserialize, Serialize};
 
 use super::{FsmState, LoggerFn, Status, LOG_CATEGORIES};
+
+/// `fmi3LogMessageCallback`: not variadic, the message is plain text (not a printf format).
+pub type Log3Fn = unsafe extern "C" fn(env: *mut c_void, status: c_int, category: *const c_char, message: *const c_char);
+
+/// The master's logger: FMI 2.0 (`fmi2CallbackLogger`) or FMI 3.0 (`fmi3LogMessageCallback`).
+#[derive(Clone, Copy)]
+pub enum Logger {
+    None,
+    Fmi2(LoggerFn),
+    Fmi3(Log3Fn),
+}
 use crate::model::{Causality, DynModel, Experiment, TOLERANCE_MAX, TOLERANCE_MIN, ModelEntry, SlotMut, Value, VarDecl, VarKind, Variability};
 
 /// Failure of an FMI call: the status to return and the reason to log.
@@ -103,8 +114,10 @@ impl Run {
 pub struct Instance {
     pub name: CString,
     pub entry: &'static ModelEntry,
-    logger: Option<LoggerFn>,
+    logger: Logger,
     env: *mut c_void,
+    /// Created by `fmi3InstantiateCoSimulation` (FMI 3.0 calls only) rather than `fmi2Instantiate`.
+    pub fmi3: bool,
     debug_logging: bool,
     categories: HashSet<&'static str>,
     pub run: Run,
@@ -121,12 +134,13 @@ fn kind_name(k: VarKind) -> &'static str {
 }
 
 impl Instance {
-    pub fn new(name: CString, entry: &'static ModelEntry, logger: Option<LoggerFn>, env: *mut c_void, logging_on: bool) -> Self {
+    pub fn new(name: CString, entry: &'static ModelEntry, logger: Logger, env: *mut c_void, logging_on: bool) -> Self {
         Instance {
             name,
             entry,
             logger,
             env,
+            fmi3: false,
             debug_logging: logging_on,
             categories: LOG_CATEGORIES.iter().map(|(n, _)| *n).collect(),
             run: Run::INSTANTIATED,
@@ -140,16 +154,29 @@ impl Instance {
     /// Sends a message to the logger callback. Warnings and errors always go out; other messages
     /// only with debug logging on and their category enabled.
     pub fn log(&self, status: Status, category: &str, message: &str) {
-        let Some(logger) = self.logger else { return };
+        if matches!(self.logger, Logger::None) {
+            return;
+        }
         if status < Status::Warning && !(self.debug_logging && (self.categories.contains(category) || self.categories.contains("logAll"))) {
             return;
         }
-        // The message is a printf format for C loggers: escape '%'; interior NULs cannot pass.
-        let text = CString::new(message.replace('%', "%%").replace('\0', "")).unwrap_or_default();
         let cat = CString::new(category).unwrap_or_default();
-        // SAFETY: the logger is the master's callback with the fmi2CallbackLogger signature; all
-        // strings are valid NUL-terminated for the duration of the call.
-        unsafe { logger(self.env, self.name.as_ptr(), status as c_int, cat.as_ptr(), text.as_ptr()) };
+        match self.logger {
+            Logger::None => {}
+            Logger::Fmi2(logger) => {
+                // The message is a printf format for C loggers: escape '%'; interior NULs cannot pass.
+                let text = CString::new(message.replace('%', "%%").replace('\0', "")).unwrap_or_default();
+                // SAFETY: the logger is the master's callback with the fmi2CallbackLogger signature; all
+                // strings are valid NUL-terminated for the duration of the call.
+                unsafe { logger(self.env, self.name.as_ptr(), status as c_int, cat.as_ptr(), text.as_ptr()) };
+            }
+            Logger::Fmi3(logger) => {
+                // FMI 3.0 messages are plain text (no printf format) and carry no instance name: prefix it.
+                let text = CString::new(format!("{}: {}", self.name.to_string_lossy(), message).replace('\0', "")).unwrap_or_default();
+                // SAFETY: the master's fmi3LogMessageCallback; strings valid for the duration of the call.
+                unsafe { logger(self.env, status as c_int, cat.as_ptr(), text.as_ptr()) };
+            }
+        }
     }
 
     pub fn log_fail(&self, func: &str, fail: &Fail) {

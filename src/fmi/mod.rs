@@ -1,8 +1,12 @@
-//! The FMI 2.0 Co-Simulation layer, written once for every model: C types, the exported C ABI
-//! (`abi`), the per-instance state machine, logging and value access (`instance`), and FMU state
+//! The FMI 2.0 and 3.0 Co-Simulation layer, written once for every model: C types, the exported C ABI
+//! (`abi` for FMI 2.0, `fmi3` and `fmi3_more` for FMI 3.0), the per-instance state machine, logging and value access (`instance`), and FMU state
 //! snapshots and their byte format (`state`). Models never see anything in here.
 
 pub mod abi;
+pub mod fmi3;
+pub mod fmi3_more;
+#[cfg(test)]
+mod fmi3_tests;
 pub mod instance;
 mod library_path;
 pub mod state;

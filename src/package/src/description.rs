@@ -18,7 +18,7 @@ use spacecraft_fmus::units;
 
 pub const GENERATION_TOOL: &str = concat!("spacecraft_fmus fmu-package ", env!("CARGO_PKG_VERSION"));
 
-fn causality_str(c: Causality) -> &'static str {
+pub(crate) fn causality_str(c: Causality) -> &'static str {
     match c {
         Causality::Parameter => "parameter",
         Causality::CalculatedParameter => "calculatedParameter",
@@ -38,7 +38,7 @@ pub(crate) fn variability_str(v: Variability) -> &'static str {
     }
 }
 
-fn initial_str(i: Initial) -> &'static str {
+pub(crate) fn initial_str(i: Initial) -> &'static str {
     match i {
         Initial::Exact => "exact",
         Initial::Approx => "approx",
@@ -60,7 +60,7 @@ pub(crate) fn start_str(s: Start) -> String {
     }
 }
 
-fn bound_str(kind: VarKind, v: f64) -> String {
+pub(crate) fn bound_str(kind: VarKind, v: f64) -> String {
     if kind == VarKind::Integer { (v as i32).to_string() } else { fmt_real(v) }
 }
 
@@ -138,6 +138,9 @@ pub fn check_declarations(entry: &ModelEntry) -> Result<(), String> {
                 return Err(format!("{name}: {} and {} share value reference {}", a.name, b.name, a.vr));
             }
         }
+        if a.vr == spacecraft_fmus::fmi::fmi3::TIME_VR {
+            return Err(format!("{name}: {} uses value reference {}, reserved for time in FMI 3.0", a.name, a.vr));
+        }
         if !a.unit.is_empty() && units::lookup(a.unit).is_none() {
             return Err(format!("{name}: variable {} uses undefined unit {}", a.name, a.unit));
         }
@@ -180,12 +183,49 @@ pub fn check_declarations(entry: &ModelEntry) -> Result<(), String> {
     Ok(())
 }
 
-fn elem<'a>(name: &'a str, attrs: &[(&'a str, String)]) -> BytesStart<'a> {
+pub(crate) fn elem<'a>(name: &'a str, attrs: &[(&'a str, String)]) -> BytesStart<'a> {
     let mut e = BytesStart::new(name);
     for (k, v) in attrs {
         e.push_attribute((*k, v.as_str()));
     }
     e
+}
+
+/// `<UnitDefinitions>` of the units a model uses, in table order (deterministic); nothing when it uses
+/// none. The same element in FMI 2.0 and 3.0.
+pub(crate) fn write_unit_definitions(w: &mut Writer<Cursor<Vec<u8>>>, entry: &ModelEntry) {
+    let empty = |w: &mut Writer<Cursor<Vec<u8>>>, name: &str, attrs: &[(&str, String)]| {
+        w.write_event(Event::Empty(elem(name, attrs))).unwrap();
+    };
+    let start = |w: &mut Writer<Cursor<Vec<u8>>>, name: &str, attrs: &[(&str, String)]| {
+        w.write_event(Event::Start(elem(name, attrs))).unwrap();
+    };
+    let end = |w: &mut Writer<Cursor<Vec<u8>>>, name: &str| {
+        w.write_event(Event::End(BytesEnd::new(name))).unwrap();
+    };
+    let used: Vec<_> = units::UNITS.iter().filter(|(n, _, _)| entry.decls.iter().any(|d| d.unit == *n)).collect();
+    if !used.is_empty() {
+        start(w, "UnitDefinitions", &[]);
+        for (name, b, display) in used {
+            start(w, "Unit", &[("name", (*name).into())]);
+            let mut attrs: Vec<(&str, String)> = vec![];
+            for (k, v) in [("kg", b.kg), ("m", b.m), ("s", b.s), ("A", b.a), ("rad", b.rad)] {
+                if v != 0 {
+                    attrs.push((k, v.to_string()));
+                }
+            }
+            if b.factor != 1.0 {
+                attrs.push(("factor", fmt_real(b.factor)));
+            }
+            empty(w, "BaseUnit", &attrs);
+            for (dn, f) in display.iter() {
+                empty(w, "DisplayUnit", &[("name", (*dn).into()), ("factor", fmt_real(*f))]);
+            }
+            end(w, "Unit");
+        }
+        end(w, "UnitDefinitions");
+    }
+
 }
 
 /// Writes the complete model description with the given GUID.
@@ -237,29 +277,7 @@ fn write_xml(entry: &ModelEntry, guid: &str, package: &PackageInfo) -> String {
         ],
     );
 
-    // Units actually used, in table order (deterministic).
-    let used: Vec<_> = units::UNITS.iter().filter(|(n, _, _)| entry.decls.iter().any(|d| d.unit == *n)).collect();
-    if !used.is_empty() {
-        start(&mut w, "UnitDefinitions", &[]);
-        for (name, b, display) in used {
-            start(&mut w, "Unit", &[("name", (*name).into())]);
-            let mut attrs: Vec<(&str, String)> = vec![];
-            for (k, v) in [("kg", b.kg), ("m", b.m), ("s", b.s), ("A", b.a), ("rad", b.rad)] {
-                if v != 0 {
-                    attrs.push((k, v.to_string()));
-                }
-            }
-            if b.factor != 1.0 {
-                attrs.push(("factor", fmt_real(b.factor)));
-            }
-            empty(&mut w, "BaseUnit", &attrs);
-            for (dn, f) in display.iter() {
-                empty(&mut w, "DisplayUnit", &[("name", (*dn).into()), ("factor", fmt_real(*f))]);
-            }
-            end(&mut w, "Unit");
-        }
-        end(&mut w, "UnitDefinitions");
-    }
+    write_unit_definitions(&mut w, entry);
 
     start(&mut w, "LogCategories", &[]);
     for (name, desc) in LOG_CATEGORIES {
@@ -361,7 +379,7 @@ pub fn project_package() -> PackageInfo {
 }
 
 /// Cargo's colon-separated authors as one `author` attribute (the package name when there are none).
-trait Author {
+pub(crate) trait Author {
     fn author(&self) -> String;
 }
 
@@ -451,6 +469,15 @@ mod tests {
         for e in spacecraft_fmus::registry::ALL {
             check_declarations(e).unwrap();
         }
+    }
+
+    #[test]
+    fn the_fmi3_time_value_reference_is_reserved() {
+        let e = spacecraft_fmus::registry::find("PdController").unwrap();
+        let mut decls = e.decls.to_vec();
+        decls[0].vr = spacecraft_fmus::fmi::fmi3::TIME_VR;
+        let bad = ModelEntry { decls: Box::leak(decls.into_boxed_slice()), ..*e };
+        assert!(check_declarations(&bad).unwrap_err().contains("reserved for time in FMI 3.0"));
     }
 
     #[test]

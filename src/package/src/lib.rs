@@ -4,11 +4,14 @@
 //! platform serves every model of a library: it is copied into each archive as
 //! `binaries/linux64/<Model>.so` (and `binaries/win64/<Model>.dll` when a Windows build is given), and
 //! `fmi2Instantiate` picks the model by file name and GUID. All platforms share one `modelDescription.xml`.
+//! The same library also exports the FMI 3.0 functions: [`write_fmu3`] writes the FMI 3.0 archive
+//! (`fmus/fmi3/<Model>.fmu`, `binaries/<platform tuple>/<Model>.<ext>`, FMI 3.0 model description).
 //!
 //! This crate, not the runtime, links the XML writer and `zip`.
 
 pub mod build;
 pub mod description;
+pub mod description3;
 pub mod docs;
 mod load;
 pub mod references;
@@ -21,6 +24,7 @@ use zip::write::SimpleFileOptions;
 use zip::{CompressionMethod, DateTime, ZipWriter};
 
 use crate::description::{check_declarations, documentation_html, model_description};
+use crate::description3::model_description3;
 use spacecraft_fmus::export::{read_catalogue, PackageInfo, RUNTIME_VERSION};
 use spacecraft_fmus::model::guid::compute_fresh;
 use spacecraft_fmus::model::ModelEntry;
@@ -126,6 +130,42 @@ pub fn stale_model_descriptions(units: &[Unit], dir: &Path) -> Vec<String> {
         .collect()
 }
 
+/// Writes `<dir>/<Model>.xml` (FMI 3.0) for every unit; returns the paths written.
+pub fn write_model_descriptions3(units: &[Unit], dir: &Path) -> std::io::Result<Vec<String>> {
+    fs::create_dir_all(dir)?;
+    let mut written = vec![];
+    for u in units {
+        let p = dir.join(format!("{}.xml", u.name()));
+        fs::write(&p, model_description3(&u.entry, u.guid, u.package))?;
+        written.push(p.display().to_string());
+    }
+    Ok(written)
+}
+
+/// Names of the units whose committed FMI 3.0 `<dir>/<Model>.xml` differs from the generated one.
+pub fn stale_model_descriptions3(units: &[Unit], dir: &Path) -> Vec<String> {
+    units
+        .iter()
+        .filter(|u| fs::read_to_string(dir.join(format!("{}.xml", u.name()))).ok().as_deref() != Some(model_description3(&u.entry, u.guid, u.package).as_str()))
+        .map(|u| format!("fmi3/{}", u.name()))
+        .collect()
+}
+
+/// FMI 3.0 platform tuple of a binary stored under an FMI 2.0 platform folder. A `darwin64` build is
+/// told apart by its Mach-O CPU type (x86_64 or arm64).
+pub fn platform_tuple(b: &Binary) -> Option<&'static str> {
+    match b.platform {
+        "linux64" => Some("x86_64-linux"),
+        "win64" => Some("x86_64-windows"),
+        "darwin64" => match b.bytes.get(4..8) {
+            Some([0x07, 0, 0, 0x01]) => Some("x86_64-darwin"),
+            Some([0x0c, 0, 0, 0x01]) => Some("aarch64-darwin"),
+            _ => None,
+        },
+        _ => None,
+    }
+}
+
 /// One platform's build of the cdylib, to be stored as `binaries/<platform>/<Model>.<ext>`.
 #[derive(Clone, Copy, Debug)]
 pub struct Binary<'a> {
@@ -167,6 +207,31 @@ pub fn write_fmu(unit: &Unit, binaries: &[Binary], out_dir: &Path) -> std::io::R
     Ok(path)
 }
 
+/// Writes one FMI 3.0 `.fmu` archive: the FMI 3.0 model description, the same binaries under FMI 3.0
+/// platform tuples (`binaries/x86_64-linux/<Model>.so`, ...) and the documentation. Deterministic.
+pub fn write_fmu3(unit: &Unit, binaries: &[Binary], out_dir: &Path) -> std::io::Result<std::path::PathBuf> {
+    let entry = &unit.entry;
+    if binaries.is_empty() {
+        return Err(std::io::Error::other("no binary to package"));
+    }
+    fs::create_dir_all(out_dir)?;
+    let path = out_dir.join(format!("{}.fmu", entry.info.name));
+    let mut zip = ZipWriter::new(fs::File::create(&path)?);
+    let opts = SimpleFileOptions::default().compression_method(CompressionMethod::Deflated).last_modified_time(DateTime::default());
+    let add = |zip: &mut ZipWriter<fs::File>, name: &str, data: &[u8], mode: u32| -> std::io::Result<()> {
+        zip.start_file(name, opts.unix_permissions(mode)).map_err(std::io::Error::other)?;
+        zip.write_all(data)
+    };
+    add(&mut zip, "modelDescription.xml", model_description3(entry, unit.guid, unit.package).as_bytes(), 0o644)?;
+    for b in binaries {
+        let tuple = platform_tuple(b).ok_or_else(|| std::io::Error::other(format!("no FMI 3.0 platform tuple for the {} binary", b.platform)))?;
+        add(&mut zip, &format!("binaries/{tuple}/{}.{}", entry.info.name, b.ext), b.bytes, 0o755)?;
+    }
+    add(&mut zip, "documentation/index.html", documentation_html(entry, unit.guid).as_bytes(), 0o644)?;
+    zip.finish().map_err(std::io::Error::other)?;
+    Ok(path)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -196,6 +261,19 @@ mod tests {
         assert!(write_fmu(&unit, &[], &dir).is_err());
         fs::remove_dir_all(&dir).ok();
         assert_eq!(platform_lib_ext("win64"), Some("dll"));
+        // FMI 3.0: the same binaries under platform tuples
+        let path3 = write_fmu3(&unit, &bins, &dir.join("fmi3")).unwrap();
+        let mut zip3 = zip::ZipArchive::new(fs::File::open(&path3).unwrap()).unwrap();
+        let names3: Vec<String> = (0..zip3.len()).map(|i| zip3.by_index(i).unwrap().name().unwrap().to_string()).collect();
+        assert_eq!(names3[1..3], [format!("binaries/x86_64-linux/{n}.so"), format!("binaries/x86_64-windows/{n}.dll")]);
+        let mut x = String::new();
+        std::io::Read::read_to_string(&mut zip3.by_name("modelDescription.xml").unwrap(), &mut x).unwrap();
+        assert!(x.contains(r#"fmiVersion="3.0""#));
+        let mac = |cpu: u8| [0xcf, 0xfa, 0xed, 0xfe, cpu, 0, 0, 0x01];
+        assert_eq!(platform_tuple(&Binary { platform: "darwin64", ext: "dylib", bytes: &mac(0x0c) }), Some("aarch64-darwin"));
+        assert_eq!(platform_tuple(&Binary { platform: "darwin64", ext: "dylib", bytes: &mac(0x07) }), Some("x86_64-darwin"));
+        assert_eq!(platform_tuple(&Binary { platform: "darwin64", ext: "dylib", bytes: b"junk" }), None);
+        fs::remove_dir_all(&dir).ok();
         assert_eq!(platform_lib_ext("win32"), None);
     }
 }

@@ -7,8 +7,10 @@
 //! - `--crate DIR`: the model crate (a `cdylib` calling `spacecraft_fmus::export_fmus!`); it is built
 //!   with `cargo build --release --lib`. Default: this project's `src/cdylib` (all registered models).
 //! - `--lib PATH`: package an already built host library instead of building a crate.
-//! - `--out DIR`: where `<Model>.fmu` go (default `DIR/fmus`; for the project, `fmus/`).
-//! - `--xml DIR`: also write `<Model>.xml` there (the project: `modelDescription/`, always).
+//! - `--out DIR`: where `<Model>.fmu` go (default `DIR/fmus`; for the project, `fmus/`); the FMI 3.0
+//!   archives of the same models go to `DIR/fmi3/<Model>.fmu`.
+//! - `--xml DIR`: also write `<Model>.xml` there, and the FMI 3.0 ones in `DIR/fmi3/` (the project:
+//!   `modelDescription/`, always).
 //! - `--win64`: add `binaries/win64/<Model>.dll` from `scripts/build_win64.sh`: `auto` (default) when
 //!   the cross toolchain is installed, `yes` requires it, `no` skips it (also `SCFMU_NO_WIN64=1`).
 //! - `--add-lib PLATFORM=PATH`: store another platform's build of the same crate (linux64, win64, darwin64).
@@ -21,7 +23,10 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use spacecraft_fmus_package::build::{cargo_build, win64_available, win64_build};
-use spacecraft_fmus_package::{platform_lib_ext, stale_model_descriptions, units_of_library, write_fmu, write_model_descriptions, Binary, PLATFORM};
+use spacecraft_fmus_package::{
+    platform_lib_ext, stale_model_descriptions, stale_model_descriptions3, units_of_library, write_fmu, write_fmu3, write_model_descriptions, write_model_descriptions3, Binary,
+    PLATFORM,
+};
 
 struct Args {
     krate: Option<PathBuf>,
@@ -110,6 +115,7 @@ fn run() -> Result<(), String> {
         let mut stale = vec![];
         if let Some(x) = &xml {
             stale.extend(stale_model_descriptions(&units, x));
+            stale.extend(stale_model_descriptions3(&units, &x.join("fmi3")));
         }
         if let Some(d) = &docs {
             stale.extend(spacecraft_fmus_package::docs::stale_pages(d));
@@ -150,6 +156,7 @@ fn run() -> Result<(), String> {
 
     if let Some(x) = &xml {
         write_model_descriptions(&units, x).map_err(|e| format!("cannot write model descriptions to {}: {e}", x.display()))?;
+        write_model_descriptions3(&units, &x.join("fmi3")).map_err(|e| format!("cannot write FMI 3.0 model descriptions to {}/fmi3: {e}", x.display()))?;
     }
     if let Some(d) = &docs {
         spacecraft_fmus_package::docs::write_pages(d).map_err(|e| format!("cannot write docs/models and docs/references.md: {e}"))?;
@@ -158,6 +165,8 @@ fn run() -> Result<(), String> {
     for u in &units {
         let p = write_fmu(u, &binaries, &out).map_err(|e| format!("{}: {e}", u.name()))?;
         println!("wrote {} ({})", p.display(), binaries.iter().map(|b| b.platform).collect::<Vec<_>>().join(" + "));
+        let p3 = write_fmu3(u, &binaries, &out.join("fmi3")).map_err(|e| format!("{} (FMI 3.0): {e}", u.name()))?;
+        println!("wrote {} (FMI 3.0)", p3.display());
     }
     Ok(())
 }

@@ -6,7 +6,7 @@ use std::str::FromStr;
 
 use spacecraft_fmus::registry;
 use spacecraft_fmus_package::description::model_description;
-use spacecraft_fmus_package::{stale_model_descriptions, Unit};
+use spacecraft_fmus_package::{stale_model_descriptions, stale_model_descriptions3, Unit};
 
 fn xml(e: &spacecraft_fmus::model::ModelEntry) -> String {
     let u = Unit::registered(e);
@@ -19,6 +19,14 @@ fn committed_model_descriptions_are_not_stale() {
     let units: Vec<Unit> = registry::ALL.iter().map(Unit::registered).collect();
     let stale = stale_model_descriptions(&units, &dir);
     assert!(stale.is_empty(), "stale modelDescription/ for {stale:?}: run scripts/build_fmus.sh and commit");
+}
+
+#[test]
+fn committed_fmi3_model_descriptions_are_not_stale() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../modelDescription/fmi3");
+    let units: Vec<Unit> = registry::ALL.iter().map(Unit::registered).collect();
+    let stale = stale_model_descriptions3(&units, &dir);
+    assert!(stale.is_empty(), "stale modelDescription/fmi3/ for {stale:?}: run scripts/build_fmus.sh and commit");
 }
 
 #[test]
