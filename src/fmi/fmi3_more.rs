@@ -53,7 +53,7 @@ pub extern "C" fn fmi3SerializedFMUStateSize(c: Instance3, state: *mut c_void, s
     call3(c, "fmi3SerializedFMUStateSize", mask3::ANY, |inst| {
         let out = out_ptr(size, "size")?;
         Snapshot::with_handle(state as *mut Snapshot, |snap| {
-            let bytes = snap.to_bytes(guid(inst.entry))?;
+            let bytes = snap.to_bytes(&guid(inst.entry))?;
             *out = bytes.len();
             snap.serialized = Some(bytes);
             Ok(())
@@ -66,7 +66,7 @@ pub extern "C" fn fmi3SerializeFMUState(c: Instance3, state: *mut c_void, buffer
         Snapshot::with_handle(state as *mut Snapshot, |snap| {
             let bytes = match snap.serialized.take() {
                 Some(b) => b,
-                None => snap.to_bytes(guid(inst.entry))?,
+                None => snap.to_bytes(&guid(inst.entry))?,
             };
             if size != bytes.len() {
                 return Err(Fail::error(format!("size {size} differs from fmi3SerializedFMUStateSize = {}", bytes.len())));
@@ -81,7 +81,7 @@ pub extern "C" fn fmi3DeserializeFMUState(c: Instance3, buffer: *const u8, size:
     call3(c, "fmi3DeserializeFMUState", mask3::ANY, |inst| {
         let slot = out_ptr(state, "FMUState")?;
         let bytes = unsafe { slice(buffer, size, "serializedState[]")? };
-        let snap = Snapshot::from_bytes(bytes, inst, guid(inst.entry))?;
+        let snap = Snapshot::from_bytes(bytes, inst, &guid(inst.entry))?;
         if slot.is_null() {
             *slot = snap.into_handle(c as usize) as *mut c_void;
             Ok(())

@@ -49,7 +49,7 @@ unsafe extern "C" fn record(env: *mut c_void, status: c_int, _cat: *const c_char
 }
 
 fn new(log: &Log) -> Instance3 {
-    let token = CString::new(crate::model::guid::guid(&MODELS[0])).unwrap();
+    let token = CString::new(crate::model::guid::guid(&MODELS[0]).as_str()).unwrap();
     let c = fmi3InstantiateCoSimulation(MODELS, c"t".as_ptr(), token.as_ptr(), std::ptr::null(), 0, 0, 0, 0, std::ptr::null(), 0, log as *const Log as *mut c_void, Some(record), std::ptr::null());
     assert!(!c.is_null());
     c

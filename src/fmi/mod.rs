@@ -3,6 +3,7 @@
 //! snapshots and their byte format (`state`). Models never see anything in here.
 
 pub mod abi;
+mod abi_more;
 pub mod fmi3;
 pub mod fmi3_more;
 #[cfg(test)]
