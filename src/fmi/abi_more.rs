@@ -6,73 +6,30 @@ use std::ffi::{c_char, c_int, c_void};
 
 use super::abi::{call, out_ptr, slice, slice_mut, Component};
 use super::instance::{CallResult, Fail, Instance};
-use super::state::Snapshot;
+use super::state_calls;
 use super::{mask, status_kind, FsmState};
-use crate::model::guid::guid;
 
 // ----- FMU state -----------------------------------------------------------------------------------
 
 pub extern "C" fn fmi2GetFMUstate(c: Component, state: *mut *mut c_void) -> c_int {
-    call(c, "fmi2GetFMUstate", mask::FMU_STATE, |inst| {
-        let slot = out_ptr(state, "FMUstate")?;
-        let snap = Snapshot::capture(inst);
-        if slot.is_null() {
-            *slot = snap.into_handle(c as usize) as *mut c_void;
-            Ok(())
-        } else {
-            // Reuse of a state we handed out earlier (allowed by the standard).
-            Snapshot::with_handle(*slot as *mut Snapshot, |s| {
-                *s = snap;
-                Ok(())
-            })
-        }
-    })
+    call(c, "fmi2GetFMUstate", mask::FMU_STATE, |inst| state_calls::get(inst, out_ptr(state, "FMUstate")?, c as usize))
 }
 
 pub extern "C" fn fmi2SetFMUstate(c: Component, state: *mut c_void) -> c_int {
-    call(c, "fmi2SetFMUstate", mask::FMU_STATE, |inst| {
-        Snapshot::with_handle(state as *mut Snapshot, |snap| snap.restore_into(inst))
-    })
+    call(c, "fmi2SetFMUstate", mask::FMU_STATE, |inst| state_calls::set(inst, state))
 }
 
 pub extern "C" fn fmi2FreeFMUstate(c: Component, state: *mut *mut c_void) -> c_int {
-    call(c, "fmi2FreeFMUstate", mask::FMU_STATE, |_inst| {
-        let slot = out_ptr(state, "FMUstate")?;
-        if slot.is_null() {
-            return Ok(()); // freeing NULL is a no-op
-        }
-        Snapshot::free_handle(*slot as *mut Snapshot)?;
-        *slot = std::ptr::null_mut();
-        Ok(())
-    })
+    call(c, "fmi2FreeFMUstate", mask::FMU_STATE, |_inst| state_calls::free(out_ptr(state, "FMUstate")?))
 }
 
 pub extern "C" fn fmi2SerializedFMUstateSize(c: Component, state: *mut c_void, size: *mut usize) -> c_int {
-    call(c, "fmi2SerializedFMUstateSize", mask::FMU_STATE, |inst| {
-        let out = out_ptr(size, "size")?;
-        Snapshot::with_handle(state as *mut Snapshot, |snap| {
-            let bytes = snap.to_bytes(&guid(inst.entry))?;
-            *out = bytes.len();
-            snap.serialized = Some(bytes);
-            Ok(())
-        })
-    })
+    call(c, "fmi2SerializedFMUstateSize", mask::FMU_STATE, |inst| state_calls::serialized_size(inst, state, out_ptr(size, "size")?))
 }
 
 pub extern "C" fn fmi2SerializeFMUstate(c: Component, state: *mut c_void, buffer: *mut c_char, size: usize) -> c_int {
     call(c, "fmi2SerializeFMUstate", mask::FMU_STATE, |inst| {
-        Snapshot::with_handle(state as *mut Snapshot, |snap| {
-            let bytes = match snap.serialized.take() {
-                Some(b) => b,
-                None => snap.to_bytes(&guid(inst.entry))?,
-            };
-            if size != bytes.len() {
-                return Err(Fail::error(format!("size {size} differs from fmi2SerializedFMUstateSize = {}", bytes.len())));
-            }
-            let out = unsafe { slice_mut(buffer as *mut u8, size, "serializedState[]")? };
-            out.copy_from_slice(&bytes);
-            Ok(())
-        })
+        state_calls::serialize(inst, state, size, "fmi2SerializedFMUstateSize", || unsafe { slice_mut(buffer as *mut u8, size, "serializedState[]") })
     })
 }
 
@@ -80,16 +37,7 @@ pub extern "C" fn fmi2DeSerializeFMUstate(c: Component, buffer: *const c_char, s
     call(c, "fmi2DeSerializeFMUstate", mask::FMU_STATE, |inst| {
         let slot = out_ptr(state, "FMUstate")?;
         let bytes = unsafe { slice(buffer as *const u8, size, "serializedState[]")? };
-        let snap = Snapshot::from_bytes(bytes, inst, &guid(inst.entry))?;
-        if slot.is_null() {
-            *slot = snap.into_handle(c as usize) as *mut c_void;
-            Ok(())
-        } else {
-            Snapshot::with_handle(*slot as *mut Snapshot, |s| {
-                *s = snap;
-                Ok(())
-            })
-        }
+        state_calls::deserialize(inst, bytes, slot, c as usize)
     })
 }
 

@@ -10,70 +10,30 @@ use std::ffi::{c_char, c_int, c_void};
 use super::abi::{out_ptr, slice, slice_mut};
 use super::fmi3::{call3, log_without_instance3, mask3, Instance3};
 use super::instance::{CallResult, Fail, Log3Fn};
-use super::state::Snapshot;
-use crate::model::guid::guid;
+use super::state_calls;
 use crate::model::{Causality, Feedthrough, ModelEntry};
 
 // ----- FMU state ------------------------------------------------------------------------------------
 
 pub extern "C" fn fmi3GetFMUState(c: Instance3, state: *mut *mut c_void) -> c_int {
-    call3(c, "fmi3GetFMUState", mask3::ANY, |inst| {
-        let slot = out_ptr(state, "FMUState")?;
-        let snap = Snapshot::capture(inst);
-        if slot.is_null() {
-            *slot = snap.into_handle(c as usize) as *mut c_void;
-            Ok(())
-        } else {
-            // overwrite a state handed out earlier (allowed by the standard)
-            Snapshot::with_handle(*slot as *mut Snapshot, |s| {
-                *s = snap;
-                Ok(())
-            })
-        }
-    })
+    call3(c, "fmi3GetFMUState", mask3::ANY, |inst| state_calls::get(inst, out_ptr(state, "FMUState")?, c as usize))
 }
 
 pub extern "C" fn fmi3SetFMUState(c: Instance3, state: *mut c_void) -> c_int {
-    call3(c, "fmi3SetFMUState", mask3::ANY, |inst| Snapshot::with_handle(state as *mut Snapshot, |snap| snap.restore_into(inst)))
+    call3(c, "fmi3SetFMUState", mask3::ANY, |inst| state_calls::set(inst, state))
 }
 
 pub extern "C" fn fmi3FreeFMUState(c: Instance3, state: *mut *mut c_void) -> c_int {
-    call3(c, "fmi3FreeFMUState", mask3::ANY, |_| {
-        let slot = out_ptr(state, "FMUState")?;
-        if slot.is_null() {
-            return Ok(()); // freeing NULL is a no-op
-        }
-        Snapshot::free_handle(*slot as *mut Snapshot)?;
-        *slot = std::ptr::null_mut();
-        Ok(())
-    })
+    call3(c, "fmi3FreeFMUState", mask3::ANY, |_| state_calls::free(out_ptr(state, "FMUState")?))
 }
 
 pub extern "C" fn fmi3SerializedFMUStateSize(c: Instance3, state: *mut c_void, size: *mut usize) -> c_int {
-    call3(c, "fmi3SerializedFMUStateSize", mask3::ANY, |inst| {
-        let out = out_ptr(size, "size")?;
-        Snapshot::with_handle(state as *mut Snapshot, |snap| {
-            let bytes = snap.to_bytes(&guid(inst.entry))?;
-            *out = bytes.len();
-            snap.serialized = Some(bytes);
-            Ok(())
-        })
-    })
+    call3(c, "fmi3SerializedFMUStateSize", mask3::ANY, |inst| state_calls::serialized_size(inst, state, out_ptr(size, "size")?))
 }
 
 pub extern "C" fn fmi3SerializeFMUState(c: Instance3, state: *mut c_void, buffer: *mut u8, size: usize) -> c_int {
     call3(c, "fmi3SerializeFMUState", mask3::ANY, |inst| {
-        Snapshot::with_handle(state as *mut Snapshot, |snap| {
-            let bytes = match snap.serialized.take() {
-                Some(b) => b,
-                None => snap.to_bytes(&guid(inst.entry))?,
-            };
-            if size != bytes.len() {
-                return Err(Fail::error(format!("size {size} differs from fmi3SerializedFMUStateSize = {}", bytes.len())));
-            }
-            unsafe { slice_mut(buffer, size, "serializedState[]")? }.copy_from_slice(&bytes);
-            Ok(())
-        })
+        state_calls::serialize(inst, state, size, "fmi3SerializedFMUStateSize", || unsafe { slice_mut(buffer, size, "serializedState[]") })
     })
 }
 
@@ -81,16 +41,7 @@ pub extern "C" fn fmi3DeserializeFMUState(c: Instance3, buffer: *const u8, size:
     call3(c, "fmi3DeserializeFMUState", mask3::ANY, |inst| {
         let slot = out_ptr(state, "FMUState")?;
         let bytes = unsafe { slice(buffer, size, "serializedState[]")? };
-        let snap = Snapshot::from_bytes(bytes, inst, &guid(inst.entry))?;
-        if slot.is_null() {
-            *slot = snap.into_handle(c as usize) as *mut c_void;
-            Ok(())
-        } else {
-            Snapshot::with_handle(*slot as *mut Snapshot, |s| {
-                *s = snap;
-                Ok(())
-            })
-        }
+        state_calls::deserialize(inst, bytes, slot, c as usize)
     })
 }
 

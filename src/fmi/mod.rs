@@ -11,6 +11,7 @@ mod fmi3_tests;
 pub mod instance;
 mod library_path;
 pub mod state;
+mod state_calls;
 
 use std::collections::HashSet;
 use std::ffi::{c_char, c_int, c_void};

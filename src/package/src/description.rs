@@ -13,7 +13,7 @@ use quick_xml::Writer;
 
 use spacecraft_fmus::export::PackageInfo;
 use spacecraft_fmus::fmi::LOG_CATEGORIES;
-use spacecraft_fmus::model::{Bound, Causality, Feedthrough, Initial, ModelEntry, Start, VarDecl, VarKind, Variability};
+use spacecraft_fmus::model::{Bound, Causality, Feedthrough, Initial, ModelEntry, ModelInfo, Start, VarDecl, VarKind, Variability};
 use spacecraft_fmus::units;
 
 pub const GENERATION_TOOL: &str = concat!("spacecraft_fmus fmu-package ", env!("CARGO_PKG_VERSION"));
@@ -193,6 +193,22 @@ pub(crate) fn elem<'a>(name: &'a str, attrs: &[(&'a str, String)]) -> BytesStart
 
 /// `<UnitDefinitions>` of the units a model uses, in table order (deterministic); nothing when it uses
 /// none. The same element in FMI 2.0 and 3.0.
+/// `<LogCategories>` and `<DefaultExperiment>`, the same in FMI 2.0 and 3.0.
+pub(crate) fn write_categories_and_experiment(w: &mut Writer<Cursor<Vec<u8>>>, info: &ModelInfo) {
+    w.write_event(Event::Start(elem("LogCategories", &[]))).unwrap();
+    for (name, desc) in LOG_CATEGORIES {
+        w.write_event(Event::Empty(elem("Category", &[("name", (*name).into()), ("description", (*desc).into())]))).unwrap();
+    }
+    w.write_event(Event::End(BytesEnd::new("LogCategories"))).unwrap();
+    let experiment = [
+        ("startTime", "0.0".into()),
+        ("stopTime", fmt_real(info.default_stop_time)),
+        ("tolerance", "1e-8".into()),
+        ("stepSize", fmt_real(info.default_step)),
+    ];
+    w.write_event(Event::Empty(elem("DefaultExperiment", &experiment))).unwrap();
+}
+
 pub(crate) fn write_unit_definitions(w: &mut Writer<Cursor<Vec<u8>>>, entry: &ModelEntry) {
     let empty = |w: &mut Writer<Cursor<Vec<u8>>>, name: &str, attrs: &[(&str, String)]| {
         w.write_event(Event::Empty(elem(name, attrs))).unwrap();
@@ -278,23 +294,7 @@ fn write_xml(entry: &ModelEntry, guid: &str, package: &PackageInfo) -> String {
     );
 
     write_unit_definitions(&mut w, entry);
-
-    start(&mut w, "LogCategories", &[]);
-    for (name, desc) in LOG_CATEGORIES {
-        empty(&mut w, "Category", &[("name", (*name).into()), ("description", (*desc).into())]);
-    }
-    end(&mut w, "LogCategories");
-
-    empty(
-        &mut w,
-        "DefaultExperiment",
-        &[
-            ("startTime", "0.0".into()),
-            ("stopTime", fmt_real(info.default_stop_time)),
-            ("tolerance", "1e-8".into()),
-            ("stepSize", fmt_real(info.default_step)),
-        ],
-    );
+    write_categories_and_experiment(&mut w, info);
 
     start(&mut w, "ModelVariables", &[]);
     for (i, d) in entry.decls.iter().enumerate() {

@@ -13,12 +13,11 @@ use quick_xml::events::{BytesDecl, BytesEnd, Event};
 use quick_xml::Writer;
 
 use crate::description::{
-    bound_str, causality_str, elem, Author, fmt_real, initial_str, initial_unknowns, start_str, variability_str, write_unit_definitions, GENERATION_TOOL,
+    bound_str, causality_str, elem, Author, initial_str, initial_unknowns, start_str, variability_str, write_categories_and_experiment, write_unit_definitions, GENERATION_TOOL,
 };
 use spacecraft_fmus::export::PackageInfo;
 use spacecraft_fmus::fmi::fmi3::TIME_VR;
 use spacecraft_fmus::fmi::fmi3_more::output_dependency_vrs;
-use spacecraft_fmus::fmi::LOG_CATEGORIES;
 use spacecraft_fmus::model::{Causality, ModelEntry, VarKind};
 
 type W = Writer<Cursor<Vec<u8>>>;
@@ -81,22 +80,7 @@ pub fn model_description3(entry: &ModelEntry, token: &str, package: &PackageInfo
         ],
     );
     write_unit_definitions(&mut w, entry);
-
-    start(&mut w, "LogCategories", &[]);
-    for (name, desc) in LOG_CATEGORIES {
-        empty(&mut w, "Category", &[("name", (*name).into()), ("description", (*desc).into())]);
-    }
-    end(&mut w, "LogCategories");
-    empty(
-        &mut w,
-        "DefaultExperiment",
-        &[
-            ("startTime", "0.0".into()),
-            ("stopTime", fmt_real(info.default_stop_time)),
-            ("tolerance", "1e-8".into()),
-            ("stepSize", fmt_real(info.default_step)),
-        ],
-    );
+    write_categories_and_experiment(&mut w, info);
 
     start(&mut w, "ModelVariables", &[]);
     empty(

@@ -109,46 +109,46 @@ pub fn platform_lib_ext(platform: &str) -> Option<&'static str> {
     }
 }
 
-/// Writes `<dir>/<Model>.xml` for every unit; returns the paths written.
-pub fn write_model_descriptions(units: &[Unit], dir: &Path) -> std::io::Result<Vec<String>> {
+/// A model-description writer: FMI 2.0 ([`model_description`]) or FMI 3.0 ([`model_description3`]).
+type Render = fn(&ModelEntry, &str, &PackageInfo) -> String;
+
+fn write_rendered(units: &[Unit], dir: &Path, render: Render) -> std::io::Result<Vec<String>> {
     fs::create_dir_all(dir)?;
     let mut written = vec![];
     for u in units {
         let p = dir.join(format!("{}.xml", u.name()));
-        fs::write(&p, model_description(&u.entry, u.guid, u.package))?;
+        fs::write(&p, render(&u.entry, u.guid, u.package))?;
         written.push(p.display().to_string());
     }
     Ok(written)
+}
+
+fn stale_rendered(units: &[Unit], dir: &Path, render: Render, prefix: &str) -> Vec<String> {
+    units
+        .iter()
+        .filter(|u| fs::read_to_string(dir.join(format!("{}.xml", u.name()))).ok().as_deref() != Some(render(&u.entry, u.guid, u.package).as_str()))
+        .map(|u| format!("{prefix}{}", u.name()))
+        .collect()
+}
+
+/// Writes `<dir>/<Model>.xml` for every unit; returns the paths written.
+pub fn write_model_descriptions(units: &[Unit], dir: &Path) -> std::io::Result<Vec<String>> {
+    write_rendered(units, dir, model_description)
 }
 
 /// Names of the units whose committed `<dir>/<Model>.xml` differs from the generated one.
 pub fn stale_model_descriptions(units: &[Unit], dir: &Path) -> Vec<String> {
-    units
-        .iter()
-        .filter(|u| fs::read_to_string(dir.join(format!("{}.xml", u.name()))).ok().as_deref() != Some(model_description(&u.entry, u.guid, u.package).as_str()))
-        .map(|u| u.name().to_string())
-        .collect()
+    stale_rendered(units, dir, model_description, "")
 }
 
 /// Writes `<dir>/<Model>.xml` (FMI 3.0) for every unit; returns the paths written.
 pub fn write_model_descriptions3(units: &[Unit], dir: &Path) -> std::io::Result<Vec<String>> {
-    fs::create_dir_all(dir)?;
-    let mut written = vec![];
-    for u in units {
-        let p = dir.join(format!("{}.xml", u.name()));
-        fs::write(&p, model_description3(&u.entry, u.guid, u.package))?;
-        written.push(p.display().to_string());
-    }
-    Ok(written)
+    write_rendered(units, dir, model_description3)
 }
 
 /// Names of the units whose committed FMI 3.0 `<dir>/<Model>.xml` differs from the generated one.
 pub fn stale_model_descriptions3(units: &[Unit], dir: &Path) -> Vec<String> {
-    units
-        .iter()
-        .filter(|u| fs::read_to_string(dir.join(format!("{}.xml", u.name()))).ok().as_deref() != Some(model_description3(&u.entry, u.guid, u.package).as_str()))
-        .map(|u| format!("fmi3/{}", u.name()))
-        .collect()
+    stale_rendered(units, dir, model_description3, "fmi3/")
 }
 
 /// FMI 3.0 platform tuple of a binary stored under an FMI 2.0 platform folder. A `darwin64` build is
