@@ -1,5 +1,6 @@
-"""FMU access: where the FMUs are, unpacking, digests, and :class:`Fmu`, one instantiated co-simulation
-FMU with name-based access (fmpy's FMU2Slave underneath).
+"""FMU access: where the FMUs are, unpacking, digests, and :class:`Fmu`, one instantiated FMU with
+name-based access (fmpy's FMU2Slave underneath, or FMU2Model with SciPy's solve_ivp for a unit run as
+Model Exchange).
 
 Where the FMUs are is decided here and nowhere else (:func:`fmu_dir`), first match wins:
 
@@ -20,7 +21,11 @@ from importlib import resources
 from pathlib import Path
 
 from fmpy import extract, read_model_description
-from fmpy.fmi2 import FMU2Slave, defaultCallbacks, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
+from ctypes import POINTER, c_double
+
+import numpy as np
+from fmpy.fmi2 import FMU2Model, FMU2Slave, defaultCallbacks, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
+from scipy.integrate import solve_ivp
 
 _FMU_DIR_OVERRIDE: Path | None = None
 
@@ -129,14 +134,22 @@ def recording_callbacks(messages: list) -> fmi2CallbackFunctions:
 
 
 class Fmu:
-    """One instantiated co-simulation FMU with name-based access. With `initialize=True` (default) it
-    is set up, given `params` in initialization mode, and ready to step at `start_time`. Every
-    logger message is kept in `messages` as (status, category, text)."""
+    """One instantiated FMU with name-based access. With `initialize=True` (default) it is set up,
+    given `params` in initialization mode, and ready to step at `start_time`. Every logger message is
+    kept in `messages` as (status, category, text).
+
+    ``interface="cs"`` (default) runs the unit as FMI 2.0 Co-Simulation. ``interface="me"`` runs a
+    unit that offers Model Exchange under SciPy's ``solve_ivp`` instead: :meth:`do_step` integrates its
+    continuous states from t to t + dt with the inputs held (like a co-simulation step), stops at the
+    unit's time events, and runs the event iteration where the unit asks for it (after
+    ``fmi2CompletedIntegratorStep``, e.g. a quaternion renormalisation). ``me_method`` and
+    ``me_rtol``/``me_atol`` choose the solver (default DOP853, 1e-10/1e-12)."""
 
     def __init__(self, model: str, params: dict | None = None, name: str | None = None,
                  start_time: float = 0.0, stop_time: float | None = None, tolerance: float | None = None,
                  path: Path | None = None, initialize: bool = True, logging_on: bool = False,
-                 unpacked: tuple | None = None):
+                 unpacked: tuple | None = None, interface: str = "cs", me_method: str = "DOP853",
+                 me_rtol: float = 1e-10, me_atol: float = 1e-12):
         self.model = model
         self.path = Path(path) if path else fmu_path(model)
         if unpacked is None:  # (model description, unzip directory) shared by instances; kept on close
@@ -149,9 +162,21 @@ class Fmu:
         self.vars = {v.name: v for v in self.md.modelVariables}
         self.messages: list[tuple[int, str, str]] = []
         self.callbacks = recording_callbacks(self.messages)
-        self.slave = FMU2Slave(guid=self.md.guid, unzipDirectory=self.unzipdir,
-                               modelIdentifier=self.md.coSimulation.modelIdentifier,
-                               instanceName=name or model)
+        if interface not in ("cs", "me"):
+            raise ValueError(f"{model}: interface {interface!r} is neither 'cs' nor 'me'")
+        self.interface = interface
+        if interface == "me":
+            if self.md.modelExchange is None:
+                raise ValueError(f"{model} offers no Model Exchange interface (Co-Simulation only)")
+            self.slave = FMU2Model(guid=self.md.guid, unzipDirectory=self.unzipdir,
+                                   modelIdentifier=self.md.modelExchange.modelIdentifier, instanceName=name or model)
+            self.nx = sum(1 for v in self.md.modelVariables if v.derivative is not None)
+            self.me_method, self.me_rtol, self.me_atol = me_method, me_rtol, me_atol
+            self.next_event: float | None = None
+        else:
+            self.slave = FMU2Slave(guid=self.md.guid, unzipDirectory=self.unzipdir,
+                                   modelIdentifier=self.md.coSimulation.modelIdentifier,
+                                   instanceName=name or model)
         self.slave.instantiate(callbacks=self.callbacks, loggingOn=logging_on)
         self.time = start_time
         if initialize:
@@ -159,7 +184,62 @@ class Fmu:
             self.slave.enterInitializationMode()
             for k, v in (params or {}).items():
                 self.set(k, v)
-            self.slave.exitInitializationMode()
+            self.exit_initialization_mode()
+
+    def exit_initialization_mode(self) -> None:
+        """Leaves initialization mode; a Model Exchange unit then runs its first event iteration and
+        enters continuous-time mode."""
+        self.slave.exitInitializationMode()
+        if self.interface == "me":
+            self._event_iteration()
+            self.slave.enterContinuousTimeMode()
+
+    # ----- Model Exchange ------------------------------------------------------------------
+    def _event_iteration(self) -> None:
+        while True:
+            needed, terminate, _, _, defined, t_next = self.slave.newDiscreteStates()
+            if terminate:
+                raise RuntimeError(f"{self.model}: the unit asked to terminate at t = {self.time}")
+            if not needed:
+                break
+        self.next_event = t_next if defined else None
+
+    def _states(self) -> np.ndarray:
+        x = np.zeros(self.nx)
+        if self.nx:
+            self.slave.getContinuousStates(x.ctypes.data_as(POINTER(c_double)), self.nx)
+        return x
+
+    def _rhs(self, t: float, x: np.ndarray) -> np.ndarray:
+        x = np.ascontiguousarray(x, dtype=float)
+        self.slave.setTime(t)
+        self.slave.setContinuousStates(x.ctypes.data_as(POINTER(c_double)), self.nx)
+        dx = np.zeros(self.nx)
+        self.slave.getDerivatives(dx.ctypes.data_as(POINTER(c_double)), self.nx)
+        return dx
+
+    def _me_step(self, t: float, dt: float) -> None:
+        t_end = t + dt
+        eps = 1e-12 * max(1.0, abs(t_end))
+        while t < t_end - eps:
+            t_stop = t_end if self.next_event is None or self.next_event >= t_end - eps else self.next_event
+            if self.nx:
+                sol = solve_ivp(self._rhs, (t, t_stop), self._states(), method=self.me_method,
+                                rtol=self.me_rtol, atol=self.me_atol)
+                if not sol.success:
+                    raise RuntimeError(f"{self.model}: solve_ivp failed from t = {t} to {t_stop}: {sol.message}")
+                self._rhs(t_stop, sol.y[:, -1])  # leaves the unit at (t_stop, x(t_stop))
+            else:
+                self.slave.setTime(t_stop)
+            enter, terminate = self.slave.completedIntegratorStep()
+            if terminate:
+                raise RuntimeError(f"{self.model}: the unit asked to terminate at t = {t_stop}")
+            at_event = self.next_event is not None and abs(t_stop - self.next_event) <= eps
+            if enter or at_event:
+                self.slave.enterEventMode()
+                self._event_iteration()
+                self.slave.enterContinuousTimeMode()
+            t = t_stop
 
     # ----- name-based access -------------------------------------------------------------
     def var(self, name: str):
@@ -202,7 +282,10 @@ class Fmu:
         self.slave.setReal([self.var(n).valueReference for n in names], [float(x) for x in values])
 
     def do_step(self, t: float, dt: float) -> None:
-        self.slave.doStep(currentCommunicationPoint=t, communicationStepSize=dt)
+        if self.interface == "me":
+            self._me_step(t, dt)
+        else:
+            self.slave.doStep(currentCommunicationPoint=t, communicationStepSize=dt)
         self.time = t + dt
 
     def close(self) -> None:

@@ -64,7 +64,7 @@
 pub use crate::math;
 pub use crate::model::{
     check, check_derived, check_finite_state, Bound, Causality, Experiment, Feedthrough, Fmu, Model, ModelEntry, ModelInfo, ModelResult,
-    ParamEnum, Start, VarDecl, VarKind, Variability, Variables, SWITCH,
+    ParamEnum, Start, StateDecl, VarDecl, VarKind, Variability, Variables, DERIVATIVE_VR_BASE, RESERVED_VR_START, STATE_VR_BASE, SWITCH,
 };
 pub use crate::models::attitude::control::shared::{check_unit_quaternions, AttitudeControllerPorts};
 pub use crate::{declare_variables, export_fmus, param_enum};
@@ -72,7 +72,7 @@ pub use nalgebra::{Quaternion, Vector3};
 pub use serde::{Deserialize, Serialize};
 
 /// Version of the catalogue's byte layout; the packaging tool refuses any other.
-pub const CATALOGUE_FORMAT: u32 = 1;
+pub const CATALOGUE_FORMAT: u32 = 2;
 
 /// Version of this crate, recorded in every catalogue (and part of every GUID).
 pub const RUNTIME_VERSION: &str = env!("CARGO_PKG_VERSION");
@@ -114,6 +114,8 @@ pub struct ModelDescription {
     pub variable_step: bool,
     pub guid: String,
     pub variables: Vec<VariableDescription>,
+    /// Model Exchange: the continuous states as (name, unit, description); `None` = Co-Simulation only.
+    pub states: Option<Vec<(String, String, String)>>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -186,6 +188,7 @@ impl ModelDescription {
                     },
                 })
                 .collect(),
+            states: e.states.map(|l| l.iter().map(|x| (x.name.into(), x.unit.into(), x.description.into())).collect()),
         }
     }
 
@@ -241,7 +244,10 @@ impl ModelDescription {
                 },
             })
             .collect();
-        ModelEntry { info, decls: Box::leak(decls.into_boxed_slice()), create: no_model }
+        let states: Option<&'static [StateDecl]> = self.states.map(|l| {
+            &*Box::leak(l.into_iter().map(|(n, u, d)| StateDecl::new(leak(n), leak(u), leak(d))).collect::<Vec<_>>().into_boxed_slice())
+        });
+        ModelEntry { info, decls: Box::leak(decls.into_boxed_slice()), states, create: no_model }
     }
 }
 
@@ -361,6 +367,20 @@ macro_rules! export_fmus {
             #[no_mangle] pub extern "C" fn fmi2GetRealStatus(c: Component, k: c_int, v: *mut f64) -> c_int { abi::fmi2GetRealStatus(c, k, v) }
             #[no_mangle] pub extern "C" fn fmi2GetIntegerStatus(c: Component, k: c_int, v: *mut c_int) -> c_int { abi::fmi2GetIntegerStatus(c, k, v) }
             #[no_mangle] pub extern "C" fn fmi2GetBooleanStatus(c: Component, k: c_int, v: *mut c_int) -> c_int { abi::fmi2GetBooleanStatus(c, k, v) }
+            #[no_mangle] pub extern "C" fn fmi2EnterEventMode(c: Component) -> c_int { abi::fmi2EnterEventMode(c) }
+            #[no_mangle] pub extern "C" fn fmi2NewDiscreteStates(c: Component, info: *mut abi::EventInfo2) -> c_int { abi::fmi2NewDiscreteStates(c, info) }
+            #[no_mangle] pub extern "C" fn fmi2EnterContinuousTimeMode(c: Component) -> c_int { abi::fmi2EnterContinuousTimeMode(c) }
+            #[no_mangle] pub extern "C" fn fmi2CompletedIntegratorStep(c: Component, no_prior: c_int, enter: *mut c_int, term: *mut c_int) -> c_int {
+                abi::fmi2CompletedIntegratorStep(c, no_prior, enter, term)
+            }
+            #[no_mangle] pub extern "C" fn fmi2SetTime(c: Component, t: f64) -> c_int { abi::fmi2SetTime(c, t) }
+            #[no_mangle] pub extern "C" fn fmi2SetContinuousStates(c: Component, x: *const f64, n: usize) -> c_int { abi::fmi2SetContinuousStates(c, x, n) }
+            #[no_mangle] pub extern "C" fn fmi2GetDerivatives(c: Component, dx: *mut f64, n: usize) -> c_int { abi::fmi2GetDerivatives(c, dx, n) }
+            #[no_mangle] pub extern "C" fn fmi2GetEventIndicators(c: Component, z: *mut f64, n: usize) -> c_int { abi::fmi2GetEventIndicators(c, z, n) }
+            #[no_mangle] pub extern "C" fn fmi2GetContinuousStates(c: Component, x: *mut f64, n: usize) -> c_int { abi::fmi2GetContinuousStates(c, x, n) }
+            #[no_mangle] pub extern "C" fn fmi2GetNominalsOfContinuousStates(c: Component, x: *mut f64, n: usize) -> c_int {
+                abi::fmi2GetNominalsOfContinuousStates(c, x, n)
+            }
             #[no_mangle] pub extern "C" fn fmi2GetStringStatus(c: Component, k: c_int, v: *mut *const c_char) -> c_int { abi::fmi2GetStringStatus(c, k, v) }
             // FMI 3.0 Co-Simulation: the same instances and models (src/export3.rs)
             $crate::__export_fmi3!(MODELS);

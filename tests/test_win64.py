@@ -55,6 +55,12 @@ FMI2_CS_FUNCTIONS = {
     "fmi2SetRealInputDerivatives", "fmi2GetRealOutputDerivatives", "fmi2DoStep", "fmi2CancelStep",
     "fmi2GetStatus", "fmi2GetRealStatus", "fmi2GetIntegerStatus", "fmi2GetBooleanStatus", "fmi2GetStringStatus",
 }
+# ... and the Model Exchange ones (section 3.2), exported by every binary: the plants and static laws use them
+FMI2_ME_FUNCTIONS = {
+    "fmi2EnterEventMode", "fmi2NewDiscreteStates", "fmi2EnterContinuousTimeMode", "fmi2CompletedIntegratorStep",
+    "fmi2SetTime", "fmi2SetContinuousStates", "fmi2GetDerivatives", "fmi2GetEventIndicators",
+    "fmi2GetContinuousStates", "fmi2GetNominalsOfContinuousStates",
+}
 
 # Windows system DLLs a Rust std cdylib may import. Anything else (libgcc_s_seh-1.dll,
 # libwinpthread-1.dll, libstdc++-6.dll, ...) would have to be shipped inside the FMU.
@@ -148,8 +154,9 @@ def test_dll_exports_the_fmi2_functions_and_imports_only_system_dlls(loop_dir):
     d, _ = loop_dir
     imports, exports = pe_imports_exports(d / "AttitudePlant.dll")
     fmi = {e for e in exports if e.startswith("fmi2")}
-    assert fmi == FMI2_CS_FUNCTIONS, (sorted(FMI2_CS_FUNCTIONS - fmi), sorted(fmi - FMI2_CS_FUNCTIONS))
-    assert len(fmi) == 34
+    want = FMI2_CS_FUNCTIONS | FMI2_ME_FUNCTIONS
+    assert fmi == want, (sorted(want - fmi), sorted(fmi - want))
+    assert len(fmi) == 44
     lower = [i.lower() for i in imports]
     assert lower and set(lower) <= SYSTEM_DLLS | {i for i in lower if i.startswith("api-ms-win-")}, imports
     # The win7 target: no bcryptprimitives.dll!ProcessPrng (absent from Wine 8 and from Windows < 10)

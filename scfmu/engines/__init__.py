@@ -35,12 +35,14 @@ def resolve_engine(engine: str) -> str:
     return engine
 
 
-def reference_master(scenario: Scenario, path_of=None) -> tuple[CoSimulation, dict, dict]:
+def reference_master(scenario: Scenario, path_of=None, model_exchange=frozenset()) -> tuple[CoSimulation, dict, dict]:
     """(CoSimulation, {instance: Fmu}, log spec) for the scenario; the caller runs and closes it.
-    ``path_of(model)`` gives the FMU file of a model (default ``fmus/<Model>.fmu``)."""
+    ``path_of(model)`` gives the FMU file of a model (default ``fmus/<Model>.fmu``). The instances
+    named in ``model_exchange`` run as FMI 2.0 Model Exchange units integrated by SciPy's solve_ivp
+    between communication points (their inputs held over each step)."""
     if path_of is None:
         scenario = resolve(scenario)
-    fmus = build_fmus(scenario, path_of=path_of)
+    fmus = build_fmus(scenario, path_of=path_of, model_exchange=model_exchange)
     # the scenario's wiring (explicit exceptions included) replaces the master's own name matching
     sim = CoSimulation(list(fmus.values()), unconnected={n for f in fmus.values() for n in f.inputs()})
     sim.links = []
@@ -56,8 +58,8 @@ def reference_master(scenario: Scenario, path_of=None) -> tuple[CoSimulation, di
     return sim, fmus, log
 
 
-def run_reference(scenario: Scenario, path_of=None) -> dict[str, np.ndarray]:
-    sim, fmus, log = reference_master(scenario, path_of)
+def run_reference(scenario: Scenario, path_of=None, model_exchange=frozenset()) -> dict[str, np.ndarray]:
+    sim, fmus, log = reference_master(scenario, path_of, model_exchange)
     try:
         try:
             return sim.run(scenario.stop_time, scenario.step, log, t0=scenario.start_time)

@@ -45,17 +45,22 @@ def _raw(slave, name: str, argtypes, restype=c_int):
     return f
 
 
-def build_fmus(scenario: Scenario, path_of=None, reuse: bool = False) -> dict[str, Fmu]:
+def build_fmus(scenario: Scenario, path_of=None, reuse: bool = False, model_exchange=frozenset()) -> dict[str, Fmu]:
     """Instantiates and initializes every instance of the scenario (parameters in initialization mode),
     then writes the fixed ``inputs``. Returns {instance name: Fmu} in Gauss–Seidel order. With ``reuse``
-    the FMUs are unpacked once per process (``master.unpacked``)."""
+    the FMUs are unpacked once per process (``master.unpacked``). Instances named in ``model_exchange``
+    run as Model Exchange units under SciPy's solver (:class:`scfmu.fmu.Fmu`; the reference master only)."""
+    unknown = set(model_exchange) - {c.name for c in scenario.components}
+    if unknown:
+        raise KeyError(f"model_exchange names no instance of {scenario.name}: {sorted(unknown)}")
     fmus: dict[str, Fmu] = {}
     try:
         for c in scenario.components:
             p = path_of(c.model) if path_of else fmu_path(c.model)
             # the same calls as Fmu(initialize=True), keeping the instance to report its log messages
             fmus[c.name] = Fmu(c.model, name=c.name, start_time=scenario.start_time, path=p, initialize=False,
-                               unpacked=unpacked(p) if reuse else None)
+                               unpacked=unpacked(p) if reuse else None,
+                               interface="me" if c.name in model_exchange else "cs")
         initialize_fmus(fmus, scenario)
     except Exception:
         for f in fmus.values():
@@ -74,7 +79,7 @@ def initialize_fmus(fmus: dict[str, Fmu], scenario: Scenario) -> None:
         for k, v in c.params.items():
             f.set(k, v)
         try:
-            f.slave.exitInitializationMode()
+            f.exit_initialization_mode()
         except Exception:
             msgs = "; ".join(m[2] for m in f.messages if m[0] >= 2)
             raise SimulationError("fmu_error", f"{c.name} ({c.model}): fmi2ExitInitializationMode failed"

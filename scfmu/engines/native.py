@@ -193,8 +193,10 @@ def build_container(scenario: Scenario, starts: dict | None = None) -> Path:
                 cv = cv_of.get((c.name, u.variable.name))
                 if cv is None:
                     continue
+                # a dependency on a nested continuous state (a local of a Model Exchange capable FMU) is
+                # internal to the container: only container variables are listed
                 deps = None if u.dependencies is None else sorted(
-                    (cv_of[(c.name, d.name)] for d in u.dependencies), key=lambda x: order[id(x)])
+                    (cv_of[(c.name, d.name)] for d in u.dependencies if (c.name, d.name) in cv_of), key=lambda x: order[id(x)])
                 unknowns.append(Unknown(variable=cv, dependencies=deps))
         unknowns.sort(key=lambda u: order[id(u.variable)])
         setattr(md, attr, unknowns)

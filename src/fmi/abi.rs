@@ -21,6 +21,7 @@ use super::{mask, BuildAddrHasher, CallbackFunctions, FsmState, LiveSet, Status}
 use crate::model::guid::guid;
 use crate::model::{ModelEntry, Value, VarKind};
 
+pub use super::abi_me::*;
 pub use super::abi_more::*;
 
 pub(crate) type Component = *mut c_void;
@@ -224,8 +225,8 @@ pub fn fmi2Instantiate(
         if name.to_bytes().is_empty() {
             return Err("instanceName is empty".into());
         }
-        if fmu_type != 1 {
-            return Err(format!("fmuType {fmu_type} requested, but this FMU supports only Co-Simulation (fmi2CoSimulation = 1)"));
+        if fmu_type != 0 && fmu_type != 1 {
+            return Err(format!("fmuType {fmu_type} is neither fmi2ModelExchange (0) nor fmi2CoSimulation (1)"));
         }
         if fmu_guid.is_null() {
             return Err("fmuGUID is NULL".into());
@@ -233,7 +234,11 @@ pub fn fmi2Instantiate(
         // SAFETY: non-null C string from the master.
         let requested = unsafe { CStr::from_ptr(fmu_guid) }.to_string_lossy();
         let entry = find_model(models, &requested)?;
-        let inst = Box::new(Instance::new(name.to_owned(), entry, functions.logger.map_or(Logger::None, Logger::Fmi2), functions.component_environment, logging_on != 0));
+        if fmu_type == 0 && !entry.model_exchange() {
+            return Err(format!("fmuType fmi2ModelExchange requested, but {} supports only Co-Simulation (fmi2CoSimulation = 1)", entry.info.name));
+        }
+        let mut inst = Box::new(Instance::new(name.to_owned(), entry, functions.logger.map_or(Logger::None, Logger::Fmi2), functions.component_environment, logging_on != 0));
+        inst.model_exchange = fmu_type == 0;
         inst.trace(|| format!("fmi2Instantiate: {} instance of {}", inst.name.to_string_lossy(), entry.info.name));
         Ok(register(inst))
     });

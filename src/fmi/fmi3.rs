@@ -96,6 +96,8 @@ pub fn state_name(s: FsmState) -> &'static str {
         FsmState::StepComplete | FsmState::StepFailed | FsmState::StepCanceled => "Step Mode",
         FsmState::Terminated | FsmState::Error => "Terminated",
         FsmState::Fatal => "Fatal",
+        FsmState::EventMode => "Event Mode",
+        FsmState::ContinuousTimeMode => "Continuous-Time Mode",
     }
 }
 

@@ -18,7 +18,7 @@ pub enum Logger {
     Fmi2(LoggerFn),
     Fmi3(Log3Fn),
 }
-use crate::model::{Causality, DynModel, Experiment, TOLERANCE_MAX, TOLERANCE_MIN, ModelEntry, SlotMut, Value, VarDecl, VarKind, Variability};
+use crate::model::{Causality, DynModel, Experiment, RESERVED_VR_START, TOLERANCE_MAX, TOLERANCE_MIN, ModelEntry, SlotMut, Value, VarDecl, VarKind, Variability};
 
 /// Failure of an FMI call: the status to return and the reason to log.
 #[derive(Debug)]
@@ -101,7 +101,10 @@ impl Run {
         }
         // only the states in which fmi2GetFMUstate can be called on this FMU (StepFailed and
         // StepCanceled are never entered: fmi2DoStep never returns fmi2Pending or fmi2Discard)
-        if !matches!(self.fsm, FsmState::Instantiated | FsmState::InitializationMode | FsmState::StepComplete | FsmState::Terminated | FsmState::Error) {
+        if !matches!(
+            self.fsm,
+            FsmState::Instantiated | FsmState::InitializationMode | FsmState::StepComplete | FsmState::Terminated | FsmState::Error | FsmState::EventMode | FsmState::ContinuousTimeMode
+        ) {
             return Err(format!("state machine state {:?} cannot be restored (no FMU state can be taken in it)", self.fsm));
         }
         Ok(())
@@ -118,6 +121,10 @@ pub struct Instance {
     env: *mut c_void,
     /// Created by `fmi3InstantiateCoSimulation` (FMI 3.0 calls only) rather than `fmi2Instantiate`.
     pub fmi3: bool,
+    /// Instantiated as Model Exchange (`fmi2Instantiate` with fmuType fmi2ModelExchange).
+    pub model_exchange: bool,
+    /// Model Exchange: time of the last event (the solver may not go back before it).
+    pub event_time: f64,
     debug_logging: bool,
     categories: HashSet<&'static str>,
     pub run: Run,
@@ -141,6 +148,8 @@ impl Instance {
             logger,
             env,
             fmi3: false,
+            model_exchange: false,
+            event_time: f64::NEG_INFINITY,
             debug_logging: logging_on,
             categories: LOG_CATEGORIES.iter().map(|(n, _)| *n).collect(),
             run: Run::INSTANTIATED,
@@ -265,6 +274,16 @@ impl Instance {
     pub fn set_values(&mut self, kind: VarKind, vrs: &[u32], value: impl Fn(usize) -> Value) -> CallResult {
         let mut sets_parameter = false;
         for (i, vr) in vrs.iter().enumerate() {
+            if kind == VarKind::Real {
+                if let Some(var) = self.layer_var(*vr) {
+                    let (super::instance_me::LayerVar::State(k) | super::instance_me::LayerVar::Derivative(k)) = var;
+                    let name = self.entry.state_decls()[k].name;
+                    return Err(Fail::error(match var {
+                        super::instance_me::LayerVar::State(_) => format!("{name} is a continuous state: set it with fmi2SetContinuousStates (Model Exchange)"),
+                        super::instance_me::LayerVar::Derivative(_) => format!("der({name}) is a state derivative and cannot be set"),
+                    }));
+                }
+            }
             let (_, d) = self.decl(kind, *vr)?;
             self.check_settable(d)?;
             if let Value::Real(x) = value(i) {
@@ -309,6 +328,12 @@ impl Instance {
     pub fn get_values(&mut self, kind: VarKind, vrs: &[u32], mut write: impl FnMut(usize, Value)) -> CallResult {
         self.ensure_outputs()?;
         for (i, vr) in vrs.iter().enumerate() {
+            if kind == VarKind::Real && *vr >= RESERVED_VR_START {
+                if let Some(var) = self.layer_var(*vr) {
+                    write(i, Value::Real(self.layer_value(var)?));
+                    continue;
+                }
+            }
             let (index, d) = self.decl(kind, *vr)?;
             let v = self.model.value(index).ok_or_else(|| Fail::error(format!("internal: no storage for {}", d.name)))?;
             if let Value::Real(x) = v {
@@ -369,7 +394,8 @@ impl Instance {
         self.run.params_dirty = false;
         self.run.outputs_dirty = true;
         self.ensure_outputs()?;
-        self.run.fsm = FsmState::StepComplete;
+        self.run.fsm = if self.model_exchange { FsmState::EventMode } else { FsmState::StepComplete };
+        self.event_time = self.run.time;
         Ok(())
     }
 
@@ -399,6 +425,7 @@ impl Instance {
     pub fn reset(&mut self) {
         self.model = (self.entry.create)();
         self.run = Run::INSTANTIATED;
+        self.event_time = f64::NEG_INFINITY;
     }
 
     /// Directional derivative of Real outputs with respect to Real inputs, by central differences

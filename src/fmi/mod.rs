@@ -3,12 +3,14 @@
 //! snapshots and their byte format (`state`). Models never see anything in here.
 
 pub mod abi;
+mod abi_me;
 mod abi_more;
 pub mod fmi3;
 pub mod fmi3_more;
 #[cfg(test)]
 mod fmi3_tests;
 pub mod instance;
+pub mod instance_me;
 mod library_path;
 pub mod state;
 mod state_calls;
@@ -113,6 +115,10 @@ pub enum FsmState {
     Terminated,
     Error,
     Fatal,
+    /// Model Exchange (FMI 2.0 section 3.2.3): event mode (after initialization and at events).
+    EventMode,
+    /// Model Exchange: continuous-time mode (the importer's solver integrates).
+    ContinuousTimeMode,
 }
 
 impl FsmState {
@@ -133,15 +139,16 @@ pub mod mask {
         }
         bits
     }
-    pub const SET_DEBUG_LOGGING: u16 = m(&[Instantiated, InitializationMode, StepComplete, StepFailed, StepCanceled, Terminated, Error]);
+    pub const SET_DEBUG_LOGGING: u16 =
+        m(&[Instantiated, InitializationMode, StepComplete, StepFailed, StepCanceled, Terminated, Error, EventMode, ContinuousTimeMode]);
     pub const FREE_INSTANCE: u16 = SET_DEBUG_LOGGING; // fmi2FreeInstance itself is always honoured (also after fmi2Fatal)
     pub const SETUP_EXPERIMENT: u16 = m(&[Instantiated]);
     pub const ENTER_INITIALIZATION_MODE: u16 = m(&[Instantiated]);
     pub const EXIT_INITIALIZATION_MODE: u16 = m(&[InitializationMode]);
-    pub const TERMINATE: u16 = m(&[StepComplete, StepFailed]);
+    pub const TERMINATE: u16 = m(&[StepComplete, StepFailed, EventMode, ContinuousTimeMode]);
     pub const RESET: u16 = FREE_INSTANCE;
-    pub const GET: u16 = m(&[InitializationMode, StepComplete, StepFailed, StepCanceled, Terminated, Error]);
-    pub const SET: u16 = m(&[Instantiated, InitializationMode, StepComplete]);
+    pub const GET: u16 = m(&[InitializationMode, StepComplete, StepFailed, StepCanceled, Terminated, Error, EventMode, ContinuousTimeMode]);
+    pub const SET: u16 = m(&[Instantiated, InitializationMode, StepComplete, EventMode, ContinuousTimeMode]);
     pub const FMU_STATE: u16 = FREE_INSTANCE;
     pub const DIRECTIONAL_DERIVATIVE: u16 = GET;
     pub const SET_INPUT_DERIVATIVES: u16 = m(&[Instantiated, InitializationMode, StepComplete]);
@@ -149,6 +156,14 @@ pub mod mask {
     pub const DO_STEP: u16 = m(&[StepComplete]);
     pub const CANCEL_STEP: u16 = 0; // StepInProgress only, which this FMU never enters
     pub const GET_STATUS: u16 = m(&[StepComplete, StepFailed, Terminated]);
+    // Model Exchange (FMI 2.0.4, ME state table)
+    pub const SET_TIME: u16 = m(&[EventMode, ContinuousTimeMode]);
+    pub const SET_CONTINUOUS_STATES: u16 = m(&[ContinuousTimeMode]);
+    pub const GET_ME_VALUES: u16 = m(&[InitializationMode, EventMode, ContinuousTimeMode, Terminated, Error]);
+    pub const ENTER_EVENT_MODE: u16 = m(&[EventMode, ContinuousTimeMode]);
+    pub const NEW_DISCRETE_STATES: u16 = m(&[EventMode]);
+    pub const ENTER_CONTINUOUS_TIME_MODE: u16 = m(&[EventMode]);
+    pub const COMPLETED_INTEGRATOR_STEP: u16 = m(&[ContinuousTimeMode]);
 }
 
 /// `fmi2StatusKind` (all four listed; only the last two have values here).

@@ -68,6 +68,11 @@ impl Snapshot {
         if self.model_name != inst.entry.info.name {
             return Err(Fail::error(format!("FMU state belongs to {}, not to {}", self.model_name, inst.entry.info.name)));
         }
+        let me_state = matches!(self.run.fsm, FsmState::EventMode | FsmState::ContinuousTimeMode);
+        if (me_state && !inst.model_exchange) || (inst.model_exchange && matches!(self.run.fsm, FsmState::StepComplete | FsmState::StepFailed)) {
+            let kind = |me: bool| if me { "Model Exchange" } else { "Co-Simulation" };
+            return Err(Fail::error(format!("FMU state was taken from a {} instance; this instance runs {}", kind(me_state), kind(inst.model_exchange))));
+        }
         inst.model = self.model.clone_box();
         inst.run = self.run;
         Ok(())

@@ -33,6 +33,13 @@ fn fingerprint(entry: &ModelEntry) -> String {
             d.vr, d.name, d.kind, d.causality, d.variability, d.unit, unit, d.description, d.bound.min_max(), start
         );
     }
+    // Model Exchange models only, so that a Co-Simulation-only model keeps its GUID.
+    if let Some(states) = entry.states {
+        let _ = writeln!(s, "model exchange: {} states", states.len());
+        for x in states {
+            let _ = writeln!(s, "state|{}|{}|{}", x.name, x.unit, x.description);
+        }
+    }
     s
 }
 

@@ -78,6 +78,40 @@ impl<M: Model> Fmu<M> {
         Ok(())
     }
 
+    /// Model Exchange: the continuous states into `x`.
+    pub fn get_states(&self, x: &mut [f64]) -> ModelResult {
+        self.state.as_ref().ok_or(NOT_INITIALIZED)?.get_states(x);
+        Ok(())
+    }
+
+    /// Model Exchange: replaces the continuous states.
+    pub fn set_states(&mut self, x: &[f64]) -> ModelResult {
+        self.state.as_mut().ok_or(NOT_INITIALIZED)?.set_states(x);
+        Ok(())
+    }
+
+    /// Model Exchange: ẋ at time t for the current inputs and states.
+    pub fn derivatives(&self, t: f64, dx: &mut [f64]) -> ModelResult {
+        self.state.as_ref().ok_or(NOT_INITIALIZED)?.derivatives(&self.v, t, dx)
+    }
+
+    /// Model Exchange: the next time event after t.
+    pub fn next_time_event(&self, t: f64) -> Option<f64> {
+        self.state.as_ref().and_then(|s| s.next_time_event(&self.v, t))
+    }
+
+    /// Model Exchange: event update at t; whether the continuous states changed.
+    pub fn event_update(&mut self, t: f64) -> Result<bool, String> {
+        let v = &self.v;
+        self.state.as_mut().ok_or(NOT_INITIALIZED)?.event_update(v, t)
+    }
+
+    /// Model Exchange: after an accepted integrator step; whether the model asks for an event.
+    pub fn completed_integrator_step(&mut self, t: f64) -> bool {
+        let v = &self.v;
+        self.state.as_mut().is_some_and(|s| s.completed_integrator_step(v, t))
+    }
+
     /// Whether the parameters have been applied (there is an internal state).
     pub fn is_initialized(&self) -> bool {
         self.state.is_some()
@@ -112,6 +146,13 @@ pub trait DynModel: Send {
     /// Checks a restored state and rebuilds its unserialized parts (see [`Fmu::validate`]).
     fn validate(&mut self, exp: &Experiment) -> ModelResult;
     fn is_initialized(&self) -> bool;
+    /// Model Exchange (see [`Model::STATES`]); the layer checks lengths and finiteness.
+    fn get_states(&self, x: &mut [f64]) -> ModelResult;
+    fn set_states(&mut self, x: &[f64]) -> ModelResult;
+    fn derivatives(&self, t: f64, dx: &mut [f64]) -> ModelResult;
+    fn next_time_event(&self, t: f64) -> Option<f64>;
+    fn event_update(&mut self, t: f64) -> Result<bool, String>;
+    fn completed_integrator_step(&mut self, t: f64) -> bool;
     /// Test support: the internal state as JSON, a replacement decoded from JSON, the evolving paths.
     #[cfg(test)]
     fn state_json(&self) -> serde_json::Value;
@@ -162,6 +203,24 @@ impl<M: Model> DynModel for Fmu<M> {
     }
     fn is_initialized(&self) -> bool {
         Fmu::is_initialized(self)
+    }
+    fn get_states(&self, x: &mut [f64]) -> ModelResult {
+        Fmu::get_states(self, x)
+    }
+    fn set_states(&mut self, x: &[f64]) -> ModelResult {
+        Fmu::set_states(self, x)
+    }
+    fn derivatives(&self, t: f64, dx: &mut [f64]) -> ModelResult {
+        Fmu::derivatives(self, t, dx)
+    }
+    fn next_time_event(&self, t: f64) -> Option<f64> {
+        Fmu::next_time_event(self, t)
+    }
+    fn event_update(&mut self, t: f64) -> Result<bool, String> {
+        Fmu::event_update(self, t)
+    }
+    fn completed_integrator_step(&mut self, t: f64) -> bool {
+        Fmu::completed_integrator_step(self, t)
     }
     #[cfg(test)]
     fn state_json(&self) -> serde_json::Value {

@@ -406,19 +406,87 @@ pub trait Model: Clone + Serialize + DeserializeOwned + Send + 'static {
     fn restored(&mut self) -> ModelResult {
         Ok(())
     }
+
+    // ----- Model Exchange (optional) ------------------------------------------------------------
+
+    /// The continuous states when the model also offers FMI 2.0 **Model Exchange** (the importer's
+    /// solver integrates them): `None` (default) = Co-Simulation only (e.g. a sampled law); `Some(&[])`
+    /// = a static law (outputs from inputs and time, nothing to integrate). The layer publishes each
+    /// state as a local variable `name` and its derivative as `der(name)` (value references from
+    /// [`STATE_VR_BASE`] and [`DERIVATIVE_VR_BASE`]); the methods below give the layer access.
+    const STATES: Option<&'static [StateDecl]> = None;
+    /// Writes the continuous state vector (length `STATES.len()`).
+    fn get_states(&self, _x: &mut [f64]) {}
+    /// Replaces the continuous state vector (finite values, length checked by the layer).
+    fn set_states(&mut self, _x: &[f64]) {}
+    /// ẋ at time t for the current inputs and states (length `STATES.len()`); the right-hand side
+    /// valid at the instant t (after an event at t, the new one).
+    fn derivatives(&self, _v: &Self::Vars, _t: f64, _dx: &mut [f64]) -> ModelResult {
+        Ok(())
+    }
+    /// The next time event strictly after t (a fault onset, a noise-hold boundary, a knot), if any.
+    fn next_time_event(&self, _v: &Self::Vars, _t: f64) -> Option<f64> {
+        None
+    }
+    /// Event update at time t (a time event, or an event the model asked for after an integrator
+    /// step): may reset states (e.g. project a quaternion back to unit norm); returns whether it did.
+    fn event_update(&mut self, _v: &Self::Vars, _t: f64) -> Result<bool, String> {
+        Ok(false)
+    }
+    /// Called after every accepted integrator step at time t; `true` asks the importer for an event
+    /// (then [`Model::event_update`] runs), e.g. when a quaternion norm has drifted.
+    fn completed_integrator_step(&mut self, _v: &Self::Vars, _t: f64) -> bool {
+        false
+    }
 }
+
+/// A continuous state of a Model Exchange model: published as the local variable `name` and its
+/// derivative `der(name)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StateDecl {
+    pub name: &'static str,
+    /// Unit of the state (from the unit table; "" for none). The derivative carries no unit attribute.
+    pub unit: &'static str,
+    pub description: &'static str,
+}
+
+impl StateDecl {
+    pub const fn new(name: &'static str, unit: &'static str, description: &'static str) -> Self {
+        StateDecl { name, unit, description }
+    }
+}
+
+/// Value reference of continuous state i (Real, local): `STATE_VR_BASE + i`. Value references from
+/// [`RESERVED_VR_START`] on belong to the layer; a declaration may not use them.
+pub const STATE_VR_BASE: u32 = 1_000_000_000;
+/// Value reference of the derivative of continuous state i: `DERIVATIVE_VR_BASE + i`.
+pub const DERIVATIVE_VR_BASE: u32 = 1_000_100_000;
+/// First value reference reserved for the layer (continuous states, their derivatives; FMI 3.0 `time`).
+pub const RESERVED_VR_START: u32 = STATE_VR_BASE;
 
 /// Registry entry of one FMU.
 #[derive(Clone, Copy)]
 pub struct ModelEntry {
     pub info: &'static ModelInfo,
     pub decls: &'static [VarDecl],
+    /// Model Exchange: the continuous states ([`Model::STATES`]); `None` = Co-Simulation only.
+    pub states: Option<&'static [StateDecl]>,
     pub create: fn() -> Box<dyn DynModel>,
 }
 
 impl ModelEntry {
     pub const fn of<M: Model>() -> Self {
-        ModelEntry { info: &M::INFO, decls: M::Vars::DECLS, create: || Box::new(Fmu::<M>::default()) }
+        ModelEntry { info: &M::INFO, decls: M::Vars::DECLS, states: M::STATES, create: || Box::new(Fmu::<M>::default()) }
+    }
+
+    /// Whether the model offers Model Exchange.
+    pub const fn model_exchange(&self) -> bool {
+        self.states.is_some()
+    }
+
+    /// The continuous states (empty for a Co-Simulation-only model or a static law).
+    pub fn state_decls(&self) -> &'static [StateDecl] {
+        self.states.unwrap_or(&[])
     }
 
     /// Every text of the model that may cite publications: description, source, equations and the
@@ -426,6 +494,7 @@ impl ModelEntry {
     pub fn texts(&self) -> Vec<&'static str> {
         let mut t = vec![self.info.description, self.info.source, self.info.equations_html];
         t.extend(self.decls.iter().map(|d| d.description));
+        t.extend(self.state_decls().iter().map(|d| d.description));
         t
     }
 

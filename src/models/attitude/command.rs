@@ -28,6 +28,8 @@ pub struct AttitudeCommand;
 impl Model for AttitudeCommand {
     type Vars = AttitudeCommandVars;
     const EVOLVING: &'static [&'static str] = &[];
+    /// Model Exchange as a static law: no continuous state.
+    const STATES: Option<&'static [crate::model::StateDecl]> = Some(&[]);
     const INFO: ModelInfo = ModelInfo {
         name: "AttitudeCommand",
         description: "Attitude reference: a constant 321 Euler-angle command applied as a step",
@@ -48,5 +50,10 @@ w_ref = 0</pre>",
         (v.roll_ref, v.pitch_ref, v.yaw_ref) = (r, p, y);
         v.w_ref = Vector3::zeros();
         Ok(())
+    }
+
+    /// Model Exchange: the step is a time event.
+    fn next_time_event(&self, v: &AttitudeCommandVars, t: f64) -> Option<f64> {
+        (v.step_time > t).then_some(v.step_time)
     }
 }

@@ -42,6 +42,8 @@ pub struct RelativePositionCommand;
 impl Model for RelativePositionCommand {
     type Vars = RelativePositionCommandVars;
     const EVOLVING: &'static [&'static str] = &[];
+    /// Model Exchange as a static law: no continuous state.
+    const STATES: Option<&'static [crate::model::StateDecl]> = Some(&[]);
     const INFO: ModelInfo = ModelInfo {
         name: "RelativePositionCommand",
         description: "Relative-position reference: constant set-point step or smooth fifth-order polynomial transfer",
@@ -77,6 +79,12 @@ profile 1:  tau = (t - step_time) / transfer_time clamped to [0, 1]\n\
         v.vel_ref = Vector3::from_fn(|i, _| (p1[i] - p0[i]) * ds / tt);
         v.acc_ref = Vector3::from_fn(|i, _| (p1[i] - p0[i]) * dds / (tt * tt));
         Ok(())
+    }
+
+    /// Model Exchange: the step (profile 0) or the start and end of the transfer (profile 1) are time events.
+    fn next_time_event(&self, v: &RelativePositionCommandVars, t: f64) -> Option<f64> {
+        let end = if v.profile == 0 { v.step_time } else { v.step_time + v.transfer_time };
+        [v.step_time, end].into_iter().find(|te| *te > t)
     }
 }
 

@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 use crate::declare_variables;
 use crate::math::integrate::{Method, Stepper};
 use crate::math::relative_orbit::LeaderOrbit;
-use crate::model::{check_derived, check_finite_state, Experiment, Model, ModelInfo, ModelResult, ParamEnum};
+use crate::model::{check_derived, check_finite_state, Experiment, Model, ModelInfo, ModelResult, ParamEnum, StateDecl};
 
 declare_variables! {
     pub struct RelativeOrbitPlantVars {
@@ -125,6 +125,27 @@ impl Model for RelativeOrbitPlant {
         check_derived("leader orbit", &self.orbit, &fresh.orbit)?;
         check_finite_state("state vector", self.x.iter())
     }
+
+    const STATES: Option<&'static [StateDecl]> = Some(&[
+        StateDecl::new("state_pos_x", "m", "Continuous state: relative position x (radial)"),
+        StateDecl::new("state_pos_y", "m", "Continuous state: relative position y (along-track)"),
+        StateDecl::new("state_pos_z", "m", "Continuous state: relative position z (orbit normal)"),
+        StateDecl::new("state_vel_x", "m/s", "Continuous state: relative velocity x"),
+        StateDecl::new("state_vel_y", "m/s", "Continuous state: relative velocity y"),
+        StateDecl::new("state_vel_z", "m/s", "Continuous state: relative velocity z"),
+        StateDecl::new("state_nu", "rad", "Continuous state: leader true anomaly nu"),
+    ]);
+    fn get_states(&self, x: &mut [f64]) {
+        x.copy_from_slice(self.x.as_slice());
+    }
+    fn set_states(&mut self, x: &[f64]) {
+        self.x.copy_from_slice(x);
+    }
+    fn derivatives(&self, v: &RelativeOrbitPlantVars, _t: f64, dx: &mut [f64]) -> ModelResult {
+        let a_ext = (v.force + v.dist) / v.mass;
+        dx.copy_from_slice(derivative(&self.orbit, &a_ext, &self.x)?.as_slice());
+        Ok(())
+    }
 }
 
 const EQUATIONS_HTML: &str = "<pre>n    = sqrt(mu / a^3)\n\
@@ -137,7 +158,9 @@ y'' = -2 th' x' - th'' x + th'^2 y - mu y/rho_f^3 + (F_y + dist_y)/m\n\
 z'' =                             - mu z/rho_f^3 + (F_z + dist_z)/m</pre>\n\
 <p>LVLH: x radial outward, y along-track, z along the leader's angular momentum. mu/R^2 - mu (R + x)/rho_f^3 is \
 evaluated without cancellation. Fixed-step RK4 (or explicit Euler) with ceil(step / max_internal_step) equal \
-internal steps per communication step, or adaptive Dormand-Prince 5(4) with rtol = atol = the tolerance of fmi2SetupExperiment; inputs are held over the step; nu is not wrapped.</p>";
+internal steps per communication step, or adaptive Dormand-Prince 5(4) with rtol = atol = the tolerance of fmi2SetupExperiment; inputs are held over the step; nu is not wrapped.</p>\n\
+<p>Model Exchange: the state (x, y, z, x', y', z', nu) is published as state_pos_*, state_vel_*, state_nu with the \
+right-hand side above; the importer's solver integrates it (integrator and max_internal_step are not used).</p>";
 
 #[cfg(test)]
 mod tests {

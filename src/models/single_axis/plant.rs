@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::declare_variables;
 use crate::math::integrate::{Method, Stepper};
-use crate::model::{check_derived, check_finite_state, Experiment, Model, ModelInfo, ModelResult, ParamEnum};
+use crate::model::{check_derived, check_finite_state, Experiment, Model, ModelInfo, ModelResult, ParamEnum, StateDecl};
 
 declare_variables! {
     pub struct SingleAxisPlantVars {
@@ -90,6 +90,22 @@ impl Model for SingleAxisPlant {
         check_derived("inertia", &self.j_true, &fresh.j_true)?;
         check_finite_state("state vector", self.x.iter())
     }
+
+    const STATES: Option<&'static [StateDecl]> = Some(&[
+        StateDecl::new("state_theta", "rad", "Continuous state: attitude angle theta"),
+        StateDecl::new("state_omega", "rad/s", "Continuous state: angular rate omega"),
+        StateDecl::new("state_wheel_torque", "N.m", "Continuous state: wheel torque T_c after the lag"),
+    ]);
+    fn get_states(&self, x: &mut [f64]) {
+        x.copy_from_slice(self.x.as_slice());
+    }
+    fn set_states(&mut self, x: &[f64]) {
+        self.x.copy_from_slice(x);
+    }
+    fn derivatives(&self, v: &SingleAxisPlantVars, t: f64, dx: &mut [f64]) -> ModelResult {
+        dx.copy_from_slice(self.derivative(v, t, &self.x).as_slice());
+        Ok(())
+    }
 }
 
 const EQUATIONS_HTML: &str = "<pre>d(theta)/dt = omega\n\
@@ -99,7 +115,9 @@ M_c         = clamp(T_c, -T_sat, T_sat)    ([Khatoonabadi-FO] Eq. 4; saturation 
 M_d         = torque_dist + md_amp sin(md_freq t) + md_const</pre>\n\
 <p>Integration: explicit Euler (integrator = 1, default, [Khatoonabadi-FO]), classical RK4 (integrator = 0) or adaptive Dormand-Prince 5(4) (integrator = 2, tolerance from fmi2SetupExperiment) with \
 ceil(step / max_internal_step) equal internal steps per communication step; Euler evaluates every right-hand side at t_n. \
-Inputs are held over the communication step. theta(0) = init_theta, omega(0) = init_omega, T_c(0) = 0.</p>";
+Inputs are held over the communication step. theta(0) = init_theta, omega(0) = init_omega, T_c(0) = 0.</p>\n\
+<p>Model Exchange: the states (theta, omega, T_c) are published as state_theta, state_omega, state_wheel_torque with \
+the right-hand side above; the importer's solver integrates them (integrator and max_internal_step are not used).</p>";
 
 #[cfg(test)]
 mod tests {

@@ -13,7 +13,9 @@ use quick_xml::Writer;
 
 use spacecraft_fmus::export::PackageInfo;
 use spacecraft_fmus::fmi::LOG_CATEGORIES;
-use spacecraft_fmus::model::{Bound, Causality, Feedthrough, Initial, ModelEntry, ModelInfo, Start, VarDecl, VarKind, Variability};
+use spacecraft_fmus::model::{
+    Bound, Causality, Feedthrough, Initial, ModelEntry, ModelInfo, Start, VarDecl, VarKind, Variability, DERIVATIVE_VR_BASE, RESERVED_VR_START, STATE_VR_BASE,
+};
 use spacecraft_fmus::units;
 
 pub const GENERATION_TOOL: &str = concat!("spacecraft_fmus fmu-package ", env!("CARGO_PKG_VERSION"));
@@ -117,7 +119,36 @@ pub fn initial_unknowns(entry: &ModelEntry) -> Vec<(usize, Vec<usize>)> {
             deps.dedup();
             Some((i + 1, deps))
         })
+        .collect::<Vec<_>>()
+        .into_iter()
+        // Model Exchange: the states (from the parameters) and their derivatives (parameters and inputs)
+        .chain(state_indices(entry).map(|ix| (ix, params.clone())))
+        .chain(derivative_dependencies(entry).into_iter().map(|(k, _)| {
+            let mut deps: Vec<usize> = input_indices(entry).chain(params.iter().copied()).collect();
+            deps.sort_unstable();
+            (entry.decls.len() + entry.state_decls().len() + k + 1, deps)
+        }))
         .collect()
+}
+
+/// ScalarVariable indices (1-based) of the continuous states (after the declared variables).
+pub fn state_indices(entry: &ModelEntry) -> impl Iterator<Item = usize> + '_ {
+    let n = entry.decls.len();
+    (0..entry.state_decls().len()).map(move |k| n + k + 1)
+}
+
+fn input_indices(entry: &ModelEntry) -> impl Iterator<Item = usize> + '_ {
+    entry.decls.iter().enumerate().filter(|(_, d)| d.causality == Causality::Input).map(|(i, _)| i + 1)
+}
+
+/// `<Derivatives>`: for each state k, what its derivative depends on. The declarations do not say
+/// which state or input drives which derivative, so every derivative lists every state and every
+/// input: a superset (a tool may see a dependency that is not there, never miss one).
+pub fn derivative_dependencies(entry: &ModelEntry) -> Vec<(usize, Vec<usize>)> {
+    let deps: Vec<usize> = input_indices(entry).chain(state_indices(entry)).collect();
+    let mut deps = deps;
+    deps.sort_unstable();
+    (0..entry.state_decls().len()).map(|k| (k, deps.clone())).collect()
 }
 
 fn join(ix: &[usize]) -> String {
@@ -165,6 +196,27 @@ pub fn check_declarations(entry: &ModelEntry) -> Result<(), String> {
         } else if a.bound != Bound::Any {
             return Err(format!("{name}: {} has a bound but is not a parameter", a.name));
         }
+    }
+    for d in entry.decls {
+        if d.vr >= RESERVED_VR_START && d.vr != spacecraft_fmus::fmi::fmi3::TIME_VR {
+            return Err(format!("{name}: {} uses value reference {}, reserved for the layer's Model Exchange variables (>= {RESERVED_VR_START})", d.name, d.vr));
+        }
+    }
+    let states = entry.state_decls();
+    for (i, x) in states.iter().enumerate() {
+        let der = format!("der({})", x.name);
+        if entry.decl(x.name).is_some() || entry.decl(&der).is_some() || states[i + 1..].iter().any(|y| y.name == x.name) {
+            return Err(format!("{name}: continuous state {} clashes with another variable name", x.name));
+        }
+        if !x.unit.is_empty() && units::lookup(x.unit).is_none() {
+            return Err(format!("{name}: continuous state {} uses undefined unit {}", x.name, x.unit));
+        }
+        if x.description.is_empty() {
+            return Err(format!("{name}: continuous state {} has no description", x.name));
+        }
+    }
+    if states.len() > (DERIVATIVE_VR_BASE - STATE_VR_BASE) as usize {
+        return Err(format!("{name}: {} continuous states are more than the layer can number", states.len()));
     }
     if let Feedthrough::Some(list) = entry.info.feedthrough {
         for (o, ins) in list {
@@ -219,7 +271,8 @@ pub(crate) fn write_unit_definitions(w: &mut Writer<Cursor<Vec<u8>>>, entry: &Mo
     let end = |w: &mut Writer<Cursor<Vec<u8>>>, name: &str| {
         w.write_event(Event::End(BytesEnd::new(name))).unwrap();
     };
-    let used: Vec<_> = units::UNITS.iter().filter(|(n, _, _)| entry.decls.iter().any(|d| d.unit == *n)).collect();
+    let used: Vec<_> =
+        units::UNITS.iter().filter(|(n, _, _)| entry.decls.iter().any(|d| d.unit == *n) || entry.state_decls().iter().any(|x| x.unit == *n)).collect();
     if !used.is_empty() {
         start(w, "UnitDefinitions", &[]);
         for (name, b, display) in used {
@@ -275,6 +328,22 @@ fn write_xml(entry: &ModelEntry, guid: &str, package: &PackageInfo) -> String {
             ("numberOfEventIndicators", "0".into()),
         ],
     );
+    if entry.model_exchange() {
+        empty(
+            &mut w,
+            "ModelExchange",
+            &[
+                ("modelIdentifier", info.name.into()),
+                ("needsExecutionTool", "false".into()),
+                ("completedIntegratorStepNotNeeded", "false".into()),
+                ("canBeInstantiatedOnlyOncePerProcess", "false".into()),
+                ("canNotUseMemoryManagementFunctions", "true".into()),
+                ("canGetAndSetFMUstate", "true".into()),
+                ("canSerializeFMUstate", "true".into()),
+                ("providesDirectionalDerivative", "true".into()),
+            ],
+        );
+    }
     empty(
         &mut w,
         "CoSimulation",
@@ -332,6 +401,37 @@ fn write_xml(entry: &ModelEntry, guid: &str, package: &PackageInfo) -> String {
         empty(&mut w, tag, &t);
         end(&mut w, "ScalarVariable");
     }
+    let n_decl = entry.decls.len();
+    let states = entry.state_decls();
+    for (k, x) in states.iter().enumerate() {
+        w.write_event(Event::Comment(BytesText::new(&format!(" index {}: continuous state {} ", n_decl + k + 1, k + 1)))).unwrap();
+        let attrs: Vec<(&str, String)> = vec![
+            ("name", x.name.into()),
+            ("valueReference", (STATE_VR_BASE + k as u32).to_string()),
+            ("description", x.description.into()),
+            ("causality", "local".into()),
+            ("variability", "continuous".into()),
+            ("initial", "calculated".into()),
+        ];
+        start(&mut w, "ScalarVariable", &attrs);
+        let t: Vec<(&str, String)> = if x.unit.is_empty() { vec![] } else { vec![("unit", x.unit.into())] };
+        empty(&mut w, "Real", &t);
+        end(&mut w, "ScalarVariable");
+    }
+    for (k, x) in states.iter().enumerate() {
+        w.write_event(Event::Comment(BytesText::new(&format!(" index {}: derivative of state {} ", n_decl + states.len() + k + 1, k + 1)))).unwrap();
+        let attrs: Vec<(&str, String)> = vec![
+            ("name", format!("der({})", x.name)),
+            ("valueReference", (DERIVATIVE_VR_BASE + k as u32).to_string()),
+            ("description", format!("Time derivative of {}", x.name)),
+            ("causality", "local".into()),
+            ("variability", "continuous".into()),
+            ("initial", "calculated".into()),
+        ];
+        start(&mut w, "ScalarVariable", &attrs);
+        empty(&mut w, "Real", &[("derivative", (n_decl + k + 1).to_string())]);
+        end(&mut w, "ScalarVariable");
+    }
     end(&mut w, "ModelVariables");
 
     start(&mut w, "ModelStructure", &[]);
@@ -341,9 +441,19 @@ fn write_xml(entry: &ModelEntry, guid: &str, package: &PackageInfo) -> String {
         start(&mut w, "Outputs", &[]);
         for (ix, d) in &outputs {
             // An empty list is meaningful: "depends on no input" (state or time only).
-            empty(&mut w, "Unknown", &[("index", ix.to_string()), ("dependencies", join(&output_dependencies(entry, d)))]);
+            let mut deps = output_dependencies(entry, d);
+            // with Model Exchange the states are variables too: an output may depend on any of them
+            deps.extend(state_indices(entry));
+            empty(&mut w, "Unknown", &[("index", ix.to_string()), ("dependencies", join(&deps))]);
         }
         end(&mut w, "Outputs");
+    }
+    if !states.is_empty() {
+        start(&mut w, "Derivatives", &[]);
+        for (k, deps) in derivative_dependencies(entry) {
+            empty(&mut w, "Unknown", &[("index", (n_decl + states.len() + k + 1).to_string()), ("dependencies", join(&deps))]);
+        }
+        end(&mut w, "Derivatives");
     }
     let initial_unknowns = initial_unknowns(entry);
     if !initial_unknowns.is_empty() {
@@ -405,6 +515,20 @@ pub(crate) fn html_escape(s: &str) -> String {
 }
 
 /// documentation/index.html: purpose, source, equations, variable tables.
+/// Which FMI interfaces a model offers, in one sentence (model pages and documentation/index.html).
+pub fn interfaces_text(entry: &ModelEntry) -> String {
+    match entry.states {
+        Some([]) => "FMI 2.0 Model Exchange (a static law: no continuous state) and Co-Simulation; FMI 3.0 Co-Simulation.".into(),
+        Some(states) => format!(
+            "FMI 2.0 Model Exchange ({} continuous states: {}) and Co-Simulation; FMI 3.0 Co-Simulation.",
+            states.len(),
+            states.iter().map(|x| x.name).collect::<Vec<_>>().join(", ")
+        ),
+        None if !entry.info.variable_step => "FMI 2.0 and FMI 3.0 Co-Simulation only: a sampled law (its behaviour is defined at its sample times, not as a continuous right-hand side).".into(),
+        None => "FMI 2.0 and FMI 3.0 Co-Simulation only: its internal state evolves in discrete steps (not as a continuous right-hand side).".into(),
+    }
+}
+
 pub fn documentation_html(entry: &ModelEntry, guid: &str) -> String {
     let info = entry.info;
     let mut h = String::new();
@@ -414,6 +538,7 @@ pub fn documentation_html(entry: &ModelEntry, guid: &str) -> String {
     h.push_str(&format!("<h1>{}</h1>\n<p>{}</p>\n", info.name, html_escape(info.description)));
     h.push_str(&format!("<p><b>Source:</b> {}</p>\n", html_escape(info.source)));
     h.push_str(&format!("<p><b>GUID:</b> <code>{}</code> &middot; <b>Generated by:</b> {}</p>\n", guid, GENERATION_TOOL));
+    h.push_str(&format!("<p><b>Interfaces:</b> {}</p>\n", html_escape(&interfaces_text(entry))));
     h.push_str("<h2>Equations</h2>\n");
     h.push_str(info.equations_html);
     h.push_str("\n<h2>Conventions</h2>\n<ul><li>SI units on every port; degrees only where the name ends in <code>_deg</code>.</li>");

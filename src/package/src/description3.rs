@@ -132,7 +132,8 @@ pub fn model_description3(entry: &ModelEntry, token: &str, package: &PackageInfo
         // an empty list is meaningful: "depends on no input" (state or time only)
         empty(&mut w, "Output", &[("valueReference", d.vr.to_string()), ("dependencies", vrs(&output_dependency_vrs(entry, d.name)))]);
     }
-    for (ix, deps) in initial_unknowns(entry) {
+    // the declared variables only: the continuous states of FMI 2.0 Model Exchange are not published in FMI 3.0 (CS only)
+    for (ix, deps) in initial_unknowns(entry).into_iter().filter(|(ix, _)| *ix <= entry.decls.len()) {
         let dep_vrs: Vec<u32> = deps.iter().map(|i| entry.decls[i - 1].vr).collect();
         empty(&mut w, "InitialUnknown", &[("valueReference", entry.decls[ix - 1].vr.to_string()), ("dependencies", vrs(&dep_vrs))]);
     }

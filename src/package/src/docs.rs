@@ -69,6 +69,7 @@ pub fn family_markdown(f: &Family) -> String {
             i.default_step,
             if i.variable_step { "yes" } else { "no (the step must equal the declared sample time)" }
         );
+        let _ = writeln!(out, "Interfaces: {}\n", crate::description::interfaces_text(e));
         if !i.equations_html.trim().is_empty() {
             let _ = writeln!(out, "**Equations**\n\n<div>\n{}\n</div>\n", i.equations_html.trim());
         }

@@ -27,6 +27,8 @@ pub struct FeedbackLinearizingController;
 impl Model for FeedbackLinearizingController {
     type Vars = FeedbackLinearizingControllerVars;
     const EVOLVING: &'static [&'static str] = &[];
+    /// Model Exchange as a static law: no continuous state.
+    const STATES: Option<&'static [crate::model::StateDecl]> = Some(&[]);
     const INFO: ModelInfo = ModelInfo {
         name: "FeedbackLinearizingController",
         description: "Feedback-linearising quaternion attitude law with reference-derivative inputs",

@@ -46,6 +46,8 @@ pub struct FuzzyPdController {
 impl Model for FuzzyPdController {
     type Vars = FuzzyPdControllerVars;
     const EVOLVING: &'static [&'static str] = &[];
+    /// Model Exchange as a static law: no continuous state.
+    const STATES: Option<&'static [crate::model::StateDecl]> = Some(&[]);
     const INFO: ModelInfo = ModelInfo {
         name: "FuzzyPdController",
         description: "Quaternion PD attitude controller with gains scheduled by a 7x7-rule fuzzy system",

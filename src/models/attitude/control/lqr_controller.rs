@@ -32,6 +32,8 @@ pub struct LqrController {
 impl Model for LqrController {
     type Vars = LqrControllerVars;
     const EVOLVING: &'static [&'static str] = &[];
+    /// Model Exchange as a static law: no continuous state.
+    const STATES: Option<&'static [crate::model::StateDecl]> = Some(&[]);
     const INFO: ModelInfo = ModelInfo {
         name: "LqrController",
         description: "Per-axis LQR attitude controller; gains from the Riccati equation solved at initialization",

@@ -33,6 +33,8 @@ pub struct PdController {
 impl Model for PdController {
     type Vars = PdControllerVars;
     const EVOLVING: &'static [&'static str] = &[];
+    /// Model Exchange as a static law: no continuous state.
+    const STATES: Option<&'static [crate::model::StateDecl]> = Some(&[]);
     const INFO: ModelInfo = ModelInfo {
         name: "PdController",
         description: "PD attitude controller with quaternion, DCM or Euler-angle error law",

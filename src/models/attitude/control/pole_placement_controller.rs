@@ -38,6 +38,8 @@ pub struct PolePlacementController {
 impl Model for PolePlacementController {
     type Vars = PolePlacementControllerVars;
     const EVOLVING: &'static [&'static str] = &[];
+    /// Model Exchange as a static law: no continuous state.
+    const STATES: Option<&'static [crate::model::StateDecl]> = Some(&[]);
     const INFO: ModelInfo = ModelInfo {
         name: "PolePlacementController",
         description: "Per-axis pole-placement attitude controller; gains by Ackermann's formula at initialization",

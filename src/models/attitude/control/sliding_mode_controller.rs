@@ -26,6 +26,8 @@ pub struct SlidingModeController {
 impl Model for SlidingModeController {
     type Vars = SlidingModeControllerVars;
     const EVOLVING: &'static [&'static str] = &[];
+    /// Model Exchange as a static law: no continuous state.
+    const STATES: Option<&'static [crate::model::StateDecl]> = Some(&[]);
     const INFO: ModelInfo = ModelInfo {
         name: "SlidingModeController",
         description: "Quaternion sliding-mode attitude controller (equivalent control + boundary-layer switching, K = (k, k, k))",

@@ -36,6 +36,8 @@ pub struct Type2FuzzySmcController {
 impl Model for Type2FuzzySmcController {
     type Vars = Type2FuzzySmcControllerVars;
     const EVOLVING: &'static [&'static str] = &[];
+    /// Model Exchange as a static law: no continuous state.
+    const STATES: Option<&'static [crate::model::StateDecl]> = Some(&[]);
     const INFO: ModelInfo = ModelInfo {
         name: "Type2FuzzySmcController",
         description: "Quaternion sliding-mode attitude controller with the switching gain scheduled by an interval type-2 fuzzy system",

@@ -15,7 +15,8 @@ pub struct Segment {
     pub noise: Vector3<f64>,
 }
 
-fn noise_on(v: &AttitudePlantVars) -> bool {
+/// Whether the noise generator runs (its hold boundaries are also time events under Model Exchange).
+pub fn noise_on(v: &AttitudePlantVars) -> bool {
     v.dist_noise_std != Vector3::zeros()
 }
 

@@ -68,7 +68,12 @@ impl AttitudePlant {
     pub(super) fn quaternion(&self, x: &State) -> Quaternion<f64> {
         match self.kin {
             Kinematics::Quaternion => quat(x[ATT], x[ATT + 1], x[ATT + 2], x[ATT + 3]),
-            Kinematics::Dcm => quat(self.q_dcm[0], self.q_dcm[1], self.q_dcm[2], self.q_dcm[3]),
+            // Shepperd's quaternion of the state's A with the sign of the last accepted step's (equal to
+            // q_dcm itself right after a step; a Model Exchange solver also evaluates in between)
+            Kinematics::Dcm => {
+                let prev = quat(self.q_dcm[0], self.q_dcm[1], self.q_dcm[2], self.q_dcm[3]);
+                align_sign(quat_from_dcm(&Matrix3::from_column_slice(&x.as_slice()[ATT..ATT + 9])), &prev).normalize()
+            }
             Kinematics::Euler213Rates | Kinematics::LinearSmallAngle => quat_from_euler321(x[ATT], x[ATT + 1], x[ATT + 2]),
         }
     }

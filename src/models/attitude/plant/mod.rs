@@ -9,6 +9,7 @@
 
 mod actuators;
 mod environment;
+mod exchange;
 mod kinematics;
 #[cfg(test)]
 mod tests;
@@ -25,7 +26,7 @@ use self::kinematics::{attitude_rates, initial_attitude, post_step, v3, State, A
 use crate::math::attitude::{euler321_from_dcm, euler321_from_quat, wxyz};
 use crate::math::environment::CircularOrbit;
 use crate::math::integrate::Stepper;
-use crate::model::{check_derived, check_finite_state, Experiment, Feedthrough, Model, ModelInfo, ModelResult, ParamEnum};
+use crate::model::{check_derived, check_finite_state, Experiment, Feedthrough, Model, ModelInfo, ModelResult, ParamEnum, StateDecl};
 
 /// Parameters derived at initialization.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -188,5 +189,30 @@ impl Model for AttitudePlant {
             return Err("restored state: attitude quaternion is not of unit norm".into());
         }
         Ok(())
+    }
+
+    // Model Exchange: the 18-entry state vector as it is (`kinematics::N`; unused entries stay 0 and
+    // have derivative 0), the right-hand side of the internal integrator, time events at the fault
+    // onset and the noise-hold boundaries, and the invariant kept by projection at events (exchange.rs).
+    const STATES: Option<&'static [StateDecl]> = Some(&exchange::STATES);
+    fn get_states(&self, x: &mut [f64]) {
+        x.copy_from_slice(self.x.as_slice());
+    }
+    fn set_states(&mut self, x: &[f64]) {
+        self.x.copy_from_slice(x);
+    }
+    fn derivatives(&self, v: &AttitudePlantVars, t: f64, dx: &mut [f64]) -> ModelResult {
+        self.check_chart(t)?;
+        dx.copy_from_slice(self.derivative(v, t, &self.x, &segment_at(v, t)).as_slice());
+        Ok(())
+    }
+    fn next_time_event(&self, v: &AttitudePlantVars, t: f64) -> Option<f64> {
+        exchange::next_time_event(v, t)
+    }
+    fn event_update(&mut self, v: &AttitudePlantVars, t: f64) -> Result<bool, String> {
+        self.project(v, t)
+    }
+    fn completed_integrator_step(&mut self, v: &AttitudePlantVars, _t: f64) -> bool {
+        self.needs_projection(v)
     }
 }

@@ -1,0 +1,155 @@
+//! Model Exchange on an [`Instance`] (FMI 2.0 chapter 3): time, continuous states, derivatives, the
+//! event iteration and the mode switches. The importer's solver integrates; the model gives ẋ, its
+//! time events and, where it keeps an invariant (a unit quaternion), a projection at events.
+
+use super::instance::{CallResult, Fail, Instance};
+use super::FsmState;
+use crate::model::{DERIVATIVE_VR_BASE, STATE_VR_BASE};
+
+/// What `fmi2NewDiscreteStates` reports (the fields of `fmi2EventInfo`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct EventInfo {
+    pub new_discrete_states_needed: bool,
+    pub terminate_simulation: bool,
+    pub nominals_changed: bool,
+    pub values_changed: bool,
+    pub next_event_time: Option<f64>,
+}
+
+/// A variable the layer publishes for a Model Exchange model.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LayerVar {
+    State(usize),
+    Derivative(usize),
+}
+
+impl Instance {
+    pub fn n_states(&self) -> usize {
+        self.entry.state_decls().len()
+    }
+
+    /// The continuous state or derivative behind a value reference, if it is one.
+    pub fn layer_var(&self, vr: u32) -> Option<LayerVar> {
+        let n = self.n_states();
+        let k = |base: u32| vr.checked_sub(base).map(|k| k as usize).filter(|k| *k < n);
+        k(STATE_VR_BASE).map(LayerVar::State).or_else(|| k(DERIVATIVE_VR_BASE).map(LayerVar::Derivative))
+    }
+
+    /// Value of a state or derivative variable (derivatives at the current time and inputs).
+    pub fn layer_value(&mut self, var: LayerVar) -> CallResult<f64> {
+        let mut buf = vec![0.0; self.n_states()];
+        match var {
+            LayerVar::State(k) => {
+                self.model.get_states(&mut buf).map_err(Fail::error)?;
+                Ok(buf[k])
+            }
+            LayerVar::Derivative(k) => {
+                self.derivatives_into(&mut buf)?;
+                Ok(buf[k])
+            }
+        }
+    }
+
+    fn check_len(&self, what: &str, n: usize) -> CallResult {
+        let nx = self.n_states();
+        if n != nx {
+            return Err(Fail::error(format!("{what} has {n} elements, but {} has {nx} continuous states", self.entry.info.name)));
+        }
+        Ok(())
+    }
+
+    /// Refuses a Model Exchange call on a Co-Simulation instance.
+    pub fn require_model_exchange(&self) -> CallResult {
+        if self.model_exchange {
+            Ok(())
+        } else {
+            Err(Fail::error("this instance was instantiated for Co-Simulation (fmuType fmi2CoSimulation); Model Exchange functions are not available"))
+        }
+    }
+
+    pub fn set_time(&mut self, t: f64) -> CallResult {
+        if !t.is_finite() {
+            return Err(Fail::error(format!("time {t} is not finite")));
+        }
+        if self.run.fsm == FsmState::ContinuousTimeMode && t < self.run.time - 1e-9 * self.run.time.abs().max(1.0) {
+            // a solver may evaluate behind an accepted point, but never before the last event
+            if t < self.event_time {
+                return Err(Fail::error(format!("time {t} lies before the last event at t = {}", self.event_time)));
+            }
+        }
+        self.run.time = t;
+        self.run.outputs_dirty = true;
+        Ok(())
+    }
+
+    pub fn set_continuous_states(&mut self, x: &[f64]) -> CallResult {
+        self.check_len("x[]", x.len())?;
+        if let Some((k, v)) = x.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(Fail::error(format!("x[{k}] ({}) = {v} is not finite", self.entry.state_decls()[k].name)));
+        }
+        self.model.set_states(x).map_err(Fail::error)?;
+        self.run.outputs_dirty = true;
+        Ok(())
+    }
+
+    pub fn get_continuous_states(&mut self, x: &mut [f64]) -> CallResult {
+        self.check_len("x[]", x.len())?;
+        self.ensure_outputs()?;
+        self.model.get_states(x).map_err(Fail::error)
+    }
+
+    pub fn get_nominals(&mut self, x: &mut [f64]) -> CallResult {
+        self.check_len("x_nominal[]", x.len())?;
+        x.fill(1.0);
+        Ok(())
+    }
+
+    fn derivatives_into(&mut self, dx: &mut [f64]) -> CallResult {
+        self.ensure_outputs()?;
+        self.model.derivatives(self.run.time, dx).map_err(|e| Fail::error(format!("derivatives at t = {}: {e}", self.run.time)))?;
+        if let Some((k, v)) = dx.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(Fail::error(format!("der({}) = {v} at t = {}", self.entry.state_decls()[k].name, self.run.time)));
+        }
+        Ok(())
+    }
+
+    pub fn get_derivatives(&mut self, dx: &mut [f64]) -> CallResult {
+        self.check_len("derivatives[]", dx.len())?;
+        self.derivatives_into(dx)
+    }
+
+    pub fn get_event_indicators(&mut self, z: &[f64]) -> CallResult {
+        if !z.is_empty() {
+            return Err(Fail::error(format!("eventIndicators[] has {} elements, but numberOfEventIndicators = 0", z.len())));
+        }
+        Ok(())
+    }
+
+    pub fn enter_event_mode(&mut self) -> CallResult {
+        self.run.fsm = FsmState::EventMode;
+        Ok(())
+    }
+
+    /// One pass of the event iteration: the model's event update at the current time (projection,
+    /// switching at a time event), then the next time event.
+    pub fn new_discrete_states(&mut self) -> CallResult<EventInfo> {
+        self.ensure_outputs()?;
+        let t = self.run.time;
+        let changed = self.model.event_update(t).map_err(|e| Fail::error(format!("event at t = {t}: {e}")))?;
+        self.event_time = t;
+        self.run.outputs_dirty = true;
+        let next = self.model.next_time_event(t).filter(|te| te.is_finite() && *te > t);
+        Ok(EventInfo { values_changed: changed, next_event_time: next, ..EventInfo::default() })
+    }
+
+    pub fn enter_continuous_time_mode(&mut self) -> CallResult {
+        self.run.fsm = FsmState::ContinuousTimeMode;
+        Ok(())
+    }
+
+    /// After an accepted solver step: whether the model asks for an event (projection).
+    pub fn completed_integrator_step(&mut self) -> CallResult<bool> {
+        let t = self.run.time;
+        Ok(self.model.completed_integrator_step(t))
+    }
+}

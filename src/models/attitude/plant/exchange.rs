@@ -1,0 +1,105 @@
+//! Model Exchange for `AttitudePlant`: the published states, the time events and how the invariants
+//! of the attitude representation are kept when the importer's solver integrates.
+//!
+//! - Quaternion (kinematics 0): the solver integrates q̇ = ½ q ⊗ ω freely, which keeps |q| = 1 only
+//!   up to its tolerance. After an accepted step whose |q| is off by more than [`NORM_TOLERANCE`] the
+//!   plant asks for an event (`fmi2CompletedIntegratorStep` → enterEventMode) and renormalises q in
+//!   the event update (valuesOfContinuousStatesChanged); every time event renormalises too.
+//! - DCM (kinematics 1) with `dcm_orthonormalize = 1`: the same with ‖AᵀA − I‖ and the nearest
+//!   rotation matrix. The sign-continuous output quaternion follows every accepted step.
+//! - Euler angles (kinematics 2): the right-hand side refuses the singularity roll = ±90°.
+
+use nalgebra::Matrix3;
+
+use super::environment::noise_on;
+use super::kinematics::{post_step, Kinematics, ATT};
+use super::{AttitudePlant, AttitudePlantVars};
+use crate::math::attitude::orthonormalize;
+use crate::math::random::hold_index;
+use crate::model::StateDecl;
+
+/// Largest drift of |q| (or of ‖AᵀA − I‖) accepted between events.
+pub const NORM_TOLERANCE: f64 = 1e-9;
+
+const fn s(name: &'static str, unit: &'static str, description: &'static str) -> StateDecl {
+    StateDecl::new(name, unit, description)
+}
+
+/// The published continuous states, in the order of the internal state vector.
+pub const STATES: [StateDecl; super::kinematics::N] = [
+    s("state_att_1", "", "Continuous state: attitude entry 1 (q_w for kinematics 0; A column-major for 1; roll phi for 2, 3)"),
+    s("state_att_2", "", "Continuous state: attitude entry 2 (q_x; A; pitch theta)"),
+    s("state_att_3", "", "Continuous state: attitude entry 3 (q_y; A; yaw psi)"),
+    s("state_att_4", "", "Continuous state: attitude entry 4 (q_z; A; unused)"),
+    s("state_att_5", "", "Continuous state: attitude entry 5 (DCM only)"),
+    s("state_att_6", "", "Continuous state: attitude entry 6 (DCM only)"),
+    s("state_att_7", "", "Continuous state: attitude entry 7 (DCM only)"),
+    s("state_att_8", "", "Continuous state: attitude entry 8 (DCM only)"),
+    s("state_att_9", "", "Continuous state: attitude entry 9 (DCM only)"),
+    s("state_w_x", "rad/s", "Continuous state: body rate x (angle rate for kinematics 3)"),
+    s("state_w_y", "rad/s", "Continuous state: body rate y (angle rate for kinematics 3)"),
+    s("state_w_z", "rad/s", "Continuous state: body rate z (angle rate for kinematics 3)"),
+    s("state_h_wheel_x", "N.m.s", "Continuous state: wheel momentum x (actuator mode 1)"),
+    s("state_h_wheel_y", "N.m.s", "Continuous state: wheel momentum y (actuator mode 1)"),
+    s("state_h_wheel_z", "N.m.s", "Continuous state: wheel momentum z (actuator mode 1)"),
+    s("state_wheel_torque_x", "N.m", "Continuous state: lagged wheel torque x (actuator mode 1, wheel lag > 0)"),
+    s("state_wheel_torque_y", "N.m", "Continuous state: lagged wheel torque y (actuator mode 1, wheel lag > 0)"),
+    s("state_wheel_torque_z", "N.m", "Continuous state: lagged wheel torque z (actuator mode 1, wheel lag > 0)"),
+];
+
+/// The first time event after t: the fault onset or the next noise-hold boundary.
+pub fn next_time_event(v: &AttitudePlantVars, t: f64) -> Option<f64> {
+    let fault = Some(v.fault_time).filter(|tf| *tf > t);
+    let noise = noise_on(v).then(|| (hold_index(t, v.dist_noise_hold) + 1) as f64 * v.dist_noise_hold).filter(|tn| *tn > t);
+    match (fault, noise) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
+    }
+}
+
+impl AttitudePlant {
+    fn drift(&self, v: &AttitudePlantVars) -> f64 {
+        match self.kin {
+            Kinematics::Quaternion => (self.x.fixed_rows::<4>(ATT).norm() - 1.0).abs(),
+            Kinematics::Dcm if v.dcm_orthonormalize == 1 => {
+                let a = Matrix3::from_column_slice(&self.x.as_slice()[ATT..ATT + 9]);
+                (a.transpose() * a - Matrix3::identity()).abs().max()
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// After an accepted solver step: follow the output quaternion's sign (DCM) and ask for an event
+    /// when the representation has drifted.
+    pub(super) fn needs_projection(&mut self, v: &AttitudePlantVars) -> bool {
+        if self.kin == Kinematics::Dcm {
+            let mut x = self.x;
+            let _ = post_step(Kinematics::Dcm, false, &mut self.q_dcm, &mut x, 0.0);
+        }
+        self.drift(v) > NORM_TOLERANCE
+    }
+
+    /// Event update: renormalise q (re-orthonormalise A); whether the state changed.
+    pub(super) fn project(&mut self, v: &AttitudePlantVars, t: f64) -> Result<bool, String> {
+        let before = self.x;
+        match self.kin {
+            Kinematics::Quaternion => post_step(Kinematics::Quaternion, false, &mut self.q_dcm, &mut self.x, t)?,
+            Kinematics::Dcm if v.dcm_orthonormalize == 1 => {
+                let a = orthonormalize(&Matrix3::from_column_slice(&self.x.as_slice()[ATT..ATT + 9]));
+                self.x.as_mut_slice()[ATT..ATT + 9].copy_from_slice(a.as_slice());
+                let mut x = self.x;
+                post_step(Kinematics::Dcm, false, &mut self.q_dcm, &mut x, t)?;
+            }
+            _ => {}
+        }
+        Ok(self.x != before)
+    }
+
+    /// The Euler-angle chart (kinematics 2) is singular at roll = ±90°.
+    pub(super) fn check_chart(&self, t: f64) -> Result<(), String> {
+        if self.kin == Kinematics::Euler213Rates && self.x[ATT].cos().abs() < 1e-9 {
+            return Err(format!("Euler-angle kinematics (mode 2) reached the singularity roll = ±90° at t = {t}"));
+        }
+        Ok(())
+    }
+}
