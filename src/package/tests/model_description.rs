@@ -46,7 +46,16 @@ fn fmi_schema_reads_every_variable_back() {
         let xml = xml(e);
         let md = fmi_schema::fmi2::Fmi2ModelDescription::from_str(&xml).unwrap_or_else(|err| panic!("{}: {err}", e.info.name));
         assert_eq!(md.model_name, e.info.name);
-        assert_eq!(md.num_variables(), e.decls.len());
+        // the declared variables, then (Model Exchange) each continuous state and its derivative
+        let states = e.state_decls();
+        assert_eq!(md.num_variables(), e.decls.len() + 2 * states.len());
+        assert_eq!(md.model_exchange.is_some(), e.model_exchange(), "{}", e.info.name);
+        let extra = &md.model_variables.variables[e.decls.len()..];
+        for (k, x) in states.iter().enumerate() {
+            assert_eq!((extra[k].name.as_str(), extra[k].value_reference), (x.name, spacecraft_fmus::model::STATE_VR_BASE + k as u32));
+            let der = &extra[states.len() + k];
+            assert_eq!((der.name.as_str(), der.value_reference), (format!("der({})", x.name).as_str(), spacecraft_fmus::model::DERIVATIVE_VR_BASE + k as u32));
+        }
         let cs = md.co_simulation.as_ref().expect("CoSimulation element");
         assert_eq!(cs.model_identifier, e.info.name);
         assert_eq!(cs.can_get_and_set_fmu_state, Some(true));
