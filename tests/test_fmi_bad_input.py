@@ -353,7 +353,7 @@ def _slave(model="AttitudePlant", guid=None):
     return f, f.slave
 
 
-@pytest.mark.parametrize("case", ["wrong_guid", "model_exchange", "null_name", "empty_name", "null_guid", "null_callbacks"])
+@pytest.mark.parametrize("case", ["wrong_guid", "bad_fmu_type", "null_name", "empty_name", "null_guid", "null_callbacks"])
 def test_instantiate_refusals(case):
     f = Fmu("AttitudePlant", initialize=False)  # keeps the library loaded
     try:
@@ -362,8 +362,8 @@ def test_instantiate_refusals(case):
         cb = byref(f.callbacks)
         if case == "wrong_guid":
             guid = b"{00000000-0000-0000-0000-000000000000}"
-        elif case == "model_exchange":
-            kind = 0
+        elif case == "bad_fmu_type":  # AttitudePlant offers both fmi2ModelExchange (0) and fmi2CoSimulation (1)
+            kind = 2
         elif case == "null_name":
             name = None
         elif case == "empty_name":
@@ -379,6 +379,8 @@ def test_instantiate_refusals(case):
             assert len(f.messages) > n_before and "fmi2Instantiate" in f.messages[-1][2]
         if case == "wrong_guid":
             assert "does not match AttitudePlant's GUID" in f.messages[-1][2]
+        if case == "bad_fmu_type":
+            assert "fmuType 2 is neither fmi2ModelExchange (0) nor fmi2CoSimulation (1)" in f.messages[-1][2]
         f.slave.setupExperiment()  # the existing instance is unaffected
     finally:
         f.close()

@@ -1,5 +1,6 @@
 """ModelStructure of every committed modelDescription: <InitialUnknowns> is the exact FMI 2.0 list and
-its dependencies agree with the feed-through declared in <Outputs>.
+its dependencies agree with the feed-through declared in <Outputs>; for a Model Exchange model the
+continuous states and their derivatives are initial unknowns too and <Derivatives> lists the derivatives.
 
 FMI 2.0 (ModelStructure): the initial unknowns are the outputs with initial "approx"/"calculated" and the
 calculated parameters, in ScalarVariable order, no duplicates; a missing ``dependencies`` attribute means
@@ -47,19 +48,29 @@ def test_initial_unknowns_match_declared_feedthrough(path):
 
     inputs = {i for i in var if causality(i) == "input"}
     exact = {i for i in var if initial(i) == "exact" and causality(i) == "parameter"}
+    # Model Exchange: der(x) carries derivative="<index of x>"; the states and derivatives are unknowns too
+    ders = {i for i in var if var[i].find("Real") is not None and var[i].find("Real").get("derivative")}
+    states = {int(var[i].find("Real").get("derivative")) for i in ders}
     ms = root.find("ModelStructure")
     outputs = {int(u.get("index")): u for u in _children(ms, "Outputs")}
     assert set(outputs) == {i for i in var if causality(i) == "output"}
-    # Outputs: the declared feed-through, always explicit, inputs only
+    # Outputs: the declared feed-through, always explicit, inputs (and continuous states) only
     out_deps = {}
     for i, u in outputs.items():
         assert u.get("dependencies") is not None, f"{path.stem}: output {var[i].get('name')} without dependencies"
         deps = _indices(u.get("dependencies"))
-        assert set(deps) <= inputs and deps == sorted(set(deps))
-        out_deps[i] = set(deps)
+        assert set(deps) <= inputs | states and deps == sorted(set(deps))
+        out_deps[i] = set(deps) & inputs
+    # Derivatives: exactly the der() variables, depending on inputs and states only (a superset, documented)
+    derivs = _children(ms, "Derivatives")
+    assert [int(u.get("index")) for u in derivs] == sorted(ders)
+    for u in derivs:
+        assert set(_indices(u.get("dependencies"))) == inputs | states
+    for i in ders:  # a derivative depends on every input at initialization (the same superset)
+        out_deps[i] = inputs
 
     expected = sorted([i for i in var if causality(i) == "output" and initial(i) in ("approx", "calculated")]
-                      + [i for i in var if causality(i) == "calculatedParameter"])
+                      + [i for i in var if causality(i) == "calculatedParameter"] + sorted(states | ders))
     unknowns = _children(ms, "InitialUnknowns")
     listed = [int(u.get("index")) for u in unknowns]
     assert listed == expected, f"{path.stem}: InitialUnknowns {listed} != {expected}"
