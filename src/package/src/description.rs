@@ -515,6 +515,15 @@ pub(crate) fn html_escape(s: &str) -> String {
 }
 
 /// documentation/index.html: purpose, source, equations, variable tables.
+/// The variable tables of a model's documentation (HTML page and Markdown model pages), in order.
+pub(crate) const VARIABLE_SECTIONS: [(&str, Causality); 5] = [
+    ("Parameters", Causality::Parameter),
+    ("Inputs", Causality::Input),
+    ("Outputs", Causality::Output),
+    ("Calculated parameters", Causality::CalculatedParameter),
+    ("Local variables", Causality::Local),
+];
+
 /// Which FMI interfaces a model offers, in one sentence (model pages and documentation/index.html).
 pub fn interfaces_text(entry: &ModelEntry) -> String {
     match entry.states {
@@ -545,13 +554,7 @@ pub fn documentation_html(entry: &ModelEntry, guid: &str) -> String {
     h.push_str("<li>Quaternions are scalar-first Hamilton quaternions (q_w, q_x, q_y, q_z) of the body frame relative to the reference frame; A(q) maps reference components into body components.</li>");
     h.push_str("<li>Parameters are read at fmi2ExitInitializationMode; invalid values give fmi2Error with a log message.</li>");
     h.push_str("<li>\"No limit\" is encoded as 1e30.</li></ul>\n");
-    for (title, caus) in [
-        ("Parameters", Causality::Parameter),
-        ("Inputs", Causality::Input),
-        ("Outputs", Causality::Output),
-        ("Calculated parameters", Causality::CalculatedParameter),
-        ("Local variables", Causality::Local),
-    ] {
+    for (title, caus) in VARIABLE_SECTIONS {
         let rows: Vec<&VarDecl> = entry.decls.iter().filter(|d| d.causality == caus).collect();
         if rows.is_empty() {
             continue;

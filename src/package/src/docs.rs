@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use crate::description::{bound_text, start_str, variability_str};
-use spacecraft_fmus::model::{Causality, ModelEntry, VarDecl};
+use spacecraft_fmus::model::{ModelEntry, VarDecl};
 use crate::references::{self, Reference};
 use spacecraft_fmus::registry::{Family, FAMILIES};
 
@@ -73,13 +73,7 @@ pub fn family_markdown(f: &Family) -> String {
         if !i.equations_html.trim().is_empty() {
             let _ = writeln!(out, "**Equations**\n\n<div>\n{}\n</div>\n", i.equations_html.trim());
         }
-        for (title, caus) in [
-            ("Parameters", Causality::Parameter),
-            ("Inputs", Causality::Input),
-            ("Outputs", Causality::Output),
-            ("Calculated parameters", Causality::CalculatedParameter),
-            ("Local variables", Causality::Local),
-        ] {
+        for (title, caus) in crate::description::VARIABLE_SECTIONS {
             let rows: Vec<&VarDecl> = e.decls.iter().filter(|d| d.causality == caus).collect();
             variable_table(&mut out, title, &rows);
         }

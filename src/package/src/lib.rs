@@ -186,30 +186,28 @@ impl<'a> Binary<'a> {
 /// Writes one `.fmu` archive (deterministic: fixed timestamps, fixed order) holding the model
 /// description, one binary per entry of `binaries` (in the given order) and the documentation.
 pub fn write_fmu(unit: &Unit, binaries: &[Binary], out_dir: &Path) -> std::io::Result<std::path::PathBuf> {
-    let entry = &unit.entry;
-    if binaries.is_empty() {
-        return Err(std::io::Error::other("no binary to package"));
-    }
-    fs::create_dir_all(out_dir)?;
-    let path = out_dir.join(format!("{}.fmu", entry.info.name));
-    let mut zip = ZipWriter::new(fs::File::create(&path)?);
-    let opts = SimpleFileOptions::default().compression_method(CompressionMethod::Deflated).last_modified_time(DateTime::default());
-    let add = |zip: &mut ZipWriter<fs::File>, name: &str, data: &[u8], mode: u32| -> std::io::Result<()> {
-        zip.start_file(name, opts.unix_permissions(mode)).map_err(std::io::Error::other)?;
-        zip.write_all(data)
-    };
-    add(&mut zip, "modelDescription.xml", model_description(entry, unit.guid, unit.package).as_bytes(), 0o644)?;
-    for b in binaries {
-        add(&mut zip, &format!("binaries/{}/{}.{}", b.platform, entry.info.name, b.ext), b.bytes, 0o755)?;
-    }
-    add(&mut zip, "documentation/index.html", documentation_html(entry, unit.guid).as_bytes(), 0o644)?;
-    zip.finish().map_err(std::io::Error::other)?;
-    Ok(path)
+    let name = unit.entry.info.name;
+    let files = binaries.iter().map(|b| Ok((format!("binaries/{}/{name}.{}", b.platform, b.ext), b.bytes))).collect::<std::io::Result<Vec<_>>>()?;
+    write_archive(unit, &model_description(&unit.entry, unit.guid, unit.package), &files, out_dir)
 }
 
 /// Writes one FMI 3.0 `.fmu` archive: the FMI 3.0 model description, the same binaries under FMI 3.0
 /// platform tuples (`binaries/x86_64-linux/<Model>.so`, ...) and the documentation. Deterministic.
 pub fn write_fmu3(unit: &Unit, binaries: &[Binary], out_dir: &Path) -> std::io::Result<std::path::PathBuf> {
+    let name = unit.entry.info.name;
+    let files = binaries
+        .iter()
+        .map(|b| {
+            let tuple = platform_tuple(b).ok_or_else(|| std::io::Error::other(format!("no FMI 3.0 platform tuple for the {} binary", b.platform)))?;
+            Ok((format!("binaries/{tuple}/{name}.{}", b.ext), b.bytes))
+        })
+        .collect::<std::io::Result<Vec<_>>>()?;
+    write_archive(unit, &model_description3(&unit.entry, unit.guid, unit.package), &files, out_dir)
+}
+
+/// The archive both FMI versions share: `modelDescription.xml`, the binaries at their paths, then
+/// `documentation/index.html`, with fixed timestamps and order.
+fn write_archive(unit: &Unit, description: &str, binaries: &[(String, &[u8])], out_dir: &Path) -> std::io::Result<std::path::PathBuf> {
     let entry = &unit.entry;
     if binaries.is_empty() {
         return Err(std::io::Error::other("no binary to package"));
@@ -222,10 +220,9 @@ pub fn write_fmu3(unit: &Unit, binaries: &[Binary], out_dir: &Path) -> std::io::
         zip.start_file(name, opts.unix_permissions(mode)).map_err(std::io::Error::other)?;
         zip.write_all(data)
     };
-    add(&mut zip, "modelDescription.xml", model_description3(entry, unit.guid, unit.package).as_bytes(), 0o644)?;
-    for b in binaries {
-        let tuple = platform_tuple(b).ok_or_else(|| std::io::Error::other(format!("no FMI 3.0 platform tuple for the {} binary", b.platform)))?;
-        add(&mut zip, &format!("binaries/{tuple}/{}.{}", entry.info.name, b.ext), b.bytes, 0o755)?;
+    add(&mut zip, "modelDescription.xml", description.as_bytes(), 0o644)?;
+    for (name, bytes) in binaries {
+        add(&mut zip, name, bytes, 0o755)?;
     }
     add(&mut zip, "documentation/index.html", documentation_html(entry, unit.guid).as_bytes(), 0o644)?;
     zip.finish().map_err(std::io::Error::other)?;
