@@ -72,7 +72,7 @@ pub use nalgebra::{Quaternion, Vector3};
 pub use serde::{Deserialize, Serialize};
 
 /// Version of the catalogue's byte layout; the packaging tool refuses any other.
-pub const CATALOGUE_FORMAT: u32 = 2;
+pub const CATALOGUE_FORMAT: u32 = 3;
 
 /// Version of this crate, recorded in every catalogue (and part of every GUID).
 pub const RUNTIME_VERSION: &str = env!("CARGO_PKG_VERSION");
@@ -114,8 +114,18 @@ pub struct ModelDescription {
     pub variable_step: bool,
     pub guid: String,
     pub variables: Vec<VariableDescription>,
-    /// Model Exchange: the continuous states as (name, unit, description); `None` = Co-Simulation only.
-    pub states: Option<Vec<(String, String, String)>>,
+    /// Model Exchange: the continuous states; `None` = Co-Simulation only.
+    pub states: Option<Vec<StateDescription>>,
+}
+
+/// A [`StateDecl`] as owned data.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StateDescription {
+    pub name: String,
+    pub unit: String,
+    pub description: String,
+    pub depends: Option<Vec<String>>,
+    pub starts_from: Vec<String>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -188,7 +198,17 @@ impl ModelDescription {
                     },
                 })
                 .collect(),
-            states: e.states.map(|l| l.iter().map(|x| (x.name.into(), x.unit.into(), x.description.into())).collect()),
+            states: e.states.map(|l| {
+                l.iter()
+                    .map(|x| StateDescription {
+                        name: x.name.into(),
+                        unit: x.unit.into(),
+                        description: x.description.into(),
+                        depends: x.depends.map(|d| d.iter().map(|n| n.to_string()).collect()),
+                        starts_from: x.starts_from.iter().map(|n| n.to_string()).collect(),
+                    })
+                    .collect()
+            }),
         }
     }
 
@@ -245,7 +265,15 @@ impl ModelDescription {
             })
             .collect();
         let states: Option<&'static [StateDecl]> = self.states.map(|l| {
-            &*Box::leak(l.into_iter().map(|(n, u, d)| StateDecl::new(leak(n), leak(u), leak(d))).collect::<Vec<_>>().into_boxed_slice())
+            let decl = |x: StateDescription| {
+                let starts: &'static [&'static str] = Box::leak(x.starts_from.into_iter().map(leak).collect::<Vec<_>>().into_boxed_slice());
+                let s = StateDecl::new(leak(x.name), leak(x.unit), leak(x.description)).starting_from(starts);
+                match x.depends {
+                    Some(d) => s.depends_on(Box::leak(d.into_iter().map(leak).collect::<Vec<_>>().into_boxed_slice())),
+                    None => s,
+                }
+            };
+            &*Box::leak(l.into_iter().map(decl).collect::<Vec<_>>().into_boxed_slice())
         });
         ModelEntry { info, decls: Box::leak(decls.into_boxed_slice()), states, create: no_model }
     }

@@ -17,15 +17,20 @@ from fmpy.fmi2 import FMU2Model, FMU2Slave
 from fmpy.validation import validate_fmu
 
 from scfmu.engines import run_reference
+from scfmu.scenario import Component
 from scfmu.fmu import Fmu, fmu_path, recording_callbacks
 from scfmu.papers.paper000.scenarios import paper000
 
-# Written out here (the interface each model should have), not read from the code.
+# Written out here (the interface each model should have and its number of continuous states), not read
+# from the code.
 PLANTS = {"AttitudePlant": 18, "SingleAxisPlant": 3, "RelativeOrbitPlant": 7}
+STATEFUL = {"MracController": 9, "AdaptiveFuzzyController": 9, "ReferenceCorrector": 13, "AttitudeMetrics": 4,
+            "PredictivePidController": 6}
 STATIC_LAWS = {"PdController", "LqrController", "PolePlacementController", "FuzzyPdController", "SlidingModeController",
                "Type2FuzzySmcController", "FeedbackLinearizingController", "AttitudeCommand", "RelativePositionCommand"}
-CS_ONLY = {"PidController", "FopidController", "MracController", "AdaptiveFuzzyController", "ReferenceCorrector",
-           "AttitudeMetrics", "PredictivePidController", "Gyro", "StarTracker", "SunSensor", "Magnetometer", "SampleHold"}
+# sampled laws (a sample time) and the sensors (sampled noise): Co-Simulation only
+CS_ONLY = {"PidController", "FopidController", "Gyro", "StarTracker", "SunSensor", "Magnetometer", "SampleHold"}
+N_STATES = {**PLANTS, **STATEFUL}
 
 
 def path(model: str) -> str:
@@ -39,7 +44,7 @@ def dedup_last(r):
     return r[keep]
 
 
-@pytest.mark.parametrize("model", sorted(set(PLANTS) | STATIC_LAWS | CS_ONLY))
+@pytest.mark.parametrize("model", sorted(set(N_STATES) | STATIC_LAWS | CS_ONLY))
 def test_interfaces_are_the_declared_ones_and_every_fmu_validates(model):
     md = read_model_description(path(model))
     assert md.coSimulation is not None
@@ -48,7 +53,7 @@ def test_interfaces_are_the_declared_ones_and_every_fmu_validates(model):
         assert md.modelExchange is None and not states
     else:
         assert md.modelExchange is not None and md.modelExchange.modelIdentifier == model
-        assert len(states) == PLANTS.get(model, 0)
+        assert len(states) == N_STATES.get(model, 0)
         # each derivative names its state; <Derivatives> lists exactly the derivatives
         assert [u.variable for u in md.derivatives] == states
         for d in states:
@@ -215,10 +220,103 @@ def test_paper000_slew_with_model_exchange_units_gives_the_co_simulation_eulerin
     assert np.max(np.abs(cs["q_w"] - me["q_w"])) < 1e-6
 
 
+@pytest.mark.parametrize("run_id", ["000-9Lq", "000-11L"])
+def test_paper000_adaptive_runs_with_every_unit_as_model_exchange_give_the_co_simulation_eulerint(run_id):
+    """MRAC and adaptive fuzzy (their reference model and inertia estimate as continuous states) with the
+    plant, the command and the metrics (EULERINT as a state) all as ME under solve_ivp."""
+    s = paper000(run_id, stop_time=30.0)
+    cs = run_reference(s)
+    me = run_reference(s, model_exchange={"plant", "controller", "command", "metrics"})
+    a, b = cs["eulerint_deg_s"][-1], me["eulerint_deg_s"][-1]
+    assert a > 50.0
+    assert abs(b - a) <= 1e-3 * a, (a, b)
+    # measured: 144.07748949290 vs 144.07748949241 (000-9Lq), 134.71457476 vs 134.71457420 (000-11L)
+    tau = np.abs(cs["torque_applied_x"]).max()
+    assert np.max(np.abs(cs["torque_applied_x"] - me["torque_applied_x"])) <= 1e-5 * tau
+
+
+def test_metrics_as_model_exchange_integrate_constant_inputs_exactly():
+    # q = rotation of 30 deg about z, q_ref = identity: alpha = 30 deg, yaw error = -30 deg
+    c, s_ = np.cos(np.radians(15)), np.sin(np.radians(15))
+    sv = {"q_w": c, "q_z": s_, "torque_applied_x": 0.3, "torque_applied_y": -0.4}
+    r = simulate_fmu(path("AttitudeMetrics"), fmi_type="ModelExchange", solver="CVode", stop_time=10.0,
+                     output_interval=0.5, relative_tolerance=1e-10, start_values=sv,
+                     output=["eulerint_deg_s", "alpha_deg", "ise", "isf", "effort_abs"])
+    t = r["time"]
+    assert np.allclose(r["alpha_deg"], 30.0, rtol=1e-12)
+    assert np.allclose(r["eulerint_deg_s"], 30.0 * t, rtol=1e-9, atol=1e-12)
+    assert np.allclose(r["ise"], np.radians(30.0) ** 2 * t, rtol=1e-9, atol=1e-12)
+    assert np.allclose(r["isf"], 0.25 * t, rtol=1e-9, atol=1e-12)
+    assert np.allclose(r["effort_abs"], 0.7 * t, rtol=1e-9, atol=1e-12)
+
+
+@pytest.mark.parametrize("structure", [0, 1])
+def test_predictive_pid_states_as_model_exchange_follow_the_closed_form(structure):
+    # constant error e = (2, -1, 0.5) m, e' = 0: E(t) = e t (structure 0); dz/dt = -c K1 e (structure 1)
+    sv = {"pos_ref_x": 2.0, "pos_ref_y": -1.0, "pos_ref_z": 0.5, "structure": structure, "T2": 5.0, "c": 0.5}
+    r = simulate_fmu(path("PredictivePidController"), fmi_type="ModelExchange", solver="CVode", stop_time=4.0,
+                     output_interval=0.5, relative_tolerance=1e-10, start_values=sv,
+                     output=["int_error_x", "int_error_y", "dist_est_x", "dist_est_z"])
+    t, e = r["time"], np.array([2.0, -1.0, 0.5])
+    k1, k2, c, m = 10 / (3 * 25.0), 5 / (2 * 5.0), 0.5, 100.0
+    d0 = -c * (k2 * e)  # d_hat(0) = -c (e' + K2 e + K1 E(0))
+    if structure == 0:
+        assert np.allclose(r["int_error_x"], 2.0 * t, rtol=1e-9, atol=1e-12)
+        assert np.allclose(r["int_error_y"], -1.0 * t, rtol=1e-9, atol=1e-12)
+        # d_hat = -c (e' + K2 e + K1 E)
+        assert np.allclose(r["dist_est_x"], m * (d0[0] - c * k1 * 2.0 * t), rtol=1e-9)
+    else:
+        assert np.all(r["int_error_x"] == 0.0)
+        # d_hat = z + c vel, z' = -c K1 e: the same line as structure 0's d_hat
+        assert np.allclose(r["dist_est_x"], m * (d0[0] - c * k1 * 2.0 * t), rtol=1e-9)
+        assert np.allclose(r["dist_est_z"], m * (d0[2] - c * k1 * 0.5 * t), rtol=1e-9)
+
+
+def test_reference_corrector_as_model_exchange_matches_scipy_with_the_not_a_knot_spline():
+    """The corrector's open-loop copy under fmpy's CVODE against SciPy: the rigid body I w' = sat(u(t)) - w x I w,
+    q' = q (x) (0, w) / 2 driven by SciPy's own not-a-knot CubicSpline through the nodes (0 after the last knot,
+    a time event); with e(0) = e'(0) = 0 the reference q_ref is the copy's attitude."""
+    from scipy.integrate import solve_ivp
+    from scipy.interpolate import CubicSpline
+
+    inertia, limit, t_end = np.array([449.5, 264.5, 312.5]), 1.0, 10.0
+    nodes = {"x": [0.0, 0.5, -0.3, 0.2, 0.4, 0.0], "y": [0.2, -0.6, 0.1, 0.0, 0.3, -0.1], "z": [0.0, 0.1, 0.3, -0.2, 0.0, 2.0]}
+    sv = {"mode": 1, "spline_t_end": t_end, "effectiveness_x": 0.1, "effectiveness_y": 0.1, "effectiveness_z": 0.1,
+          **{f"node_{a}_{k}": v for a in "xyz" for k, v in enumerate(nodes[a])}}
+    r = dedup_last(simulate_fmu(path("ReferenceCorrector"), fmi_type="ModelExchange", solver="CVode", stop_time=15.0,
+                                output_interval=0.5, relative_tolerance=1e-11, start_values=sv,
+                                output=["q_ref_w", "q_ref_x", "q_ref_y", "q_ref_z", "u_ol_z"]))
+    knots = np.linspace(0.0, t_end, 6)
+    spl = [CubicSpline(knots, nodes[a], bc_type="not-a-knot") for a in "xyz"]
+
+    def f(t, y):
+        q, w = y[:4], y[4:]
+        u = np.clip([s(t) if t <= t_end else 0.0 for s in spl], -limit, limit)  # u_max 10 N m x effectiveness 0.1
+        wd = (u - np.cross(w, inertia * w)) / inertia
+        qd = 0.5 * np.array([-q[1:] @ w, *(q[0] * w + np.cross(q[1:], w))])
+        return np.concatenate([qd, wd])
+
+    ref = {}
+    y0 = np.array([1.0, 0, 0, 0, 0, 0, 0])
+    for a, b in [(0.0, t_end), (t_end, 15.0)]:  # the torque jumps at t_end: integrate the two pieces
+        sol = solve_ivp(f, (a, b), y0, method="DOP853", rtol=1e-12, atol=1e-14, dense_output=True)
+        y0 = sol.y[:, -1]
+        for t in r["time"]:
+            if a <= t <= b:
+                ref[float(t)] = sol.sol(t)
+    qs = np.array([ref[float(t)][:4] / np.linalg.norm(ref[float(t)][:4]) for t in r["time"]])
+    assert np.max(np.abs(qs[:, 3])) > 0.01  # a real rotation (about 2 deg about z)
+    for i, c in enumerate("wxyz"):
+        assert np.max(np.abs(r[f"q_ref_{c}"] - qs[:, i])) < 1e-7, c
+    assert r["u_ol_z"][-1] == 0.0
+
+
 def test_the_reference_master_refuses_model_exchange_for_a_unit_without_it():
     s = paper000("000-6", stop_time=1.0)
+    s = paper000("000-6", stop_time=1.0)
+    s.components[[c.name for c in s.components].index("controller")] = Component("controller", "PidController", {})
     with pytest.raises(ValueError, match="no Model Exchange"):
-        run_reference(s, model_exchange={"metrics"})
+        run_reference(s, model_exchange={"controller"})
     with pytest.raises(KeyError, match="no instance"):
         run_reference(s, model_exchange={"nosuch"})
 

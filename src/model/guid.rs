@@ -37,7 +37,7 @@ fn fingerprint(entry: &ModelEntry) -> String {
     if let Some(states) = entry.states {
         let _ = writeln!(s, "model exchange: {} states", states.len());
         for x in states {
-            let _ = writeln!(s, "state|{}|{}|{}", x.name, x.unit, x.description);
+            let _ = writeln!(s, "state|{}|{}|{}|{:?}|{:?}", x.name, x.unit, x.description, x.depends, x.starts_from);
         }
     }
     s

@@ -80,7 +80,7 @@ impl<M: Model> Fmu<M> {
 
     /// Model Exchange: the continuous states into `x`.
     pub fn get_states(&self, x: &mut [f64]) -> ModelResult {
-        self.state.as_ref().ok_or(NOT_INITIALIZED)?.get_states(x);
+        self.state.as_ref().ok_or(NOT_INITIALIZED)?.get_states(&self.v, x);
         Ok(())
     }
 

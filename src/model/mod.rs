@@ -5,6 +5,7 @@
 //! never touches C types or XML.
 
 mod declare;
+mod exchange;
 pub mod guid;
 mod instance;
 pub mod leaves;
@@ -12,6 +13,7 @@ mod param;
 #[cfg(test)]
 mod restore_tests;
 
+pub use exchange::{StateDecl, DERIVATIVE_VR_BASE, RESERVED_VR_START, STATE_VR_BASE};
 pub use declare::{concat, field_problem, no_duplicate_names, no_duplicate_vrs, same_str, total_len};
 pub use instance::{DynModel, Fmu};
 pub use param::ParamEnum;
@@ -415,8 +417,10 @@ pub trait Model: Clone + Serialize + DeserializeOwned + Send + 'static {
     /// state as a local variable `name` and its derivative as `der(name)` (value references from
     /// [`STATE_VR_BASE`] and [`DERIVATIVE_VR_BASE`]); the methods below give the layer access.
     const STATES: Option<&'static [StateDecl]> = None;
-    /// Writes the continuous state vector (length `STATES.len()`).
-    fn get_states(&self, _x: &mut [f64]) {}
+    /// Writes the continuous state vector (length `STATES.len()`). The inputs are there for a state
+    /// whose start is taken from them (e.g. a reference model starting at the measurement): until
+    /// the first `set_states`, such a model reports that start.
+    fn get_states(&self, _v: &Self::Vars, _x: &mut [f64]) {}
     /// Replaces the continuous state vector (finite values, length checked by the layer).
     fn set_states(&mut self, _x: &[f64]) {}
     /// ẋ at time t for the current inputs and states (length `STATES.len()`); the right-hand side
@@ -439,30 +443,6 @@ pub trait Model: Clone + Serialize + DeserializeOwned + Send + 'static {
         false
     }
 }
-
-/// A continuous state of a Model Exchange model: published as the local variable `name` and its
-/// derivative `der(name)`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct StateDecl {
-    pub name: &'static str,
-    /// Unit of the state (from the unit table; "" for none). The derivative carries no unit attribute.
-    pub unit: &'static str,
-    pub description: &'static str,
-}
-
-impl StateDecl {
-    pub const fn new(name: &'static str, unit: &'static str, description: &'static str) -> Self {
-        StateDecl { name, unit, description }
-    }
-}
-
-/// Value reference of continuous state i (Real, local): `STATE_VR_BASE + i`. Value references from
-/// [`RESERVED_VR_START`] on belong to the layer; a declaration may not use them.
-pub const STATE_VR_BASE: u32 = 1_000_000_000;
-/// Value reference of the derivative of continuous state i: `DERIVATIVE_VR_BASE + i`.
-pub const DERIVATIVE_VR_BASE: u32 = 1_000_100_000;
-/// First value reference reserved for the layer (continuous states, their derivatives; FMI 3.0 `time`).
-pub const RESERVED_VR_START: u32 = STATE_VR_BASE;
 
 /// Registry entry of one FMU.
 #[derive(Clone, Copy)]

@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::declare_variables;
 use crate::math::attitude::{euler321_from_quat, euler_axis_angle, wrap_pi};
-use crate::model::{check_finite_state, Experiment, Feedthrough, Model, ModelInfo, ModelResult};
+use crate::model::{check_finite_state, Experiment, Feedthrough, Model, ModelInfo, ModelResult, StateDecl};
 
 declare_variables! {
     pub struct AttitudeMetricsVars {
@@ -52,8 +52,10 @@ eulerint   = integral of alpha [deg] dt                         ([Navabi-2019] E
 ise        = integral of sum_i wrap(euler321(q_ref) - euler321(q))_i^2 dt\n\
 isf        = effort_sq = integral of |tau_applied|^2 dt\n\
 effort_abs = integral of sum_i |tau_applied,i| dt</pre>\n\
-<p>Left-rectangle rule on the communication grid: I(t_k+1) = I(t_k) + f(t_k) * step, with the inputs of t_k \
-(consistent with inputs held over the step). Integral outputs at t are over [start, t].</p>",
+<p>Co-Simulation: left-rectangle rule on the communication grid: I(t_k+1) = I(t_k) + f(t_k) * step, with the inputs of t_k \
+(consistent with inputs held over the step). Integral outputs at t are over [start, t].</p>\n\
+<p>Model Exchange: the four integrals are the continuous states state_eulerint, state_ise, state_isf and state_effort_abs \
+with the integrands above as derivatives; the importer's solver integrates them together with the plant.</p>",
         feedthrough: Feedthrough::Some(&[("alpha_deg", &["q_w", "q_x", "q_y", "q_z", "q_ref_w", "q_ref_x", "q_ref_y", "q_ref_z"])]),
         ..ModelInfo::DEFAULT
     };
@@ -79,4 +81,25 @@ effort_abs = integral of sum_i |tau_applied,i| dt</pre>\n\
     fn validate(&self, _fresh: &Self) -> ModelResult {
         check_finite_state("integrals", &self.integrals)
     }
+
+    // Model Exchange: the integrals are the states, the integrands their derivatives.
+    const STATES: Option<&'static [StateDecl]> = Some(&[
+        StateDecl::new("state_eulerint", "deg.s", "Continuous state: EULERINT, integral of alpha_deg").depends_on(&Q_AND_REF),
+        StateDecl::new("state_ise", "rad2.s", "Continuous state: ISE, integral of the squared 321 Euler-angle errors").depends_on(&Q_AND_REF),
+        StateDecl::new("state_isf", "N2.m2.s", "Continuous state: ISF, integral of the squared applied torques").depends_on(&TORQUE),
+        StateDecl::new("state_effort_abs", "N.m.s", "Continuous state: integral of the sum of absolute applied torques").depends_on(&TORQUE),
+    ]);
+    fn get_states(&self, _v: &Self::Vars, x: &mut [f64]) {
+        x.copy_from_slice(&self.integrals);
+    }
+    fn set_states(&mut self, x: &[f64]) {
+        self.integrals.copy_from_slice(x);
+    }
+    fn derivatives(&self, v: &AttitudeMetricsVars, _t: f64, dx: &mut [f64]) -> ModelResult {
+        dx.copy_from_slice(&integrands(v));
+        Ok(())
+    }
 }
+
+const Q_AND_REF: [&str; 8] = ["q_w", "q_x", "q_y", "q_z", "q_ref_w", "q_ref_x", "q_ref_y", "q_ref_z"];
+const TORQUE: [&str; 3] = ["torque_applied_x", "torque_applied_y", "torque_applied_z"];

@@ -11,7 +11,7 @@ use super::control::shared::feedback_linearization::{Gains, OpenLoopCopy};
 use crate::declare_variables;
 use crate::math::attitude::quat_from_euler321;
 use crate::math::spline::NotAKnotSpline;
-use crate::model::{Experiment, Model, ModelInfo, ModelResult};
+use crate::model::{Experiment, Model, ModelInfo, ModelResult, StateDecl};
 
 /// Number of spline nodes per axis (paper 004: 6 equally spaced nodes).
 pub const N_NODES: usize = 6;
@@ -106,7 +106,11 @@ controller commands exactly u_ol. Integrating e = q_v - q_ref_v (whose dynamics 
 of q_ref itself is the same solution; with e(0) = e'(0) = 0 the reference equals the copy's attitude to the \
 last bit, and a closed loop with the same plant parameters, RK4 step and communication step reproduces the \
 open-loop run to round-off. Other initial errors decay with the controller's error poles. u_ol is output in \
-both modes (e.g. to drive the plant open loop).</p>",
+both modes (e.g. to drive the plant open loop).</p>\n\
+<p>Model Exchange: the copy's state (q, w, e, e') is published as the continuous states state_q_*, state_w_*, \
+state_e_*, state_e_dot_* (constant in mode 0); u_ol(t) is evaluated at every instant instead of being held over a \
+communication step; the spline knots are time events (u_ol drops to 0 after the last); the copy's quaternion is \
+renormalised at an event whenever | |q| - 1 | exceeds 1e-9.</p>",
         ..ModelInfo::DEFAULT
     };
 
@@ -145,6 +149,73 @@ both modes (e.g. to drive the plant open loop).</p>",
             self.copy.step(t, h, &u)?;
         }
         Ok(())
+    }
+
+    // Model Exchange: the copy's state is continuous (mode 0: constant); u_ol(t) is evaluated at
+    // every instant (Co-Simulation holds it over the communication step); the knots are time events
+    // (u_ol drops to 0 after the last); |q| of the copy is kept by projection at events.
+    const STATES: Option<&'static [StateDecl]> = Some(&STATES);
+    fn get_states(&self, _v: &Self::Vars, x: &mut [f64]) {
+        x.copy_from_slice(self.copy.x.as_slice());
+    }
+    fn set_states(&mut self, x: &[f64]) {
+        self.copy.x.copy_from_slice(x);
+    }
+    fn derivatives(&self, _v: &Self::Vars, t: f64, dx: &mut [f64]) -> ModelResult {
+        if self.corrected {
+            dx.copy_from_slice(self.copy.rate(&self.u_ol(t)).as_slice());
+        } else {
+            dx.fill(0.0);
+        }
+        Ok(())
+    }
+    fn next_time_event(&self, _v: &Self::Vars, t: f64) -> Option<f64> {
+        (1..N_NODES).map(|k| self.t_end * k as f64 / (N_NODES - 1) as f64).find(|tk| *tk > t)
+    }
+    fn completed_integrator_step(&mut self, _v: &Self::Vars, _t: f64) -> bool {
+        self.corrected && self.drift() > NORM_TOLERANCE
+    }
+    fn event_update(&mut self, _v: &Self::Vars, t: f64) -> Result<bool, String> {
+        if !self.corrected || self.drift() == 0.0 {
+            return Ok(false);
+        }
+        let n = self.copy.x.fixed_rows::<4>(0).norm();
+        if !(n > 0.0) {
+            return Err(format!("reference corrector: quaternion norm became zero at t = {t}"));
+        }
+        self.copy.x.fixed_rows_mut::<4>(0).unscale_mut(n);
+        Ok(true)
+    }
+}
+
+/// Largest drift of the copy's |q| accepted between events under Model Exchange.
+pub const NORM_TOLERANCE: f64 = 1e-9;
+
+const fn st(name: &'static str, unit: &'static str, description: &'static str, on: &'static [&'static str]) -> StateDecl {
+    StateDecl::new(name, unit, description).depends_on(on)
+}
+
+/// The copy's state [q, ω, e, ė] under Model Exchange. q̇ = ½ q ⊗ ω (entry i not on q_i), diagonal
+/// inertia (ω̇_i on the other two rates), ë = −k_qdot ė − k_q e per axis; no inputs.
+const STATES: [StateDecl; 13] = [
+    st("state_q_w", "", "Continuous state: copy's attitude quaternion, scalar part", &["state_q_x", "state_q_y", "state_q_z", "state_w_x", "state_w_y", "state_w_z"]),
+    st("state_q_x", "", "Continuous state: copy's attitude quaternion x", &["state_q_w", "state_q_y", "state_q_z", "state_w_x", "state_w_y", "state_w_z"]),
+    st("state_q_y", "", "Continuous state: copy's attitude quaternion y", &["state_q_w", "state_q_x", "state_q_z", "state_w_x", "state_w_y", "state_w_z"]),
+    st("state_q_z", "", "Continuous state: copy's attitude quaternion z", &["state_q_w", "state_q_x", "state_q_y", "state_w_x", "state_w_y", "state_w_z"]),
+    st("state_w_x", "rad/s", "Continuous state: copy's body rate x", &["state_w_y", "state_w_z"]),
+    st("state_w_y", "rad/s", "Continuous state: copy's body rate y", &["state_w_x", "state_w_z"]),
+    st("state_w_z", "rad/s", "Continuous state: copy's body rate z", &["state_w_x", "state_w_y"]),
+    st("state_e_x", "", "Continuous state: reference error e_x = q_v,x - q_ref_v,x", &["state_e_dot_x"]),
+    st("state_e_y", "", "Continuous state: reference error e_y", &["state_e_dot_y"]),
+    st("state_e_z", "", "Continuous state: reference error e_z", &["state_e_dot_z"]),
+    st("state_e_dot_x", "1/s", "Continuous state: reference error rate e_x'", &["state_e_x", "state_e_dot_x"]),
+    st("state_e_dot_y", "1/s", "Continuous state: reference error rate e_y'", &["state_e_y", "state_e_dot_y"]),
+    st("state_e_dot_z", "1/s", "Continuous state: reference error rate e_z'", &["state_e_z", "state_e_dot_z"]),
+];
+
+impl ReferenceCorrector {
+    fn drift(&self) -> f64 {
+        (self.copy.x.fixed_rows::<4>(0).norm() - 1.0).abs()
     }
 }
 

@@ -127,15 +127,19 @@ impl Model for RelativeOrbitPlant {
     }
 
     const STATES: Option<&'static [StateDecl]> = Some(&[
-        StateDecl::new("state_pos_x", "m", "Continuous state: relative position x (radial)"),
-        StateDecl::new("state_pos_y", "m", "Continuous state: relative position y (along-track)"),
-        StateDecl::new("state_pos_z", "m", "Continuous state: relative position z (orbit normal)"),
-        StateDecl::new("state_vel_x", "m/s", "Continuous state: relative velocity x"),
-        StateDecl::new("state_vel_y", "m/s", "Continuous state: relative velocity y"),
-        StateDecl::new("state_vel_z", "m/s", "Continuous state: relative velocity z"),
-        StateDecl::new("state_nu", "rad", "Continuous state: leader true anomaly nu"),
+        // ẍ reads ẏ (Coriolis), ÿ reads ẋ, z̈ neither; gravity reads the whole position and nu
+        StateDecl::new("state_pos_x", "m", "Continuous state: relative position x (radial)").depends_on(&["state_vel_x"]),
+        StateDecl::new("state_pos_y", "m", "Continuous state: relative position y (along-track)").depends_on(&["state_vel_y"]),
+        StateDecl::new("state_pos_z", "m", "Continuous state: relative position z (orbit normal)").depends_on(&["state_vel_z"]),
+        StateDecl::new("state_vel_x", "m/s", "Continuous state: relative velocity x")
+            .depends_on(&["force_x", "dist_x", "state_pos_x", "state_pos_y", "state_pos_z", "state_vel_y", "state_nu"]),
+        StateDecl::new("state_vel_y", "m/s", "Continuous state: relative velocity y")
+            .depends_on(&["force_y", "dist_y", "state_pos_x", "state_pos_y", "state_pos_z", "state_vel_x", "state_nu"]),
+        StateDecl::new("state_vel_z", "m/s", "Continuous state: relative velocity z")
+            .depends_on(&["force_z", "dist_z", "state_pos_x", "state_pos_y", "state_pos_z", "state_nu"]),
+        StateDecl::new("state_nu", "rad", "Continuous state: leader true anomaly nu").depends_on(&["state_nu"]),
     ]);
-    fn get_states(&self, x: &mut [f64]) {
+    fn get_states(&self, _v: &Self::Vars, x: &mut [f64]) {
         x.copy_from_slice(self.x.as_slice());
     }
     fn set_states(&mut self, x: &[f64]) {

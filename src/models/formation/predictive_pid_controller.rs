@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 use crate::declare_variables;
 use crate::math::predictive_control::predictive_gains;
 use crate::math::relative_orbit::LeaderOrbit;
-use crate::model::{check_derived, check_finite_state, Experiment, Feedthrough, Model, ModelInfo, ModelResult, ParamEnum};
+use crate::model::{check_derived, check_finite_state, Experiment, Feedthrough, Model, ModelInfo, ModelResult, ParamEnum, StateDecl};
 
 declare_variables! {
     #[allow(non_snake_case)]
@@ -163,6 +163,42 @@ impl Model for PredictivePidController {
         check_derived("structure, observer gains and leader orbit", &(self.structure, self.c, self.orbit), &(fresh.structure, fresh.c, fresh.orbit))?;
         check_finite_state("integral and observer states", self.int_e.iter().chain(self.z.iter().flatten()))
     }
+
+    // Model Exchange: E and z are the states (both published; the structure not in use keeps its
+    // state constant). z starts as in Co-Simulation, from the inputs at the start (z_initial).
+    const STATES: Option<&'static [StateDecl]> = Some(&[
+        StateDecl::new("state_int_error_x", "m.s", "Continuous state: integral of the position error E_x (structure 0)").depends_on(&["pos_ref_x", "pos_x"]),
+        StateDecl::new("state_int_error_y", "m.s", "Continuous state: integral of the position error E_y (structure 0)").depends_on(&["pos_ref_y", "pos_y"]),
+        StateDecl::new("state_int_error_z", "m.s", "Continuous state: integral of the position error E_z (structure 0)").depends_on(&["pos_ref_z", "pos_z"]),
+        StateDecl::new("state_z_x", "m/s2", "Continuous state: observer state z_x, d_hat = z + c vel (structure 1)")
+            .depends_on(&["pos_ref_x", "pos_x", "vel_ref_x", "vel_x", "acc_ref_x"])
+            .starting_from(&["pos_ref_x", "pos_x", "vel_ref_x", "vel_x"]),
+        StateDecl::new("state_z_y", "m/s2", "Continuous state: observer state z_y (structure 1)")
+            .depends_on(&["pos_ref_y", "pos_y", "vel_ref_y", "vel_y", "acc_ref_y"])
+            .starting_from(&["pos_ref_y", "pos_y", "vel_ref_y", "vel_y"]),
+        StateDecl::new("state_z_z", "m/s2", "Continuous state: observer state z_z (structure 1)")
+            .depends_on(&["pos_ref_z", "pos_z", "vel_ref_z", "vel_z", "acc_ref_z"])
+            .starting_from(&["pos_ref_z", "pos_z", "vel_ref_z", "vel_z"]),
+    ]);
+    fn get_states(&self, v: &PredictivePidControllerVars, x: &mut [f64]) {
+        let z = self.z.unwrap_or_else(|| self.z_initial(v, &(v.pos_ref - v.pos), &(v.vel_ref - v.vel)));
+        x[0..3].copy_from_slice(self.int_e.as_slice());
+        x[3..6].copy_from_slice(z.as_slice());
+    }
+    fn set_states(&mut self, x: &[f64]) {
+        self.int_e = Vector3::new(x[0], x[1], x[2]);
+        self.z = Some(Vector3::new(x[3], x[4], x[5]));
+    }
+    fn derivatives(&self, v: &PredictivePidControllerVars, _t: f64, dx: &mut [f64]) -> ModelResult {
+        let (e, e_dot) = (v.pos_ref - v.pos, v.vel_ref - v.vel);
+        let (d_int, d_z) = match self.structure {
+            Structure::Pid => (e, Vector3::zeros()),
+            Structure::Observer => (Vector3::zeros(), -self.c.component_mul(&(e * v.K1 + e_dot * v.K2 + v.acc_ref))),
+        };
+        dx[0..3].copy_from_slice(d_int.as_slice());
+        dx[3..6].copy_from_slice(d_z.as_slice());
+        Ok(())
+    }
 }
 
 const EQUATIONS_HTML: &str = "<pre>Hbar_ij = (T2^(i+j-1) - T1^(i+j-1)) / ((i-1)! (j-1)! (i+j-1))     (Eq. 22)\n\
@@ -175,6 +211,9 @@ structure 0:  F = P e + D e' + I_g E + N                                (Eq. 40)
 structure 1:  F = m (K1 e + K2 e' + acc_ref + G - d_hat),  d_hat = z + c vel,\n\
               dz/dt = -c (K1 e + K2 e' + acc_ref)    (observer d_hat' = c (d - d_hat), Eq. 28)\n\
 closed loop:  (s + c)(s^2 + K2 s + K1) = 0,  poles -c and (-1.25 +- 1.3307 j)/T for T1 = 0</pre>\n\
+<p>Model Exchange: E and z are the continuous states state_int_error_* and state_z_* with dE/dt = e (structure 0) \
+and dz/dt as above (structure 1); the other structure's state stays constant. The importer's solver integrates them \
+(Co-Simulation uses the explicit Euler step shown).</p>\n\
 <p>G is the plant's G (third row mu z/rho_f^3) from the controller's own mu, semi_major_axis, eccentricity and the \
 leader_true_anomaly input. Per-axis observer gains c_x, c_y, c_z override c when >= 0. Structure 1 starts from \
 d_hat(0) = -c (e'(0) + K2 e(0) + K1 E(0)), which makes both structures equal in continuous time.</p>";

@@ -92,11 +92,11 @@ impl Model for SingleAxisPlant {
     }
 
     const STATES: Option<&'static [StateDecl]> = Some(&[
-        StateDecl::new("state_theta", "rad", "Continuous state: attitude angle theta"),
-        StateDecl::new("state_omega", "rad/s", "Continuous state: angular rate omega"),
-        StateDecl::new("state_wheel_torque", "N.m", "Continuous state: wheel torque T_c after the lag"),
+        StateDecl::new("state_theta", "rad", "Continuous state: attitude angle theta").depends_on(&["state_omega"]),
+        StateDecl::new("state_omega", "rad/s", "Continuous state: angular rate omega").depends_on(&["state_wheel_torque", "torque_dist"]),
+        StateDecl::new("state_wheel_torque", "N.m", "Continuous state: wheel torque T_c after the lag").depends_on(&["state_wheel_torque", "u"]),
     ]);
-    fn get_states(&self, x: &mut [f64]) {
+    fn get_states(&self, _v: &Self::Vars, x: &mut [f64]) {
         x.copy_from_slice(self.x.as_slice());
     }
     fn set_states(&mut self, x: &[f64]) {

@@ -14,7 +14,7 @@ use quick_xml::Writer;
 use spacecraft_fmus::export::PackageInfo;
 use spacecraft_fmus::fmi::LOG_CATEGORIES;
 use spacecraft_fmus::model::{
-    Bound, Causality, Feedthrough, Initial, ModelEntry, ModelInfo, Start, VarDecl, VarKind, Variability, DERIVATIVE_VR_BASE, RESERVED_VR_START, STATE_VR_BASE,
+    Bound, Causality, Feedthrough, Initial, ModelEntry, ModelInfo, Start, StateDecl, VarDecl, VarKind, Variability, DERIVATIVE_VR_BASE, RESERVED_VR_START, STATE_VR_BASE,
 };
 use spacecraft_fmus::units;
 
@@ -110,7 +110,10 @@ pub fn initial_unknowns(entry: &ModelEntry) -> Vec<(usize, Vec<usize>)> {
         .enumerate()
         .filter_map(|(i, d)| {
             let inputs = match d.causality {
-                Causality::Output if d.initial() != Some(Initial::Exact) => output_dependencies(entry, d),
+                // its feed-through, and the inputs any state starts from (an output may read every state)
+                Causality::Output if d.initial() != Some(Initial::Exact) => {
+                    output_dependencies(entry, d).into_iter().chain(entry.state_decls().iter().flat_map(|x| start_inputs(entry, x))).collect()
+                }
                 Causality::CalculatedParameter => vec![],
                 _ => return None,
             };
@@ -121,11 +124,20 @@ pub fn initial_unknowns(entry: &ModelEntry) -> Vec<(usize, Vec<usize>)> {
         })
         .collect::<Vec<_>>()
         .into_iter()
-        // Model Exchange: the states (from the parameters) and their derivatives (parameters and inputs)
-        .chain(state_indices(entry).map(|ix| (ix, params.clone())))
-        .chain(derivative_dependencies(entry).into_iter().map(|(k, _)| {
-            let mut deps: Vec<usize> = input_indices(entry).chain(params.iter().copied()).collect();
+        // Model Exchange: the states (from the parameters and the inputs they start from) and their
+        // derivatives (their inputs, and for each state they read the inputs that state starts from)
+        .chain(state_indices(entry).zip(entry.state_decls()).map(|(ix, x)| {
+            let mut deps: Vec<usize> = start_inputs(entry, x).chain(params.iter().copied()).collect();
             deps.sort_unstable();
+            deps.dedup();
+            (ix, deps)
+        }))
+        .chain(derivative_dependencies(entry).into_iter().map(|(k, on)| {
+            let (n_decl, states) = (entry.decls.len(), entry.state_decls());
+            let via_states = on.iter().filter(|i| **i > n_decl).flat_map(|i| start_inputs(entry, &states[i - n_decl - 1]));
+            let mut deps: Vec<usize> = on.iter().copied().filter(|i| *i <= n_decl).chain(via_states).chain(params.iter().copied()).collect();
+            deps.sort_unstable();
+            deps.dedup();
             (entry.decls.len() + entry.state_decls().len() + k + 1, deps)
         }))
         .collect()
@@ -137,18 +149,40 @@ pub fn state_indices(entry: &ModelEntry) -> impl Iterator<Item = usize> + '_ {
     (0..entry.state_decls().len()).map(move |k| n + k + 1)
 }
 
+/// ScalarVariable indices of the inputs a state's start value is taken from.
+fn start_inputs<'a>(entry: &'a ModelEntry, x: &'a StateDecl) -> impl Iterator<Item = usize> + 'a {
+    x.starts_from.iter().filter_map(move |n| input_index(entry, n))
+}
+
+fn input_index(entry: &ModelEntry, name: &str) -> Option<usize> {
+    entry.decls.iter().position(|d| d.name == name && d.causality == Causality::Input).map(|i| i + 1)
+}
+
 fn input_indices(entry: &ModelEntry) -> impl Iterator<Item = usize> + '_ {
     entry.decls.iter().enumerate().filter(|(_, d)| d.causality == Causality::Input).map(|(i, _)| i + 1)
 }
 
-/// `<Derivatives>`: for each state k, what its derivative depends on. The declarations do not say
-/// which state or input drives which derivative, so every derivative lists every state and every
-/// input: a superset (a tool may see a dependency that is not there, never miss one).
+/// `<Derivatives>`: for each state k, the ScalarVariable indices of the inputs and states its
+/// derivative depends on ([`StateDecl::depends`]: the declared list; a state that declares none
+/// depends on every input and every state).
 pub fn derivative_dependencies(entry: &ModelEntry) -> Vec<(usize, Vec<usize>)> {
-    let deps: Vec<usize> = input_indices(entry).chain(state_indices(entry)).collect();
-    let mut deps = deps;
-    deps.sort_unstable();
-    (0..entry.state_decls().len()).map(|k| (k, deps.clone())).collect()
+    let states = entry.state_decls();
+    let all: Vec<usize> = input_indices(entry).chain(state_indices(entry)).collect();
+    let index = |n: &str| input_index(entry, n).or_else(|| states.iter().position(|x| x.name == n).map(|k| entry.decls.len() + k + 1));
+    states
+        .iter()
+        .enumerate()
+        .map(|(k, x)| {
+            let mut deps: Vec<usize> = match x.depends {
+                None => all.clone(),
+                // unknown names are refused by check_declarations before any XML is written
+                Some(names) => names.iter().filter_map(|n| index(n)).collect(),
+            };
+            deps.sort_unstable();
+            deps.dedup();
+            (k, deps)
+        })
+        .collect()
 }
 
 fn join(ix: &[usize]) -> String {
@@ -213,6 +247,17 @@ pub fn check_declarations(entry: &ModelEntry) -> Result<(), String> {
         }
         if x.description.is_empty() {
             return Err(format!("{name}: continuous state {} has no description", x.name));
+        }
+        for d in x.starts_from {
+            if input_index(entry, d).is_none() {
+                return Err(format!("{name}: the start of continuous state {} is taken from {d}, which is not an input", x.name));
+            }
+        }
+        for d in x.depends.unwrap_or(&[]) {
+            let input = entry.decl(d).is_some_and(|v| v.causality == Causality::Input);
+            if !input && !states.iter().any(|y| y.name == *d) {
+                return Err(format!("{name}: the derivative of continuous state {} depends on {d}, which is neither an input nor a continuous state", x.name));
+            }
         }
     }
     if states.len() > (DERIVATIVE_VR_BASE - STATE_VR_BASE) as usize {

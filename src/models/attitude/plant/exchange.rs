@@ -21,30 +21,45 @@ use crate::model::StateDecl;
 /// Largest drift of |q| (or of ‖AᵀA − I‖) accepted between events.
 pub const NORM_TOLERANCE: f64 = 1e-9;
 
-const fn s(name: &'static str, unit: &'static str, description: &'static str) -> StateDecl {
-    StateDecl::new(name, unit, description)
+const fn s(name: &'static str, unit: &'static str, description: &'static str, on: &'static [&'static str]) -> StateDecl {
+    StateDecl::new(name, unit, description).depends_on(on)
+}
+
+// What each derivative reads, over every parameter setting (the union of the kinematics modes):
+// q̇ = ½ q ⊗ ω (entry i not on q_i), Ȧ = −[ω×] A (entry (i, j) on the other two entries of column j
+// and the two rates other than ω_i), the Euler-angle rates on roll, yaw and ω. The wheel momentum and
+// the wheel lag read the command of their axis, their own lag state, and through the magnetorquers
+// (m = k h_w × B / |B|², B = A B_R) every wheel momentum and every attitude entry. The body rates read
+// everything (full inertia, gyroscopic terms, gravity gradient, actuators): no list.
+const ATT_ALL: [&str; 9] = ["state_att_1", "state_att_2", "state_att_3", "state_att_4", "state_att_5", "state_att_6", "state_att_7", "state_att_8", "state_att_9"];
+const WHEEL_X: [&str; 14] = concat_names(&ATT_ALL, &["state_h_wheel_x", "state_h_wheel_y", "state_h_wheel_z", "state_wheel_torque_x", "torque_cmd_x"]);
+const WHEEL_Y: [&str; 14] = concat_names(&ATT_ALL, &["state_h_wheel_x", "state_h_wheel_y", "state_h_wheel_z", "state_wheel_torque_y", "torque_cmd_y"]);
+const WHEEL_Z: [&str; 14] = concat_names(&ATT_ALL, &["state_h_wheel_x", "state_h_wheel_y", "state_h_wheel_z", "state_wheel_torque_z", "torque_cmd_z"]);
+
+const fn concat_names<const N: usize>(a: &[&'static str], b: &[&'static str]) -> [&'static str; N] {
+    crate::model::concat(&[a, b], "")
 }
 
 /// The published continuous states, in the order of the internal state vector.
 pub const STATES: [StateDecl; super::kinematics::N] = [
-    s("state_att_1", "", "Continuous state: attitude entry 1 (q_w for kinematics 0; A column-major for 1; roll phi for 2, 3)"),
-    s("state_att_2", "", "Continuous state: attitude entry 2 (q_x; A; pitch theta)"),
-    s("state_att_3", "", "Continuous state: attitude entry 3 (q_y; A; yaw psi)"),
-    s("state_att_4", "", "Continuous state: attitude entry 4 (q_z; A; unused)"),
-    s("state_att_5", "", "Continuous state: attitude entry 5 (DCM only)"),
-    s("state_att_6", "", "Continuous state: attitude entry 6 (DCM only)"),
-    s("state_att_7", "", "Continuous state: attitude entry 7 (DCM only)"),
-    s("state_att_8", "", "Continuous state: attitude entry 8 (DCM only)"),
-    s("state_att_9", "", "Continuous state: attitude entry 9 (DCM only)"),
-    s("state_w_x", "rad/s", "Continuous state: body rate x (angle rate for kinematics 3)"),
-    s("state_w_y", "rad/s", "Continuous state: body rate y (angle rate for kinematics 3)"),
-    s("state_w_z", "rad/s", "Continuous state: body rate z (angle rate for kinematics 3)"),
-    s("state_h_wheel_x", "N.m.s", "Continuous state: wheel momentum x (actuator mode 1)"),
-    s("state_h_wheel_y", "N.m.s", "Continuous state: wheel momentum y (actuator mode 1)"),
-    s("state_h_wheel_z", "N.m.s", "Continuous state: wheel momentum z (actuator mode 1)"),
-    s("state_wheel_torque_x", "N.m", "Continuous state: lagged wheel torque x (actuator mode 1, wheel lag > 0)"),
-    s("state_wheel_torque_y", "N.m", "Continuous state: lagged wheel torque y (actuator mode 1, wheel lag > 0)"),
-    s("state_wheel_torque_z", "N.m", "Continuous state: lagged wheel torque z (actuator mode 1, wheel lag > 0)"),
+    s("state_att_1", "", "Continuous state: attitude entry 1 (q_w for kinematics 0; A column-major for 1; roll phi for 2, 3)", &["state_att_2", "state_att_3", "state_att_4", "state_w_x", "state_w_y", "state_w_z"]),
+    s("state_att_2", "", "Continuous state: attitude entry 2 (q_x; A; pitch theta)", &["state_att_1", "state_att_3", "state_att_4", "state_w_x", "state_w_y", "state_w_z"]),
+    s("state_att_3", "", "Continuous state: attitude entry 3 (q_y; A; yaw psi)", &["state_att_1", "state_att_2", "state_att_3", "state_att_4", "state_w_x", "state_w_y", "state_w_z"]),
+    s("state_att_4", "", "Continuous state: attitude entry 4 (q_z; A; unused)", &["state_att_1", "state_att_2", "state_att_3", "state_att_5", "state_att_6", "state_w_x", "state_w_y", "state_w_z"]),
+    s("state_att_5", "", "Continuous state: attitude entry 5 (DCM only)", &["state_att_4", "state_att_6", "state_w_x", "state_w_z"]),
+    s("state_att_6", "", "Continuous state: attitude entry 6 (DCM only)", &["state_att_4", "state_att_5", "state_w_x", "state_w_y"]),
+    s("state_att_7", "", "Continuous state: attitude entry 7 (DCM only)", &["state_att_8", "state_att_9", "state_w_y", "state_w_z"]),
+    s("state_att_8", "", "Continuous state: attitude entry 8 (DCM only)", &["state_att_7", "state_att_9", "state_w_x", "state_w_z"]),
+    s("state_att_9", "", "Continuous state: attitude entry 9 (DCM only)", &["state_att_7", "state_att_8", "state_w_x", "state_w_y"]),
+    StateDecl::new("state_w_x", "rad/s", "Continuous state: body rate x (angle rate for kinematics 3)"),
+    StateDecl::new("state_w_y", "rad/s", "Continuous state: body rate y (angle rate for kinematics 3)"),
+    StateDecl::new("state_w_z", "rad/s", "Continuous state: body rate z (angle rate for kinematics 3)"),
+    s("state_h_wheel_x", "N.m.s", "Continuous state: wheel momentum x (actuator mode 1)", &WHEEL_X),
+    s("state_h_wheel_y", "N.m.s", "Continuous state: wheel momentum y (actuator mode 1)", &WHEEL_Y),
+    s("state_h_wheel_z", "N.m.s", "Continuous state: wheel momentum z (actuator mode 1)", &WHEEL_Z),
+    s("state_wheel_torque_x", "N.m", "Continuous state: lagged wheel torque x (actuator mode 1, wheel lag > 0)", &WHEEL_X),
+    s("state_wheel_torque_y", "N.m", "Continuous state: lagged wheel torque y (actuator mode 1, wheel lag > 0)", &WHEEL_Y),
+    s("state_wheel_torque_z", "N.m", "Continuous state: lagged wheel torque z (actuator mode 1, wheel lag > 0)", &WHEEL_Z),
 ];
 
 /// The first time event after t: the fault onset or the next noise-hold boundary.

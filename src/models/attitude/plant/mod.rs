@@ -195,7 +195,7 @@ impl Model for AttitudePlant {
     // have derivative 0), the right-hand side of the internal integrator, time events at the fault
     // onset and the noise-hold boundaries, and the invariant kept by projection at events (exchange.rs).
     const STATES: Option<&'static [StateDecl]> = Some(&exchange::STATES);
-    fn get_states(&self, x: &mut [f64]) {
+    fn get_states(&self, _v: &Self::Vars, x: &mut [f64]) {
         x.copy_from_slice(self.x.as_slice());
     }
     fn set_states(&mut self, x: &[f64]) {

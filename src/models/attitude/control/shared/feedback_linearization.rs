@@ -213,6 +213,12 @@ impl OpenLoopCopy {
         d
     }
 
+    /// ẋ of the current state for the torque command u (saturated inside): the Model Exchange
+    /// right-hand side.
+    pub fn rate(&self, u: &Vector3<f64>) -> CopyState {
+        self.derivative(&self.x, &self.saturate(u))
+    }
+
     /// Advances by one communication step h with the torque command u held (saturated inside).
     pub fn step(&mut self, t: f64, h: f64, u: &Vector3<f64>) -> Result<(), String> {
         let tau = self.saturate(u);
