@@ -6,7 +6,14 @@ use std::ffi::c_int;
 
 use super::abi::{call, out_ptr, slice, slice_mut, Component};
 use super::instance::{CallResult, Fail, Instance};
-use super::mask;
+use super::{mask, FsmState};
+
+/// `fmi2GetDerivatives` (FMI 2.0 ME state table): event, continuous-time, terminated and error state,
+/// not initialization mode (the Reference FMUs use the same masks).
+const GET_DERIVATIVES: u16 = mask::GET_ME_VALUES & !FsmState::InitializationMode.bit();
+/// `fmi2GetNominalsOfContinuousStates`: also in the instantiated state (before the parameters are
+/// set, for the solver's setup), not in initialization mode.
+const GET_NOMINALS: u16 = (mask::GET_ME_VALUES | FsmState::Instantiated.bit()) & !FsmState::InitializationMode.bit();
 
 /// `fmi2EventInfo`.
 #[repr(C)]
@@ -78,7 +85,7 @@ pub extern "C" fn fmi2SetContinuousStates(c: Component, x: *const f64, nx: usize
 }
 
 pub extern "C" fn fmi2GetDerivatives(c: Component, dx: *mut f64, nx: usize) -> c_int {
-    me_call(c, "fmi2GetDerivatives", mask::GET_ME_VALUES, |inst| {
+    me_call(c, "fmi2GetDerivatives", GET_DERIVATIVES, |inst| {
         let dx = unsafe { slice_mut(dx, nx, "derivatives[]")? };
         inst.get_derivatives(dx)
     })
@@ -99,7 +106,7 @@ pub extern "C" fn fmi2GetContinuousStates(c: Component, x: *mut f64, nx: usize) 
 }
 
 pub extern "C" fn fmi2GetNominalsOfContinuousStates(c: Component, x: *mut f64, nx: usize) -> c_int {
-    me_call(c, "fmi2GetNominalsOfContinuousStates", mask::GET_ME_VALUES, |inst| {
+    me_call(c, "fmi2GetNominalsOfContinuousStates", GET_NOMINALS, |inst| {
         let x = unsafe { slice_mut(x, nx, "x_nominal[]")? };
         inst.get_nominals(x)
     })

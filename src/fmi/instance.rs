@@ -87,6 +87,9 @@ pub struct Run {
     pub outputs_dirty: bool,
     /// Parameters changed during initialization: derived quantities must be recomputed.
     pub params_dirty: bool,
+    /// Model Exchange: time of the last event (the solver may not go back before it); -inf before
+    /// initialization. Part of the run so that an FMU state restores it with the time it belongs to.
+    pub event_time: f64,
 }
 
 impl Run {
@@ -94,6 +97,9 @@ impl Run {
     pub fn validate(&self) -> Result<(), String> {
         if !self.time.is_finite() {
             return Err(format!("time {} is not finite", self.time));
+        }
+        if !(self.event_time == f64::NEG_INFINITY || (self.event_time.is_finite() && self.event_time <= self.time + 2e-9 * self.event_time.abs().max(1.0))) {
+            return Err(format!("time of the last event {} is not finite or lies after the time {}", self.event_time, self.time));
         }
         let e = &self.exp;
         if !e.start_time.is_finite() || e.tolerance.is_some_and(|t| !(t.is_finite() && t > 0.0)) || e.stop_time.is_some_and(|s| !(s.is_finite() && s >= e.start_time)) {
@@ -111,7 +117,7 @@ impl Run {
     }
 
     pub const INSTANTIATED: Run =
-        Run { fsm: FsmState::Instantiated, time: 0.0, exp: Experiment { start_time: 0.0, tolerance: None, stop_time: None }, outputs_dirty: true, params_dirty: true };
+        Run { fsm: FsmState::Instantiated, time: 0.0, exp: Experiment { start_time: 0.0, tolerance: None, stop_time: None }, outputs_dirty: true, params_dirty: true, event_time: f64::NEG_INFINITY };
 }
 
 pub struct Instance {
@@ -123,8 +129,6 @@ pub struct Instance {
     pub fmi3: bool,
     /// Instantiated as Model Exchange (`fmi2Instantiate` with fmuType fmi2ModelExchange).
     pub model_exchange: bool,
-    /// Model Exchange: time of the last event (the solver may not go back before it).
-    pub event_time: f64,
     debug_logging: bool,
     categories: HashSet<&'static str>,
     pub run: Run,
@@ -149,7 +153,6 @@ impl Instance {
             env,
             fmi3: false,
             model_exchange: false,
-            event_time: f64::NEG_INFINITY,
             debug_logging: logging_on,
             categories: LOG_CATEGORIES.iter().map(|(n, _)| *n).collect(),
             run: Run::INSTANTIATED,
@@ -395,7 +398,7 @@ impl Instance {
         self.run.outputs_dirty = true;
         self.ensure_outputs()?;
         self.run.fsm = if self.model_exchange { FsmState::EventMode } else { FsmState::StepComplete };
-        self.event_time = self.run.time;
+        self.run.event_time = self.run.time;
         Ok(())
     }
 
@@ -425,7 +428,6 @@ impl Instance {
     pub fn reset(&mut self) {
         self.model = (self.entry.create)();
         self.run = Run::INSTANTIATED;
-        self.event_time = f64::NEG_INFINITY;
     }
 
     /// Directional derivative of Real outputs with respect to Real inputs, by central differences

@@ -71,11 +71,11 @@ impl Instance {
         if !t.is_finite() {
             return Err(Fail::error(format!("time {t} is not finite")));
         }
-        if self.run.fsm == FsmState::ContinuousTimeMode && t < self.run.time - 1e-9 * self.run.time.abs().max(1.0) {
-            // a solver may evaluate behind an accepted point, but never before the last event
-            if t < self.event_time {
-                return Err(Fail::error(format!("time {t} lies before the last event at t = {}", self.event_time)));
-            }
+        // A solver may evaluate behind an accepted point, but never before the last event (event
+        // instants increase, FMI 2.0 section 3.1): checked against the event itself (up to round-off),
+        // in event mode too, so that no sequence of small steps back walks past it.
+        if t < self.run.event_time - 1e-9 * self.run.event_time.abs().max(1.0) {
+            return Err(Fail::error(format!("time {t} lies before the last event at t = {}", self.run.event_time)));
         }
         self.run.time = t;
         self.run.outputs_dirty = true;
@@ -136,7 +136,7 @@ impl Instance {
         self.ensure_outputs()?;
         let t = self.run.time;
         let changed = self.model.event_update(t).map_err(|e| Fail::error(format!("event at t = {t}: {e}")))?;
-        self.event_time = t;
+        self.run.event_time = t;
         self.run.outputs_dirty = true;
         let next = self.model.next_time_event(t).filter(|te| te.is_finite() && *te > t);
         Ok(EventInfo { values_changed: changed, next_event_time: next, ..EventInfo::default() })

@@ -19,7 +19,7 @@ use super::{BuildAddrHasher, FsmState};
 use crate::model::DynModel;
 
 const MAGIC: &[u8; 8] = b"SCFMUST\0";
-const FORMAT_VERSION: u32 = 1;
+const FORMAT_VERSION: u32 = 2; // 2: the run carries the time of the last event (Model Exchange)
 const HEADER: usize = 16;
 const TRAILER: usize = 4;
 

@@ -45,7 +45,17 @@ impl TestFmu {
         Self::with_guid(model, &guid(entry))
     }
 
+    /// Instantiates `model` as Model Exchange (fmuType fmi2ModelExchange = 0).
+    pub fn new_me(model: &'static str) -> Self {
+        let entry = registry::find(model).expect("registered");
+        Self::with_type(model, &guid(entry), 0)
+    }
+
     pub fn with_guid(model: &'static str, guid: &str) -> Self {
+        Self::with_type(model, guid, 1)
+    }
+
+    pub fn with_type(model: &'static str, guid: &str, fmu_type: c_int) -> Self {
         let log: Box<Log> = Box::new(Mutex::new(vec![]));
         let callbacks = Box::new(CallbackFunctions {
             logger: Some(logger()),
@@ -56,7 +66,7 @@ impl TestFmu {
         });
         let name = CString::new(format!("test_{model}")).unwrap();
         let g = CString::new(guid).unwrap();
-        let c = fmi2Instantiate(registry::ALL, name.as_ptr(), 1, g.as_ptr(), std::ptr::null(), &*callbacks, 0, 0);
+        let c = fmi2Instantiate(registry::ALL, name.as_ptr(), fmu_type, g.as_ptr(), std::ptr::null(), &*callbacks, 0, 0);
         TestFmu { c, model, log, callbacks }
     }
 

@@ -12,7 +12,20 @@
  *                                        (FMI forbids it); under ThreadSanitizer this must be reported, which
  *                                        shows the detector is live (results are not checked)
  *
- * LIB must be an AttitudePlant binary (value references from modelDescription/AttitudePlant.xml).
+ * Model Exchange (fmuType fmi2ModelExchange = 0), every ME entry point:
+ *   fmi_hostile LIB GUID me N_EVENTS N_FUZZ   bad calls (NULL component and pointers, wrong lengths, wrong
+ *                                        state, NaN/Inf states and time, time before the last event), very many
+ *                                        event iterations, FMU states in event and continuous-time mode
+ *                                        (corrupted ones too), each with the prescribed status and a logger
+ *                                        message naming the function; then a legitimate explicit-Euler run
+ *                                        checked against the closed form (w_z = tau/I_z t, |q| = 1 within 1e-6)
+ *   fmi_hostile LIB GUID me-reload N     dlopen + an ME instance (Euler steps, states) alive while a CS cycle
+ *                                        runs + dlclose, N times
+ *   fmi_hostile LAWLIB LAWGUID me-law N  a static law (PdController, 0 states) as ME: the same bad calls, a run
+ *                                        whose outputs equal a Co-Simulation instance's bit for bit
+ *
+ * LIB must be an AttitudePlant binary (value references from modelDescription/AttitudePlant.xml); LAWLIB a
+ * PdController binary (modelDescription/PdController.xml).
  */
 #include <dlfcn.h>
 #include <math.h>
@@ -51,7 +64,30 @@ typedef struct {
     St (*ser_size)(C, void *, size_t *);
     St (*serialize)(C, void *, char *, size_t);
     St (*deserialize)(C, const char *, size_t, void **);
+    St (*terminate)(C);
+    St (*reset)(C);
+    /* Model Exchange */
+    St (*enter_event_mode)(C);
+    St (*new_discrete_states)(C, void *);
+    St (*enter_ct_mode)(C);
+    St (*completed_step)(C, int, int *, int *);
+    St (*set_time)(C, double);
+    St (*set_states)(C, const double *, size_t);
+    St (*get_derivatives)(C, double *, size_t);
+    St (*get_indicators)(C, double *, size_t);
+    St (*get_states)(C, double *, size_t);
+    St (*get_nominals)(C, double *, size_t);
 } Fmi;
+
+/* fmi2EventInfo */
+typedef struct {
+    int new_discrete_states_needed;
+    int terminate_simulation;
+    int nominals_changed;
+    int values_changed;
+    int next_event_time_defined;
+    double next_event_time;
+} EventInfo;
 
 #if defined(__SANITIZE_THREAD__)
 /* A Rust library built with -Zsanitizer=thread calls __tsan_memcpy/__tsan_memmove/__tsan_memset, which
@@ -69,10 +105,18 @@ enum { VR_TORQUE_CMD_X = 0, VR_Q_W = 10, VR_W_X = 14, VR_MAX_STEP = 130, VR_INTE
 
 static const char *LIB, *GUID;
 static int quiet_logger_count;
+/* the last message the FMU logged on this thread (formatted: the FMU escapes '%' as "%%") */
+static __thread char last_msg[4096];
+static __thread int last_status = -1;
 
 static void logger(void *env, const char *name, int status, const char *cat, const char *msg, ...) {
     (void)env; (void)name; (void)cat;
-    if (getenv("HOSTILE_VERBOSE")) fprintf(stderr, "[%d] %s\n", status, msg);
+    va_list ap;
+    va_start(ap, msg);
+    vsnprintf(last_msg, sizeof last_msg, msg, ap);
+    va_end(ap);
+    last_status = status;
+    if (getenv("HOSTILE_VERBOSE")) fprintf(stderr, "[%d] %s\n", status, last_msg);
     __atomic_add_fetch(&quiet_logger_count, 1, __ATOMIC_RELAXED);
 }
 static const Callbacks CB = {logger, calloc, free, NULL, NULL};
@@ -105,6 +149,18 @@ static Fmi load(void) {
     f.ser_size = sym(f.lib, "fmi2SerializedFMUstateSize");
     f.serialize = sym(f.lib, "fmi2SerializeFMUstate");
     f.deserialize = sym(f.lib, "fmi2DeSerializeFMUstate");
+    f.terminate = sym(f.lib, "fmi2Terminate");
+    f.reset = sym(f.lib, "fmi2Reset");
+    f.enter_event_mode = sym(f.lib, "fmi2EnterEventMode");
+    f.new_discrete_states = sym(f.lib, "fmi2NewDiscreteStates");
+    f.enter_ct_mode = sym(f.lib, "fmi2EnterContinuousTimeMode");
+    f.completed_step = sym(f.lib, "fmi2CompletedIntegratorStep");
+    f.set_time = sym(f.lib, "fmi2SetTime");
+    f.set_states = sym(f.lib, "fmi2SetContinuousStates");
+    f.get_derivatives = sym(f.lib, "fmi2GetDerivatives");
+    f.get_indicators = sym(f.lib, "fmi2GetEventIndicators");
+    f.get_states = sym(f.lib, "fmi2GetContinuousStates");
+    f.get_nominals = sym(f.lib, "fmi2GetNominalsOfContinuousStates");
     return f;
 }
 
@@ -229,6 +285,457 @@ static void *worker(void *arg) {
     for (int i = 0; i < w->n; i++)
         if (cycle(w->f, i % 2) != w->ref) w->bad = 1;
     return NULL;
+}
+
+/* ===================================================================================================
+ * Model Exchange (fmuType fmi2ModelExchange = 0)
+ * =================================================================================================== */
+
+/* more AttitudePlant value references; continuous states and their derivatives (docs/model_exchange.md) */
+enum { NX = 18, VR_TORQUE_CMD_Z = 2, VR_Q_X = 11, VR_Q_Y = 12, VR_Q_Z = 13, VR_W_Z = 16, VR_INERTIA_ZZ = 102,
+       VR_FAULT_TIME = 126, VR_NOISE_HOLD = 183 };
+#define VR_STATE(k) (1000000000u + (unsigned)(k))
+#define VR_DER(k) (1000100000u + (unsigned)(k))
+enum { X_QW = 0, X_QX = 1, X_QY = 2, X_QZ = 3, X_WX = 9, X_WY = 10, X_WZ = 11 };
+
+static int n_checked; /* refused calls whose status and message were checked */
+
+/* The call must return `want`. A refused call on an instance must have logged, with that status, a message
+   naming `fn` and containing `reason` (when given); fn NULL: no message at all (no instance to log to). */
+static void expect_at(St got, St want, const char *fn, const char *reason, const char *call, int line) {
+    if (got != want) {
+        printf("FAIL line %d: %s returned %d, expected %d (last message: \"%s\")\n", line, call, got, want, last_msg);
+        fflush(stdout);
+        exit(1);
+    }
+    if (want == OK) return;
+    if (!fn) {
+        if (last_msg[0]) {
+            printf("FAIL line %d: %s logged \"%s\" without an instance\n", line, call, last_msg);
+            fflush(stdout);
+            exit(1);
+        }
+    } else if (!strstr(last_msg, fn) || (reason && !strstr(last_msg, reason)) || last_status != want) {
+        printf("FAIL line %d: %s: message \"%s\" (status %d) must name %s and say \"%s\"\n", line, call, last_msg,
+               last_status, fn, reason ? reason : "");
+        fflush(stdout);
+        exit(1);
+    }
+    n_checked++;
+}
+#define EXPECT(call, want, fn, reason)                                  \
+    do {                                                                \
+        last_msg[0] = 0;                                                \
+        last_status = -1;                                               \
+        St st_ = (call);                                                \
+        expect_at(st_, want, fn, reason, #call, __LINE__);              \
+    } while (0)
+#define OKAY(call) EXPECT(call, OK, NULL, NULL)
+#define REFUSED(call, fn, reason) EXPECT(call, ERROR, fn, reason)
+
+static C instance_of_type(const Fmi *f, const char *name, int type) {
+    C c = f->instantiate(name, type, GUID, NULL, &CB, 0, 0);
+    CHECK(c, "fmi2Instantiate");
+    return c;
+}
+
+/* setup, initialization with the given parameters, exit: event mode (ME) */
+static void init_with(const Fmi *f, C c, const unsigned *vr, const double *v, size_t n) {
+    OKAY(f->setup(c, 0, 0.0, 0.0, 0, 0.0));
+    OKAY(f->enter_init(c));
+    if (n) OKAY(f->set_real(c, vr, n, v));
+    OKAY(f->exit_init(c));
+}
+
+/* The event iteration (event mode): returns whether the states changed; *tnext = next time event or INFINITY. */
+static int event_iteration(const Fmi *f, C c, double *tnext) {
+    EventInfo ei;
+    int changed = 0, k = 0;
+    do {
+        memset(&ei, 0x5A, sizeof ei);
+        OKAY(f->new_discrete_states(c, &ei));
+        CHECK(ei.terminate_simulation == 0 && ei.nominals_changed == 0, "terminateSimulation or nominalsChanged");
+        CHECK(ei.new_discrete_states_needed == 0 || ei.new_discrete_states_needed == 1, "newDiscreteStatesNeeded not a Boolean");
+        CHECK(ei.next_event_time_defined == 0 || isfinite(ei.next_event_time), "non-finite next event time");
+        changed |= ei.values_changed;
+        CHECK(++k < 1000, "event iteration does not end");
+    } while (ei.new_discrete_states_needed);
+    *tnext = ei.next_event_time_defined ? ei.next_event_time : INFINITY;
+    return changed;
+}
+
+static double qnorm(const double *x) { return sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2] + x[3] * x[3]); }
+
+/* Every ME entry point with a NULL, a foreign and a freed component: fmi2Error, nothing logged. */
+static void me_bad_components(const Fmi *f) {
+    double x[NX] = {0};
+    int a = 0, b = 0;
+    EventInfo ei;
+    C freed = instance_of_type(f, "freed", 0);
+    f->free_instance(freed);
+    C bad[3] = {NULL, (C)x, freed};
+    for (int i = 0; i < 3; i++) {
+        C c = bad[i];
+        EXPECT(f->enter_event_mode(c), ERROR, NULL, NULL);
+        EXPECT(f->new_discrete_states(c, &ei), ERROR, NULL, NULL);
+        EXPECT(f->enter_ct_mode(c), ERROR, NULL, NULL);
+        EXPECT(f->completed_step(c, 1, &a, &b), ERROR, NULL, NULL);
+        EXPECT(f->set_time(c, 1.0), ERROR, NULL, NULL);
+        EXPECT(f->set_states(c, x, NX), ERROR, NULL, NULL);
+        EXPECT(f->get_derivatives(c, x, NX), ERROR, NULL, NULL);
+        EXPECT(f->get_indicators(c, x, 0), ERROR, NULL, NULL);
+        EXPECT(f->get_states(c, x, NX), ERROR, NULL, NULL);
+        EXPECT(f->get_nominals(c, x, NX), ERROR, NULL, NULL);
+    }
+    /* an ME instance of a model: freeing NULL or a freed instance again is a no-op */
+    f->free_instance(NULL);
+    f->free_instance(freed);
+}
+
+/* The calls of the FMI 2.0 ME state table that are not allowed in `state` (nx states): each refused with a
+   message naming the function and the state. `allowed_get`: GetContinuousStates/EventIndicators allowed. */
+static void me_wrong_state(const Fmi *f, C c, int nx, const char *state) {
+    double x[NX] = {1.0};
+    int a = 0, b = 0;
+    EventInfo ei;
+    int ev = !strcmp(state, "EventMode"), ct = !strcmp(state, "ContinuousTimeMode");
+    int inst = !strcmp(state, "Instantiated"), init = !strcmp(state, "InitializationMode");
+    if (!ev && !ct) {
+        REFUSED(f->enter_event_mode(c), "fmi2EnterEventMode", state);
+        REFUSED(f->set_time(c, 0.0), "fmi2SetTime", state);
+    }
+    if (!ev) {
+        REFUSED(f->new_discrete_states(c, &ei), "fmi2NewDiscreteStates", state);
+        REFUSED(f->enter_ct_mode(c), "fmi2EnterContinuousTimeMode", state);
+    }
+    if (!ct) {
+        REFUSED(f->set_states(c, x, nx), "fmi2SetContinuousStates", state);
+        REFUSED(f->completed_step(c, 1, &a, &b), "fmi2CompletedIntegratorStep", state);
+    }
+    if (inst) {
+        REFUSED(f->get_states(c, x, nx), "fmi2GetContinuousStates", state);
+        REFUSED(f->get_indicators(c, x, 0), "fmi2GetEventIndicators", state);
+    }
+    if (inst || init) REFUSED(f->get_derivatives(c, x, nx), "fmi2GetDerivatives", state);
+    if (init) REFUSED(f->get_nominals(c, x, nx), "fmi2GetNominalsOfContinuousStates", state);
+    /* fmi2DoStep is no Model Exchange call: refused in every state of an ME instance */
+    REFUSED(f->do_step(c, 0.0, 0.1, 1), "fmi2DoStep", state);
+}
+
+/* NULL arrays and pointers, wrong lengths on an instance in continuous-time mode with nx states */
+static void me_bad_pointers(const Fmi *f, C c, int nx) {
+    double x[NX + 2] = {0};
+    int a = 0, b = 0;
+    int wrong[3] = {nx + 1, nx == 0 ? 2 : nx - 1, nx == 0 ? 3 : 0};
+    REFUSED(f->completed_step(c, 1, NULL, &b), "fmi2CompletedIntegratorStep", "enterEventMode is NULL");
+    REFUSED(f->completed_step(c, 1, &a, NULL), "fmi2CompletedIntegratorStep", "terminateSimulation is NULL");
+    for (int i = 0; i < 3; i++) {
+        if (wrong[i] == 0 && nx == 0) continue;
+        char want[64];
+        snprintf(want, sizeof want, "has %d elements", wrong[i]);
+        REFUSED(f->set_states(c, x, (size_t)wrong[i]), "fmi2SetContinuousStates", want);
+        REFUSED(f->get_derivatives(c, x, (size_t)wrong[i]), "fmi2GetDerivatives", want);
+        REFUSED(f->get_states(c, x, (size_t)wrong[i]), "fmi2GetContinuousStates", want);
+        REFUSED(f->get_nominals(c, x, (size_t)wrong[i]), "fmi2GetNominalsOfContinuousStates", want);
+    }
+    if (nx > 0) {
+        REFUSED(f->set_states(c, NULL, (size_t)nx), "fmi2SetContinuousStates", "x[] is NULL");
+        REFUSED(f->get_derivatives(c, NULL, (size_t)nx), "fmi2GetDerivatives", "derivatives[] is NULL");
+        REFUSED(f->get_states(c, NULL, (size_t)nx), "fmi2GetContinuousStates", "x[] is NULL");
+        REFUSED(f->get_nominals(c, NULL, (size_t)nx), "fmi2GetNominalsOfContinuousStates", "x_nominal[] is NULL");
+        REFUSED(f->set_states(c, x, (size_t)-1), "fmi2SetContinuousStates", "impossible");
+        REFUSED(f->get_derivatives(c, x, (size_t)-1 / 8), "fmi2GetDerivatives", "impossible");
+    } else { /* 0 states: NULL with length 0 is fine */
+        OKAY(f->set_states(c, NULL, 0));
+        OKAY(f->get_derivatives(c, NULL, 0));
+        OKAY(f->get_states(c, NULL, 0));
+        OKAY(f->get_nominals(c, NULL, 0));
+    }
+    /* no event indicators */
+    OKAY(f->get_indicators(c, NULL, 0));
+    REFUSED(f->get_indicators(c, x, 1), "fmi2GetEventIndicators", "numberOfEventIndicators = 0");
+    REFUSED(f->get_indicators(c, NULL, 2), "fmi2GetEventIndicators", "is NULL");
+}
+
+/* one explicit-Euler step from (t, x) with derivatives dx to t1 (continuous-time mode), then the
+   completed step; the time event at *tnext and a requested event are handled. Returns 1 on an event. */
+static int euler_step(const Fmi *f, C c, int nx, double *x, const double *dx, double t, double t1, double *tnext) {
+    int enter = -1, term = -1;
+    for (int i = 0; i < nx; i++) x[i] += (t1 - t) * dx[i];
+    OKAY(f->set_time(c, t1));
+    OKAY(f->set_states(c, x, (size_t)nx));
+    OKAY(f->completed_step(c, 1, &enter, &term));
+    CHECK((enter == 0 || enter == 1) && term == 0, "completedIntegratorStep flags");
+    if (!enter && t1 < *tnext) return 0;
+    OKAY(f->enter_event_mode(c));
+    if (event_iteration(f, c, tnext)) OKAY(f->get_states(c, x, (size_t)nx));
+    OKAY(f->enter_ct_mode(c));
+    return 1;
+}
+
+/* The legitimate run: AttitudePlant from rest under a constant torque_cmd_z, explicit Euler with step h to
+   t_end, a time event (fault_time, no fault effects) on the way. w_z = tau/I_z t exactly (its derivative
+   is constant: Euler is exact), w_x = w_y = q_x = q_y = 0, q_z = sin(tau/I_z t^2/4) to the Euler error,
+   |q| = 1 within 1e-6 (projection at events). Returns the number of events. */
+static int me_euler_run(const Fmi *f, double h, double t_end, int *projections) {
+    const double tau = 7.0, iz = 700.0, t_fault = 1.2345;
+    C c = instance_of_type(f, "euler", 0);
+    unsigned vr[2] = {VR_TORQUE_CMD_Z, VR_FAULT_TIME};
+    double v[2] = {tau, t_fault};
+    init_with(f, c, vr, v, 2);
+    double tnext, x[NX], dx[NX], t = 0.0;
+    event_iteration(f, c, &tnext);
+    CHECK(tnext == t_fault, "the fault time is the first time event");
+    OKAY(f->enter_ct_mode(c));
+    OKAY(f->get_states(c, x, NX));
+    CHECK(x[X_QW] == 1.0 && x[X_WZ] == 0.0, "initial state at rest");
+    double nom[NX];
+    OKAY(f->get_nominals(c, nom, NX));
+    for (int i = 0; i < NX; i++) CHECK(nom[i] == 1.0, "nominal 1.0");
+    int events = 0, time_events = 0;
+    *projections = 0;
+    while (t < t_end - 1e-12) {
+        OKAY(f->get_derivatives(c, dx, NX));
+        CHECK(fabs(dx[X_WZ] - tau / iz) <= 1e-15, "der(w_z) = tau/I_z");
+        double t1 = fmin(t + h, t_end);
+        int at_time_event = t1 >= tnext - 1e-12;
+        if (at_time_event) t1 = tnext;
+        int ev = euler_step(f, c, NX, x, dx, t, t1, &tnext);
+        events += ev;
+        time_events += at_time_event;
+        if (ev && !at_time_event) {
+            (*projections)++;
+            CHECK(fabs(qnorm(x) - 1.0) < 1e-14, "projection renormalises q");
+        }
+        t = t1;
+        CHECK(fabs(x[X_WZ] - tau / iz * t) <= 1e-12 * fmax(1.0, t), "w_z = tau/I_z t");
+        CHECK(x[X_WX] == 0.0 && x[X_WY] == 0.0 && x[X_QX] == 0.0 && x[X_QY] == 0.0, "rotation about z only");
+        CHECK(fabs(qnorm(x) - 1.0) <= 1e-6, "|q| within 1e-6 of 1");
+        double th = 0.5 * tau / iz * t * t;
+        CHECK(fabs(x[X_QZ] - sin(th / 2)) <= 1e-4 && fabs(x[X_QW] - cos(th / 2)) <= 1e-4, "q follows the closed form");
+    }
+    CHECK(time_events == 1, "the fault time event was met once");
+    /* outputs agree with the states */
+    unsigned ov[5] = {VR_W_Z, VR_Q_Z, VR_STATE(X_WZ), VR_DER(X_WZ), VR_Q_X};
+    double o[5];
+    OKAY(f->get_real(c, ov, 5, o));
+    CHECK(o[0] == x[X_WZ] && o[2] == x[X_WZ] && fabs(o[1] - x[X_QZ]) < 1e-6 && o[4] == 0.0, "outputs = states");
+    CHECK(fabs(o[3] - tau / iz) <= 1e-15, "der(state_w_z) by value reference");
+    OKAY(f->terminate(c));
+    /* after fmi2Terminate the ME getters are allowed (FMI 2.0 state table), the rest is refused */
+    OKAY(f->get_derivatives(c, dx, NX));
+    OKAY(f->get_states(c, x, NX));
+    me_wrong_state(f, c, NX, "Terminated");
+    REFUSED(f->set_states(c, x, NX), "fmi2SetContinuousStates", "Terminated");
+    f->free_instance(c);
+    return events;
+}
+
+/* serialized FMU state of `s` (freed by the caller) */
+static unsigned char *ser(const Fmi *f, C c, void *s, size_t *n) {
+    OKAY(f->ser_size(c, s, n));
+    unsigned char *b = malloc(*n);
+    OKAY(f->serialize(c, s, (char *)b, *n));
+    return b;
+}
+
+/* a restored ME state is refused or usable: the getters answer OK with finite values or Error */
+static int me_try_state(const Fmi *f, C c, const unsigned char *b, size_t n) {
+    void *s = NULL;
+    last_msg[0] = 0;
+    St st = f->deserialize(c, (const char *)b, n, &s);
+    if (st != OK) {
+        CHECK(st == ERROR && strstr(last_msg, "fmi2DeSerializeFMUstate"), "deserialize: neither OK nor Error with a message");
+        return 0;
+    }
+    CHECK(f->set_state(c, s) == OK, "set an accepted state");
+    double x[NX], dx[NX];
+    St g = f->get_states(c, x, NX);
+    CHECK(g == OK || g == ERROR, "get states after restore");
+    if (g == OK) for (int i = 0; i < NX; i++) CHECK(isfinite(x[i]), "fmi2OK with a non-finite state");
+    g = f->get_derivatives(c, dx, NX);
+    CHECK(g == OK || g == ERROR, "get derivatives after restore");
+    if (g == OK) for (int i = 0; i < NX; i++) CHECK(isfinite(dx[i]), "fmi2OK with a non-finite derivative");
+    St e = f->enter_event_mode(c);
+    CHECK(e == OK || e == ERROR, "enter event mode after restore");
+    if (e == OK) {
+        EventInfo ei;
+        St d = f->new_discrete_states(c, &ei);
+        CHECK(d == OK || d == ERROR, "event iteration after restore");
+        if (d == OK) CHECK(!ei.next_event_time_defined || isfinite(ei.next_event_time), "next event time finite");
+    }
+    CHECK(f->free_state(c, &s) == OK, "free state");
+    return 1;
+}
+
+/* FMU states in event and continuous-time mode, corrupted ones, across ME and CS instances */
+static int me_states(const Fmi *f, int n_fuzz) {
+    C c = instance_of_type(f, "states", 0);
+    unsigned vr[4] = {VR_INIT_W_X, VR_FAULT_TIME, VR_NOISE_STD_X, VR_NOISE_HOLD};
+    double v[4] = {0.05, 0.7071, 1e-3, 0.25};
+    init_with(f, c, vr, v, 4);
+    double tnext, x[NX], dx[NX];
+    void *s_ev = NULL, *s_ct = NULL;
+    OKAY(f->get_state(c, &s_ev)); /* event mode, before the first event iteration */
+    event_iteration(f, c, &tnext);
+    CHECK(tnext == 0.25, "first noise-hold boundary");
+    OKAY(f->enter_ct_mode(c));
+    /* Euler to the fault time 0.7071 through the events at 0.25, 0.5 */
+    OKAY(f->get_states(c, x, NX));
+    double t = 0.0;
+    while (t < 0.7071) {
+        OKAY(f->get_derivatives(c, dx, NX));
+        double t1 = fmin(t + 0.01, tnext);
+        euler_step(f, c, NX, x, dx, t, t1, &tnext);
+        t = t1;
+    }
+    CHECK(t == 0.7071 && tnext == 0.75, "at the fault time, next boundary 0.75");
+    OKAY(f->set_time(c, 0.72));
+    OKAY(f->get_state(c, &s_ct)); /* continuous-time mode at 0.72, last event at 0.7071 */
+    double x_ct[NX], dx_ct[NX];
+    OKAY(f->get_states(c, x_ct, NX));
+    OKAY(f->get_derivatives(c, dx_ct, NX));
+    /* the event-mode state brings event mode back: continuous-time calls are refused again */
+    OKAY(f->set_state(c, s_ev));
+    me_wrong_state(f, c, NX, "EventMode");
+    event_iteration(f, c, &tnext);
+    CHECK(tnext == 0.25, "next event after restoring the initial state");
+    /* the continuous-time state: same states and derivatives, the same last event */
+    OKAY(f->set_state(c, s_ct));
+    OKAY(f->get_states(c, x, NX));
+    OKAY(f->get_derivatives(c, dx, NX));
+    CHECK(!memcmp(x, x_ct, sizeof x) && !memcmp(dx, dx_ct, sizeof dx), "restored states and derivatives");
+    OKAY(f->set_time(c, 0.71));
+    REFUSED(f->set_time(c, 0.70), "fmi2SetTime", "before the last event at t = 0.7071");
+    /* serialize / deserialize (also into a second ME instance, whose own run is elsewhere) */
+    size_t n;
+    unsigned char *b = ser(f, c, s_ct, &n);
+    C c2 = instance_of_type(f, "states2", 0);
+    init_with(f, c2, vr, v, 4);
+    void *s2 = NULL;
+    OKAY(f->deserialize(c2, (const char *)b, n, &s2));
+    OKAY(f->set_state(c2, s2));
+    OKAY(f->get_states(c2, x, NX));
+    OKAY(f->get_derivatives(c2, dx, NX));
+    CHECK(!memcmp(x, x_ct, sizeof x) && !memcmp(dx, dx_ct, sizeof dx), "deserialized states and derivatives");
+    REFUSED(f->set_time(c2, 0.70), "fmi2SetTime", "before the last event at t = 0.7071");
+    OKAY(f->enter_event_mode(c2));
+    OKAY(f->set_time(c2, 0.75));
+    event_iteration(f, c2, &tnext);
+    CHECK(tnext == 1.0, "next event of the restored run");
+    /* a state reused as the target of fmi2GetFMUstate in event mode */
+    OKAY(f->get_state(c2, &s2));
+    REFUSED(f->set_time(c2, 0.74), "fmi2SetTime", "before the last event at t = 0.75");
+    /* a Model Exchange state is refused by a Co-Simulation instance and the other way round */
+    C cs = ready(f, 0);
+    void *s_cs = NULL, *s_x = NULL;
+    OKAY(f->deserialize(cs, (const char *)b, n, &s_x));
+    REFUSED(f->set_state(cs, s_x), "fmi2SetFMUstate", "taken from a Model Exchange instance");
+    OKAY(f->get_state(cs, &s_cs));
+    size_t ncs;
+    unsigned char *bcs = ser(f, cs, s_cs, &ncs);
+    void *s_y = NULL;
+    OKAY(f->deserialize(c, (const char *)bcs, ncs, &s_y));
+    REFUSED(f->set_state(c, s_y), "fmi2SetFMUstate", "taken from a Co-Simulation instance");
+    /* ME calls on the Co-Simulation instance */
+    int a, bb;
+    EventInfo ei;
+    REFUSED(f->set_time(cs, 1.0), "fmi2SetTime", "instantiated for Co-Simulation");
+    REFUSED(f->enter_event_mode(cs), "fmi2EnterEventMode", "instantiated for Co-Simulation");
+    REFUSED(f->new_discrete_states(cs, &ei), "fmi2NewDiscreteStates", "instantiated for Co-Simulation");
+    REFUSED(f->enter_ct_mode(cs), "fmi2EnterContinuousTimeMode", "instantiated for Co-Simulation");
+    REFUSED(f->completed_step(cs, 1, &a, &bb), "fmi2CompletedIntegratorStep", "instantiated for Co-Simulation");
+    REFUSED(f->set_states(cs, x, NX), "fmi2SetContinuousStates", "instantiated for Co-Simulation");
+    REFUSED(f->get_derivatives(cs, dx, NX), "fmi2GetDerivatives", "instantiated for Co-Simulation");
+    REFUSED(f->get_indicators(cs, NULL, 0), "fmi2GetEventIndicators", "instantiated for Co-Simulation");
+    REFUSED(f->get_states(cs, x, NX), "fmi2GetContinuousStates", "instantiated for Co-Simulation");
+    REFUSED(f->get_nominals(cs, x, NX), "fmi2GetNominalsOfContinuousStates", "instantiated for Co-Simulation");
+    free(bcs);
+    f->free_instance(cs); /* s_cs and s_x go with it */
+    /* corrupted serialized states */
+    unsigned char *m = malloc(n);
+    memcpy(m, b, n);
+    m[n / 2] ^= 0x10; /* CRC no longer matches */
+    REFUSED(f->deserialize(c, (const char *)m, n, &s_y), "fmi2DeSerializeFMUstate", "CRC");
+    REFUSED(f->deserialize(c, (const char *)b, n - 1, &s_y), "fmi2DeSerializeFMUstate", "does not match its header");
+    REFUSED(f->deserialize(c, NULL, n, &s_y), "fmi2DeSerializeFMUstate", "NULL");
+    REFUSED(f->deserialize(c, (const char *)b, 0, &s_y), "fmi2DeSerializeFMUstate", "too short");
+    REFUSED(f->deserialize(c, (const char *)b, n, NULL), "fmi2DeSerializeFMUstate", "NULL");
+    /* the time of the last event (0.7071) made NaN or later than the time (0.72), with a valid CRC: refused.
+       Its first copy is the run's (the run precedes the model, whose fault_time is 0.7071 too). */
+    double evil[2] = {NAN, 0.9}, te = 0.7071;
+    size_t at = 0;
+    for (size_t i = 16; i + 8 <= n - 4 && !at; i++)
+        if (!memcmp(b + i, &te, 8)) at = i;
+    CHECK(at, "the time of the last event was not found in the serialized state");
+    for (int k = 0; k < 2; k++) {
+        memcpy(m, b, n);
+        memcpy(m + at, &evil[k], 8);
+        fix_crc(m, n);
+        REFUSED(f->deserialize(c, (const char *)m, n, &s_y), "fmi2DeSerializeFMUstate", "time of the last event");
+    }
+    /* a state of format version 1 (before the time of the last event was stored) */
+    memcpy(m, b, n);
+    m[8] = 1;
+    fix_crc(m, n);
+    REFUSED(f->deserialize(c, (const char *)m, n, &s_y), "fmi2DeSerializeFMUstate", "format version 1");
+    /* random mutations with a valid CRC: refused or usable */
+    int accepted = 0;
+    for (int i = 0; i < n_fuzz; i++) {
+        memcpy(m, b, n);
+        int flips = 1 + (int)(next() % 4);
+        for (int k = 0; k < flips; k++) {
+            size_t pos = 16 + next() % (n - 20);
+            if (next() % 2) m[pos] ^= (unsigned char)(1u << (next() % 8)); else m[pos] = (unsigned char)next();
+        }
+        fix_crc(m, n);
+        accepted += me_try_state(f, c, m, n);
+    }
+    /* freeing: NULL slot, foreign pointer */
+    REFUSED(f->free_state(c, NULL), "fmi2FreeFMUstate", "NULL");
+    void *foreign = m;
+    REFUSED(f->set_state(c, foreign), "fmi2SetFMUstate", "not created by this FMU");
+    OKAY(f->free_state(c, &s_ev));
+    OKAY(f->free_state(c, &s_ev)); /* NULL after the first free: a no-op */
+    free(m);
+    free(b);
+    f->free_instance(c2); /* s2 with it */
+    f->free_instance(c);  /* s_ct with it */
+    return accepted;
+}
+
+/* PdController value references (modelDescription/PdController.xml): inputs q 0-3, w 4-6, output torque_cmd 20-22 */
+enum { LAW_Q_W = 0, LAW_W_X = 4, LAW_TORQUE_X = 20 };
+
+/* the law's inputs at time t: a unit quaternion and a body rate */
+static void law_inputs(double t, double *u) {
+    double a = 0.3 * sin(t), ax[3] = {0.6, -0.48, 0.64};
+    u[0] = cos(a / 2);
+    for (int i = 0; i < 3; i++) u[1 + i] = sin(a / 2) * ax[i];
+    u[4] = 0.1 * sin(2 * t); u[5] = -0.05 * cos(t); u[6] = 0.02;
+}
+
+/* an ME instance of AttitudePlant after a few Euler steps, with FMU states (freed with the instance) */
+static C me_reload_instance(const Fmi *f, double *x) {
+    C c = instance_of_type(f, "reload-me", 0);
+    unsigned vr = VR_INIT_W_X;
+    double w = 0.05, tnext, dx[NX], t = 0.0;
+    init_with(f, c, &vr, &w, 1);
+    event_iteration(f, c, &tnext);
+    OKAY(f->enter_ct_mode(c));
+    OKAY(f->get_states(c, x, NX));
+    for (int k = 0; k < 20; k++, t += 0.01) {
+        OKAY(f->get_derivatives(c, dx, NX));
+        euler_step(f, c, NX, x, dx, t, t + 0.01, &tnext);
+    }
+    void *s = NULL, *s2 = NULL;
+    OKAY(f->get_state(c, &s));
+    size_t n;
+    unsigned char *b = ser(f, c, s, &n);
+    OKAY(f->deserialize(c, (const char *)b, n, &s2));
+    OKAY(f->set_state(c, s2));
+    free(b);
+    return c;
 }
 
 int main(int argc, char **argv) {
@@ -370,6 +877,200 @@ int main(int argc, char **argv) {
         f.free_instance(c);
         dlclose(f.lib);
         printf("ok extreme\n");
+    } else if (!strcmp(mode, "me")) {
+        int n_events = atoi(argv[4]), n_fuzz = atoi(argv[5]);
+        rng = 20261124;
+        Fmi f = load();
+        me_bad_components(&f);
+        /* the life cycle of an ME instance, with the calls each state refuses */
+        C c = instance_of_type(&f, "me", 0);
+        double x[NX], x0[NX], dx[NX], tnext;
+        me_wrong_state(&f, c, NX, "Instantiated");
+        OKAY(f.get_nominals(c, x, NX)); /* allowed before initialization */
+        OKAY(f.setup(c, 0, 0.0, 0.0, 0, 0.0));
+        OKAY(f.enter_init(c));
+        me_wrong_state(&f, c, NX, "InitializationMode");
+        OKAY(f.get_states(c, x, NX));
+        CHECK(x[X_QW] == 1.0, "initial q_w");
+        OKAY(f.get_indicators(c, NULL, 0));
+        OKAY(f.exit_init(c));
+        me_wrong_state(&f, c, NX, "EventMode");
+        REFUSED(f.new_discrete_states(c, NULL), "fmi2NewDiscreteStates", "fmi2EventInfo is NULL");
+        event_iteration(&f, c, &tnext);
+        CHECK(isinf(tnext), "no time event with the default parameters");
+        OKAY(f.enter_ct_mode(c));
+        me_wrong_state(&f, c, NX, "ContinuousTimeMode");
+        me_bad_pointers(&f, c, NX);
+        /* NaN and Inf states and times: refused, the instance unchanged */
+        OKAY(f.get_states(c, x0, NX));
+        memcpy(x, x0, sizeof x);
+        const double bad[3] = {NAN, INFINITY, -INFINITY};
+        const int at[4] = {X_QW, X_QZ, X_WZ, NX - 1};
+        for (int i = 0; i < 3; i++) {
+            for (int k = 0; k < 4; k++) {
+                x[at[k]] = bad[i];
+                REFUSED(f.set_states(c, x, NX), "fmi2SetContinuousStates", "is not finite");
+                x[at[k]] = x0[at[k]];
+            }
+            REFUSED(f.set_time(c, bad[i]), "fmi2SetTime", "is not finite");
+        }
+        OKAY(f.get_states(c, x, NX));
+        CHECK(!memcmp(x, x0, sizeof x), "refused states left the instance unchanged");
+        /* huge finite states: finite derivatives with fmi2OK, or fmi2Error with a message */
+        x[X_WX] = 1e200;
+        x[X_WY] = -1e200;
+        OKAY(f.set_states(c, x, NX));
+        last_msg[0] = 0;
+        St st = f.get_derivatives(c, dx, NX);
+        if (st == OK) for (int i = 0; i < NX; i++) CHECK(isfinite(dx[i]), "fmi2OK with a non-finite derivative");
+        else CHECK(st == ERROR && strstr(last_msg, "fmi2GetDerivatives"), "huge states: neither finite nor a message");
+        OKAY(f.set_states(c, x0, NX));
+        /* time going backwards: behind the accepted point but after the last event is allowed, before it not */
+        OKAY(f.set_time(c, 2.0));
+        OKAY(f.set_time(c, 1.0));
+        REFUSED(f.set_time(c, -0.5), "fmi2SetTime", "before the last event at t = 0");
+        OKAY(f.set_time(c, 2.0));
+        OKAY(f.enter_event_mode(c));
+        event_iteration(&f, c, &tnext);
+        REFUSED(f.set_time(c, 1.5), "fmi2SetTime", "before the last event at t = 2"); /* event mode */
+        OKAY(f.enter_ct_mode(c));
+        REFUSED(f.set_time(c, 1.999), "fmi2SetTime", "before the last event at t = 2");
+        OKAY(f.set_time(c, 2.0 - 1e-12)); /* round-off below the event */
+        OKAY(f.set_time(c, 2.0));
+        /* very many event iterations at one instant, and many event/continuous-time switches */
+        OKAY(f.enter_event_mode(c));
+        OKAY(f.enter_event_mode(c)); /* allowed in event mode */
+        int changed = 0;
+        for (int i = 0; i < n_events; i++) {
+            EventInfo ei;
+            OKAY(f.new_discrete_states(c, &ei));
+            CHECK(!ei.new_discrete_states_needed && !ei.terminate_simulation && !ei.next_event_time_defined, "event info");
+            changed += ei.values_changed;
+        }
+        CHECK(changed <= 1, "the event update keeps changing the states");
+        OKAY(f.enter_ct_mode(c));
+        double t = 2.0;
+        for (int i = 0; i < n_events; i++) {
+            t = 2.0 + (i + 1) * 1e-3;
+            OKAY(f.set_time(c, t));
+            OKAY(f.enter_event_mode(c));
+            event_iteration(&f, c, &tnext);
+            OKAY(f.enter_ct_mode(c));
+        }
+        REFUSED(f.set_time(c, t - 1e-3), "fmi2SetTime", "before the last event");
+        OKAY(f.get_states(c, x, NX));
+        CHECK(!memcmp(x, x0, sizeof x), "event iterations changed a unit quaternion at rest");
+        /* reset: instantiated again, and a new run */
+        OKAY(f.reset(c));
+        me_wrong_state(&f, c, NX, "Instantiated");
+        init_with(&f, c, NULL, NULL, 0);
+        event_iteration(&f, c, &tnext);
+        OKAY(f.enter_ct_mode(c));
+        OKAY(f.set_time(c, 0.0));
+        OKAY(f.terminate(c));
+        REFUSED(f.terminate(c), "fmi2Terminate", "Terminated");
+        f.free_instance(c);
+        int accepted = me_states(&f, n_fuzz);
+        int proj = 0;
+        int events = me_euler_run(&f, 1e-3, 3.0, &proj);
+        CHECK(proj > 10, "no projection events in the Euler run");
+        dlclose(f.lib);
+        printf("ok me: %d refused calls with status and message checked, %d event iterations, %d of %d mutated ME "
+               "states accepted and usable, Euler run with %d events (%d projections)\n", n_checked, 2 * n_events, accepted,
+               n_fuzz, events, proj);
+    } else if (!strcmp(mode, "me-reload")) {
+        int n = atoi(argv[4]);
+        double w0 = 0.0, x0[NX], x[NX];
+        for (int i = 0; i < n; i++) {
+            Fmi f = load();
+            C me = me_reload_instance(&f, x);
+            double w = cycle(&f, 1); /* a Co-Simulation cycle while the ME instance lives */
+            if (i == 0) { w0 = w; memcpy(x0, x, sizeof x); }
+            CHECK(w == w0 && !memcmp(x, x0, sizeof x), "reload not bit-identical");
+            f.free_instance(me);
+            CHECK(dlclose(f.lib) == 0, "dlclose");
+        }
+        printf("ok me-reload %d\n", n);
+    } else if (!strcmp(mode, "me-law")) {
+        int n = atoi(argv[4]);
+        Fmi f = load();
+        me_bad_components(&f);
+        C c = instance_of_type(&f, "law-me", 0);
+        double tnext;
+        me_wrong_state(&f, c, 0, "Instantiated");
+        OKAY(f.get_nominals(c, NULL, 0));
+        OKAY(f.setup(c, 0, 0.0, 0.0, 0, 0.0));
+        OKAY(f.enter_init(c));
+        me_wrong_state(&f, c, 0, "InitializationMode");
+        OKAY(f.get_states(c, NULL, 0));
+        OKAY(f.exit_init(c));
+        me_wrong_state(&f, c, 0, "EventMode");
+        REFUSED(f.new_discrete_states(c, NULL), "fmi2NewDiscreteStates", "fmi2EventInfo is NULL");
+        CHECK(!event_iteration(&f, c, &tnext) && isinf(tnext), "a static law has no events");
+        OKAY(f.enter_ct_mode(c));
+        me_wrong_state(&f, c, 0, "ContinuousTimeMode");
+        me_bad_pointers(&f, c, 0);
+        REFUSED(f.set_time(c, NAN), "fmi2SetTime", "is not finite");
+        /* the same inputs into a Co-Simulation instance: the same outputs, bit for bit */
+        C cs = instance_of_type(&f, "law-cs", 1);
+        init_with(&f, cs, NULL, NULL, 0);
+        unsigned in[7] = {LAW_Q_W, LAW_Q_W + 1, LAW_Q_W + 2, LAW_Q_W + 3, LAW_W_X, LAW_W_X + 1, LAW_W_X + 2};
+        unsigned out[3] = {LAW_TORQUE_X, LAW_TORQUE_X + 1, LAW_TORQUE_X + 2};
+        void *s = NULL;
+        double u[7], y_me[3], y_cs[3], y_saved[3] = {0}, t_saved = 0;
+        for (int i = 0; i < n; i++) {
+            double t = i * 0.01;
+            int enter = -1, term = -1;
+            law_inputs(t, u);
+            OKAY(f.set_time(c, t));
+            OKAY(f.set_real(c, in, 7, u));
+            OKAY(f.set_states(c, NULL, 0));
+            OKAY(f.get_derivatives(c, NULL, 0));
+            OKAY(f.completed_step(c, 1, &enter, &term));
+            CHECK(enter == 0 && term == 0, "a static law asks for no event");
+            OKAY(f.get_real(c, out, 3, y_me));
+            OKAY(f.set_real(cs, in, 7, u));
+            OKAY(f.get_real(cs, out, 3, y_cs));
+            OKAY(f.do_step(cs, t, 0.01, 1));
+            CHECK(!memcmp(y_me, y_cs, sizeof y_me), "ME and CS outputs differ");
+            for (int k = 0; k < 3; k++) CHECK(isfinite(y_me[k]), "finite torque");
+            if (i % 10 == 9) { /* an external event now and then (the inputs changed discontinuously) */
+                OKAY(f.enter_event_mode(c));
+                event_iteration(&f, c, &tnext);
+                OKAY(f.enter_ct_mode(c));
+            }
+            if (i == n / 2) {
+                OKAY(f.get_state(c, &s));
+                memcpy(y_saved, y_me, sizeof y_me);
+                t_saved = t;
+            }
+        }
+        /* FMU state in continuous-time mode: serialized, restored, the same outputs; corrupted: refused */
+        size_t len;
+        unsigned char *b = ser(&f, c, s, &len);
+        void *s2 = NULL;
+        OKAY(f.deserialize(c, (const char *)b, len, &s2));
+        OKAY(f.set_state(c, s2));
+        OKAY(f.get_real(c, out, 3, y_me));
+        CHECK(!memcmp(y_me, y_saved, sizeof y_me), "restored law outputs");
+        REFUSED(f.set_time(c, t_saved - 1.0), "fmi2SetTime", "before the last event");
+        b[len / 2] ^= 1;
+        REFUSED(f.deserialize(c, (const char *)b, len, &s2), "fmi2DeSerializeFMUstate", "CRC");
+        b[len / 2] ^= 1;
+        void *s3 = NULL;
+        OKAY(f.deserialize(cs, (const char *)b, len, &s3));
+        REFUSED(f.set_state(cs, s3), "fmi2SetFMUstate", "taken from a Model Exchange instance");
+        REFUSED(f.set_time(cs, 0.0), "fmi2SetTime", "instantiated for Co-Simulation");
+        REFUSED(f.get_derivatives(cs, NULL, 0), "fmi2GetDerivatives", "instantiated for Co-Simulation");
+        free(b);
+        OKAY(f.terminate(c));
+        OKAY(f.get_derivatives(c, NULL, 0));
+        OKAY(f.get_states(c, NULL, 0));
+        me_wrong_state(&f, c, 0, "Terminated");
+        f.free_instance(cs);
+        f.free_instance(c);
+        dlclose(f.lib);
+        printf("ok me-law: %d refused calls with status and message checked, %d steps equal to Co-Simulation\n", n_checked, n);
     } else {
         fprintf(stderr, "unknown mode %s\n", mode);
         return 2;
