@@ -272,9 +272,12 @@ pub(super) fn free_instance(c: Component, fmi3: bool) {
     });
     let mut live = live_instances();
     if live.is_empty() {
-        // the last instance: give the set's memory back and remove the panic hook
+        // the last instance: give the set's memory back and remove the panic hook (not while the
+        // calling thread unwinds: take_hook panics then, which would abort inside extern "C")
         live.shrink_to_fit();
-        drop(std::panic::take_hook());
+        if !std::thread::panicking() {
+            drop(std::panic::take_hook());
+        }
     }
 }
 
