@@ -67,7 +67,7 @@ pub(crate) fn bound_str(kind: VarKind, v: f64) -> String {
 }
 
 /// 1-based indices (position in ModelVariables) of the inputs the output `out` depends on directly.
-fn output_dependencies(entry: &ModelEntry, out: &VarDecl) -> Vec<usize> {
+pub fn output_dependencies(entry: &ModelEntry, out: &VarDecl) -> Vec<usize> {
     let index_of = |name: &str| {
         entry
             .decls
