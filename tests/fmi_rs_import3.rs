@@ -27,7 +27,10 @@ fn fmu3_file(model: &str) -> PathBuf {
 /// vector and the trajectories of `outputs` (Float64 variables), by name.
 fn simulate3(fmu: &Path, stop: f64, dt: f64, start: &[(&str, &str)], outputs: &[&str]) -> (Vec<f64>, HashMap<String, Vec<f64>>) {
     let stem = fmu.file_stem().unwrap().to_string_lossy().to_string();
-    let dir = std::env::temp_dir().join(format!("scfmu_fmirs3_{}_{}", std::process::id(), stem));
+    // one directory per call: tests run in parallel and two of them simulate the same model
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("scfmu_fmirs3_{}_{}_{call}", std::process::id(), stem));
     let _ = std::fs::remove_dir_all(&dir);
     fmi_rs::zip::extract_zip_archive(fmu, &dir).expect("unzip");
     let md = Arc::new(ModelDescription::from_path(&dir.join("modelDescription.xml")).expect("modelDescription"));
@@ -128,7 +131,7 @@ fn fmi3_attitude_plant_rate_under_constant_torque_matches_closed_form() {
 /// with ω × Jω = 0 about a principal axis, so ω̇_z = τ/I_z.
 #[test]
 fn fmi_rs_drives_an_fmi3_model_exchange_instance_and_the_derivatives_follow_the_closed_form() {
-    use fmi_rs::fmi3::fmi3Status;
+    use fmi_rs::fmi3::types::fmi3Status;
     use fmi_rs::fmi3::log::DefaultLogger;
     use fmi_rs::fmi3::native::NativeLibrary;
     use fmi_rs::fmi3::{Implementation, FMU3};
