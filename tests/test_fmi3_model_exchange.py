@@ -463,3 +463,32 @@ def test_co_simulation_keeps_refusing_event_mode(tmp_path):
         err(cs, cs.s.fmi3UpdateDiscreteStates, *[byref(b) for b in bs], byref(t), contains="has no Event Mode")
     finally:
         cs.close()
+
+
+def test_directional_derivatives_of_state_derivatives_follow_the_rigid_body(me):
+    """providesDirectionalDerivatives = true in <ModelExchange>: the Jacobian entries a stiff solver asks
+    for, against the rigid body by hand. At q = (cos(a/2), 0, 0, sin(a/2)), w = (0, 0, w_z) with J diagonal:
+    d(w_z')/d(tau_z) = 1/I_z, d(q_w')/d(w_z) = -q_z/2, d(q_z')/d(w_z) = q_w/2, d(w_x')/d(w_y) = (I_y - I_z) w_z / I_x."""
+    ix, iy, iz = 1000.0, 500.0, 700.0
+    a, wz = 0.7, 0.03
+    me.to_continuous_time()
+    n = me.n
+    x = (c_double * n)()
+    me.s.getContinuousStates(x, n)
+    order = [u.variable.derivative.name for u in me.md.derivatives]
+    x[order.index("state_att_1")], x[order.index("state_att_4")] = math.cos(a / 2), math.sin(a / 2)
+    x[order.index("state_w_z")] = wz
+    me.s.setTime(1.0)
+    me.s.setContinuousStates(x, n)
+    v = me.vr
+    d = me.s.getDirectionalDerivative([v["der(state_w_z)"]], [v["torque_cmd_z"]], [1.0])
+    assert d[0] == pytest.approx(1 / iz, rel=1e-9)
+    d = me.s.getDirectionalDerivative([v["der(state_att_1)"], v["der(state_att_4)"], v["der(state_w_x)"]], [v["state_w_z"]], [1.0])
+    assert d[:2] == pytest.approx([-math.sin(a / 2) / 2, math.cos(a / 2) / 2], rel=1e-8)
+    assert abs(d[2]) < 1e-12
+    d = me.s.getDirectionalDerivative([v["der(state_w_x)"]], [v["state_w_y"]], [1.0])
+    assert d[0] == pytest.approx((iy - iz) * wz / ix, rel=1e-7)
+    # outputs with respect to states: w_z is the state itself
+    assert me.s.getDirectionalDerivative([v["w_z"]], [v["state_w_z"]], [2.0]) == pytest.approx([2.0], rel=1e-9)
+    err(me, me.s.fmi3GetDirectionalDerivative, vrs(v["state_w_z"]), 1, vrs(v["state_w_x"]), 1, f64(1.0), 1, f64(0.0), 1,
+        contains="is neither a Float64 output nor a state derivative")

@@ -73,7 +73,11 @@ pub extern "C" fn fmi3GetDirectionalDerivative(
         let knowns = unsafe { slice(knowns, n_knowns, "knowns[]")? };
         let seed = unsafe { slice(seed, n_seed, "seed[]")? };
         let out = unsafe { slice_mut(sensitivity, n_sensitivity, "sensitivity[]")? };
-        let d = inst.directional_derivative(unknowns, knowns, seed)?;
+        let d = if inst.model_exchange {
+            super::fmi3_me::directional_derivative_me(inst, unknowns, knowns, seed)?
+        } else {
+            inst.directional_derivative(unknowns, knowns, seed)?
+        };
         out.copy_from_slice(&d);
         Ok(())
     })
