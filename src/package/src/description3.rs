@@ -243,4 +243,32 @@ mod tests {
             assert_ne!(d.vr, TIME_VR);
         }
     }
+
+    /// Model Exchange in FMI 3.0 follows the declarations: a `<ModelExchange>` element, a Float64 per state
+    /// and per derivative (whose `derivative` is the state's value reference) and a
+    /// `<ContinuousStateDerivative>` per state exactly for the models that declare states; none otherwise.
+    #[test]
+    fn model_exchange_elements_follow_the_declared_states() {
+        for e in spacecraft_fmus::registry::ALL {
+            let x = model_description3(e, "{token}", &crate::description::project_package());
+            let n = e.state_decls().len();
+            assert_eq!(x.contains("<ModelExchange "), e.model_exchange(), "{}", e.info.name);
+            assert_eq!(x.matches("<ContinuousStateDerivative ").count(), n, "{}", e.info.name);
+            for (k, s) in e.state_decls().iter().enumerate() {
+                let (svr, dvr) = (STATE_VR_BASE + k as u32, DERIVATIVE_VR_BASE + k as u32);
+                assert!(x.contains(&format!(r#"name="{}" valueReference="{svr}""#, s.name)), "{}", s.name);
+                assert!(x.contains(&format!(r#"name="der({})" valueReference="{dvr}""#, s.name)), "{}", s.name);
+                assert!(x.contains(&format!(r#"derivative="{svr}"/>"#)), "{}", s.name);
+                assert!(x.contains(&format!(r#"<InitialUnknown valueReference="{svr}""#)) && x.contains(&format!(r#"<InitialUnknown valueReference="{dvr}""#)));
+            }
+            // the schema's order of the ModelStructure elements
+            let (o, c, i) = (x.rfind("<Output "), x.find("<ContinuousStateDerivative "), x.find("<InitialUnknown "));
+            if let (Some(o), Some(c)) = (o, c) {
+                assert!(o < c, "{}", e.info.name);
+            }
+            if let (Some(c), Some(i)) = (c, i) {
+                assert!(c < i, "{}", e.info.name);
+            }
+        }
+    }
 }
