@@ -11,7 +11,7 @@
 //!
 //! A Model Exchange function called on a Co-Simulation instance is refused (fmi3Error, with a message
 //! saying so), as is a Co-Simulation function on a Model Exchange instance.
-#![allow(non_snake_case, clippy::missing_safety_doc, clippy::not_unsafe_ptr_arg_deref)]
+#![allow(non_snake_case, clippy::missing_safety_doc, clippy::not_unsafe_ptr_arg_deref, clippy::too_many_arguments)]
 
 use std::ffi::{c_char, c_int, c_void, CStr};
 
@@ -141,7 +141,6 @@ pub(super) fn enter_event_mode(c: Instance3) -> c_int {
 }
 
 /// `fmi3UpdateDiscreteStates` on a Model Exchange instance: one pass of the event iteration.
-#[allow(clippy::too_many_arguments)]
 pub(super) fn update_discrete_states(
     c: Instance3,
     discrete_states_need_update: *mut u8,
