@@ -23,7 +23,7 @@ macro_rules! __export_fmi3 {
                 f3::fmi3InstantiateCoSimulation($models, name, token, resources, visible, logging_on, event_mode_used, early_return_allowed, required, n_required, env, log, update)
             }
             #[no_mangle] pub extern "C" fn fmi3InstantiateModelExchange(name: *const c_char, token: *const c_char, resources: *const c_char, visible: u8, logging_on: u8, env: *mut c_void, log: Log3) -> Inst3 {
-                f3m::fmi3InstantiateModelExchange(name, token, resources, visible, logging_on, env, log)
+                f3m::fmi3InstantiateModelExchange($models, name, token, resources, visible, logging_on, env, log)
             }
             #[no_mangle] pub extern "C" fn fmi3InstantiateScheduledExecution(name: *const c_char, token: *const c_char, resources: *const c_char, visible: u8, logging_on: u8, env: *mut c_void, log: Log3,
                 clock_update: *const c_void, lock: *const c_void, unlock: *const c_void) -> Inst3 {

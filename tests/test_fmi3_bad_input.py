@@ -191,7 +191,11 @@ def test_unsupported_functions_error_with_reason(fmu):
     fmu.s.fmi3Reset(fmu.c)
     n = c_size_t(99)
     assert status(fmu.s.fmi3GetNumberOfVariableDependencies, fmu.c, fmu.vr["w_x"], byref(n)) == OK
-    assert n.value == 0  # AttitudePlant: no direct feed-through
+    # AttitudePlant: no direct feed-through from an input; with Model Exchange its outputs depend on its 18
+    # continuous states, the list <Output dependencies> of the description gives too
+    out = next(u for u in fmu.md.outputs if u.variable.name == "w_x")
+    assert n.value == 18 == len(out.dependencies)
+    assert all(v.causality == "local" and v.name.startswith("state_") for v in out.dependencies)
 
 
 def test_fmu_state_round_trip(fmu):

@@ -1,7 +1,8 @@
 """The FMI 3.0 entry points against a hostile C master (tests/hostile/fmi3_hostile.c, compiled here with
 gcc, loading the binary of fmus/fmi3/AttitudePlant.fmu with dlopen): NULL and foreign pointers, wrong
 states, NaN, odd bool bytes, wrong counts, corrupted FMU states and every refused function give the
-prescribed status and a message naming the function; FMI 2.0 and 3.0 instances of one library coexist
+prescribed status and a message naming the function, on the Co-Simulation and on the Model Exchange
+entry points; FMI 2.0 and 3.0 instances of one library coexist
 and agree bit for bit; under valgrind memcheck there is no invalid access and nothing leaks per instance
 (the leak checks per library load are in tests/test_hardening.py)."""
 
@@ -64,14 +65,22 @@ def test_fmi2_and_fmi3_instances_coexist_and_agree(hostile3):
     run(hostile3, "mixed")
 
 
-def test_abuse_and_mixed_under_valgrind_have_no_memory_errors(hostile3):
-    for mode in ("abuse", "mixed"):
+def test_model_exchange_abuse_gives_prescribed_statuses_and_the_closed_form(hostile3):
+    p = run(hostile3, "me")
+    assert int(re.search(r"\((\d+) log messages\)", p.stdout).group(1)) >= 50
+    # explicit Euler over 100 steps of 0.01 s under 0.4 N m about the principal axis x: w_x = tau t / I_xx
+    assert float(p.stdout.split("w_x=")[1]) == pytest.approx(0.4 * 1.0 / 1000.0, abs=1e-14)
+
+
+def test_abuse_mixed_and_model_exchange_under_valgrind_have_no_memory_errors(hostile3):
+    for mode in ("abuse", "mixed", "me"):
         p = run(hostile3, mode, valgrind=True, timeout=600)
         assert "ERROR SUMMARY: 0 errors" in p.stderr, p.stderr[-2000:]
 
 
 def test_cycles_are_bit_identical_and_leak_nothing_per_instance(hostile3):
-    """5 and 60 instantiate/step/state/serialize/free cycles leave the same heap behind: whatever the
+    """5 and 60 instantiate/step/state/serialize/free cycles (each with a Model Exchange instance freed
+    while it holds an FMU state) leave the same heap behind: whatever the
     library keeps per load, nothing is lost per instance or per FMU state."""
     few = run(hostile3, "cycles", 5, valgrind=True, timeout=600)
     many = run(hostile3, "cycles", 60, valgrind=True, timeout=600)

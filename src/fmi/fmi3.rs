@@ -41,14 +41,15 @@ pub mod mask3 {
         }
         bits
     }
+    // Event Mode and Continuous-Time Mode are reached by Model Exchange instances only (`fmi3_me`).
     /// Every state but Fatal (the super state "FMU State Settable" plus Terminated).
-    pub const ANY: u16 = m(&[Instantiated, InitializationMode, StepComplete, Terminated]);
+    pub const ANY: u16 = m(&[Instantiated, InitializationMode, StepComplete, Terminated, EventMode, ContinuousTimeMode]);
     pub const ENTER_INITIALIZATION_MODE: u16 = m(&[Instantiated]);
     pub const EXIT_INITIALIZATION_MODE: u16 = m(&[InitializationMode]);
-    pub const TERMINATE: u16 = m(&[StepComplete]);
-    pub const GET: u16 = m(&[InitializationMode, StepComplete, Terminated]);
-    pub const SET: u16 = m(&[Instantiated, InitializationMode, StepComplete]);
-    pub const DIRECTIONAL_DERIVATIVE: u16 = m(&[InitializationMode, StepComplete, Terminated]);
+    pub const TERMINATE: u16 = m(&[StepComplete, EventMode, ContinuousTimeMode]);
+    pub const GET: u16 = m(&[InitializationMode, StepComplete, Terminated, EventMode, ContinuousTimeMode]);
+    pub const SET: u16 = m(&[Instantiated, InitializationMode, StepComplete, EventMode, ContinuousTimeMode]);
+    pub const DIRECTIONAL_DERIVATIVE: u16 = m(&[InitializationMode, StepComplete, Terminated, EventMode, ContinuousTimeMode]);
     pub const DO_STEP: u16 = m(&[StepComplete]);
     pub const OUTPUT_DERIVATIVES: u16 = m(&[StepComplete, Terminated]);
 }
@@ -81,7 +82,7 @@ pub(super) fn call3(c: Instance3, func: &str, allowed: u16, f: impl FnOnce(&mut 
                 Status::Error => inst.run.fsm = FsmState::Terminated,
                 _ => {}
             }
-            let reason = fail.reason.replace("fmi2SetupExperiment", "fmi3EnterInitializationMode");
+            let reason = fail.reason.replace("fmi2SetupExperiment", "fmi3EnterInitializationMode").replace("fmi2SetContinuousStates", "fmi3SetContinuousStates");
             inst.log_fail(func, &Fail { status: fail.status, reason });
             fail.status as c_int
         }
@@ -245,8 +246,9 @@ fn set3<T: Copy>(c: Instance3, func: &str, kind: VarKind, vr: *const u32, n: usi
         let vrs = unsafe { slice(vr, n, "valueReferences[]")? };
         let vals = unsafe { slice(value, n, "values[]")? };
         if vrs.contains(&TIME_VR) {
-            return Err(Fail::error(format!("value reference {TIME_VR} is time, the independent variable: it cannot be set (it advances with fmi3DoStep)")));
+            return Err(Fail::error(time_not_settable(inst)));
         }
+        super::fmi3_me::refuse_discrete_in_continuous_time(inst, kind_name3(kind), vrs)?;
         inst.set_values(kind, vrs, |i| conv(vals[i]))
     })
 }
@@ -273,8 +275,33 @@ pub extern "C" fn fmi3GetFloat64(c: Instance3, vr: *const u32, n: usize, value: 
     })
 }
 
+fn time_not_settable(inst: &Instance) -> String {
+    let how = if inst.model_exchange { "it is set with fmi3SetTime" } else { "it advances with fmi3DoStep" };
+    format!("value reference {TIME_VR} is time, the independent variable: it cannot be set ({how})")
+}
+
+fn kind_name3(kind: VarKind) -> &'static str {
+    match kind {
+        VarKind::Real => "Float64",
+        VarKind::Integer => "Int32",
+        VarKind::Boolean => "Boolean",
+    }
+}
+
 pub extern "C" fn fmi3SetFloat64(c: Instance3, vr: *const u32, n: usize, value: *const f64, nv: usize) -> c_int {
-    set3(c, "fmi3SetFloat64", VarKind::Real, vr, n, value, nv, Value::Real)
+    call3(c, "fmi3SetFloat64", mask3::SET, |inst| {
+        scalar_count(n, nv)?;
+        let vrs = unsafe { slice(vr, n, "valueReferences[]")? };
+        let vals = unsafe { slice(value, n, "values[]")? };
+        if vrs.contains(&TIME_VR) {
+            return Err(Fail::error(time_not_settable(inst)));
+        }
+        if inst.model_exchange && matches!(inst.run.fsm, FsmState::EventMode | FsmState::ContinuousTimeMode) {
+            // continuous states can be set by value reference; in Continuous-Time Mode only they and continuous inputs
+            return super::fmi3_me::set_float64_me(inst, vrs, vals);
+        }
+        inst.set_values(VarKind::Real, vrs, |i| Value::Real(vals[i]))
+    })
 }
 
 pub extern "C" fn fmi3GetInt32(c: Instance3, vr: *const u32, n: usize, value: *mut i32, nv: usize) -> c_int {
@@ -306,7 +333,11 @@ pub extern "C" fn fmi3DoStep(
     early_return: *mut u8,
     last_successful_time: *mut f64,
 ) -> c_int {
-    call3(c, "fmi3DoStep", mask3::DO_STEP, |inst| {
+    call3(c, "fmi3DoStep", mask3::ANY, |inst| {
+        super::fmi3_me::require_co_simulation(inst)?;
+        if mask3::DO_STEP & inst.run.fsm.bit() == 0 {
+            return Err(Fail::error(format!("not allowed in state {} (illegal call sequence)", state_name(inst.run.fsm))));
+        }
         inst.trace(|| format!("fmi3DoStep(currentCommunicationPoint={t}, communicationStepSize={h})"));
         let ev = out_ptr(event_handling_needed, "eventHandlingNeeded")?;
         let term = out_ptr(terminate_simulation, "terminateSimulation")?;

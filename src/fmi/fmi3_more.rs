@@ -11,7 +11,7 @@ use super::abi::{out_ptr, slice, slice_mut};
 use super::fmi3::{call3, log_without_instance3, mask3, Instance3};
 use super::instance::{CallResult, Fail, Log3Fn};
 use super::state_calls;
-use crate::model::{Causality, Feedthrough, ModelEntry};
+use crate::model::{Causality, Feedthrough, ModelEntry, STATE_VR_BASE};
 
 // ----- FMU state ------------------------------------------------------------------------------------
 
@@ -20,6 +20,7 @@ pub extern "C" fn fmi3GetFMUState(c: Instance3, state: *mut *mut c_void) -> c_in
 }
 
 pub extern "C" fn fmi3SetFMUState(c: Instance3, state: *mut c_void) -> c_int {
+    // the state carries the time of its last event (Model Exchange), restored with it
     call3(c, "fmi3SetFMUState", mask3::ANY, |inst| state_calls::set(inst, state))
 }
 
@@ -68,7 +69,11 @@ pub extern "C" fn fmi3GetDirectionalDerivative(
         let knowns = unsafe { slice(knowns, n_knowns, "knowns[]")? };
         let seed = unsafe { slice(seed, n_seed, "seed[]")? };
         let out = unsafe { slice_mut(sensitivity, n_sensitivity, "sensitivity[]")? };
-        let d = inst.directional_derivative(unknowns, knowns, seed)?;
+        let d = if inst.model_exchange {
+            super::fmi3_me::directional_derivative_me(inst, unknowns, knowns, seed)?
+        } else {
+            inst.directional_derivative(unknowns, knowns, seed)?
+        };
         out.copy_from_slice(&d);
         Ok(())
     })
@@ -88,9 +93,18 @@ pub fn output_dependency_vrs(entry: &ModelEntry, output: &str) -> Vec<u32> {
     }
 }
 
+/// The knowns an output depends on after initialization (`<Output dependencies>` in the FMI 3.0 model
+/// description): the inputs it feeds through from and, for a model with Model Exchange, every
+/// continuous state (value references from [`STATE_VR_BASE`]).
+pub fn output_dependencies_with_states(entry: &ModelEntry, output: &str) -> Vec<u32> {
+    let mut deps = output_dependency_vrs(entry, output);
+    deps.extend((0..entry.state_decls().len() as u32).map(|k| STATE_VR_BASE + k));
+    deps
+}
+
 fn output_dependencies(inst: &super::instance::Instance, vr: u32) -> CallResult<Vec<u32>> {
     match inst.entry.decls.iter().find(|d| d.vr == vr) {
-        Some(d) if d.causality == Causality::Output => Ok(output_dependency_vrs(inst.entry, d.name)),
+        Some(d) if d.causality == Causality::Output => Ok(output_dependencies_with_states(inst.entry, d.name)),
         Some(d) => Err(Fail::error(format!("{} (value reference {vr}) is not an output: dependencies are declared for outputs only", d.name))),
         None => Err(Fail::error(format!("unknown value reference {vr}"))),
     }
@@ -150,8 +164,18 @@ pub extern "C" fn fmi3ExitConfigurationMode(c: Instance3) -> c_int {
     refuse(c, "fmi3ExitConfigurationMode", mask3::ANY, "this FMU has no structural parameters (Configuration Mode is never entered)")
 }
 
+/// Model Exchange: from Continuous-Time Mode to Event Mode. Co-Simulation: refused (no Event Mode).
 pub extern "C" fn fmi3EnterEventMode(c: Instance3) -> c_int {
+    if is_model_exchange(c) {
+        return super::fmi3_me::enter_event_mode(c);
+    }
     refuse(c, "fmi3EnterEventMode", mask3::ANY, "hasEventMode = false (instantiate with eventModeUsed = false)")
+}
+
+/// Whether `c` is a live FMI 3.0 Model Exchange instance (the functions both interfaces share pick their
+/// rules by it; anything else goes the Co-Simulation way, which refuses unknown pointers).
+fn is_model_exchange(c: Instance3) -> bool {
+    super::abi::instance_of(c, true).is_some_and(|inst| inst.model_exchange)
 }
 
 pub extern "C" fn fmi3EnterStepMode(c: Instance3) -> c_int {
@@ -163,10 +187,17 @@ pub extern "C" fn fmi3GetOutputDerivatives(c: Instance3, _vr: *const u32, _n: us
 }
 
 pub extern "C" fn fmi3EvaluateDiscreteStates(c: Instance3) -> c_int {
+    if is_model_exchange(c) {
+        return refuse(c, "fmi3EvaluateDiscreteStates", mask3::ANY, "providesEvaluateDiscreteStates = false (fmi3UpdateDiscreteStates evaluates them)");
+    }
     refuse(c, "fmi3EvaluateDiscreteStates", mask3::ANY, "this Co-Simulation FMU has no Event Mode")
 }
 
-pub extern "C" fn fmi3UpdateDiscreteStates(c: Instance3, _a: *mut u8, _b: *mut u8, _nominals_changed: *mut u8, _d: *mut u8, _e: *mut u8, _t: *mut f64) -> c_int {
+/// Model Exchange: one pass of the event iteration. Co-Simulation: refused (no Event Mode).
+pub extern "C" fn fmi3UpdateDiscreteStates(c: Instance3, need: *mut u8, terminate: *mut u8, nominals_changed: *mut u8, values_changed: *mut u8, defined: *mut u8, t: *mut f64) -> c_int {
+    if is_model_exchange(c) {
+        return super::fmi3_me::update_discrete_states(c, need, terminate, nominals_changed, values_changed, defined, t);
+    }
     refuse(c, "fmi3UpdateDiscreteStates", mask3::ANY, "this Co-Simulation FMU has no Event Mode")
 }
 
@@ -253,20 +284,13 @@ pub extern "C" fn fmi3SetShiftFraction(c: Instance3, vr: *const u32, n: usize, _
     no_such_type(c, "fmi3SetShiftFraction", mask3::ANY, "Clock", vr, n)
 }
 
-// ----- Model Exchange and Scheduled Execution: not provided -----------------------------------------
+// ----- Model Exchange (in `fmi3_me`) and Scheduled Execution (not provided) ------------------------
 
-pub extern "C" fn fmi3InstantiateModelExchange(
-    _name: *const c_char,
-    _token: *const c_char,
-    _resources: *const c_char,
-    _visible: u8,
-    _logging_on: u8,
-    env: *mut c_void,
-    log_message: Option<Log3Fn>,
-) -> Instance3 {
-    log_without_instance3(log_message, env, "fmi3InstantiateModelExchange", "this FMU provides Co-Simulation only (no <ModelExchange> element)");
-    std::ptr::null_mut()
-}
+pub use super::fmi3_me::{
+    fmi3CompletedIntegratorStep, fmi3EnterContinuousTimeMode, fmi3GetContinuousStateDerivatives, fmi3GetContinuousStates, fmi3GetEventIndicators,
+    fmi3GetNominalsOfContinuousStates, fmi3GetNumberOfContinuousStates, fmi3GetNumberOfEventIndicators, fmi3InstantiateModelExchange, fmi3SetContinuousStates,
+    fmi3SetTime,
+};
 
 pub extern "C" fn fmi3InstantiateScheduledExecution(
     _name: *const c_char,
@@ -280,50 +304,8 @@ pub extern "C" fn fmi3InstantiateScheduledExecution(
     _lock: *const c_void,
     _unlock: *const c_void,
 ) -> Instance3 {
-    log_without_instance3(log_message, env, "fmi3InstantiateScheduledExecution", "this FMU provides Co-Simulation only (no <ScheduledExecution> element)");
+    log_without_instance3(log_message, env, "fmi3InstantiateScheduledExecution", "this FMU provides no Scheduled Execution (no <ScheduledExecution> element)");
     std::ptr::null_mut()
-}
-
-const ME_ONLY: &str = "Model Exchange function; this FMU provides Co-Simulation only";
-
-pub extern "C" fn fmi3EnterContinuousTimeMode(c: Instance3) -> c_int {
-    refuse(c, "fmi3EnterContinuousTimeMode", mask3::ANY, ME_ONLY)
-}
-
-pub extern "C" fn fmi3CompletedIntegratorStep(c: Instance3, _no_prior: u8, _enter_event: *mut u8, _terminate: *mut u8) -> c_int {
-    refuse(c, "fmi3CompletedIntegratorStep", mask3::ANY, ME_ONLY)
-}
-
-pub extern "C" fn fmi3SetTime(c: Instance3, _t: f64) -> c_int {
-    refuse(c, "fmi3SetTime", mask3::ANY, ME_ONLY)
-}
-
-pub extern "C" fn fmi3SetContinuousStates(c: Instance3, _x: *const f64, _n: usize) -> c_int {
-    refuse(c, "fmi3SetContinuousStates", mask3::ANY, ME_ONLY)
-}
-
-pub extern "C" fn fmi3GetContinuousStateDerivatives(c: Instance3, _dx: *mut f64, _n: usize) -> c_int {
-    refuse(c, "fmi3GetContinuousStateDerivatives", mask3::ANY, ME_ONLY)
-}
-
-pub extern "C" fn fmi3GetEventIndicators(c: Instance3, _z: *mut f64, _n: usize) -> c_int {
-    refuse(c, "fmi3GetEventIndicators", mask3::ANY, ME_ONLY)
-}
-
-pub extern "C" fn fmi3GetContinuousStates(c: Instance3, _x: *mut f64, _n: usize) -> c_int {
-    refuse(c, "fmi3GetContinuousStates", mask3::ANY, ME_ONLY)
-}
-
-pub extern "C" fn fmi3GetNominalsOfContinuousStates(c: Instance3, _x: *mut f64, _n: usize) -> c_int {
-    refuse(c, "fmi3GetNominalsOfContinuousStates", mask3::ANY, ME_ONLY)
-}
-
-pub extern "C" fn fmi3GetNumberOfEventIndicators(c: Instance3, _n: *mut usize) -> c_int {
-    refuse(c, "fmi3GetNumberOfEventIndicators", mask3::ANY, ME_ONLY)
-}
-
-pub extern "C" fn fmi3GetNumberOfContinuousStates(c: Instance3, _n: *mut usize) -> c_int {
-    refuse(c, "fmi3GetNumberOfContinuousStates", mask3::ANY, ME_ONLY)
 }
 
 pub extern "C" fn fmi3ActivateModelPartition(c: Instance3, _clock: u32, _t: f64) -> c_int {

@@ -6,6 +6,7 @@ pub mod abi;
 mod abi_me;
 mod abi_more;
 pub mod fmi3;
+pub mod fmi3_me;
 pub mod fmi3_more;
 #[cfg(test)]
 mod fmi3_tests;

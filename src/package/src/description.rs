@@ -67,7 +67,7 @@ pub(crate) fn bound_str(kind: VarKind, v: f64) -> String {
 }
 
 /// 1-based indices (position in ModelVariables) of the inputs the output `out` depends on directly.
-fn output_dependencies(entry: &ModelEntry, out: &VarDecl) -> Vec<usize> {
+pub fn output_dependencies(entry: &ModelEntry, out: &VarDecl) -> Vec<usize> {
     let index_of = |name: &str| {
         entry
             .decls
@@ -572,9 +572,9 @@ pub(crate) const VARIABLE_SECTIONS: [(&str, Causality); 5] = [
 /// Which FMI interfaces a model offers, in one sentence (model pages and documentation/index.html).
 pub fn interfaces_text(entry: &ModelEntry) -> String {
     match entry.states {
-        Some([]) => "FMI 2.0 Model Exchange (a static law: no continuous state) and Co-Simulation; FMI 3.0 Co-Simulation.".into(),
+        Some([]) => "FMI 2.0 and FMI 3.0 Model Exchange (a static law: no continuous state) and Co-Simulation.".into(),
         Some(states) => format!(
-            "FMI 2.0 Model Exchange ({} continuous states: {}) and Co-Simulation; FMI 3.0 Co-Simulation.",
+            "FMI 2.0 and FMI 3.0 Model Exchange ({} continuous states: {}) and Co-Simulation.",
             states.len(),
             states.iter().map(|x| x.name).collect::<Vec<_>>().join(", ")
         ),
