@@ -24,16 +24,8 @@ use crate::model::{Causality, ModelEntry, Value, VarKind, Variability};
 
 /// Sets of states in which an FMI 3.0 Model Exchange function may be called.
 pub mod mask3me {
-    use super::FsmState::{self, *};
-    const fn m(states: &[FsmState]) -> u16 {
-        let mut bits = 0;
-        let mut i = 0;
-        while i < states.len() {
-            bits |= states[i].bit();
-            i += 1;
-        }
-        bits
-    }
+    use super::FsmState::*;
+    use crate::fmi::mask_of as m;
     /// `fmi3EnterEventMode`: from Continuous-Time Mode (FMI 3.0 section 3.2.1).
     pub const ENTER_EVENT_MODE: u16 = m(&[ContinuousTimeMode]);
     /// `fmi3UpdateDiscreteStates`, `fmi3EnterContinuousTimeMode`: Event Mode only.
