@@ -235,6 +235,31 @@ def test_paper000_adaptive_runs_with_every_unit_as_model_exchange_give_the_co_si
     assert np.max(np.abs(cs["torque_applied_x"] - me["torque_applied_x"])) <= 1e-5 * tau
 
 
+def test_directional_derivatives_of_the_state_derivatives_follow_the_rigid_body_jacobian():
+    """fmi2GetDirectionalDerivative on an ME instance takes states as knowns and derivatives as unknowns
+    (providesDirectionalDerivative): at rest with identity attitude, d(w_z')/d(torque_cmd_z) = 1/I_z,
+    d(q_x')/d(w_x) = q_w / 2 = 0.5 and d(q_w')/d(w_x) = -q_x / 2 = 0."""
+    md = read_model_description(path("AttitudePlant"))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    m = FMU2Model(guid=md.guid, unzipDirectory=extract(path("AttitudePlant")), modelIdentifier="AttitudePlant",
+                  instanceName="jac")
+    m.instantiate()
+    try:
+        m.setupExperiment(startTime=0.0)
+        m.enterInitializationMode()
+        m.exitInitializationMode()
+        m.newDiscreteStates()
+        m.enterContinuousTimeMode()
+        d = m.getDirectionalDerivative([vr["der(state_w_z)"], vr["der(state_att_2)"], vr["der(state_att_1)"]],
+                                       [vr["torque_cmd_z"]], [1.0])
+        assert abs(d[0] - 1 / 700.0) < 1e-9 and d[1] == 0.0 and d[2] == 0.0
+        d = m.getDirectionalDerivative([vr["der(state_att_2)"], vr["der(state_att_1)"]], [vr["state_w_x"]], [1.0])
+        assert abs(d[0] - 0.5) < 1e-9 and abs(d[1]) < 1e-12
+    finally:
+        m.terminate()
+        m.freeInstance()
+
+
 def test_metrics_as_model_exchange_integrate_constant_inputs_exactly():
     # q = rotation of 30 deg about z, q_ref = identity: alpha = 30 deg, yaw error = -30 deg
     c, s_ = np.cos(np.radians(15)), np.sin(np.radians(15))

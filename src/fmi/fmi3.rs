@@ -31,16 +31,8 @@ const VERSION: &CStr = c"3.0";
 
 /// Sets of states in which an FMI 3.0 Co-Simulation function may be called.
 pub mod mask3 {
-    use super::FsmState::{self, *};
-    const fn m(states: &[FsmState]) -> u16 {
-        let mut bits = 0;
-        let mut i = 0;
-        while i < states.len() {
-            bits |= states[i].bit();
-            i += 1;
-        }
-        bits
-    }
+    use super::FsmState::*;
+    use crate::fmi::mask_of as m;
     // Event Mode and Continuous-Time Mode are reached by Model Exchange instances only (`fmi3_me`).
     /// Every state but Fatal (the super state "FMU State Settable" plus Terminated).
     pub const ANY: u16 = m(&[Instantiated, InitializationMode, StepComplete, Terminated, EventMode, ContinuousTimeMode]);

@@ -70,7 +70,7 @@ pub extern "C" fn fmi3GetDirectionalDerivative(
         let seed = unsafe { slice(seed, n_seed, "seed[]")? };
         let out = unsafe { slice_mut(sensitivity, n_sensitivity, "sensitivity[]")? };
         let d = if inst.model_exchange {
-            super::fmi3_me::directional_derivative_me(inst, unknowns, knowns, seed)?
+            inst.directional_derivative_me(unknowns, knowns, seed)?
         } else {
             inst.directional_derivative(unknowns, knowns, seed)?
         };

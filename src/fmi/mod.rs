@@ -128,18 +128,22 @@ impl FsmState {
     }
 }
 
+/// The set of states (as bits) in which a function may be called: the masks of `mask`, `fmi3::mask3`
+/// and `fmi3_me::mask3me`.
+pub const fn mask_of(states: &[FsmState]) -> u16 {
+    let mut bits = 0;
+    let mut i = 0;
+    while i < states.len() {
+        bits |= states[i].bit();
+        i += 1;
+    }
+    bits
+}
+
 /// Sets of states in which a function may be called (FMI 2.0.4, CS state table).
 pub mod mask {
     use super::FsmState::*;
-    const fn m(states: &[super::FsmState]) -> u16 {
-        let mut bits = 0;
-        let mut i = 0;
-        while i < states.len() {
-            bits |= states[i].bit();
-            i += 1;
-        }
-        bits
-    }
+    use crate::fmi::mask_of as m;
     pub const SET_DEBUG_LOGGING: u16 =
         m(&[Instantiated, InitializationMode, StepComplete, StepFailed, StepCanceled, Terminated, Error, EventMode, ContinuousTimeMode]);
     pub const FREE_INSTANCE: u16 = SET_DEBUG_LOGGING; // fmi2FreeInstance itself is always honoured (also after fmi2Fatal)

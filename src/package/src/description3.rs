@@ -82,29 +82,9 @@ pub fn model_description3(entry: &ModelEntry, token: &str, package: &PackageInfo
             ("variableNamingConvention", "flat".into()),
         ],
     );
-    if entry.model_exchange() {
-        empty(
-            &mut w,
-            "ModelExchange",
-            &[
-                ("modelIdentifier", info.name.into()),
-                ("needsExecutionTool", "false".into()),
-                ("canBeInstantiatedOnlyOncePerProcess", "false".into()),
-                ("canGetAndSetFMUState", "true".into()),
-                ("canSerializeFMUState", "true".into()),
-                ("providesDirectionalDerivatives", "true".into()),
-                ("providesAdjointDerivatives", "false".into()),
-                ("providesPerElementDependencies", "false".into()),
-                // the plants project the attitude back onto its manifold in the step event it requests
-                ("needsCompletedIntegratorStep", "true".into()),
-                ("providesEvaluateDiscreteStates", "false".into()),
-            ],
-        );
-    }
-    empty(
-        &mut w,
-        "CoSimulation",
-        &[
+    // the attributes both interface elements have, in the order of the standard's schema
+    let shared = || -> Vec<(&str, String)> {
+        vec![
             ("modelIdentifier", info.name.into()),
             ("needsExecutionTool", "false".into()),
             ("canBeInstantiatedOnlyOncePerProcess", "false".into()),
@@ -113,15 +93,28 @@ pub fn model_description3(entry: &ModelEntry, token: &str, package: &PackageInfo
             ("providesDirectionalDerivatives", "true".into()),
             ("providesAdjointDerivatives", "false".into()),
             ("providesPerElementDependencies", "false".into()),
-            ("canHandleVariableCommunicationStepSize", info.variable_step.to_string()),
-            ("maxOutputDerivativeOrder", "0".into()),
-            ("providesIntermediateUpdate", "false".into()),
-            ("mightReturnEarlyFromDoStep", "false".into()),
-            ("canReturnEarlyAfterIntermediateUpdate", "false".into()),
-            ("hasEventMode", "false".into()),
+        ]
+    };
+    if entry.model_exchange() {
+        let mut me = shared();
+        me.extend([
+            // the plants project the attitude back onto its manifold in the step event it requests
+            ("needsCompletedIntegratorStep", "true".into()),
             ("providesEvaluateDiscreteStates", "false".into()),
-        ],
-    );
+        ]);
+        empty(&mut w, "ModelExchange", &me);
+    }
+    let mut cs = shared();
+    cs.extend([
+        ("canHandleVariableCommunicationStepSize", info.variable_step.to_string()),
+        ("maxOutputDerivativeOrder", "0".into()),
+        ("providesIntermediateUpdate", "false".into()),
+        ("mightReturnEarlyFromDoStep", "false".into()),
+        ("canReturnEarlyAfterIntermediateUpdate", "false".into()),
+        ("hasEventMode", "false".into()),
+        ("providesEvaluateDiscreteStates", "false".into()),
+    ]);
+    empty(&mut w, "CoSimulation", &cs);
     write_unit_definitions(&mut w, entry);
     write_categories_and_experiment(&mut w, info);
 

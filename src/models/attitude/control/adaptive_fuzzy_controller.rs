@@ -4,11 +4,11 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::shared::mrac::{Mrac, MRAC_STATES, MracVariables, ReferenceGains};
+use super::shared::mrac::{Mrac, MracVariables, ReferenceGains};
 use super::shared::AttitudeControllerPorts;
 use crate::declare_variables;
 use crate::math::fuzzy::{Defuzz, PdFuzzySystem};
-use crate::model::{check, Experiment, Feedthrough, Model, ModelInfo, ModelResult, ParamEnum, StateDecl};
+use crate::model::{check, Experiment, Feedthrough, Model, ModelInfo, ModelResult, ParamEnum};
 
 declare_variables! {
     pub struct AdaptiveFuzzyControllerVars {
@@ -90,24 +90,7 @@ requirement checked at initialization: lambda1_min^2 >= 4 lambda2_max (real nega
         self.0.validate(&fresh.0)
     }
 
-    // Model Exchange: x_m, ẋ_m and Î are the states (shared::mrac::MRAC_STATES); Î is kept at its
-    // bound by an event after any solver step that left it below.
-    const STATES: Option<&'static [StateDecl]> = Some(&MRAC_STATES);
-    fn get_states(&self, v: &Self::Vars, x: &mut [f64]) {
-        self.0.get_states(&v.ports, x)
-    }
-    fn set_states(&mut self, x: &[f64]) {
-        self.0.set_states(x)
-    }
-    fn derivatives(&self, v: &Self::Vars, _t: f64, dx: &mut [f64]) -> ModelResult {
-        self.0.derivatives(&v.ports, dx)
-    }
-    fn completed_integrator_step(&mut self, _v: &Self::Vars, _t: f64) -> bool {
-        self.0.below_bound()
-    }
-    fn event_update(&mut self, _v: &Self::Vars, _t: f64) -> Result<bool, String> {
-        Ok(self.0.project())
-    }
+    crate::mrac_model_exchange!();
 }
 
 #[cfg(test)]

@@ -4,10 +4,10 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::shared::mrac::{Mrac, MRAC_STATES, MracVariables, ReferenceGains, EQUATIONS_HTML};
+use super::shared::mrac::{Mrac, MracVariables, ReferenceGains, EQUATIONS_HTML};
 use super::shared::AttitudeControllerPorts;
 use crate::declare_variables;
-use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult, StateDecl};
+use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult};
 
 declare_variables! {
     pub struct MracControllerVars {
@@ -49,24 +49,7 @@ impl Model for MracController {
         self.0.validate(&fresh.0)
     }
 
-    // Model Exchange: x_m, ẋ_m and Î are the states (shared::mrac::MRAC_STATES); Î is kept at its
-    // bound by an event after any solver step that left it below.
-    const STATES: Option<&'static [StateDecl]> = Some(&MRAC_STATES);
-    fn get_states(&self, v: &Self::Vars, x: &mut [f64]) {
-        self.0.get_states(&v.ports, x)
-    }
-    fn set_states(&mut self, x: &[f64]) {
-        self.0.set_states(x)
-    }
-    fn derivatives(&self, v: &Self::Vars, _t: f64, dx: &mut [f64]) -> ModelResult {
-        self.0.derivatives(&v.ports, dx)
-    }
-    fn completed_integrator_step(&mut self, _v: &Self::Vars, _t: f64) -> bool {
-        self.0.below_bound()
-    }
-    fn event_update(&mut self, _v: &Self::Vars, _t: f64) -> Result<bool, String> {
-        Ok(self.0.project())
-    }
+    crate::mrac_model_exchange!();
 }
 
 #[cfg(test)]

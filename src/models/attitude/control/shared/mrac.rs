@@ -150,6 +150,32 @@ pub const MRAC_STATES: [StateDecl; 9] = [
     StateDecl::new("state_ihat_z", "kg.m2", "Continuous state: inertia estimate I^_z").depends_on(&IHAT_Z),
 ];
 
+/// The Model Exchange members of `impl Model` for a controller that wraps [`Mrac`] (`struct C(Mrac)`)
+/// and embeds the controller ports (`v.ports`): the states [`MRAC_STATES`], Î kept at its bound by an
+/// event after any solver step that left it below.
+#[macro_export]
+#[doc(hidden)]
+macro_rules! mrac_model_exchange {
+    () => {
+        const STATES: Option<&'static [$crate::model::StateDecl]> = Some(&$crate::models::attitude::control::shared::mrac::MRAC_STATES);
+        fn get_states(&self, v: &Self::Vars, x: &mut [f64]) {
+            self.0.get_states(&v.ports, x)
+        }
+        fn set_states(&mut self, x: &[f64]) {
+            self.0.set_states(x)
+        }
+        fn derivatives(&self, v: &Self::Vars, _t: f64, dx: &mut [f64]) -> $crate::model::ModelResult {
+            self.0.derivatives(&v.ports, dx)
+        }
+        fn completed_integrator_step(&mut self, _v: &Self::Vars, _t: f64) -> bool {
+            self.0.below_bound()
+        }
+        fn event_update(&mut self, _v: &Self::Vars, _t: f64) -> Result<bool, String> {
+            Ok(self.0.project())
+        }
+    };
+}
+
 impl MracVariables {
     /// The adaptive core for the given reference-model gains, and its initial state; writes the
     /// calculated parameters.
