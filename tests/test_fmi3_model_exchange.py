@@ -109,32 +109,8 @@ def test_co_simulation_only_units_have_no_model_exchange_in_fmi3(model):
 
 # ----- fmpy's FMI 3.0 Model Exchange master (CVODE) ---------------------------------------------------
 
-def test_single_axis_plant_fmi3_me_follows_the_closed_form_step_response():
-    # J theta'' = T_c, T T_c' = K u - T_c from rest: theta = a (t^2/2 - T t + T^2 (1 - e^{-t/T})), a = K u / J
-    sv = {"u": 0.5, "md_amp": 0.0, "md_const": 0.0}
-    r = simulate_fmu(fmu3("SingleAxisPlant"), fmi_type="ModelExchange", solver="CVode", stop_time=10.0,
-                     output_interval=0.01, relative_tolerance=1e-10, start_values=sv, output=["theta", "omega"])
-    t, tc, a = r["time"], 0.2, 0.5 / 7.7
-    theta = a * (t * t / 2 - tc * t + tc * tc * (1 - np.exp(-t / tc)))
-    omega = a * (t - tc * (1 - np.exp(-t / tc)))
-    assert np.max(np.abs(r["theta"] - theta)) < 1e-8
-    assert np.max(np.abs(r["omega"] - omega)) < 1e-9
-
-
-def test_attitude_plant_fmi3_me_spins_up_as_the_closed_form_under_a_constant_torque():
-    # torque about the principal axis z from rest: w_z = tau/I_z t, q = (cos(th/2), 0, 0, sin(th/2)), th = tau t^2 / (2 I_z)
-    tau, iz = 0.2, 700.0
-    r = simulate_fmu(fmu3("AttitudePlant"), fmi_type="ModelExchange", solver="CVode", stop_time=20.0,
-                     output_interval=0.1, relative_tolerance=1e-10, start_values={"torque_cmd_z": tau},
-                     output=["w_x", "w_y", "w_z", "q_w", "q_x", "q_y", "q_z"])
-    t = r["time"]
-    assert t[-1] == pytest.approx(20.0)
-    assert np.max(np.abs(r["w_z"] - tau * t / iz)) < 1e-10
-    assert np.max(np.abs(r["w_x"])) < 1e-14 and np.max(np.abs(r["w_y"])) < 1e-14
-    th = tau * t * t / (2 * iz)
-    assert np.max(np.abs(r["q_w"] - np.cos(th / 2))) < 1e-8
-    assert np.max(np.abs(r["q_z"] - np.sin(th / 2))) < 1e-8
-    assert np.max(np.abs(r["q_x"])) < 1e-14 and np.max(np.abs(r["q_y"])) < 1e-14
+# The closed forms of SingleAxisPlant and AttitudePlant run on both versions' FMUs in
+# tests/test_model_exchange.py (parametrized over FMI 2.0 and FMI 3.0).
 
 
 @pytest.mark.parametrize("model", sorted(PLANT_CASES))

@@ -73,10 +73,15 @@ def test_a_co_simulation_only_unit_refuses_model_exchange_with_a_message():
     assert any("supports only Co-Simulation" in m[2] for m in msgs), msgs
 
 
-def test_single_axis_plant_under_cvode_follows_the_closed_form_step_response():
+def fmu_of(version: str, model: str) -> str:
+    return path(model) if version == "fmi2" else str(fmu_path(model).parent / "fmi3" / f"{model}.fmu")
+
+
+@pytest.mark.parametrize("version", ["fmi2", "fmi3"])
+def test_single_axis_plant_under_cvode_follows_the_closed_form_step_response(version):
     # theta(t) of J theta'' = T_c, T T_c' = K u - T_c from rest: a (t^2/2 - T t + T^2 (1 - e^{-t/T})), a = K u / J
     sv = {"u": 0.5, "md_amp": 0.0, "md_const": 0.0}
-    r = simulate_fmu(path("SingleAxisPlant"), fmi_type="ModelExchange", solver="CVode", stop_time=10.0,
+    r = simulate_fmu(fmu_of(version, "SingleAxisPlant"), fmi_type="ModelExchange", solver="CVode", stop_time=10.0,
                      output_interval=0.01, relative_tolerance=1e-10, start_values=sv, output=["theta", "omega"])
     t, tc, a = r["time"], 0.2, 0.5 / 7.7
     theta = a * (t * t / 2 - tc * t + tc * tc * (1 - np.exp(-t / tc)))
@@ -85,18 +90,22 @@ def test_single_axis_plant_under_cvode_follows_the_closed_form_step_response():
     assert np.max(np.abs(r["omega"] - omega)) < 1e-9
 
 
-def test_attitude_plant_under_cvode_spins_up_as_the_closed_form_under_a_constant_torque():
-    # torque about the principal axis z from rest: w_z = tau t / I_z, yaw = tau t^2 / (2 I_z), no coupling
+@pytest.mark.parametrize("version", ["fmi2", "fmi3"])
+def test_attitude_plant_under_cvode_spins_up_as_the_closed_form_under_a_constant_torque(version):
+    # torque about the principal axis z from rest: w_z = tau t / I_z, q = (cos(th/2), 0, 0, sin(th/2)) with
+    # th = tau t^2 / (2 I_z), no coupling into x and y
     tau, iz = 0.2, 700.0
-    r = simulate_fmu(path("AttitudePlant"), fmi_type="ModelExchange", solver="CVode", stop_time=20.0,
+    r = simulate_fmu(fmu_of(version, "AttitudePlant"), fmi_type="ModelExchange", solver="CVode", stop_time=20.0,
                      output_interval=0.1, relative_tolerance=1e-10, start_values={"torque_cmd_z": tau},
-                     output=["w_x", "w_z", "q_w", "q_z"])
+                     output=["w_x", "w_y", "w_z", "q_w", "q_x", "q_y", "q_z"])
     t = r["time"]
+    assert t[-1] == pytest.approx(20.0)
     assert np.max(np.abs(r["w_z"] - tau * t / iz)) < 1e-10
-    assert np.max(np.abs(r["w_x"])) < 1e-14
-    psi = tau * t * t / (2 * iz)
-    assert np.max(np.abs(r["q_w"] - np.cos(psi / 2))) < 1e-8
-    assert np.max(np.abs(r["q_z"] - np.sin(psi / 2))) < 1e-8
+    assert np.max(np.abs(r["w_x"])) < 1e-14 and np.max(np.abs(r["w_y"])) < 1e-14
+    th = tau * t * t / (2 * iz)
+    assert np.max(np.abs(r["q_w"] - np.cos(th / 2))) < 1e-8
+    assert np.max(np.abs(r["q_z"] - np.sin(th / 2))) < 1e-8
+    assert np.max(np.abs(r["q_x"])) < 1e-14 and np.max(np.abs(r["q_y"])) < 1e-14
 
 
 PLANT_CASES = {
