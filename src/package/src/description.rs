@@ -14,9 +14,12 @@ use quick_xml::Writer;
 use spacecraft_fmus::export::PackageInfo;
 use spacecraft_fmus::fmi::LOG_CATEGORIES;
 use spacecraft_fmus::model::{
-    Bound, Causality, Feedthrough, Initial, ModelEntry, ModelInfo, Start, StateDecl, VarDecl, VarKind, Variability, DERIVATIVE_VR_BASE, RESERVED_VR_START, STATE_VR_BASE,
+    Bound, Causality, Feedthrough, Initial, ModelEntry, ModelInfo, Start, VarDecl, VarKind, Variability, DERIVATIVE_VR_BASE, RESERVED_VR_START, STATE_VR_BASE,
 };
 use spacecraft_fmus::units;
+
+pub use crate::structure::{derivative_dependencies, initial_unknowns, output_dependencies, state_indices};
+use crate::structure::input_index;
 
 pub const GENERATION_TOOL: &str = concat!("spacecraft_fmus fmu-package ", env!("CARGO_PKG_VERSION"));
 
@@ -64,125 +67,6 @@ pub(crate) fn start_str(s: Start) -> String {
 
 pub(crate) fn bound_str(kind: VarKind, v: f64) -> String {
     if kind == VarKind::Integer { (v as i32).to_string() } else { fmt_real(v) }
-}
-
-/// 1-based indices (position in ModelVariables) of the inputs the output `out` depends on directly.
-pub fn output_dependencies(entry: &ModelEntry, out: &VarDecl) -> Vec<usize> {
-    let index_of = |name: &str| {
-        entry
-            .decls
-            .iter()
-            .position(|d| d.name == name)
-            .unwrap_or_else(|| panic!("{}: feedthrough names unknown variable {name}", entry.info.name))
-            + 1
-    };
-    let inputs = || entry.decls.iter().enumerate().filter(|(_, d)| d.causality == Causality::Input).map(|(i, _)| i + 1);
-    match entry.info.feedthrough {
-        Feedthrough::None => vec![],
-        Feedthrough::AllInputs => inputs().collect(),
-        Feedthrough::Some(list) => list
-            .iter()
-            .filter(|(o, _)| *o == out.name)
-            .flat_map(|(_, ins)| ins.iter().map(|n| index_of(n)))
-            .collect(),
-    }
-}
-
-/// `<InitialUnknowns>` with their dependencies, from the same declaration as `<Outputs>`.
-///
-/// FMI 2.0 lists as initial unknowns the outputs with `initial` approx/calculated and the calculated
-/// parameters, each in ScalarVariable order; their knowns in Initialization Mode are the inputs and the
-/// variables with `initial="exact"` (our parameters). An output depends on the inputs it feeds through
-/// (the model's `Feedthrough`, the same list as in `<Outputs>`) and on the parameters; a calculated
-/// parameter depends on the parameters only. The parameter part is a superset (the declarations do not
-/// say which parameter feeds which output); parameters are never connected, so it cannot create a loop.
-pub fn initial_unknowns(entry: &ModelEntry) -> Vec<(usize, Vec<usize>)> {
-    let params: Vec<usize> = entry
-        .decls
-        .iter()
-        .enumerate()
-        .filter(|(_, d)| d.causality == Causality::Parameter && d.initial() == Some(Initial::Exact))
-        .map(|(i, _)| i + 1)
-        .collect();
-    entry
-        .decls
-        .iter()
-        .enumerate()
-        .filter_map(|(i, d)| {
-            let inputs = match d.causality {
-                // its feed-through, and the inputs any state starts from (an output may read every state)
-                Causality::Output if d.initial() != Some(Initial::Exact) => {
-                    output_dependencies(entry, d).into_iter().chain(entry.state_decls().iter().flat_map(|x| start_inputs(entry, x))).collect()
-                }
-                Causality::CalculatedParameter => vec![],
-                _ => return None,
-            };
-            let mut deps: Vec<usize> = inputs.into_iter().chain(params.iter().copied()).collect();
-            deps.sort_unstable();
-            deps.dedup();
-            Some((i + 1, deps))
-        })
-        .collect::<Vec<_>>()
-        .into_iter()
-        // Model Exchange: the states (from the parameters and the inputs they start from) and their
-        // derivatives (their inputs, and for each state they read the inputs that state starts from)
-        .chain(state_indices(entry).zip(entry.state_decls()).map(|(ix, x)| {
-            let mut deps: Vec<usize> = start_inputs(entry, x).chain(params.iter().copied()).collect();
-            deps.sort_unstable();
-            deps.dedup();
-            (ix, deps)
-        }))
-        .chain(derivative_dependencies(entry).into_iter().map(|(k, on)| {
-            let (n_decl, states) = (entry.decls.len(), entry.state_decls());
-            let via_states = on.iter().filter(|i| **i > n_decl).flat_map(|i| start_inputs(entry, &states[i - n_decl - 1]));
-            let mut deps: Vec<usize> = on.iter().copied().filter(|i| *i <= n_decl).chain(via_states).chain(params.iter().copied()).collect();
-            deps.sort_unstable();
-            deps.dedup();
-            (entry.decls.len() + entry.state_decls().len() + k + 1, deps)
-        }))
-        .collect()
-}
-
-/// ScalarVariable indices (1-based) of the continuous states (after the declared variables).
-pub fn state_indices(entry: &ModelEntry) -> impl Iterator<Item = usize> + '_ {
-    let n = entry.decls.len();
-    (0..entry.state_decls().len()).map(move |k| n + k + 1)
-}
-
-/// ScalarVariable indices of the inputs a state's start value is taken from.
-fn start_inputs<'a>(entry: &'a ModelEntry, x: &'a StateDecl) -> impl Iterator<Item = usize> + 'a {
-    x.starts_from.iter().filter_map(move |n| input_index(entry, n))
-}
-
-fn input_index(entry: &ModelEntry, name: &str) -> Option<usize> {
-    entry.decls.iter().position(|d| d.name == name && d.causality == Causality::Input).map(|i| i + 1)
-}
-
-fn input_indices(entry: &ModelEntry) -> impl Iterator<Item = usize> + '_ {
-    entry.decls.iter().enumerate().filter(|(_, d)| d.causality == Causality::Input).map(|(i, _)| i + 1)
-}
-
-/// `<Derivatives>`: for each state k, the ScalarVariable indices of the inputs and states its
-/// derivative depends on ([`StateDecl::depends`]: the declared list; a state that declares none
-/// depends on every input and every state).
-pub fn derivative_dependencies(entry: &ModelEntry) -> Vec<(usize, Vec<usize>)> {
-    let states = entry.state_decls();
-    let all: Vec<usize> = input_indices(entry).chain(state_indices(entry)).collect();
-    let index = |n: &str| input_index(entry, n).or_else(|| states.iter().position(|x| x.name == n).map(|k| entry.decls.len() + k + 1));
-    states
-        .iter()
-        .enumerate()
-        .map(|(k, x)| {
-            let mut deps: Vec<usize> = match x.depends {
-                None => all.clone(),
-                // unknown names are refused by check_declarations before any XML is written
-                Some(names) => names.iter().filter_map(|n| index(n)).collect(),
-            };
-            deps.sort_unstable();
-            deps.dedup();
-            (k, deps)
-        })
-        .collect()
 }
 
 fn join(ix: &[usize]) -> String {

@@ -15,6 +15,7 @@ pub mod description3;
 pub mod docs;
 mod load;
 pub mod references;
+pub mod structure;
 
 use std::fs;
 use std::io::Write;
