@@ -14,17 +14,10 @@ from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi3 import FMU3Slave, fmi3Boolean, fmi3Float32, fmi3Float64, fmi3Int32, fmi3ValueReference
 
+from test_fmi_bad_input import ERROR, OK, status  # statuses and the raw-call status helper
+
 ROOT = Path(__file__).resolve().parents[1]
-OK, WARNING, DISCARD, ERROR, FATAL = 0, 1, 2, 3, 4
 TIME_VR = 2147483647
-
-
-def status(fn, *args) -> int:
-    try:
-        r = fn(*args)
-        return int(r) if r is not None else OK
-    except FMICallException as e:
-        return e.status
 
 
 def vrs(*v):

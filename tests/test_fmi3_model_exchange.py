@@ -14,16 +14,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 from fmpy import extract, read_model_description, simulate_fmu
-from fmpy.fmi1 import FMICallException
-from fmpy.fmi3 import FMU3Model, FMU3Slave, fmi3Boolean, fmi3Float64, fmi3Int32, fmi3ValueReference
+from fmpy.fmi3 import FMU3Model, FMU3Slave, fmi3Boolean, fmi3Float64, fmi3Int32
 from fmpy.validation import validate_fmu
 
+from test_fmi3_bad_input import ERROR, OK, TIME_VR, f64, status, vrs  # the raw-call helpers
 from test_model_exchange import PLANT_CASES, dedup_last
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = sorted(p.stem for p in (ROOT / "modelDescription" / "fmi3").glob("*.xml"))
-OK, WARNING, DISCARD, ERROR, FATAL = 0, 1, 2, 3, 4
-TIME_VR = 2147483647
 
 
 def fmu3(model: str) -> str:
@@ -136,22 +134,6 @@ def test_a_command_step_is_a_time_event_in_fmi3_as_in_fmi2():
 
 
 # ----- the C functions through fmpy's ctypes bindings ---------------------------------------------------
-
-def status(fn, *args) -> int:
-    try:
-        r = fn(*args)
-        return int(r) if r is not None else OK
-    except FMICallException as e:
-        return e.status
-
-
-def vrs(*v):
-    return (fmi3ValueReference * len(v))(*v)
-
-
-def f64(*v):
-    return (fmi3Float64 * len(v))(*v)
-
 
 class Me3:
     """One FMI 3.0 instance (Model Exchange unless `cs`) with a recording logger."""
