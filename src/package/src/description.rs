@@ -172,6 +172,43 @@ pub(crate) fn elem<'a>(name: &'a str, attrs: &[(&'a str, String)]) -> BytesStart
     e
 }
 
+pub(crate) type W = Writer<Cursor<Vec<u8>>>;
+
+/// `<name attrs/>`.
+pub(crate) fn empty(w: &mut W, name: &str, attrs: &[(&str, String)]) {
+    w.write_event(Event::Empty(elem(name, attrs))).unwrap();
+}
+
+/// `<name attrs>`.
+pub(crate) fn start(w: &mut W, name: &str, attrs: &[(&str, String)]) {
+    w.write_event(Event::Start(elem(name, attrs))).unwrap();
+}
+
+/// `</name>`.
+pub(crate) fn end(w: &mut W, name: &str) {
+    w.write_event(Event::End(BytesEnd::new(name))).unwrap();
+}
+
+/// The value attributes of a declared variable's type element (`<Real>`, `<Float64>`, …), in the
+/// order both FMI versions write them: unit, min, max, start.
+pub(crate) fn value_attrs(d: &VarDecl) -> Vec<(&'static str, String)> {
+    let mut t: Vec<(&str, String)> = vec![];
+    if !d.unit.is_empty() {
+        t.push(("unit", d.unit.into()));
+    }
+    let (min, max) = d.bound.min_max();
+    if let Some(m) = min {
+        t.push(("min", bound_str(d.kind, m)));
+    }
+    if let Some(m) = max {
+        t.push(("max", bound_str(d.kind, m)));
+    }
+    if d.has_start() {
+        t.push(("start", start_str(d.start)));
+    }
+    t
+}
+
 /// `<UnitDefinitions>` of the units a model uses, in table order (deterministic); nothing when it uses
 /// none. The same element in FMI 2.0 and 3.0.
 /// `<LogCategories>` and `<DefaultExperiment>`, the same in FMI 2.0 and 3.0.
@@ -190,16 +227,7 @@ pub(crate) fn write_categories_and_experiment(w: &mut Writer<Cursor<Vec<u8>>>, i
     w.write_event(Event::Empty(elem("DefaultExperiment", &experiment))).unwrap();
 }
 
-pub(crate) fn write_unit_definitions(w: &mut Writer<Cursor<Vec<u8>>>, entry: &ModelEntry) {
-    let empty = |w: &mut Writer<Cursor<Vec<u8>>>, name: &str, attrs: &[(&str, String)]| {
-        w.write_event(Event::Empty(elem(name, attrs))).unwrap();
-    };
-    let start = |w: &mut Writer<Cursor<Vec<u8>>>, name: &str, attrs: &[(&str, String)]| {
-        w.write_event(Event::Start(elem(name, attrs))).unwrap();
-    };
-    let end = |w: &mut Writer<Cursor<Vec<u8>>>, name: &str| {
-        w.write_event(Event::End(BytesEnd::new(name))).unwrap();
-    };
+pub(crate) fn write_unit_definitions(w: &mut W, entry: &ModelEntry) {
     let used: Vec<_> =
         units::UNITS.iter().filter(|(n, _, _)| entry.decls.iter().any(|d| d.unit == *n) || entry.state_decls().iter().any(|x| x.unit == *n)).collect();
     if !used.is_empty() {
@@ -230,15 +258,6 @@ pub(crate) fn write_unit_definitions(w: &mut Writer<Cursor<Vec<u8>>>, entry: &Mo
 fn write_xml(entry: &ModelEntry, guid: &str, package: &PackageInfo) -> String {
     let info = entry.info;
     let mut w = Writer::new_with_indent(Cursor::new(Vec::new()), b' ', 2);
-    let empty = |w: &mut Writer<Cursor<Vec<u8>>>, name: &str, attrs: &[(&str, String)]| {
-        w.write_event(Event::Empty(elem(name, attrs))).unwrap();
-    };
-    let start = |w: &mut Writer<Cursor<Vec<u8>>>, name: &str, attrs: &[(&str, String)]| {
-        w.write_event(Event::Start(elem(name, attrs))).unwrap();
-    };
-    let end = |w: &mut Writer<Cursor<Vec<u8>>>, name: &str| {
-        w.write_event(Event::End(BytesEnd::new(name))).unwrap();
-    };
 
     w.write_event(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None))).unwrap();
     start(
@@ -308,20 +327,7 @@ fn write_xml(entry: &ModelEntry, guid: &str, package: &PackageInfo) -> String {
             attrs.push(("initial", initial_str(init).into()));
         }
         start(&mut w, "ScalarVariable", &attrs);
-        let mut t: Vec<(&str, String)> = vec![];
-        if !d.unit.is_empty() {
-            t.push(("unit", d.unit.into()));
-        }
-        let (min, max) = d.bound.min_max();
-        if let Some(m) = min {
-            t.push(("min", bound_str(d.kind, m)));
-        }
-        if let Some(m) = max {
-            t.push(("max", bound_str(d.kind, m)));
-        }
-        if d.has_start() {
-            t.push(("start", start_str(d.start)));
-        }
+        let t = value_attrs(d);
         let tag = match d.kind {
             VarKind::Real => "Real",
             VarKind::Integer => "Integer",

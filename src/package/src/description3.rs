@@ -15,30 +15,16 @@
 
 use std::io::Cursor;
 
-use quick_xml::events::{BytesDecl, BytesEnd, Event};
+use quick_xml::events::{BytesDecl, Event};
 use quick_xml::Writer;
 
 use crate::description::{
-    bound_str, causality_str, derivative_dependencies, elem, initial_str, initial_unknowns, output_dependencies, start_str, state_indices, variability_str,
+    causality_str, derivative_dependencies, empty, end, initial_str, initial_unknowns, output_dependencies, start, state_indices, value_attrs, variability_str,
     write_categories_and_experiment, write_unit_definitions, Author, GENERATION_TOOL,
 };
 use spacecraft_fmus::export::PackageInfo;
 use spacecraft_fmus::fmi::fmi3::TIME_VR;
 use spacecraft_fmus::model::{Causality, ModelEntry, VarKind, DERIVATIVE_VR_BASE, STATE_VR_BASE};
-
-type W = Writer<Cursor<Vec<u8>>>;
-
-fn empty(w: &mut W, name: &str, attrs: &[(&str, String)]) {
-    w.write_event(Event::Empty(elem(name, attrs))).unwrap();
-}
-
-fn start(w: &mut W, name: &str, attrs: &[(&str, String)]) {
-    w.write_event(Event::Start(elem(name, attrs))).unwrap();
-}
-
-fn end(w: &mut W, name: &str) {
-    w.write_event(Event::End(BytesEnd::new(name))).unwrap();
-}
 
 fn vrs(list: &[u32]) -> String {
     list.iter().map(|v| v.to_string()).collect::<Vec<_>>().join(" ")
@@ -141,19 +127,7 @@ pub fn model_description3(entry: &ModelEntry, token: &str, package: &PackageInfo
         if let Some(init) = d.initial() {
             attrs.push(("initial", initial_str(init).into()));
         }
-        if !d.unit.is_empty() {
-            attrs.push(("unit", d.unit.into()));
-        }
-        let (min, max) = d.bound.min_max();
-        if let Some(m) = min {
-            attrs.push(("min", bound_str(d.kind, m)));
-        }
-        if let Some(m) = max {
-            attrs.push(("max", bound_str(d.kind, m)));
-        }
-        if d.has_start() {
-            attrs.push(("start", start_str(d.start)));
-        }
+        attrs.extend(value_attrs(d));
         let tag = match d.kind {
             VarKind::Real => "Float64",
             VarKind::Integer => "Int32",
