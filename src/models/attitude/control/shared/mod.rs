@@ -7,6 +7,7 @@
 pub mod error_law;
 pub mod feedback_linearization;
 pub mod mrac;
+pub mod mrac_exchange;
 pub mod ports;
 pub mod smc;
 
