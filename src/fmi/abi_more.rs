@@ -57,8 +57,7 @@ pub extern "C" fn fmi2GetDirectionalDerivative(
         let knowns = unsafe { slice(v_known, n_known, "vKnown_ref[]")? };
         let seed = unsafe { slice(dv_known, n_known, "dvKnown[]")? };
         let out = unsafe { slice_mut(dv_unknown, n_unknown, "dvUnknown[]")? };
-        // Model Exchange: state derivatives as unknowns, states as knowns too
-        let d = if inst.model_exchange { inst.directional_derivative_me(unknowns, knowns, seed)? } else { inst.directional_derivative(unknowns, knowns, seed)? };
+        let d = inst.directional_derivative(unknowns, knowns, seed)?;
         out.copy_from_slice(&d);
         Ok(())
     })

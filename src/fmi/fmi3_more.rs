@@ -69,11 +69,7 @@ pub extern "C" fn fmi3GetDirectionalDerivative(
         let knowns = unsafe { slice(knowns, n_knowns, "knowns[]")? };
         let seed = unsafe { slice(seed, n_seed, "seed[]")? };
         let out = unsafe { slice_mut(sensitivity, n_sensitivity, "sensitivity[]")? };
-        let d = if inst.model_exchange {
-            inst.directional_derivative_me(unknowns, knowns, seed)?
-        } else {
-            inst.directional_derivative(unknowns, knowns, seed)?
-        };
+        let d = inst.directional_derivative(unknowns, knowns, seed)?;
         out.copy_from_slice(&d);
         Ok(())
     })

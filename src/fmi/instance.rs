@@ -231,7 +231,7 @@ impl Instance {
 
     /// Declaration index and declaration of a value reference of the given kind.
     #[inline]
-    fn decl(&self, kind: VarKind, vr: u32) -> CallResult<(usize, &'static VarDecl)> {
+    pub(super) fn decl(&self, kind: VarKind, vr: u32) -> CallResult<(usize, &'static VarDecl)> {
         if let Some(i) = self.index.get(kind, vr) {
             return Ok((i, &self.entry.decls[i]));
         }
@@ -429,52 +429,4 @@ impl Instance {
         self.model = (self.entry.create)();
         self.run = Run::INSTANTIATED;
     }
-
-    /// Directional derivative of Real outputs with respect to Real inputs, by central differences
-    /// on a copy of the model (the instance itself is not touched).
-    pub fn directional_derivative(&mut self, unknowns: &[u32], knowns: &[u32], dv_known: &[f64]) -> CallResult<Vec<f64>> {
-        self.ensure_outputs()?;
-        let mut known_decls = Vec::with_capacity(knowns.len());
-        for vr in knowns {
-            let (i, d) = self.decl(VarKind::Real, *vr)?;
-            if d.causality != Causality::Input {
-                return Err(Fail::error(format!("known {} is not an input", d.name)));
-            }
-            known_decls.push(i);
-        }
-        let mut unknown_decls = Vec::with_capacity(unknowns.len());
-        for vr in unknowns {
-            let (i, d) = self.decl(VarKind::Real, *vr)?;
-            if d.causality != Causality::Output {
-                return Err(Fail::error(format!("unknown {} is not an output", d.name)));
-            }
-            unknown_decls.push(i);
-        }
-        if let Some(x) = dv_known.iter().find(|x| !x.is_finite()) {
-            return Err(Fail::error(format!("seed value {x} is not finite")));
-        }
-        let dmax = dv_known.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-        if dmax == 0.0 {
-            return Ok(vec![0.0; unknowns.len()]);
-        }
-        let xmax = known_decls.iter().fold(0.0f64, |a, i| match self.model.value(*i) {
-            Some(Value::Real(x)) => a.max(x.abs()),
-            _ => a,
-        });
-        let eps = 1e-6 * (1.0 + xmax) / dmax;
-        let eval = |sign: f64| -> CallResult<Vec<f64>> {
-            let mut m = self.model.clone_box();
-            for (i, dv) in known_decls.iter().zip(dv_known) {
-                if let Some(SlotMut::Real(s)) = m.slot(*i) {
-                    *s += sign * eps * dv;
-                }
-            }
-            m.update_outputs(self.run.time).map_err(Fail::error)?;
-            Ok(unknown_decls.iter().map(|i| if let Some(Value::Real(x)) = m.value(*i) { x } else { f64::NAN }).collect())
-        };
-        let plus = eval(1.0)?;
-        let minus = eval(-1.0)?;
-        Ok(plus.iter().zip(&minus).map(|(p, m)| (p - m) / (2.0 * eps)).collect())
-    }
-
 }

@@ -4,7 +4,7 @@
 
 use super::instance::{CallResult, Fail, Instance};
 use super::FsmState;
-use crate::model::{Causality, Value, VarKind, DERIVATIVE_VR_BASE, STATE_VR_BASE};
+use crate::model::{DERIVATIVE_VR_BASE, STATE_VR_BASE};
 
 /// What `fmi2NewDiscreteStates` reports (the fields of `fmi2EventInfo`).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -152,101 +152,4 @@ impl Instance {
         let t = self.run.time;
         Ok(self.model.completed_integrator_step(t))
     }
-}
-
-// ----- directional derivatives with states and derivatives ------------------------------------------
-
-/// A known of a Model Exchange directional derivative: an input (declaration index) or a state.
-enum Known {
-    Input(usize),
-    State(usize),
-}
-
-/// An unknown: an output (declaration index) or a state derivative.
-enum Unknown {
-    Output(usize),
-    Derivative(usize),
-}
-
-impl Instance {
-/// `fmi2GetDirectionalDerivative` / `fmi3GetDirectionalDerivative` on a Model Exchange instance:
-/// besides outputs with respect to inputs (as in Co-Simulation), the state derivatives are unknowns
-/// and the continuous states are knowns (the Jacobian ∂ẋ/∂x an implicit solver needs; FMI 2.0
-/// section 3.2.2, FMI 3.0 section 2.2.11). Central differences on a copy of the model at the current
-/// time, inputs and states; the instance itself is not touched.
-pub fn directional_derivative_me(&mut self, unknowns: &[u32], knowns: &[u32], seed: &[f64]) -> CallResult<Vec<f64>> {
-    let inst = self;
-    if !unknowns.iter().chain(knowns).any(|vr| inst.layer_var(*vr).is_some()) {
-        return inst.directional_derivative(unknowns, knowns, seed);
-    }
-    inst.ensure_outputs()?;
-    let real_decl = |vr: u32| inst.entry.decls.iter().position(|d| d.vr == vr && d.kind == VarKind::Real);
-    let mut ks = Vec::with_capacity(knowns.len());
-    for vr in knowns {
-        ks.push(match (inst.layer_var(*vr), real_decl(*vr)) {
-            (Some(LayerVar::State(k)), _) => Known::State(k),
-            (None, Some(i)) if inst.entry.decls[i].causality == Causality::Input => Known::Input(i),
-            _ => return Err(Fail::error(format!("known {vr} is neither a Real input nor a continuous state"))),
-        });
-    }
-    let mut us = Vec::with_capacity(unknowns.len());
-    for vr in unknowns {
-        us.push(match (inst.layer_var(*vr), real_decl(*vr)) {
-            (Some(LayerVar::Derivative(k)), _) => Unknown::Derivative(k),
-            (None, Some(i)) if inst.entry.decls[i].causality == Causality::Output => Unknown::Output(i),
-            _ => return Err(Fail::error(format!("unknown {vr} is neither a Real output nor a state derivative"))),
-        });
-    }
-    if let Some(x) = seed.iter().find(|x| !x.is_finite()) {
-        return Err(Fail::error(format!("seed value {x} is not finite")));
-    }
-    let dmax = seed.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-    if dmax == 0.0 {
-        return Ok(vec![0.0; unknowns.len()]);
-    }
-    let n = inst.n_states();
-    let mut x0 = vec![0.0; n];
-    inst.model.get_states(&mut x0).map_err(Fail::error)?;
-    let xmax = ks.iter().fold(0.0f64, |a, k| match k {
-        Known::State(k) => a.max(x0[*k].abs()),
-        Known::Input(i) => match inst.model.value(*i) {
-            Some(Value::Real(x)) => a.max(x.abs()),
-            _ => a,
-        },
-    });
-    let eps = 1e-6 * (1.0 + xmax) / dmax;
-    let t = inst.run.time;
-    let eval = |sign: f64| -> CallResult<Vec<f64>> {
-        let mut m = inst.model.clone_box();
-        let mut x = x0.clone();
-        for (k, dv) in ks.iter().zip(seed) {
-            match k {
-                Known::State(k) => x[*k] += sign * eps * dv,
-                Known::Input(i) => {
-                    if let Some(crate::model::SlotMut::Real(s)) = m.slot(*i) {
-                        *s += sign * eps * dv;
-                    }
-                }
-            }
-        }
-        m.set_states(&x).map_err(Fail::error)?;
-        m.update_outputs(t).map_err(Fail::error)?;
-        let mut dx = vec![0.0; n];
-        m.derivatives(t, &mut dx).map_err(|e| Fail::error(format!("derivatives at t = {t}: {e}")))?;
-        Ok(us
-            .iter()
-            .map(|u| match u {
-                Unknown::Derivative(k) => dx[*k],
-                Unknown::Output(i) => if let Some(Value::Real(y)) = m.value(*i) { y } else { f64::NAN },
-            })
-            .collect())
-    };
-    let plus = eval(1.0)?;
-    let minus = eval(-1.0)?;
-    let d: Vec<f64> = plus.iter().zip(&minus).map(|(p, m)| (p - m) / (2.0 * eps)).collect();
-    if let Some(v) = d.iter().find(|v| !v.is_finite()) {
-        return Err(Fail::error(format!("directional derivative {v} at t = {t} is not finite")));
-    }
-    Ok(d)
-}
 }

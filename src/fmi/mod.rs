@@ -12,6 +12,7 @@ pub mod fmi3_more;
 mod fmi3_tests;
 pub mod instance;
 pub mod instance_me;
+mod jacobian;
 mod library_path;
 pub mod state;
 mod state_calls;
