@@ -46,8 +46,10 @@ def main() -> int:
         os.write(out, (text + "\n").encode())
 
     unit = None
+    import time
     for name in job["checks"]:
         emit("B " + name)
+        t0 = time.monotonic()
         trace.lines = []
         try:
             if unit is None:
@@ -71,6 +73,7 @@ def main() -> int:
             res = {"status": "fail", "kind": "checker_error",
                    "detail": f"{type(e).__name__}: {e} ({traceback.format_exc().splitlines()[-3].strip()})",
                    "reproducer": list(trace.lines)}
+        res["seconds"] = round(time.monotonic() - t0, 3)
         emit("E " + json.dumps(res))
     return 0
 

@@ -45,7 +45,7 @@ def _one_child(spec, checks, options, timeout) -> dict:
         sel = selectors.DefaultSelector()
         sel.register(proc.stdout, selectors.EVENT_READ)
         current, lines, buf = None, [], b""
-        deadline = time.monotonic() + timeout
+        deadline = time.monotonic() + timeout + 60.0  # starting Python is not the FMU's time
         hung = False
         fd = proc.stdout.fileno()
         while True:
