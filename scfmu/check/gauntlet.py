@@ -484,8 +484,9 @@ def random_sequences(u: Unit, o: dict) -> dict:
             total += 1
             _check_status_valid(u, s, a)
             if forbidden and s <= WARNING and st != "unknown":
-                raise Fail("wrong_status", f"random sequence {k}: the last call is forbidden in state '{st}' "
-                                           f"but returned {s_name(u.v, s)}")
+                last = u.trace.lines[-1] if u.trace.lines else a
+                raise Fail("wrong_status", f"random sequence {k}: {last.split(' -> ')[0]} is forbidden in state "
+                                           f"'{st}' but returned {s_name(u.v, s)}")
             if s <= WARNING:
                 ok += 1
             if s > WARNING or st == "unknown":
