@@ -12,7 +12,7 @@ import random
 import struct
 import threading
 
-from .fmi import ERROR, OK, WARNING, Lib
+from .fmi import OK, WARNING, Lib
 from .unit import Unit, s_name
 
 NOT_OK = "a status other than OK/Warning"
@@ -690,9 +690,10 @@ def threads(u: Unit, o: dict) -> dict:
             hh = w.new()
             if hh is None:
                 results[i] = "instantiation returned NULL"
+                barrier.abort()  # the others must not wait for this thread
                 return
             s = w.start(hh)
-            barrier.wait()
+            barrier.wait(timeout=60)
             if s > WARNING:
                 results[i] = f"initialization returned {s_name(u.v, s)}"
                 return
@@ -702,7 +703,9 @@ def threads(u: Unit, o: dict) -> dict:
         except Fail as e:
             results[i] = e.detail
         except threading.BrokenBarrierError:
-            results[i] = "barrier broken"
+            results[i] = "another thread failed before the common start"
+        except Exception as e:  # e.g. a function missing from the binary
+            results[i] = f"{type(e).__name__}: {e}"
 
     u.trace.start(f"threads: {nt} threads, {n} steps each, the same inputs")
     u.trace.note(f"{nt} threads each: instantiate, initialize, {n} x (set inputs, step, get outputs), free")

@@ -11,7 +11,7 @@ import ctypes
 import math
 from ctypes import byref, c_bool, c_double, c_int, c_size_t, c_uint8, c_uint32, c_void_p
 
-from .fmi import (ERROR, FATAL, OK, WARNING, LOG3, LOGGER2, ALLOC2, FREE2, STEPFINISHED2, Callbacks2, EventInfo2,
+from .fmi import (ERROR, OK, WARNING, LOG3, LOGGER2, ALLOC2, FREE2, STEPFINISHED2, Callbacks2, EventInfo2,
                   Lib, TYPES2, TYPES3, Trace)
 
 _libc = ctypes.CDLL(None)
