@@ -130,3 +130,44 @@ def test_the_command_line_exit_codes_and_reports(broken, tmp_path):
         p = run(*args)
         assert p.returncode == 2, (args, p.stdout, p.stderr)
         assert needle in p.stderr and "Traceback" not in p.stderr, p.stderr
+
+
+def test_a_model_description_against_the_schema_is_a_failed_row_not_a_traceback(tmp_path):
+    """An FMU whose modelDescription breaks the schema (causality="sideways"): `schema` fails with the line
+    and the reason; the checks that need the description read are not applicable; exit status 1."""
+    ok = build_broken(tmp_path, "ok")
+    bad = tmp_path / "BadSchema.fmu"
+    with zipfile.ZipFile(ok) as zin, zipfile.ZipFile(bad, "w") as zout:
+        for item in zin.infolist():
+            data = zin.read(item)
+            if item.filename == "modelDescription.xml":
+                data = data.replace(b'causality="input"', b'causality="sideways"')
+            zout.writestr(item, data)
+    rep = check(bad, quick=True)
+    assert rep.row("schema")["status"] == "fail"
+    assert "sideways" in rep.row("schema")["detail"] and "line " in rep.row("schema")["detail"]
+    assert rep.failed_checks() == {"schema"}
+    assert rep.row("nominal_run")["status"] == "n/a"
+    assert not rep.ok
+    p = subprocess.run([sys.executable, "-m", "scfmu", "check", str(bad), "--quick"], capture_output=True, text=True,
+                       timeout=300)
+    assert p.returncode == 1 and "Traceback" not in p.stdout + p.stderr, p.stderr
+
+
+def test_an_archive_that_cannot_be_extracted_fails_the_archive_check(tmp_path):
+    """A byte of the binary changed inside the zip (its CRC no longer matches): the modelDescription still
+    reads (schema passes), the extraction fails: `archive` fails, the dynamic checks are not applicable."""
+    ok = build_broken(tmp_path, "ok")
+    stored = tmp_path / "Stored.fmu"
+    with zipfile.ZipFile(ok) as zin, zipfile.ZipFile(stored, "w", zipfile.ZIP_STORED) as zout:
+        for item in zin.infolist():
+            zout.writestr(item.filename, zin.read(item))
+    data = bytearray(stored.read_bytes())
+    i = data.index(b"\x7fELF") + 200
+    data[i] ^= 0xFF
+    stored.write_bytes(bytes(data))
+    rep = check(stored, quick=True)
+    assert rep.row("schema")["status"] == "pass"
+    assert rep.failed_checks() == {"archive"}, rep.text()
+    assert "CRC" in rep.row("archive")["detail"] or "Bad" in rep.row("archive")["detail"], rep.row("archive")
+    assert rep.row("threads")["status"] == "n/a"

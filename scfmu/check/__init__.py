@@ -19,7 +19,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-STATIC_CHECKS = ("schema", "units", "start_values", "model_structure", "value_references", "variables", "binaries")
+STATIC_CHECKS = ("schema", "archive", "units", "start_values", "model_structure", "value_references", "variables", "binaries")
 DYNAMIC_CHECKS = ("nominal_run", "state_machine", "bad_arguments", "random_sequences", "fmu_state", "memory",
                   "threads")
 
@@ -121,11 +121,17 @@ def check(path, *, quick: bool = False, seed: int = 0, sequences: int | None = N
         md, d, created = _extract(path)
     except Exception as e:  # an archive the extraction refuses, or a description fmpy cannot read
         msg = str(e).splitlines()[0] if str(e) else type(e).__name__
-        rep.rows.append({"check": "variables", "status": "fail", "kind": "model_description",
-                         "detail": f"the FMU cannot be extracted or read: {msg}"})
-        _skip_rest(rep, "the FMU cannot be extracted or read")
+        if rep.rows[0]["status"] == "fail":  # fmpy refuses to read what fails the schema: already reported
+            _skip_rest(rep, "the modelDescription fails the schema (see schema)")
+        else:
+            rep.rows.append({"check": "archive", "status": "fail", "kind": "archive",
+                             "detail": f"the FMU cannot be extracted or read: {msg}"})
+            _skip_rest(rep, "the FMU cannot be extracted or read (see archive)")
         rep.seconds = time.monotonic() - t_start
         return rep
+    files = [p for p in d.rglob("*") if p.is_file()]
+    rep.rows.append({"check": "archive", "status": "pass",
+                     "detail": f"extracted: {len(files)} files, {sum(p.stat().st_size for p in files) / 1e6:.1f} MB"})
     try:
         rep.model = md.modelName
         rep.rows.extend(rule_checks(md))
