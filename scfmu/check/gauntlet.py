@@ -126,9 +126,13 @@ def _cs_forbidden(u: Unit):
         (f"{p}ExitInitializationMode after initialization", ready, lambda h: u.exit_init(h)),
         (f"{p}Terminate in Instantiated", None, lambda h: u.terminate(h)),
     ]
-    if u.v == 2:
+    if u.v == 2:  # FMI 2.0's tables (the FMI 3.0 ones differ in detail here; not judged there)
         items.append(("fmi2SetupExperiment after initialization", ready,
                       lambda h: u.lib.call("fmi2SetupExperiment", h, 0, 0.0, 0.0, 0, 0.0)))
+        items.append(("fmi2Terminate in Initialization Mode", init, lambda h: u.terminate(h)))
+        items.append(("fmi2Terminate after terminate", term, lambda h: u.terminate(h)))
+        if u.outputs:
+            items.append(("reading the outputs in Instantiated", None, lambda h: u.get(h, u.outputs[:1])[0]))
     if inp:
         items.append((f"setting input {inp[0]['name']} after terminate", term,
                       lambda h: u.set(h, inp, [inp[0].get("start") or 0.0])))
@@ -156,6 +160,7 @@ def _cs_forbidden(u: Unit):
             (f"{p}EnterContinuousTimeMode in Continuous-Time Mode", ready,
              lambda h: u.lib.call(f"{p}EnterContinuousTimeMode", h)),
             (f"{p}CompletedIntegratorStep in Event Mode", event_mode, lambda h: _completed(u, h)),
+            (f"{p}EnterEventMode in Instantiated", None, lambda h: u.lib.call(f"{p}EnterEventMode", h)),
             ("event update in Continuous-Time Mode", ready, lambda h: u.event_iteration(h, limit=1)),
         ]
         if n:
