@@ -171,3 +171,12 @@ def test_an_archive_that_cannot_be_extracted_fails_the_archive_check(tmp_path):
     assert rep.failed_checks() == {"archive"}, rep.text()
     assert "CRC" in rep.row("archive")["detail"] or "Bad" in rep.row("archive")["detail"], rep.row("archive")
     assert rep.row("threads")["status"] == "n/a"
+
+
+def test_benchmark_preflight_check_stops_a_failing_unit(broken):
+    """`scfmu benchmark UNIT.fmu --check`: the unit that accepts calls in every state is stopped before any run."""
+    p = subprocess.run([sys.executable, "-m", "scfmu", "benchmark", str(broken["lax"]), "--check", "--quick"],
+                       capture_output=True, text=True, timeout=600)
+    assert p.returncode == 1, p.stdout + p.stderr
+    assert "fails scfmu check (bad_arguments, random_sequences, state_machine); not benchmarked" in p.stderr
+    assert "Traceback" not in p.stderr
