@@ -161,3 +161,19 @@ def test_fmi3_random_sequence_fuzzer_with_reinitialisation():
           f"{reinit} re-initialisations after errors")
     assert len(FMI3) >= 24 and calls > 24 * n * 50
     assert share > 0.75
+
+
+@pytest.mark.parametrize("variant,kind", [("crash", "crash"), ("hang", "hang"), ("nan", "nonfinite"),
+                                          ("error", "error_status")])
+def test_the_c_foreign_failure_variants_fail_the_nominal_run(foreign, variant, kind):
+    """The C PD controller's failure variants of the bring-your-own-unit tests (failing from t = 0.5 s): the
+    nominal run (100 steps of 0.01 s) meets the failure at the step from t = 0.5."""
+    rep = check(foreign.c_pd(variant), quick=True, timeout=3, checks=["nominal_run"])
+    r = rep.row("nominal_run", "cs")
+    assert r["status"] == "fail" and r["kind"] == kind, r
+    last = r["reproducer"][-1]
+    if variant == "nan":
+        assert last.startswith("fmi2GetReal(c1, {30, 31, 32}, 3, values) -> fmi2OK"), last
+        assert r["reproducer"][-2].startswith("fmi2DoStep(c1, 0.49"), r["reproducer"][-2]
+    else:
+        assert last.startswith("fmi2DoStep(c1, 0.5"), last
