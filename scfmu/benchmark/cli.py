@@ -28,6 +28,8 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="Monte Carlo cases with 10 draws (the same set-up otherwise)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--out", default=None, help="output folder (default out/benchmark/<family>)")
+    ap.add_argument("--check", action="store_true", help="first run `scfmu check --quick` on the unit (an .fmu); "
+                    "stop with exit status 1 if a check fails")
     a = ap.parse_args(argv)
     if a.family not in REGISTRY.families():
         print(f"scfmu benchmark: no family {a.family!r}; known: {', '.join(REGISTRY.families())}", file=sys.stderr)
@@ -39,6 +41,14 @@ def main(argv=None) -> int:
             print(f"scfmu benchmark: {unit}: no such file", file=sys.stderr)
             return 2
         unit = str(p.resolve())
+        if a.check:
+            from ..check import check_quick
+            rep = check_quick(unit)
+            print(rep.text(), file=sys.stderr)
+            if not rep.ok:
+                print(f"scfmu benchmark: {unit} fails scfmu check ({', '.join(sorted(rep.failed_checks()))}); "
+                      "not benchmarked", file=sys.stderr)
+                return 1
     label = a.label or (Path(unit).stem if unit else None)
     out = Path(a.out or Path("out") / "benchmark" / a.family)
     print(f"benchmark {a.family}: {label or 'built-in controllers only'} → {out}")

@@ -1,0 +1,734 @@
+"""The dynamic checks of ``scfmu check`` (they run in a child process: see scfmu.check.runner).
+
+Each check takes a :class:`~scfmu.check.unit.Unit` and the options and returns a result dict
+(status "pass" | "fail" | "n/a", kind, detail, reproducer, metrics). A failure raises :class:`Fail`; the
+reproducer is the call list of the scenario that failed (the current :class:`~scfmu.check.fmi.Trace`).
+A crash or a hang is seen by the parent, which has the same call list from the child's output."""
+
+from __future__ import annotations
+
+import math
+import random
+import struct
+import threading
+
+from .fmi import OK, WARNING, Lib
+from .unit import Unit, s_name
+
+NOT_OK = "a status other than OK/Warning"
+
+
+class Fail(Exception):
+    def __init__(self, kind: str, detail: str):
+        super().__init__(detail)
+        self.kind, self.detail = kind, detail
+
+
+class NotApplicable(Exception):
+    pass
+
+
+def _rss() -> int:
+    """Resident set size of this process in bytes (Linux /proc; elsewhere the peak from getrusage)."""
+    try:
+        with open("/proc/self/statm") as f:
+            import os
+            return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+    except OSError:
+        import resource
+        return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+
+
+def _need(u: Unit, h, what: str):
+    if h is None:
+        raise Fail("error_status", f"{what}: instantiation returned NULL")
+    return h
+
+
+def _expect_refused(u: Unit, s: int, what: str, kind: str = "wrong_status"):
+    if s in (OK, WARNING):
+        raise Fail(kind, f"{what} returned {s_name(u.v, s)}; the standard prescribes an error status")
+
+
+def _expect_ok(u: Unit, s: int, what: str):
+    if s > WARNING:
+        msg = u.messages[-1][1] if u.messages else "no log message"
+        raise Fail("error_status", f"{what} returned {s_name(u.v, s)} ({msg})")
+
+
+def _check_status_valid(u: Unit, s: int, what: str):
+    if not 0 <= s <= (5 if u.v == 2 else 4):
+        raise Fail("invalid_status", f"{what} returned the invalid status value {s}")
+
+
+def _steps(u: Unit, h, t: float, n: int, inputs=None) -> tuple[float, list]:
+    """n steps of u.dt with the outputs checked after each; returns (time, outputs after each step)."""
+    outs = []
+    for k in range(n):
+        if inputs is not None:
+            _expect_ok(u, u.set(h, u.inputs, inputs(k)), "setting the inputs")
+        s = u.step(h, t, u.dt)
+        _check_status_valid(u, s, "a step")
+        _expect_ok(u, s, f"the step from t = {t!r}")
+        t += u.dt
+        s, vals, problem = u.outputs_ok(h)
+        _expect_ok(u, s, "reading the outputs")
+        if problem:
+            raise Fail("nonfinite", problem)
+        outs.append(vals)
+    return t, outs
+
+
+def _bits(rows) -> bytes:
+    return b"".join(struct.pack(f"<{len(r)}d", *[float(x) for x in r]) for r in rows)
+
+
+def _inputs_fn(u: Unit, seed: int):
+    """The input sequence of the nominal, FMU-state and thread runs: the inputs' start values (an operating
+    point the modelDescription promises; perturbing them could break a unit's input contract, e.g. a unit
+    quaternion). `seed` is kept for the signature: the sequence is the same for every seed."""
+    base = u.nominal_inputs()
+    return lambda k: base
+
+
+# ============================================================================================ checks
+def nominal_run(u: Unit, o: dict) -> dict:
+    """The default experiment (capped at `steps`): every call OK, every output finite."""
+    u.trace.start("nominal run")
+    h = _need(u, u.new(), "instantiate")
+    _expect_ok(u, u.start(h), "initialization")
+    n = max(1, min(o["steps"], int(round((u.spec["stop_time"] - u.start_time) / u.dt)) or o["steps"]))
+    t, _ = _steps(u, h, u.start_time, n, _inputs_fn(u, o["seed"]))
+    _expect_ok(u, u.terminate(h), "terminate")
+    u.free(h)
+    return {"detail": f"{n} steps of {u.dt:g} s from t = {u.start_time:g}: every call OK, outputs finite",
+            "metrics": {"steps": n}}
+
+
+def _cs_forbidden(u: Unit):
+    """(title, reach, call): a call the standard forbids in the state `reach` leads to."""
+    p = u.p
+    init = lambda h: u.enter_init(h)  # noqa: E731
+    ready = lambda h: u.start(h)  # noqa: E731
+
+    def term(h):
+        u.start(h)
+        return u.terminate(h)
+    inp = u.real_inputs[:1]
+    step = lambda h: u.step(h, u.start_time, u.dt)  # noqa: E731
+    items = [
+        ("step in Instantiated", None, step),
+        ("step in Initialization Mode", init, step),
+        ("step after terminate", term, lambda h: u.step(h, u.start_time + u.dt, u.dt)),
+        (f"{p}ExitInitializationMode in Instantiated", None, lambda h: u.exit_init(h)),
+        (f"{p}EnterInitializationMode twice", init, lambda h: u.enter_init(h)),
+        (f"{p}EnterInitializationMode after initialization", ready, lambda h: u.enter_init(h)),
+        (f"{p}ExitInitializationMode after initialization", ready, lambda h: u.exit_init(h)),
+        (f"{p}Terminate in Instantiated", None, lambda h: u.terminate(h)),
+    ]
+    if u.v == 2:  # FMI 2.0's tables (the FMI 3.0 ones differ in detail here; not judged there)
+        items.append(("fmi2SetupExperiment after initialization", ready,
+                      lambda h: u.lib.call("fmi2SetupExperiment", h, 0, 0.0, 0.0, 0, 0.0)))
+        items.append(("fmi2Terminate in Initialization Mode", init, lambda h: u.terminate(h)))
+        items.append(("fmi2Terminate after terminate", term, lambda h: u.terminate(h)))
+        if u.outputs:
+            items.append(("reading the outputs in Instantiated", None, lambda h: u.get(h, u.outputs[:1])[0]))
+    if inp:
+        items.append((f"setting input {inp[0]['name']} after terminate", term,
+                      lambda h: u.set(h, inp, [inp[0].get("start") or 0.0])))
+    if u.me:
+        p = u.p
+        n = u.nx
+        from ctypes import c_double
+
+        def set_states(h):
+            xs = (c_double * max(n, 1))()
+            return u.lib.call(f"{p}SetContinuousStates", h, xs, n, shown=[u.lib.handle_name(h), "x", str(n)])
+
+        def derivs(h):
+            dx = (c_double * max(n, 1))()
+            name = "fmi2GetDerivatives" if u.v == 2 else "fmi3GetContinuousStateDerivatives"
+            return u.lib.call(name, h, dx, n, shown=[u.lib.handle_name(h), "dx", str(n)])
+
+        def event_mode(h):
+            s = u.enter_init(h)
+            return max(s, u.exit_init(h))
+        items = [it for it in items if not it[0].startswith("step")]
+        items += [
+            (f"{p}SetTime in Instantiated", None, lambda h: u.lib.call(f"{p}SetTime", h, 0.0)),
+            (f"{p}EnterContinuousTimeMode in Instantiated", None, lambda h: u.lib.call(f"{p}EnterContinuousTimeMode", h)),
+            (f"{p}EnterContinuousTimeMode in Continuous-Time Mode", ready,
+             lambda h: u.lib.call(f"{p}EnterContinuousTimeMode", h)),
+            (f"{p}CompletedIntegratorStep in Event Mode", event_mode, lambda h: _completed(u, h)),
+            (f"{p}EnterEventMode in Instantiated", None, lambda h: u.lib.call(f"{p}EnterEventMode", h)),
+            ("event update in Continuous-Time Mode", ready, lambda h: u.event_iteration(h, limit=1)),
+        ]
+        if n:
+            items += [(f"{p}SetContinuousStates in Instantiated", None, set_states),
+                      (f"{p}SetContinuousStates in Event Mode", event_mode, set_states),
+                      ("the derivatives in Instantiated", None, derivs)]
+    return items
+
+
+def _completed(u: Unit, h):
+    from ctypes import byref, c_bool, c_int
+    if u.v == 2:
+        a, b = c_int(), c_int()
+        return u.lib.call("fmi2CompletedIntegratorStep", h, 1, byref(a), byref(b),
+                          shown=[u.lib.handle_name(h), "fmi2True", "&enterEventMode", "&terminateSimulation"])
+    a, b = c_bool(), c_bool()
+    return u.lib.call("fmi3CompletedIntegratorStep", h, True, byref(a), byref(b),
+                      shown=[u.lib.handle_name(h), "true", "&enterEventMode", "&terminateSimulation"])
+
+
+def state_machine(u: Unit, o: dict) -> dict:
+    """Calls the standard forbids in a state must be refused (an error status); calls it allows must work:
+    the outputs in Initialization Mode, after a step and after terminate, Reset from every state and after
+    an error, free in every state."""
+    failures, first = [], None
+    n_calls = 0
+    for title, reach, call in _cs_forbidden(u):
+        u.trace.start(f"state machine: {title}")
+        h = _need(u, u.new(), "instantiate")
+        if reach is not None:
+            s = reach(h)
+            if s > WARNING:
+                raise Fail("error_status", f"reaching the state for '{title}' failed: "
+                                           f"{u.trace.lines[-1] if u.trace.lines else ''}")
+        s = call(h)
+        n_calls += 1
+        _check_status_valid(u, s, title)
+        if s <= WARNING:
+            failures.append(f"{title} returned {s_name(u.v, s)}")
+            if first is None:
+                first = list(u.trace.lines)
+        u.free(h)
+    # allowed calls
+    u.trace.start("state machine: allowed calls")
+    h = _need(u, u.new(), "instantiate")
+    _expect_ok(u, u.enter_init(h), "initialization")
+    if u.outputs:
+        _expect_ok(u, u.outputs_ok(h)[0], "reading the outputs in Initialization Mode")
+    _expect_ok(u, u.exit_init(h), "exit initialization")
+    u.free(h)
+    for where in ("after a step", "after terminate", "after an error"):
+        u.trace.start(f"state machine: Reset {where}")
+        h = _need(u, u.new(), "instantiate")
+        _expect_ok(u, u.start(h), "initialization")
+        _expect_ok(u, u.step(h, u.start_time, u.dt), "a step")
+        if where == "after terminate":
+            _expect_ok(u, u.terminate(h), "terminate")
+            if u.outputs:
+                s, _, problem = u.outputs_ok(h)
+                _expect_ok(u, s, "reading the outputs after terminate")
+        if where == "after an error":
+            u.lib.call(f"{u.p}ExitInitializationMode", h)  # forbidden here: an error (checked above)
+        _expect_ok(u, u.reset(h), f"{u.p}Reset {where}")
+        _expect_ok(u, u.start(h), f"initialization after {u.p}Reset")
+        _steps(u, h, u.start_time, 3)
+        u.free(h)
+    u.trace.start("state machine: free in every state")
+    for reach in (None, lambda h: u.enter_init(h), lambda h: u.start(h)):
+        h = _need(u, u.new(), "instantiate")
+        if reach:
+            reach(h)
+        u.free(h)
+    if failures:
+        u.trace.lines = first
+        raise Fail("wrong_state", f"{len(failures)} of {n_calls} calls in a forbidden state were accepted: "
+                   + "; ".join(failures[:4]) + (" ..." if len(failures) > 4 else ""))
+    return {"detail": f"{n_calls} calls in forbidden states refused; outputs readable in Initialization Mode and "
+                      "after terminate; Reset works after a step, terminate and an error",
+            "metrics": {"forbidden_calls": n_calls}}
+
+
+def bad_arguments(u: Unit, o: dict) -> dict:
+    """NULL pointers, a wrong GUID/token, unknown value references, NaN/Inf inputs, zero, negative and
+    non-finite steps: refused (or, for values the unit accepts, no non-finite output with OK); never a crash."""
+    from ctypes import c_double, c_uint32
+    p, v = u.p, u.v
+    notes = []
+    u.trace.start("bad arguments: wrong GUID / instantiation token")
+    h = u.new(token="{00000000-0000-0000-0000-000000000000}")
+    if h is not None:
+        u.free(h)
+        raise Fail("wrong_status", "instantiation with a wrong GUID/instantiationToken returned an instance")
+    u.trace.start("bad arguments: NULL GUID / instantiation token")
+    h = u.new(null_token=True)
+    if h is not None:
+        u.free(h)
+        raise Fail("wrong_status", "instantiation with a NULL GUID/instantiationToken returned an instance")
+    if v == 2:
+        u.trace.start("bad arguments: NULL callback functions")
+        h = u.new(null_callbacks=True)
+        if h is not None:
+            u.free(h)
+            notes.append("NULL callbacks accepted")
+    u.trace.start("bad arguments: NULL instance")
+    calls = [(f"{p}EnterInitializationMode(NULL)", lambda: u.enter_init(None)),
+             (f"{p}ExitInitializationMode(NULL)", lambda: u.exit_init(None)),
+             (f"{p}Terminate(NULL)", lambda: u.terminate(None)),
+             (f"{p}Reset(NULL)", lambda: u.reset(None))]
+    if u.outputs:
+        calls.append(("reading the outputs of NULL", lambda: u.get(None, u.outputs[:1])[0]))
+    if u.real_inputs:
+        calls.append(("setting an input of NULL", lambda: u.set(None, u.real_inputs[:1], [0.0])))
+    if not u.me:
+        calls.append(("a step of NULL", lambda: u.step(None, 0.0, u.dt)))
+    for what, f in calls:
+        _expect_refused(u, f(), what)
+    u.lib.call(f"{p}FreeInstance", None)
+
+    u.trace.start("bad arguments: NULL arrays and unknown value references")
+    h = _need(u, u.new(), "instantiate")
+    _expect_ok(u, u.start(h), "initialization")
+    getter = "fmi2GetReal" if v == 2 else "fmi3GetFloat64"
+    setter = "fmi2SetReal" if v == 2 else "fmi3SetFloat64"
+    ext = [] if v == 2 else [1]
+    real_out = [x for x in u.outputs if x["type"] in ("Real", "Float64")]
+    if real_out:
+        vr1 = (c_uint32 * 1)(real_out[0]["vr"])
+        val = (c_double * 1)()
+        hn = u.lib.handle_name(h)
+        sh = [] if v == 2 else ["1"]
+        _expect_refused(u, u.lib.call(getter, h, None, 1, val, *ext, shown=[hn, "NULL", "1", "values", *sh]),
+                        f"{getter} with a NULL value-reference array")
+        _expect_refused(u, u.lib.call(getter, h, vr1, 1, None, *ext, shown=[hn, f"{{{real_out[0]['vr']}}}", "1",
+                                                                              "NULL", *sh]),
+                        f"{getter} with a NULL value array")
+    used = set(u.spec["all_vrs"])
+    unknown = max(used, default=0) + 1000
+    while unknown in used:
+        unknown += 1
+    vr = (c_uint32 * 1)(unknown)
+    val = (c_double * 1)(0.0)
+    hn = u.lib.handle_name(h)
+    sh = [] if v == 2 else ["1"]
+    s = u.lib.call(getter, h, vr, 1, val, *ext, shown=[hn, f"{{{unknown}}}", "1", "values", *sh])
+    _expect_refused(u, s, f"{getter} of the unknown value reference {unknown}")
+    u.free(h)
+    h = _need(u, u.new(), "instantiate")
+    _expect_ok(u, u.start(h), "initialization")
+    hn = u.lib.handle_name(h)
+    s = u.lib.call(setter, h, vr, 1, val, *ext, shown=[hn, f"{{{unknown}}}", "1", "{0.0}", *sh])
+    _expect_refused(u, s, f"{setter} of the unknown value reference {unknown}")
+    u.free(h)
+
+    # non-finite inputs: refused, or no non-finite output returned with OK afterwards
+    accepted = []
+    for var in u.real_inputs:
+        for bad in (math.nan, math.inf, -math.inf):
+            u.trace.start(f"bad arguments: input {var['name']} = {bad}")
+            h = _need(u, u.new(), "instantiate")
+            _expect_ok(u, u.start(h), "initialization")
+            s = u.set(h, [var], [bad])
+            if s <= WARNING:
+                s = u.step(h, u.start_time, u.dt)
+                if s <= WARNING:
+                    s2, _, problem = u.outputs_ok(h)
+                    if problem:
+                        u.free(h)
+                        raise Fail("nonfinite", f"input {var['name']} = {bad} accepted, then {problem}")
+                    accepted.append(var["name"])
+            u.free(h)
+    # bad steps
+    bad_steps = [(0.0, None), (-u.dt, "negative"), (math.nan, "NaN"), (math.inf, "infinite"), (-math.inf, "negative")]
+    zero_ok = None
+    for dt, must in bad_steps:
+        u.trace.start(f"bad arguments: step size {dt}")
+        h = _need(u, u.new(), "instantiate")
+        _expect_ok(u, u.start(h), "initialization")
+        if u.me:
+            s = u.lib.call(f"{p}SetTime", h, u.start_time + dt if math.isfinite(dt) else dt)
+            label = f"{p}SetTime to start time + {dt}"
+            must = "NaN" if math.isnan(dt) else None  # time may be set back in Model Exchange
+        else:
+            s = u.step(h, u.start_time, dt)
+            label = f"a step of size {dt}"
+        _check_status_valid(u, s, label)
+        if must and s <= WARNING:
+            if must == "infinite":
+                _, _, problem = u.outputs_ok(h)
+                if problem:
+                    raise Fail("nonfinite", f"{label} accepted, then {problem}")
+            else:
+                raise Fail("wrong_status", f"{label} returned {s_name(v, s)}; a {must} step must be refused")
+        if dt == 0.0:
+            zero_ok = s <= WARNING
+        u.free(h)
+    if not u.me:
+        u.trace.start("bad arguments: NaN communication point")
+        h = _need(u, u.new(), "instantiate")
+        _expect_ok(u, u.start(h), "initialization")
+        s = u.step(h, math.nan, u.dt)
+        if s <= WARNING:
+            raise Fail("wrong_status", f"a step from t = NaN returned {s_name(v, s)}")
+        u.free(h)
+    detail = (f"wrong and NULL GUID refused, NULL instance and arrays refused, unknown value reference {unknown} "
+              f"refused, non-finite inputs {'accepted by ' + ', '.join(sorted(set(accepted))[:3]) + ' without a non-finite output' if accepted else 'refused'}, "
+              f"negative/NaN steps refused, zero step {'accepted' if zero_ok else 'refused'}")
+    if notes:
+        detail += "; " + "; ".join(notes)
+    return {"detail": detail, "metrics": {"nonfinite_inputs_accepted": len(accepted)}}
+
+
+# ----------------------------------------------------------------------------------- random sequences
+# the modelled states
+INST, INIT, READY, TERM = "instantiated", "initialization", "ready", "terminated"
+ACTIONS = ("set", "get", "step", "step", "step", "bad_step", "enter_init", "exit_init", "terminate", "reset",
+           "state", "free_new", "extreme")
+
+
+# the calls a well-behaved master makes in each state (three quarters of the calls; the rest are any call)
+LEGAL = {INST: ("enter_init", "set", "state"), INIT: ("set", "get", "exit_init", "exit_init"),
+         READY: ("set", "get", "step", "step", "step", "step", "state", "extreme", "terminate"),
+         TERM: ("get", "reset", "free_new")}
+
+
+def random_sequences(u: Unit, o: dict) -> dict:
+    """`sequences` seeded random call sequences of `length` calls from the unit's state machine (legal calls,
+    forbidden calls, extreme values, bad steps, FMU states), re-initialised after every error so that
+    sequences reach deep states. Fails on a forbidden call accepted, a non-finite output returned with OK, an
+    invalid status or (seen by the parent) a crash or hang. Reports the share of calls that succeeded."""
+    rng = random.Random(o["seed"] * 7919 + 11)
+    n_seq, length = o["sequences"], o["length"]
+    total = ok = reinit = 0
+    can_state = u.spec["can_get_set_state"]
+    for k in range(n_seq):
+        u.trace.start(f"random sequence {k} (seed {o['seed']})")
+        h = _need(u, u.new(), "instantiate")
+        st, t = INST, u.start_time
+        saved = None
+        for _ in range(length):
+            a = rng.choice(ACTIONS) if rng.random() < 0.25 else rng.choice(LEGAL[st] if st in LEGAL else ACTIONS)
+            forbidden = False
+            s = OK
+            if a == "set":
+                if not u.inputs:
+                    continue
+                base = u.nominal_inputs()
+                scale = rng.choice([0.0, 0.0, 1e-3, 0.1])  # mostly the start values, sometimes perturbed
+                vals = [b + rng.gauss(0, scale * (1 + abs(b))) if var["type"] in ("Real", "Float64") else b
+                        for var, b in zip(u.inputs, base)]
+                vals = [min(max(x, var["min"]), var["max"]) if var["type"] in ("Real", "Float64") and
+                        var.get("min") is not None and var.get("max") is not None else x
+                        for var, x in zip(u.inputs, vals)]
+                forbidden = st == TERM
+                s = u.set(h, u.inputs, vals)
+            elif a == "extreme":
+                if not u.real_inputs:
+                    continue
+                var = rng.choice(u.real_inputs)
+                x = rng.choice([math.nan, math.inf, -math.inf, 1e300, -1e300, 5e-324])
+                forbidden = st == TERM
+                s = u.set(h, [var], [x])
+            elif a == "get":
+                if not u.outputs or st == INST:
+                    continue
+                s, _, problem = u.outputs_ok(h)
+                if problem:
+                    raise Fail("nonfinite", f"random sequence {k}: {problem}")
+            elif a in ("step", "bad_step"):
+                dt = u.dt * rng.choice([1, 1, 1, 0.5, 2, 10]) if a == "step" else \
+                    rng.choice([0.0, -u.dt, math.nan, 1e9 * u.dt])
+                if u.me and st == READY:
+                    s = u.me_step(h, t, dt) if math.isfinite(dt) and dt > 0 else \
+                        u.lib.call(f"{u.p}SetTime", h, t + dt if not math.isnan(dt) else dt)
+                    if s <= WARNING and math.isnan(dt):
+                        forbidden = True
+                else:
+                    forbidden = st != READY or (a == "bad_step" and (math.isnan(dt) or dt < 0))
+                    s = u.step(h, t, dt)
+                if s <= WARNING and st == READY and math.isfinite(dt) and dt > 0:
+                    t += dt
+            elif a == "enter_init":
+                forbidden = st != INST
+                s = u.enter_init(h, t) if st == INST or rng.random() < 0.5 else \
+                    u.lib.call(f"{u.p}EnterInitializationMode", h) if u.v == 2 else u.enter_init(h, t)
+                if s <= WARNING:
+                    st = INIT
+            elif a == "exit_init":
+                forbidden = st != INIT
+                s = u.exit_init(h)
+                if s <= WARNING and st == INIT:
+                    st = READY
+                    if u.me:
+                        s = max(s, u.event_iteration(h))
+                        if s <= WARNING:
+                            s = max(s, u.lib.call(f"{u.p}EnterContinuousTimeMode", h))
+            elif a == "terminate":
+                forbidden = st == INST
+                s = u.terminate(h)
+                if s <= WARNING and st != INST:
+                    st = TERM
+            elif a == "reset":
+                s = u.reset(h)
+                if s <= WARNING:
+                    st, t = INST, u.start_time
+            elif a == "state":
+                if not can_state:
+                    continue
+                if saved is None or rng.random() < 0.5:
+                    if saved is not None:
+                        u.free_state(h, saved)
+                    s, saved = u.get_state(h)
+                    if s > WARNING:
+                        saved = None
+                else:
+                    s = u.set_state(h, saved)
+                    if s <= WARNING:
+                        st = "unknown"  # the restored state's mode is not modelled: re-initialise
+            elif a == "free_new":
+                if saved is not None:
+                    u.free_state(h, saved)
+                    saved = None
+                u.free(h)
+                h = _need(u, u.new(), "instantiate")
+                st, t = INST, u.start_time
+                continue
+            total += 1
+            _check_status_valid(u, s, a)
+            if forbidden and s <= WARNING and st != "unknown":
+                last = u.trace.lines[-1] if u.trace.lines else a
+                raise Fail("wrong_status", f"random sequence {k}: {last.split(' -> ')[0]} is forbidden in state "
+                                           f"'{st}' but returned {s_name(u.v, s)}")
+            if s <= WARNING:
+                ok += 1
+            if s > WARNING or st == "unknown":
+                reinit += 1
+                if saved is not None:
+                    u.free_state(h, saved)
+                    saved = None
+                s = u.reset(h)
+                if s > WARNING:
+                    u.free(h)
+                    h = _need(u, u.new(), "instantiate")
+                s = u.start(h)
+                st, t = (READY, u.start_time) if s <= WARNING else (INST, u.start_time)
+        if saved is not None:
+            u.free_state(h, saved)
+        u.free(h)
+    share = ok / total if total else 0.0
+    return {"detail": f"{n_seq} sequences x {length} calls (seed {o['seed']}): {ok} of {total} calls succeeded "
+                      f"({100 * share:.1f} %), {reinit} re-initialisations after errors",
+            "metrics": {"sequences": n_seq, "calls": total, "succeeded": ok, "share_succeeded": share,
+                        "reinitialisations": reinit}}
+
+
+def fmu_state(u: Unit, o: dict) -> dict:
+    """Get/set FMU state round trip (bit-identical continuation), serialize/deserialize into another
+    instance, and corrupted serialized states (random byte changes, truncation, empty, NULL): refused or
+    usable (finite outputs), never a crash."""
+    if not u.spec["can_get_set_state"]:
+        raise NotApplicable("canGetAndSetFMUstate is false")
+    inputs = _inputs_fn(u, o["seed"])
+    u.trace.start("FMU state: get, step, set, step again")
+    h = _need(u, u.new(), "instantiate")
+    _expect_ok(u, u.start(h), "initialization")
+    t, _ = _steps(u, h, u.start_time, 5, inputs)
+    s, st = u.get_state(h)
+    _expect_ok(u, s, "getting the FMU state")
+    x_saved = list(u.x.get(h, []))
+    n = 10
+    _, y1 = _steps(u, h, t, n, lambda k: inputs(k + 5))
+    _expect_ok(u, u.set_state(h, st), "setting the FMU state")
+    if u.me:
+        u.x[h] = list(x_saved)
+    _, y2 = _steps(u, h, t, n, lambda k: inputs(k + 5))
+    if _bits(y1) != _bits(y2):
+        raise Fail("nondeterministic", "the steps after restoring the FMU state differ from the first ones")
+    metrics = {"round_trip": "bit-identical"}
+    detail = "get/set round trip bit-identical"
+    if u.spec["can_serialize_state"] and u.spec["only_once"]:
+        detail += "; serialization not checked (canBeInstantiatedOnlyOncePerProcess: no second instance)"
+    elif u.spec["can_serialize_state"]:
+        u.trace.start("FMU state: serialize, deserialize into a second instance")
+        s, data = u.serialize(h, st)
+        _expect_ok(u, s, "serializing the FMU state")
+        h2 = _need(u, u.new(), "instantiate")
+        _expect_ok(u, u.start(h2), "initialization")
+        s, st2 = u.deserialize(h2, data)
+        _expect_ok(u, s, "deserializing the FMU state")
+        _expect_ok(u, u.set_state(h2, st2), "setting the deserialized FMU state")
+        if u.me:
+            u.x[h2] = list(x_saved)
+        _, y3 = _steps(u, h2, t, n, lambda k: inputs(k + 5))
+        if _bits(y1) != _bits(y3):
+            raise Fail("nondeterministic", "a second instance restored from the serialized state steps differently")
+        u.free_state(h2, st2)
+        u.free(h2)
+        # corrupted states
+        rng = random.Random(o["seed"] * 31 + 7)
+        refused = usable = 0
+        cases = [("empty", b""), ("truncated", data[: len(data) // 2]), ("one byte short", data[:-1]),
+                 ("garbage", bytes(rng.randrange(256) for _ in range(len(data)))), ("NULL", None)]
+        for i in range(o["mutations"]):
+            b = bytearray(data)
+            for _ in range(rng.choice([1, 1, 2, 4, 16])):
+                pos = rng.randrange(len(b))
+                b[pos] = rng.randrange(256)
+            cases.append((f"mutation {i}", bytes(b)))
+        h3 = _need(u, u.new(), "instantiate")
+        _expect_ok(u, u.start(h3), "initialization")
+        for label, bad in cases:
+            u.trace.start(f"FMU state: deserialize a corrupted state ({label})")
+            s, st3 = u.deserialize(h3, bad, label=label)
+            _check_status_valid(u, s, "deserialize")
+            if s > WARNING or not st3:
+                if label in ("empty", "NULL") and s <= WARNING:
+                    raise Fail("wrong_status", f"deserializing a {label} state returned {s_name(u.v, s)}")
+                refused += 1
+                if s > WARNING:
+                    u.reset(h3)
+                    u.free(h3)
+                    h3 = _need(u, u.new(), "instantiate")
+                    _expect_ok(u, u.start(h3), "initialization")
+                continue
+            s = u.set_state(h3, st3)
+            if s <= WARNING:
+                u.x.pop(h3, None)
+                s = u.step(h3, t, u.dt)
+                if s <= WARNING:
+                    _, _, problem = u.outputs_ok(h3)
+                    if problem:
+                        raise Fail("nonfinite", f"a corrupted state ({label}) was accepted, then {problem}")
+                usable += 1
+            else:
+                refused += 1
+            u.free_state(h3, st3)
+            u.free(h3)
+            h3 = _need(u, u.new(), "instantiate")
+            _expect_ok(u, u.start(h3), "initialization")
+        u.free(h3)
+        detail += (f"; serialized ({len(data)} bytes) and restored in a second instance bit-identical; "
+                   f"{len(cases)} corrupted states: {refused} refused, {usable} usable with finite outputs")
+        metrics.update(serialized_bytes=len(data), corrupted=len(cases), refused=refused, usable=usable)
+    u.trace.start("FMU state: set a NULL state")
+    _expect_refused(u, u.set_state(h, None), "setting a NULL FMU state")
+    u.free_state(h, st)
+    u.free(h)
+    return {"detail": detail, "metrics": metrics}
+
+
+def memory(u: Unit, o: dict) -> dict:
+    """Repeated instantiate/initialize/step/free cycles and library load/unload cycles with the resident
+    memory measured: the growth over the second half of the cycles must stay below the limit."""
+    cycles, loads = o["cycles"], o["loads"]
+    limit = o["memory_limit"]
+
+    def one(unit):
+        h = _need(unit, unit.new(), "instantiate")
+        _expect_ok(unit, unit.start(h), "initialization")
+        _steps(unit, h, unit.start_time, 3)
+        s, st = (unit.get_state(h) if unit.spec["can_get_set_state"] else (OK, None))
+        if st:
+            unit.free_state(h, st)
+        unit.terminate(h)
+        unit.free(h)
+
+    u.trace.start("memory: instantiate/free cycles")
+    warm = max(10, cycles // 10)
+    for _ in range(warm):
+        one(u)
+        u.trace.lines.clear()
+    r0 = _rss()
+    for i in range(cycles):
+        if i == cycles // 2:
+            r_half = _rss()
+        one(u)
+        u.trace.lines.clear()
+    r1 = _rss()
+    per_cycle = (r1 - r_half) / max(1, cycles - cycles // 2)
+    u.trace.start("memory: instantiate/free cycles")
+    one(u)
+    if r1 - r_half > limit:
+        raise Fail("leak", f"resident memory grew by {(r1 - r_half) / 1024:.0f} kB over the last "
+                   f"{cycles - cycles // 2} instantiate/free cycles ({per_cycle / 1024:.1f} kB per instance; "
+                   f"limit {limit / 1024:.0f} kB)")
+    # load / unload
+    u.trace.start("memory: load/unload cycles")
+    r2 = _rss()
+    rl = None
+    for i in range(loads):
+        if i == loads // 2:
+            rl = _rss()
+        lib = Lib(u.spec["library"], u.v, u.trace)
+        u2 = Unit(u.spec, u.trace, lib)
+        one(u2)
+        lib.unload()
+        u.trace.lines.clear()
+    r3 = _rss()
+    load_growth = r3 - (rl if rl is not None else r2)
+    if load_growth > 4 * limit:
+        raise Fail("leak", f"resident memory grew by {load_growth / 1024:.0f} kB over the last "
+                   f"{loads - loads // 2} load/unload cycles (limit {4 * limit / 1024:.0f} kB)")
+    return {"detail": f"{cycles} instantiate/free cycles: {(r1 - r0) / 1024:+.0f} kB in all, "
+                      f"{per_cycle:+.0f} B per instance over the second half; {loads} load/unload cycles: "
+                      f"{load_growth / 1024:+.0f} kB over the second half",
+            "metrics": {"cycles": cycles, "rss_growth_bytes": r1 - r0, "bytes_per_instance_second_half": per_cycle,
+                        "loads": loads, "load_growth_bytes": load_growth}}
+
+
+def threads(u: Unit, o: dict) -> dict:
+    """The same inputs on N threads at once (one instance each): every thread's outputs bit-identical to
+    a run on the main thread."""
+    if u.spec["only_once"]:
+        raise NotApplicable("canBeInstantiatedOnlyOncePerProcess is true")
+    nt, n = o["threads"], o["thread_steps"]
+    inputs = _inputs_fn(u, o["seed"])
+    u.trace.start("threads: reference run on the main thread")
+    h = _need(u, u.new(), "instantiate")
+    _expect_ok(u, u.start(h), "initialization")
+    _, ref = _steps(u, h, u.start_time, n, inputs)
+    u.free(h)
+    ref_bits = _bits(ref)
+    results: list = [None] * nt
+    barrier = threading.Barrier(nt)
+    from .fmi import Trace
+    tu = []
+    for _ in range(nt):
+        tr = Trace(None)
+        tu.append(Unit(u.spec, tr, Lib(u.spec["library"], u.v, tr)))
+
+    def work(i):
+        try:
+            w = tu[i]
+            w._counter = 100 * (i + 1)
+            hh = w.new()
+            if hh is None:
+                results[i] = "instantiation returned NULL"
+                barrier.abort()  # the others must not wait for this thread
+                return
+            s = w.start(hh)
+            barrier.wait(timeout=60)
+            if s > WARNING:
+                results[i] = f"initialization returned {s_name(u.v, s)}"
+                return
+            _, outs = _steps(w, hh, w.start_time, n, inputs)
+            w.free(hh)
+            results[i] = _bits(outs)
+        except Fail as e:
+            results[i] = e.detail
+        except threading.BrokenBarrierError:
+            results[i] = "another thread failed before the common start"
+        except Exception as e:  # e.g. a function missing from the binary
+            results[i] = f"{type(e).__name__}: {e}"
+
+    u.trace.start(f"threads: {nt} threads, {n} steps each, the same inputs")
+    u.trace.note(f"{nt} threads each: instantiate, initialize, {n} x (set inputs, step, get outputs), free")
+    ts = [threading.Thread(target=work, args=(i,)) for i in range(nt)]
+    for th in ts:
+        th.start()
+    for th in ts:
+        th.join()
+    bad = [i for i, r in enumerate(results) if r != ref_bits]
+    if bad:
+        r = results[bad[0]]
+        why = r if isinstance(r, str) else "outputs differ from the main thread's run"
+        raise Fail("nondeterministic", f"{len(bad)} of {nt} threads: {why}")
+    return {"detail": f"{nt} threads x {n} steps: outputs bit-identical to the main thread's run",
+            "metrics": {"threads": nt, "steps": n}}
+
+
+CHECKS = {"nominal_run": nominal_run, "state_machine": state_machine, "bad_arguments": bad_arguments,
+          "random_sequences": random_sequences, "fmu_state": fmu_state, "memory": memory, "threads": threads}

@@ -1,0 +1,108 @@
+"""Runs the dynamic checks of one FMU interface in isolated child processes (scfmu.check.child) with a
+time limit per check: a crash, an abort or a hang of the FMU ends only the child; the check that was
+running is failed with the call list it was making, and a fresh child continues with the next checks."""
+
+from __future__ import annotations
+
+import json
+import os
+import selectors
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+
+
+def _signame(rc: int) -> str:
+    try:
+        return signal.Signals(-rc).name
+    except (ValueError, AttributeError):
+        return f"signal {-rc}"
+
+
+def run_checks(spec: dict, checks: list[str], options: dict, timeout: float) -> dict:
+    """{check name: result dict} for `checks` on the interface `spec`; each check gets `timeout` seconds."""
+    results: dict = {}
+    todo = list(checks)
+    while todo:
+        results.update(_one_child(spec, todo, options, timeout))
+        todo = [c for c in todo if c not in results]
+    return results
+
+
+def _one_child(spec, checks, options, timeout) -> dict:
+    job = json.dumps({"spec": spec, "checks": checks, "options": options}).encode()
+    results: dict = {}
+    with tempfile.TemporaryDirectory(prefix="scfmu_check_") as tmp, \
+            tempfile.TemporaryFile(dir=tmp) as err:
+        env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
+        env.pop("PYTHONFAULTHANDLER", None)  # the FMU's signal is reported from the exit status
+        proc = subprocess.Popen([sys.executable, "-m", "scfmu.check.child"], stdin=subprocess.PIPE,
+                                stdout=subprocess.PIPE, stderr=err, cwd=tmp, env=env, start_new_session=True)
+        proc.stdin.write(job)
+        proc.stdin.close()
+        sel = selectors.DefaultSelector()
+        sel.register(proc.stdout, selectors.EVENT_READ)
+        current, lines, buf = None, [], b""
+        deadline = time.monotonic() + timeout + 60.0  # starting Python is not the FMU's time
+        hung = False
+        fd = proc.stdout.fileno()
+        while True:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                hung = True
+                break
+            if not sel.select(timeout=min(left, 1.0)):
+                continue
+            chunk = os.read(fd, 1 << 16)
+            if not chunk:
+                break
+            buf += chunk
+            *complete, buf = buf.split(b"\n")
+            for raw in complete:
+                line = raw.decode(errors="replace")
+                tag, _, rest = line.partition(" ")
+                if tag == "B":
+                    current, lines = rest, []
+                    deadline = time.monotonic() + timeout
+                elif tag == "S":
+                    lines = []
+                elif tag == "C":
+                    lines.append(rest)
+                elif tag == "R" and lines:
+                    lines[-1] = rest
+                elif tag == "E" and current:
+                    results[current] = json.loads(rest)
+                    current = None
+        sel.close()
+        if hung:
+            try:
+                os.killpg(proc.pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+        try:
+            rc = proc.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+            rc = proc.wait()
+        err.seek(0)
+        stderr = err.read()[-4000:].decode(errors="replace").strip()
+        if current is not None and current not in results:
+            last = lines[-1] if lines else "(no call yet)"
+            if hung:
+                results[current] = {"status": "fail", "kind": "hang",
+                                    "detail": f"no answer within {timeout:g} s; the call in progress: {last}",
+                                    "reproducer": lines}
+            else:
+                how = f"killed by {_signame(rc)}" if rc < 0 else f"exited with status {rc}"
+                tail = " | ".join(stderr.splitlines()[-3:])
+                results[current] = {"status": "fail", "kind": "crash",
+                                    "detail": f"the process was {how} during {last}" + (f" (stderr: {tail})" if tail else ""),
+                                    "reproducer": lines}
+        elif not results and rc != 0:  # the child died before its first check (e.g. cannot start)
+            tail = " | ".join(stderr.splitlines()[-3:])
+            results[checks[0]] = {"status": "fail", "kind": "crash",
+                                  "detail": f"the check process exited with status {rc} before the check began: {tail}",
+                                  "reproducer": []}
+    return results
