@@ -99,7 +99,7 @@ def evaluate(expr, env: dict, where: str = "binding"):
         if isinstance(node, ast.Expression):
             return ev(node.body)
         if isinstance(node, ast.Constant):
-            return node.value
+            return float(node.value)  # floats: 10 ** 10 ** 10 overflows at once instead of computing a huge integer
         if isinstance(node, ast.Name):
             if node.id not in env:
                 raise ProfileError(f"{where}: {expr!r} names {node.id!r}, which this place does not offer "
@@ -107,7 +107,7 @@ def evaluate(expr, env: dict, where: str = "binding"):
             v = env[node.id]
             if isinstance(v, bool) or not isinstance(v, (int, float)):
                 raise ProfileError(f"{where}: {node.id} = {v!r} is not a number")
-            return v
+            return float(v)
         if isinstance(node, ast.BinOp):
             return _BINOPS[type(node.op)](ev(node.left), ev(node.right))
         if isinstance(node, ast.UnaryOp):
