@@ -42,7 +42,6 @@ from ..scenario import get
 from ..scenario import profile as profiles
 from ..scenario.check import IncompatibleUnit, require
 from ..scenario.resolve import unbound_slots
-from ..scenario.ssp import file_stem
 
 UNIT = "unit under test"
 
@@ -263,8 +262,7 @@ def run(unit: str | None, family: str, out: str | Path, label: str | None = None
                 every = max(1, sc.n_steps // 1500)
                 c = campaign.Campaign(sc, sets, seeds, timeseries=[k for k in keys if k in sc.log] or None,
                                       ts_every=every)
-                folder = out / "runs" / file_stem(case.scenario + ("_" + "_".join(f"{k}{v}" for k, v in case.overrides.items())
-                                                                   if case.overrides else "")) / _slug(name)
+                folder = out / "runs" / _slug(case.label) / _slug(name)  # one folder per case (two cases may share a scenario)
                 table = campaign.run(c, folder, client=client, progress=False, overwrite=True)
                 rows = sorted(table.to_pylist(), key=lambda r: r["run"])
                 e.runs = len(rows)
