@@ -381,13 +381,18 @@ def _figure(out: Path, case, entries: list[Entry], unit_label) -> str | None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(8, 3.8))
+    groups = {g[0]: g for g in identical_groups(case, entries)}  # identical responses: one line, one label
+    hidden = {x for g in groups.values() for x in g[1:]}
     for e in es:
+        if e.controller in hidden and e.controller != unit_label:
+            continue
         y = np.asarray(e.series[case.signal], dtype=float)
         if case.signal in ("roll", "pitch", "yaw", "theta"):
             y = np.degrees(y)
         ax.plot(e.series["time"], y, lw=2.2 if e.controller == unit_label else 1.0,
                 ls="-" if e.controller == unit_label else "--",
-                label=e.controller + (" (re-tuned)" if e.envelope == "retuned" else ""))
+                label=(" = ".join(groups[e.controller]) if e.controller in groups else e.controller)
+                + (" (re-tuned)" if e.envelope == "retuned" else ""))
     ax.set_xlabel("time [s]")
     ax.set_ylabel(_signal_label(case.signal))
     who = f"{unit_label} vs the built-in controllers" if unit_label else "built-in controllers"
