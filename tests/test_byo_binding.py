@@ -102,7 +102,7 @@ def test_profile_file_errors_name_the_key(tmp_path):
 
 
 # ----- binding a J-named unit ------------------------------------------------------------------------------------------
-def test_unbound_inertia_is_reported_by_run_and_campaign_and_strict_refuses(units, tmp_path):
+def test_unbound_inertia_is_reported_by_run_and_campaign_and_strict_refuses(units, prof, tmp_path):
     fmu = units.c_pd("j_names")
     want = "slot value inertia_xx = 4 not passed: the unit kept its own J1 = 1000"
     r = scfmu("run", CASE, "--t-end", "2", "--fmu", f"controller={fmu}", "--out", tmp_path / "run")
@@ -116,6 +116,11 @@ def test_unbound_inertia_is_reported_by_run_and_campaign_and_strict_refuses(unit
     assert want in r.stderr
     man = json.loads((tmp_path / "c" / "manifest.json").read_text())
     assert any(want in x for x in man["unbound_slot_values"]), man
+    r = scfmu("campaign", CASE, "--t-end", "2", "--fmu", f"controller={fmu}", "--profile", prof, "--strict",
+              "--workers", "1", "--out", tmp_path / "cp", "--no-progress", "--no-plots")
+    assert r.returncode == 0 and "warning:" not in r.stderr, r.stdout + r.stderr
+    man = json.loads((tmp_path / "cp" / "manifest.json").read_text())
+    assert man["unbound_slot_values"] == [] and man["scenario"]["components"][1]["bind"]["J1"] == "inertia_xx"
     r = scfmu("run", CASE, "--t-end", "2", "--fmu", f"controller={fmu}", "--strict", "--out", tmp_path / "s")
     assert r.returncode == 2 and "Traceback" not in r.stderr, r.stderr
     refusal = [x for x in r.stderr.splitlines() if "--strict" in x]

@@ -236,8 +236,10 @@ def run(unit: str | None, family: str, out: str | Path, label: str | None = None
                 entries.append(e)
                 try:
                     if b is None:
-                        e.envelope, e.config = "unit", "the unit under test" + (
-                            f" with profile {Path(profile.path).name}" if profile is not None and profile.path else "")
+                        e.envelope, e.config = "unit", "the unit under test" + "".join(
+                            [f" with {', '.join(f'{k} = {v}' for k, v in unit_params.items())}" if unit_params else "",
+                             f", profile {Path(profile.path).name}" if profile is not None and profile.path else "",
+                             f", --map {', '.join(f'{k}={v}' for k, v in port_map.items())}" if port_map else ""])
                         sc = unit_scenario(base, case, model, unit_params, port_map, profile)
                     else:
                         e.envelope, params, e.config = configure(b, case, base)
