@@ -131,3 +131,21 @@ def _series_of(out: Path, x: dict):
         return None
     t = pq.read_table(files[0])
     return {k: t.column(k).to_numpy() for k in t.column_names}
+
+
+def test_builtin_tuning_reaches_the_run_on_its_own_scenario(tmp_path):
+    """On their own paper's scenarios the built-ins run with their registered parameters even where the
+    scenario's place holds the same model (paper 001's four NPPID cases differ only by T2 and c)."""
+    from scfmu import metrics
+    from scfmu.engines import simulate
+    from scfmu.registry import REGISTRY
+    from scfmu.scenario import get
+    r = scfmu("benchmark", "--family", "formation", "--cases", "paper001/a/dist1", "--out", tmp_path)
+    assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
+    rows = {x["controller"]: float(x["ise [m²·s]"]) for x in csv.DictReader(open(tmp_path / "results.csv"))}
+    REGISTRY.load()
+    for b in [b for b in REGISTRY.controllers if b.family == "formation"][::3]:  # cases a and d
+        sc = get("paper001/a/dist1").with_overrides({f"controller.{k}": v for k, v in b.params.items()})
+        ise = metrics.compute(sc.metrics, simulate(sc, "native"))["ise"]
+        assert math.isclose(rows[b.label], ise, rel_tol=1e-9), (b.label, rows[b.label], ise)
+    assert len({round(v, 6) for v in rows.values()}) == 4, rows

@@ -248,8 +248,7 @@ def run(unit: str | None, family: str, out: str | Path, label: str | None = None
                             log(f"  {case.label} / {name}: {e.status}")
                             continue
                         sc = base.with_models({case.slot: model})
-                        if sc.component(case.slot).model != base.component(case.slot).model:
-                            sc = sc.with_overrides({f"{case.slot}.{k}": v for k, v in params.items()})
+                        sc = sc.with_overrides({f"{case.slot}.{k}": v for k, v in params.items()})
                         sc.component(case.slot).unused = sorted(set(b.unused))
                     require(sc, instantiate=False)
                 except (IncompatibleUnit, KeyError, profiles.ProfileError) as err:
