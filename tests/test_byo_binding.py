@@ -180,12 +180,17 @@ def test_benchmark_names_unbound_slots_beside_the_unit_and_binds_with_a_profile(
     rows = {x["controller"]: x for x in csv.DictReader(open(tmp_path / "plain" / "results.csv"))}
     assert want in rows["CJ"]["unbound slot values"] and rows["PD, quaternion error"]["unbound slot values"] == ""
     assert want in r.stderr
-    r = scfmu("benchmark", fmu, "--label", "CJ", "--controllers", "PdController", "--cases", CASE, "--profile", prof,
-              "--strict", "--out", tmp_path / "bound", timeout=900)
+    # one profile, evaluated per scenario: 4/5/3.5 kg·m² on 003-N, 1000/500/700 kg·m² on the large slew
+    r = scfmu("benchmark", fmu, "--label", "CJ", "--controllers", "PdController", "--cases", f"{CASE},default",
+              "--profile", prof, "--strict", "--out", tmp_path / "bound", timeout=900)
     assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
-    rows = {x["controller"]: x for x in csv.DictReader(open(tmp_path / "bound" / "results.csv"))}
-    assert rows["CJ"]["unbound slot values"] == ""
-    ise = float(rows["CJ"]["ise [rad²·s]"])
-    assert math.isclose(ise, pd_ise, rel_tol=1e-6) and rows["CJ"]["rank"] == rows["PD, quaternion error"]["rank"] == "1"
+    rows = {(x["scenario"][:5], x["controller"]): x for x in csv.DictReader(open(tmp_path / "bound" / "results.csv"))}
+    mine, pd = rows[("003-N", "CJ")], rows[("003-N", "PD, quaternion error")]
+    assert mine["unbound slot values"] == "" and "profile cpd_j.toml" in mine["configuration"]
+    ise = float(mine["ise [rad²·s]"])
+    assert math.isclose(ise, pd_ise, rel_tol=1e-6) and mine["rank"] == pd["rank"] == "1"
+    mine, pd = rows[("large", "CJ")], rows[("large", "PD, quaternion error")]
+    k = "eulerint_deg_s [deg·s]"
+    assert math.isclose(float(mine[k]), float(pd[k]), rel_tol=1e-6) and abs(float(pd[k]) - 156.408) < 1e-3
     r = scfmu("benchmark", fmu, "--controllers", "PdController", "--cases", CASE, "--strict", "--out", tmp_path / "s")
     assert r.returncode == 2 and r.stderr.count("\n") == 1 and "inertia_xx = 4 not passed" in r.stderr, r.stderr
