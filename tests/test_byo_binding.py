@@ -72,7 +72,10 @@ def test_profile_expressions_are_arithmetic_only():
     assert profiles.evaluate("4 * inertia_xx + sqrt(step) - inertia_yy / 2", env) == pytest.approx(16.0 + 0.1 - 2.5, rel=1e-15)
     assert profiles.evaluate("max(inertia_xx, inertia_yy) ** 2", env) == 25.0
     assert profiles.evaluate("-abs(-inertia_yy)", env) == -5.0
-    for bad in ("__import__('os').system('true')", "inertia_xx.real", "[1, 2]", "lambda: 1", "'a' * 3",
+    assert profiles.evaluate("0.5 * plant.u_max_x", {"plant.u_max_x": 10.0}) == 5.0  # another unit's parameter
+    with pytest.raises(profiles.ProfileError, match="names 'plant.__class__'"):  # a key, never an attribute
+        profiles.evaluate("plant.__class__", {"plant.u_max_x": 10.0})
+    for bad in ("__import__('os').system('true')", "inertia_xx.real.imag", "(1).real", "[1, 2]", "lambda: 1", "'a' * 3",
                 "open('x')", "inertia_xx if 1 else 2", "True + 1"):
         with pytest.raises(profiles.ProfileError):
             profiles.evaluate(bad, env, "J1")

@@ -12,7 +12,8 @@ its parameters comes from::
     J1 = "inertia_xx"
     J2 = "inertia_yy"
     J3 = "inertia_zz"
-    kp = "4 * inertia_xx"    # + - * / ** ( ), sqrt abs min max, numbers, slot names, step, stop_time
+    kp = "4 * inertia_xx"    # + - * / ** ( ), sqrt abs min max, numbers, slot names, step, stop_time,
+    u_max = "plant.u_max_x"  # and INSTANCE.PARAMETER of the loop's other units (set or default value)
     wn = 1.0
 
     [ports]                  # the unit's port = the scenario's port; a vector stem renames every element
@@ -66,6 +67,8 @@ def _parse(expr: str, where: str) -> ast.AST:
     for node in ast.walk(tree):
         ok = isinstance(node, (ast.Expression, ast.BinOp, ast.UnaryOp, ast.Name, ast.Load, ast.Call,
                                *(_BINOPS), *(_UNARY)))
+        # instance.parameter of another unit of the loop (plant.u_max_x): one level, names only
+        ok = ok or (isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name))
         ok = ok or (isinstance(node, ast.Constant) and isinstance(node.value, (int, float))
                     and not isinstance(node.value, bool))
         if isinstance(node, ast.Call):
@@ -82,7 +85,9 @@ def names_in(expr) -> set:
         return set()
     tree = _parse(expr, "binding")
     funcs = {n.func.id for n in ast.walk(tree) if isinstance(n, ast.Call)}
-    return {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)} - funcs
+    inst = {n.value.id for n in ast.walk(tree) if isinstance(n, ast.Attribute)}
+    return ({n.id for n in ast.walk(tree) if isinstance(n, ast.Name)} - funcs - inst) | \
+        {f"{n.value.id}.{n.attr}" for n in ast.walk(tree) if isinstance(n, ast.Attribute)}
 
 
 def evaluate(expr, env: dict, where: str = "binding"):
@@ -100,13 +105,16 @@ def evaluate(expr, env: dict, where: str = "binding"):
             return ev(node.body)
         if isinstance(node, ast.Constant):
             return float(node.value)  # floats: 10 ** 10 ** 10 overflows at once instead of computing a huge integer
-        if isinstance(node, ast.Name):
-            if node.id not in env:
-                raise ProfileError(f"{where}: {expr!r} names {node.id!r}, which this place does not offer "
-                                   f"(slot values and scenario fields: {', '.join(sorted(env)) or 'none'})")
-            v = env[node.id]
+        if isinstance(node, (ast.Name, ast.Attribute)):
+            name = node.id if isinstance(node, ast.Name) else f"{node.value.id}.{node.attr}"
+            if name not in env:
+                near = sorted(k for k in env if "." not in k)
+                raise ProfileError(f"{where}: {expr!r} names {name!r}, which this place does not offer "
+                                   f"(slot values and scenario fields: {', '.join(near) or 'none'}"
+                                   f"{'; or INSTANCE.PARAMETER of another unit' if '.' in name or len(near) < len(env) else ''})")
+            v = env[name]
             if isinstance(v, bool) or not isinstance(v, (int, float)):
-                raise ProfileError(f"{where}: {node.id} = {v!r} is not a number")
+                raise ProfileError(f"{where}: {name} = {v!r} is not a number")
             return float(v)
         if isinstance(node, ast.BinOp):
             return _BINOPS[type(node.op)](ev(node.left), ev(node.right))

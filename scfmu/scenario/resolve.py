@@ -52,7 +52,24 @@ def expand_ports(c, names: dict) -> None:
 
 
 def _env(s: Scenario, c) -> dict:
-    return {**{k: getattr(s, k) for k in ("step", "stop_time")}, **c.slot}
+    """What a binding may read: the scenario's step and stop time, ``INSTANCE.PARAMETER`` of the other units
+    (the value the scenario sets, else the unit's start value) and the place's slot values."""
+    env = {k: getattr(s, k) for k in ("step", "stop_time")}
+    for other in s.components:
+        if other.name == c.name:
+            continue
+        try:
+            names = declared(other.model)
+        except Exception:
+            names = {}
+        for n, v in names.items():
+            if v.causality == "parameter" and v.type == "Real" and v.start is not None:
+                try:
+                    env[f"{other.name}.{n}"] = float(v.start)
+                except (TypeError, ValueError):
+                    pass
+        env.update({f"{other.name}.{k}": v for k, v in other.params.items()})
+    return {**env, **c.slot}
 
 
 def _coerce(v, var, where: str):
