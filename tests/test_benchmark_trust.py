@@ -75,6 +75,8 @@ def test_equivalent_controllers_share_one_rank(tmp_path_factory, case):
     assert rows["PD, quaternion error"]["rank"] == ("2" if mrac < vals[0] else "1")
     md = (out / "benchmark.md").read_text()
     assert "PD, quaternion error = LQR = pole placement = C unit: identical responses" in md, md[:3000]
+    warn = md.split("## Warnings")[1].split("\n## ")[0]
+    assert "PD, quaternion error = LQR = pole placement = C unit: identical responses (tied) on 1 of 1" in warn
 
 
 def _error(series: dict) -> np.ndarray | None:

@@ -177,8 +177,9 @@ def test_benchmark_names_unbound_slots_beside_the_unit_and_binds_with_a_profile(
     want = "inertia_xx = 4 not passed: the unit kept its own J1 = 1000"
     md = (tmp_path / "plain" / "benchmark.md").read_text()
     warn = md.split("## Warnings")[1].split("\n## ")[0]
-    assert want in warn, warn
-    assert "| **CJ ⚠** |" in md and f"⚠ CJ: controller: slot value {want}" in md
+    assert ("CJ: slot value inertia_xx (4) not passed in 1 of 1 scenarios: the unit kept its own J1 = 1000; "
+            'bind it: a profile line J1 = "inertia_xx"') in warn, warn
+    assert "| **CJ ⚠** |" in md and f"⚠ CJ: controller: slot value {want}" in md  # beside the unit's results
     assert want in (tmp_path / "plain" / "index.html").read_text()
     rows = {x["controller"]: x for x in csv.DictReader(open(tmp_path / "plain" / "results.csv"))}
     assert want in rows["CJ"]["unbound slot values"] and rows["PD, quaternion error"]["unbound slot values"] == ""

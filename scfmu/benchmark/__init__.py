@@ -123,6 +123,7 @@ class Entry:
     config: str = ""  # how the controller is configured on this scenario (paper's tuning, rule, your unit)
     envelope: str = ""  # "home" (its paper's tuning), "retuned", "outside", "unit"
     unbound: list = field(default_factory=list)  # slot values the unit does not receive (texts)
+    unbound_items: list = field(default_factory=list)  # the same as scfmu.scenario.resolve.Unbound
     flags: list = field(default_factory=list)  # e.g. "error grew: …"
     rows: list = field(default_factory=list)  # the campaign rows of the runs that succeeded
     error0: float = math.nan  # main error at the start and at the end of the first run [deg] (if logged)
@@ -255,7 +256,8 @@ def run(unit: str | None, family: str, out: str | Path, label: str | None = None
                     e.status = "n/a: " + str(err.args[0] if err.args else err).replace("\n", " ")[:400]
                     log(f"  {case.label} / {name}: {e.status}")
                     continue
-                e.unbound = [u.text() for u in unbound_slots(sc, [case.slot])]
+                e.unbound_items = unbound_slots(sc, [case.slot])
+                e.unbound = [u.text() for u in e.unbound_items]
                 for u in e.unbound:
                     log(f"  warning: {case.label} / {name}: {u}")
                 keys = [case.signal] + [k for k in ("alpha_deg", "roll", "pitch", "yaw", "roll_ref", "pitch_ref",
@@ -411,9 +413,21 @@ def warnings(cases, entries: list[Entry], unit_label, ctx: dict) -> list[str]:
     """The lines of the warnings block: unbound slot values, built-ins out of their envelope (not designed
     for the plant, re-tuned), runs whose error grew, identical responses (ties), and the registered extras."""
     out = []
+    # unbound slot values: one line per (controller, slot value) over the scenarios (the full sentence of
+    # each scenario is next to the controller's results there)
+    per: dict = {}
     for e in entries:
-        for u in e.unbound:
-            out.append(f"{e.case} / {e.controller}: {u}")
+        for u in e.unbound_items:
+            per.setdefault((e.controller, u.slot), []).append((e.case, u))
+    n_cases = len(cases)
+    for (ctrl, slot), items in per.items():
+        u0 = items[0][1]
+        vals = ", ".join(dict.fromkeys(f"{u.value:g}" if isinstance(u.value, float) else str(u.value) for _, u in items))
+        kept = (f"the unit kept its own {', '.join(f'{n} = {st}' for n, st, _ in u0.kept)}; bind it: a profile line "
+                f"{u0.kept[0][0]} = \"{slot}\" or --map {u0.instance}.{u0.kept[0][0]}={slot}" if u0.kept else
+                f"the unit has no parameter {slot!r} and no binding reads it; bind it with a profile or --map, or "
+                f"declare it unused in the profile")
+        out.append(f"{ctrl}: slot value {slot} ({vals}) not passed in {len(items)} of {n_cases} scenarios: {kept}")
     for e in entries:
         if e.envelope == "outside":
             out.append(f"{e.case} / {e.controller}: {e.status} (not run)")
@@ -424,9 +438,13 @@ def warnings(cases, entries: list[Entry], unit_label, ctx: dict) -> list[str]:
     for e in entries:
         for f in e.flags:
             out.append(f"{e.case} / {e.controller}: {f}")
+    ties: dict = {}
     for case in cases:
         for g in identical_groups(case, entries):
-            out.append(f"{case.label}: {' = '.join(g)}: identical responses (tied)")
+            ties.setdefault(tuple(g), []).append(case.label)
+    for g, labels in ties.items():
+        out.append(f"{' = '.join(g)}: identical responses (tied) on {len(labels)} of {n_cases} scenarios: "
+                   + "; ".join(labels))
     for fn in WARNINGS:
         out += list(fn(cases, entries, ctx) or [])
     return out

@@ -141,6 +141,8 @@ class Unbound:
         head = f"{self.instance}: slot value {self.slot} = {v} not passed"
         if self.kept:
             own = ", ".join(f"{n} = {st}" for n, st, _ in self.kept)
+            if len(self.kept) == 1 and self.kept[0][1] == v:
+                own += " (equal to the slot value here, by its default)"
             return (f"{head}: the unit kept its own {own} (bind it: a profile line {self.kept[0][0]} = "
                     f"\"{self.slot}\", or --map {self.instance}.{self.kept[0][0]}={self.slot})")
         return (f"{head}: the unit has no parameter {self.slot!r} and no binding reads it (bind it with a profile "
