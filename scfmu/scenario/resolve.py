@@ -13,7 +13,7 @@ from __future__ import annotations
 import copy
 from dataclasses import dataclass, field
 
-from ..fmu import fmu_path, unpacked
+from ..fmu import fmu_path, is_path, unpacked
 from .model import Scenario
 from .profile import ProfileError, evaluate, names_in
 
@@ -158,7 +158,8 @@ def _start(v):
 
 
 def unbound_slots(scenario: Scenario, instances=None) -> list[Unbound]:
-    """The slot values of the swapped instances (or of ``instances``) that their units do not receive:
+    """The slot values of the swapped instances, of the units given as files and of those with a profile (or
+    of ``instances``) that their units do not receive:
     no parameter of that name, not read by a binding (``bind``, ``--map`` of a parameter), not listed in
     ``unused``. Reads the units' model descriptions; an instance whose unit cannot be read is skipped
     (the pre-flight check reports it)."""
@@ -167,7 +168,9 @@ def unbound_slots(scenario: Scenario, instances=None) -> list[Unbound]:
     except Exception:  # a wrong binding is reported by the pre-flight check
         s = scenario
     out = []
-    for inst in (instances if instances is not None else s.swapped):
+    if instances is None:  # swapped units, units given by path (a scenario file's), units with a profile
+        instances = [c.name for c in s.components if c.name in s.swapped or c.bind or c.unused or is_path(c.model)]
+    for inst in instances:
         c = s.component(inst)
         if not c.slot:
             continue
