@@ -339,19 +339,25 @@ def ranks(cases, entries: list[Entry]) -> dict:
 
 
 def identical_groups(case, entries: list[Entry]) -> list[list[str]]:
-    """Groups (2 or more) of controllers on ``case`` whose responses are identical: the case's signal of the
-    first run differs by at most :data:`RESPONSE_RESOLUTION` at every logged sample, and the primary metric
-    is equal within its resolution."""
+    """Groups (2 or more) of controllers on ``case`` whose responses are identical: the case's plotted signal
+    and the main error (α, or the largest angle error) of the first run differ by at most
+    :data:`RESPONSE_RESOLUTION` at every logged sample, and the primary metric is equal within its resolution."""
     es = [e for e in entries if e.case == case.label and e.series and case.signal in e.series]
     rel, ab = RESPONSE_RESOLUTION
+
+    def same(a, b) -> bool:
+        if a is None or b is None:
+            return a is None and b is None
+        a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+        return a.shape == b.shape and bool(np.all(np.isfinite(a)) and np.all(np.isfinite(b))) and \
+            float(np.max(np.abs(a - b))) <= rel * float(max(np.max(np.abs(a)), np.max(np.abs(b)))) + ab
+
     groups: list[list[Entry]] = []
     for e in es:
-        y = np.asarray(e.series[case.signal], dtype=float)
         for g in groups:
-            r = np.asarray(g[0].series[case.signal], dtype=float)
-            if r.shape == y.shape and np.all(np.isfinite(y)) and \
-                    float(np.max(np.abs(y - r))) <= rel * float(max(np.max(np.abs(r)), np.max(np.abs(y)))) + ab and \
-                    equal(g[0].means.get(case.primary, math.nan), e.means.get(case.primary, math.nan), case.primary):
+            r = g[0]
+            if same(r.series[case.signal], e.series[case.signal]) and same(error_series(r.series), error_series(e.series)) \
+                    and equal(r.means.get(case.primary, math.nan), e.means.get(case.primary, math.nan), case.primary):
                 g.append(e)
                 break
         else:
@@ -475,8 +481,9 @@ def write_page(out: Path, family: str, cases, entries: list[Entry], unit_label, 
              f"the runs of a scenario that succeeded. Pass: every run succeeded and settled (2 % band) before its end. "
              f"Rank: by the scenario's primary metric (lower is better) among the controllers that pass; values "
              f"equal within the resolution |a − b| ≤ {rel:g}·max(|a|, |b|) + {ab:g} (in the metric's unit) share a "
-             f"rank (1, 2, 2, 4). Responses are identical when the plotted signal differs by at most "
-             f"{RESPONSE_RESOLUTION[0]:g} of its largest value (+ {RESPONSE_RESOLUTION[1]:g}) at every logged sample. "
+             f"rank (1, 2, 2, 4). Responses are identical when the plotted signal and the main error differ by at most "
+             f"{RESPONSE_RESOLUTION[0]:g} of their largest value (+ {RESPONSE_RESOLUTION[1]:g}) at every logged sample "
+             f"of the first run and the primary metric is equal. "
              f"Built-in controllers run with their paper's tuning on their paper's scenarios and re-tuned by a "
              f"stated rule elsewhere (the 'configuration' lines), or are listed as not designed for the plant.")
     md += [intro, ""]

@@ -105,7 +105,8 @@ def check(scenario: Scenario, instantiate: bool = True) -> Report:
                 rep.errors.append(f"{c.name} ({c.model}): no parameter {k!r}")
         for theirs in c.ports:
             if theirs not in vars_of[c.name]:
-                rep.errors.append(f"{c.name} ({c.model}): port map names {theirs!r}, which the unit does not have")
+                rep.errors.append(f"{c.name} ({c.model}): port map names {theirs!r}, which the unit does not have "
+                                  f"(neither a port, a vector stem {theirs}_x…, nor a parameter)")
     if rep.errors:
         return rep
     ports = {c.name: ([n for n, v in vars_of[c.name].items() if v.causality == "input"],
