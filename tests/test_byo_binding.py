@@ -198,3 +198,19 @@ def test_benchmark_names_unbound_slots_beside_the_unit_and_binds_with_a_profile(
     assert math.isclose(float(mine[k]), float(pd[k]), rel_tol=1e-6) and abs(float(pd[k]) - 156.408) < 1e-3
     r = scfmu("benchmark", fmu, "--controllers", "PdController", "--cases", CASE, "--strict", "--out", tmp_path / "s")
     assert r.returncode == 2 and r.stderr.count("\n") == 1 and "inertia_xx = 4 not passed" in r.stderr, r.stderr
+
+
+def test_export_writes_the_bound_values_into_the_ssp(units, prof, tmp_path):
+    """`scfmu export ssp` with a profile: the SSP's parameter set of the unit holds the place's inertia under
+    the unit's names (read back from the archive's XML); without it, the export warns."""
+    import xml.etree.ElementTree as ET
+    import zipfile
+    fmu = units.c_pd("j_names")
+    r = scfmu("export", "ssp", CASE, "--fmu", f"controller={fmu}", "--profile", prof, "--out", tmp_path / "a")
+    assert r.returncode == 0 and "warning:" not in r.stderr, r.stdout + r.stderr
+    with zipfile.ZipFile(next((tmp_path / "a").glob("*.ssp"))) as z:
+        root = ET.fromstring(z.read("resources/controller.ssv"))
+    vals = {p.get("name"): float(p[0].get("value")) for p in root.iter("{http://ssp-standard.org/SSP1/SystemStructureParameterValues}Parameter")}
+    assert vals == {"J1": 4.0, "J2": 5.0, "J3": 3.5}, vals
+    r = scfmu("export", "ssp", CASE, "--fmu", f"controller={fmu}", "--out", tmp_path / "b")
+    assert r.returncode == 0 and "inertia_xx = 4 not passed: the unit kept its own J1 = 1000" in r.stderr, r.stderr
