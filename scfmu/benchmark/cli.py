@@ -1,7 +1,10 @@
 """``scfmu benchmark [PATH] --family attitude|single_axis|formation``: a controller (any FMI 2.0
 Co-Simulation FMU, or a model name) through the family's standard scenarios beside the built-in
-controllers; one HTML + Markdown page (``out/benchmark/<family>/``) with the metrics, pass/fail, the
-unit's rank per scenario and overlaid responses."""
+controllers; one HTML + Markdown page (``out/benchmark/<family>/``) with the warnings first (slot values
+that reached no parameter of the unit, built-ins re-tuned for or not designed for a plant, runs whose error
+grew, ties), the metrics with their units, pass/fail, the unit's rank per scenario and overlaid responses.
+``--profile FILE`` binds the unit's parameters to each scenario's slot values (e.g. ``J1 = "inertia_xx"``);
+``--strict`` refuses to run when one would not reach the unit."""
 
 from __future__ import annotations
 
@@ -48,7 +51,6 @@ def main(argv=None) -> int:
         unit = str(p.resolve())
     label = a.label or (Path(unit).stem if unit else None)
     out = Path(a.out or Path("out") / "benchmark" / a.family)
-    print(f"benchmark {a.family}: {label or 'built-in controllers only'} → {out}")
     prof = None
     if a.profile:
         if not unit:
@@ -59,6 +61,7 @@ def main(argv=None) -> int:
         except profiles.ProfileError as e:
             print(f"scfmu benchmark: {e}", file=sys.stderr)
             return 2
+    print(f"benchmark {a.family}: {label or 'built-in controllers only'} → {out}")
     try:
         entries = run(unit, a.family, out, label=label, unit_params={k: value(v) for k, v in pairs(a.set, "--set").items()},
                       port_map=pairs(a.map, "--map"), quick=a.quick, workers=a.workers,
