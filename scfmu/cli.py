@@ -69,15 +69,18 @@ def _export(argv) -> int:
     ap.add_argument("--fmu", action="append", default=[], metavar="INSTANCE=PATH", help="use this FMU for INSTANCE")
     ap.add_argument("--map", action="append", default=[], metavar="INSTANCE.THEIRS=OURS", help="rename a unit's port")
     ap.add_argument("--set", action="append", default=[], metavar="INSTANCE.VAR=VALUE", help="parameter or input")
+    ap.add_argument("--profile", action="append", default=[], metavar="[INSTANCE=]FILE", help="unit profile (TOML)")
     a = ap.parse_args(argv)
     out = a.out or ("fmus/ssp" if a.kind == "ssp" else "fmus/loops")
     items = a.names or None
-    if a.fmu or a.map or a.set or any(n.endswith((".toml", ".json")) for n in a.names):
+    if a.fmu or a.map or a.set or a.profile or any(n.endswith((".toml", ".json")) for n in a.names):
         if len(a.names) != 1:
             print("scfmu export: --fmu/--map/--set and scenario files take exactly one scenario", file=sys.stderr)
             return 2
-        ns = argparse.Namespace(scenario=a.names[0], fmu=a.fmu, map=a.map, set=a.set, params=None, t_end=None, dt=None)
+        ns = argparse.Namespace(scenario=a.names[0], fmu=a.fmu, map=a.map, set=a.set, params=None, t_end=None, dt=None,
+                                profile=a.profile)
         items = [options.build(ns, notice=lambda t: print(t, file=sys.stderr))]
+        options.binding_report(items[0], "scfmu export", False, lambda t: print(t, file=sys.stderr))
     try:
         export(a.kind, out, items)
     except (RuntimeError, KeyError, ValueError) as e:

@@ -81,12 +81,28 @@ class BenchmarkCase:
 
 @dataclass
 class BuiltinController:
-    """A controller of the family that the benchmark runs beside the user's: a model and its parameters."""
+    """A controller of the family that the benchmark runs beside the user's: a model, its parameters (its
+    paper's tuning) and its design envelope, i.e. how it is configured on each benchmark scenario:
+
+    * ``home``: glob patterns of the scenario names its paper's tuning was made for (default: the scenarios
+      the same plug-in registers); there it runs with ``params`` (plus the place's slot values);
+    * ``retune``: elsewhere, ``"module:function"`` (or a callable) ``(slot: dict, scenario) -> (params,
+      rule)``: the parameters for that plant from the place's slot values and the scenario (inertia, run
+      length, …) and one sentence stating the rule; it may raise ``ValueError(reason)`` for a plant it has
+      no rule for;
+    * ``outside``: without ``retune`` (or when it refuses), the reason shown as "not designed for this
+      plant" (the pair is listed, not run);
+    * ``unused``: slot values its law does not take (e.g. products of inertia for a diagonal-inertia law),
+      stated on the page instead of warned about."""
     family: str
     model: str
     label: str
     params: dict = field(default_factory=dict)
     plugin: str = ""
+    home: tuple = ()
+    retune: object = None
+    outside: str = ""
+    unused: tuple = ()
 
 
 class Registry:
@@ -127,9 +143,12 @@ class Registry:
         self.benchmark_cases.append(BenchmarkCase(family, scenario, label, slot, seeds, primary, signal,
                                                   dict(overrides or {}), monte_carlo, self._current))
 
-    def controller(self, family: str, model: str, label: str, params: dict | None = None) -> None:
-        """A built-in controller the benchmark compares a user's unit with."""
-        self.controllers.append(BuiltinController(family, model, label, dict(params or {}), self._current))
+    def controller(self, family: str, model: str, label: str, params: dict | None = None, home=(), retune=None,
+                   outside: str = "", unused=()) -> None:
+        """A built-in controller the benchmark compares a user's unit with (see :class:`BuiltinController`
+        for its design envelope: ``home``, ``retune``, ``outside``, ``unused``)."""
+        self.controllers.append(BuiltinController(family, model, label, dict(params or {}), self._current,
+                                                  tuple(home), retune, outside, tuple(unused)))
 
     def families(self) -> list[str]:
         self.load()

@@ -9,6 +9,7 @@ inertia diag(1000, 500, 700) kg·m², no torque limit, RK4 0.01 s, communication
 from __future__ import annotations
 
 import argparse
+import json
 import math
 from pathlib import Path
 
@@ -82,6 +83,7 @@ def main(argv=None) -> int:
     except IncompatibleUnit as e:
         print(f"scfmu run: {e}", file=sys.stderr)
         return 2
+    unbound = options.binding_report(sc, "scfmu run", args.strict, lambda t: print(t, file=sys.stderr))
     stem = file_stem(sc.name)
     out = Path(args.out or Path("out") / stem)
     out.mkdir(parents=True, exist_ok=True)
@@ -100,11 +102,17 @@ def main(argv=None) -> int:
             print(f"  {k:24s} {v:14.6g}")
     csv = out / f"{stem}.csv"
     write_csv(csv, r)
-    written = [csv]
+    manifest = out / f"{stem}.manifest.json"  # what ran: the scenario as plain data, units, metrics, warnings
+    manifest.write_text(json.dumps({"scenario": sc.to_dict(), "engine": args.engine, "metrics": m,
+                                    "unbound_slot_values": unbound}, indent=1, default=str))
+    written = [csv, manifest]
     if not args.no_plot:
         png = out / f"{stem}.png"
         title = sc.name + (f": EULERINT = {m['eulerint_deg_s']:.2f} deg·s"
                            if math.isfinite(m.get("eulerint_deg_s", math.nan)) else "")
+        if unbound:
+            title += f"\n⚠ {len(unbound)} slot value(s) not passed to the unit: " + ", ".join(
+                t.split("slot value ")[1].split(" not passed")[0] for t in unbound)
         plot(r, png, title)
         written.append(png)
     print("wrote " + " and ".join(str(p) for p in written))

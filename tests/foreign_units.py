@@ -45,6 +45,7 @@ C_VARIANTS = {
     "nan": "torque_cmd_* are NaN once the model time >= fail_time (every call returns fmi2OK)",
     "error": "fmi2DoStep from t >= fail_time logs a message and returns fmi2Error",
     "wrong_ports": "outputs tau_x/_y/_z instead of torque_cmd_*, inputs omega_x/_y/_z instead of w_x/_y/_z",
+    "j_names": "the nominal inertia parameters are named J1/J2/J3 (not inertia_xx/_yy/_zz); law and ports unchanged",
     "bad_unit": "torque_cmd_* declared in unit 'N' instead of 'N.m'",
     "no_unit": "no unit on any port (w_*, w_ref_*, torque_cmd_*)",
     "no_binary": "the FMU has no binaries/ folder at all (nothing to load on any platform)",
@@ -99,6 +100,9 @@ def c_model_description(variant: str = "ok", guid: str | None = None, fail_time:
     if variant == "wrong_ports":
         sub(r'name="torque_cmd_([xyz])"', r'name="tau_\1"', 3)
         sub(r'name="w_([xyz])"', r'name="omega_\1"', 3)
+    elif variant == "j_names":
+        for i, a in enumerate(("xx", "yy", "zz"), 1):
+            sub(f'name="inertia_{a}"', f'name="J{i}"', 1)
     elif variant == "bad_unit":
         sub(r'(name="torque_cmd_[xyz]"[^>]*>\s*<Real) unit="N.m"', r'\1 unit="N"', 3)
         sub(r"(\s*)<Unit name=\"N.m\">", r'\1<Unit name="N">\1  <BaseUnit kg="1" m="1" s="-2"/>\1</Unit>\g<0>', 1)

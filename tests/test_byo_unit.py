@@ -257,7 +257,8 @@ def test_benchmark_ranks_a_unit_beside_the_builtins(tmp_path, my_pd):
     by = {(x["scenario"].split(" (")[0], x["controller"]): x for x in rows}
     large = [k for k in by if k[0].startswith("large slew")][0][0]
     mine, pd = by[(large, "MyPd")], by[(large, "PD, quaternion error")]
-    assert mine["eulerint_deg_s"] == pd["eulerint_deg_s"] and abs(float(mine["eulerint_deg_s"]) - 156.408) < 1e-3
+    k = "eulerint_deg_s [deg·s]"
+    assert mine[k] == pd[k] and abs(float(mine[k]) - 156.408) < 1e-3
     assert mine["pass"] == "True" and mine["rank"] == pd["rank"]  # the same law: the same rank
     md = (tmp_path / "benchmark.md").read_text()
     assert "**MyPd**" in md and "rank" in md and len(list((tmp_path / "figures").glob("*.png"))) == 2

@@ -1,7 +1,10 @@
 """``scfmu benchmark [PATH] --family attitude|single_axis|formation``: a controller (any FMI 2.0
 Co-Simulation FMU, or a model name) through the family's standard scenarios beside the built-in
-controllers; one HTML + Markdown page (``out/benchmark/<family>/``) with the metrics, pass/fail, the
-unit's rank per scenario and overlaid responses."""
+controllers; one HTML + Markdown page (``out/benchmark/<family>/``) with the warnings first (slot values
+that reached no parameter of the unit, built-ins re-tuned for or not designed for a plant, runs whose error
+grew, ties), the metrics with their units, pass/fail, the unit's rank per scenario and overlaid responses.
+``--profile FILE`` binds the unit's parameters to each scenario's slot values (e.g. ``J1 = "inertia_xx"``);
+``--strict`` refuses to run when one would not reach the unit."""
 
 from __future__ import annotations
 
@@ -10,8 +13,9 @@ import sys
 from pathlib import Path
 
 from ..registry import REGISTRY
+from ..scenario import profile as profiles
 from ..scenario.options import pairs, value
-from . import run
+from . import StrictRefusal, run
 
 
 def main(argv=None) -> int:
@@ -22,7 +26,13 @@ def main(argv=None) -> int:
     ap.add_argument("--family", default="attitude", help="attitude, single_axis or formation")
     ap.add_argument("--label", help="name of the unit in the tables (default: its file name)")
     ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help="a parameter of the unit")
-    ap.add_argument("--map", action="append", default=[], metavar="THEIRS=OURS", help="rename a port of the unit")
+    ap.add_argument("--map", action="append", default=[], metavar="THEIRS=OURS",
+                    help="the unit's port (or vector stem: omega=w) THEIRS plays the scenario's port OURS; a "
+                         "parameter THEIRS takes the place's slot value OURS (J1=inertia_xx) in every scenario")
+    ap.add_argument("--profile", metavar="FILE", help="the unit's profile (TOML: [params] J1 = \"inertia_xx\", "
+                                                      "[ports], unused = [...]), applied in every scenario")
+    ap.add_argument("--strict", action="store_true",
+                    help="refuse to run (exit 2) when a slot value of a scenario reaches no parameter of the unit")
     ap.add_argument("--controllers", help="comma-separated built-in controllers to compare (default: all of the family)")
     ap.add_argument("--cases", help="comma-separated scenario names (or parts of their titles) to run (default: all)")
     ap.add_argument("--quick", action="store_true", help="Monte Carlo cases with 10 draws (the same set-up otherwise)")
@@ -51,13 +61,30 @@ def main(argv=None) -> int:
                 return 1
     label = a.label or (Path(unit).stem if unit else None)
     out = Path(a.out or Path("out") / "benchmark" / a.family)
+    prof = None
+    if a.profile:
+        if not unit:
+            print("scfmu benchmark: --profile needs a unit under test", file=sys.stderr)
+            return 2
+        try:
+            prof = profiles.load(a.profile)
+        except profiles.ProfileError as e:
+            print(f"scfmu benchmark: {e}", file=sys.stderr)
+            return 2
     print(f"benchmark {a.family}: {label or 'built-in controllers only'} → {out}")
-    entries = run(unit, a.family, out, label=label, unit_params={k: value(v) for k, v in pairs(a.set, "--set").items()},
-                  port_map=pairs(a.map, "--map"), quick=a.quick, workers=a.workers,
-                  controllers=[x.strip() for x in a.controllers.split(",")] if a.controllers else None,
-                  cases=[x.strip() for x in a.cases.split(",")] if a.cases else None)
+    try:
+        entries = run(unit, a.family, out, label=label, unit_params={k: value(v) for k, v in pairs(a.set, "--set").items()},
+                      port_map=pairs(a.map, "--map"), quick=a.quick, workers=a.workers,
+                      controllers=[x.strip() for x in a.controllers.split(",")] if a.controllers else None,
+                      cases=[x.strip() for x in a.cases.split(",")] if a.cases else None, profile=prof, strict=a.strict)
+    except StrictRefusal as e:
+        print(f"scfmu benchmark: {e}", file=sys.stderr)
+        return 2
     print(f"wrote {out / 'index.html'}, {out / 'benchmark.md'} and {out / 'results.csv'}")
     mine = [e for e in entries if e.controller == label] if label else []
+    unbound = sorted({u for e in mine for u in e.unbound})
+    for u in unbound:
+        print(f"warning: {u} (shown beside the unit's results on the page)", file=sys.stderr)
     if mine and all(e.status for e in mine):
         print("scfmu benchmark: the unit fits none of the scenarios (see the n/a reasons)", file=sys.stderr)
         return 1

@@ -50,6 +50,7 @@ from .. import fmu as fmu_access
 from .. import metrics as run_metrics
 from ..engines import SimulationError, resolve_engine, simulate
 from ..scenario.model import Scenario
+from ..scenario.resolve import unbound_slots
 
 ROW_FIXED = ("run", "override_index", "seed", "status", "message")
 
@@ -466,6 +467,7 @@ def run(c: Campaign, out_dir: str | Path, scheduler: str | None = None, n_worker
             (out_dir / "results.parquet").unlink(missing_ok=True)
     specs = c.runs()
     manifest = {"campaign_id": cid, **c.describe(), "n_runs": len(specs), "fmus": fmus,
+                "unbound_slot_values": [u.text() for u in unbound_slots(c.scenario)],
                 "engine_used": ("native" if c.log_every != 1 else resolve_engine("auto")) if c.engine == "auto" else c.engine,
                 "packages": package_versions(), "created": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
                 "row_columns": _row_columns(c)}

@@ -114,6 +114,7 @@ def main(argv=None) -> int:
     except IncompatibleUnit as e:
         print(f"scfmu campaign: {e}", file=sys.stderr)
         return 2
+    options.binding_report(c.scenario, "scfmu campaign", args.strict, lambda t: print(t, file=sys.stderr))
     out = Path(args.out or Path("out") / "campaign" / c.scenario.name.replace("/", "_"))
     print(f"campaign {c.campaign_id()}: scenario {c.scenario.name}, {len(c.overrides)} parameter set(s) × "
           f"{len(c.seeds)} seed(s) = {len(c.overrides) * len(c.seeds)} runs, engine {c.engine} → {out}")

@@ -105,7 +105,8 @@ def check(scenario: Scenario, instantiate: bool = True) -> Report:
                 rep.errors.append(f"{c.name} ({c.model}): no parameter {k!r}")
         for theirs in c.ports:
             if theirs not in vars_of[c.name]:
-                rep.errors.append(f"{c.name} ({c.model}): port map names {theirs!r}, which the unit does not have")
+                rep.errors.append(f"{c.name} ({c.model}): port map names {theirs!r}, which the unit does not have "
+                                  f"(neither a port, a vector stem {theirs}_x…, nor a parameter)")
     if rep.errors:
         return rep
     ports = {c.name: ([n for n, v in vars_of[c.name].items() if v.causality == "input"],
@@ -113,6 +114,9 @@ def check(scenario: Scenario, instantiate: bool = True) -> Report:
     problems = sc.wiring_problems(ports)
     if problems:
         rep.errors += [f"wiring: {x}" for x in problems]
+        hint = suggest_maps(sc, vars_of, mds)
+        if hint:
+            rep.errors.append("wiring: closest names: " + " ".join(hint))
         return rep
     links = sc.wiring(ports)
     for d, di, s, so in links:
@@ -136,6 +140,78 @@ def check(scenario: Scenario, instantiate: bool = True) -> Report:
         if v is None or v.causality != "input":
             rep.errors.append(f"fixed input {q}: {inst} has no input {var!r}")
     return rep
+
+
+# names a unit may use for the family's ports (a hint only: the suggestion is still checked by unit and axis)
+SYNONYMS = {"omega": ("w",), "rate": ("w",), "w_meas": ("w",), "tau": ("torque_cmd",), "torque": ("torque_cmd",),
+            "u": ("torque_cmd",), "quat": ("q",), "att": ("q",), "q_meas": ("q",), "q_cmd": ("q_ref",),
+            "w_cmd": ("w_ref",)}
+
+
+def _split(name: str) -> tuple[str, str]:
+    """(stem, axis suffix) of a port name: ``omega_x`` → (omega, x); no suffix → (name, "")."""
+    from .resolve import VECTOR_SUFFIXES
+    stem, sep, suf = name.rpartition("_")
+    return (stem, suf) if sep and stem and suf in VECTOR_SUFFIXES else (name, "")
+
+
+def suggest_maps(sc: Scenario, vars_of: dict, mds: dict) -> list[str]:
+    """``--map`` flags (or ``connections`` entries) that would wire the inputs left without a source: for
+    each, the other instances' outputs with the same axis suffix and unit and not already feeding that
+    instance, the closest by name (difflib ratio of the stems, or a usual synonym such as omega → w); a
+    vector whose elements all map the same way is one flag (``--map controller.omega=w``)."""
+    import difflib
+    names = [c.name for c in sc.components]
+    ours = {n: {sc.alias(n, p): v for p, v in vars_of[n].items()} for n in names}
+    outs = {n: [p for p, v in ours[n].items() if v.causality == "output"] for n in names}
+    picks: dict = {}
+    for d in names:
+        wired = set()
+        for p, v in ours[d].items():
+            if v.causality == "input":
+                src = [s for s in names if s != d and p in outs[s]]
+                if len(src) == 1:
+                    wired.add((src[0], p))
+        for i, v in ours[d].items():
+            q = f"{d}.{i}"
+            if v.causality != "input" or q in sc.connections or q in sc.inputs or sc._is_unconnected(d, i):
+                continue
+            if any(i in outs[s] for s in names if s != d):
+                continue
+            si, ax = _split(i)
+            ui = _unit(mds[sc.component(d).model], v)
+            best = None
+            for s in names:
+                if s == d:
+                    continue
+                for o in outs[s]:
+                    so, ox = _split(o)
+                    if ox != ax or (s, o) in wired or _unit(mds[sc.component(s).model], ours[s][o]) != ui:
+                        continue
+                    score = max(difflib.SequenceMatcher(None, si, so).ratio(),
+                                1.0 if so in SYNONYMS.get(si, ()) or si in SYNONYMS.get(so, ()) else 0.0)
+                    if score >= 0.5 and (best is None or score > best[0]):
+                        best = (score, s, o)
+            if best is None:
+                continue
+            _, s, o = best
+            if d in sc.swapped or s not in sc.swapped:
+                inst, theirs, target = d, sc.native_name(d, i), o  # rename the input of the unit that has it
+            else:
+                inst, theirs, target = s, sc.native_name(s, o), i  # rename the output of the swapped unit
+            if d not in sc.swapped and s not in sc.swapped:
+                picks[(None, q, f"{s}.{o}")] = None
+                continue
+            (ts, tx), (gs, gx) = _split(theirs), _split(target)
+            key = (inst, ts, gs) if tx and tx == gx else (inst, theirs, target)
+            picks.setdefault(key, []).append(tx)
+    out = []
+    for (inst, a, b), axes in picks.items():
+        if inst is None:
+            out.append(f'connections "{a}" = "{b}"')
+        else:
+            out.append(f"--map {inst}.{a}={b}")
+    return out
 
 
 def resolve_safely(scenario: Scenario, rep: Report) -> Scenario:

@@ -29,7 +29,7 @@ from pathlib import Path
 from .model import Component, Scenario
 
 _FIELDS = {f.name for f in fields(Scenario)}
-_COMPONENT = {"name", "model", "params", "slot", "ports"}
+_COMPONENT = {"name", "model", "params", "slot", "ports", "bind", "unused"}
 _TYPES = {"name": str, "stop_time": (int, float), "step": (int, float), "start_time": (int, float), "log": dict,
           "connections": dict, "unconnected": list, "inputs": dict, "auto_connect": bool, "seed_params": list,
           "metrics": str, "description": str, "components": list}
@@ -64,14 +64,16 @@ def from_data(data: dict, where: str = "scenario", base: Path | None = None) -> 
         for req in ("name", "model"):
             if not isinstance(c.get(req), str) or not c[req]:
                 raise ScenarioFileError(f"{w}: {req!r} must be a non-empty string")
-        for k in ("params", "slot", "ports"):
+        for k in ("params", "slot", "ports", "bind"):
             if k in c and not isinstance(c[k], dict):
                 raise ScenarioFileError(f"{w} ({c['name']}): {k!r} must be a table")
+        if not isinstance(c.get("unused", []), list):
+            raise ScenarioFileError(f"{w} ({c['name']}): 'unused' must be a list of slot names")
         model = c["model"]
         if base is not None and (model.endswith(".fmu") or "/" in model) and not Path(model).is_absolute():
             model = str((base / model).resolve())
         comps.append(Component(c["name"], model, dict(c.get("params", {})), dict(c.get("slot", {})),
-                               dict(c.get("ports", {}))))
+                               dict(c.get("ports", {})), dict(c.get("bind", {})), list(c.get("unused", []))))
     d = {k: v for k, v in data.items() if k != "components"}
     d.setdefault("name", where)
     sc = Scenario(components=comps, **d)

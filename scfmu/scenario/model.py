@@ -46,7 +46,13 @@ class Component:
     * ``slot``: parameters that any unit in this place is given *if it declares them* (e.g. the nominal
       inertia an attitude controller should assume); they survive a swap;
     * ``ports``: renames ``{"the unit's port name": "the scenario's port name"}`` for a unit whose port
-      names differ from the family's (``--map``).
+      names differ from the family's (``--map``); a vector stem (``"omega": "w"``) renames every element
+      (``omega_x`` plays ``w_x``, …), and a name that is a *parameter* of the unit binds it to a slot value
+      (``"J1": "inertia_xx"``; see ``bind``);
+    * ``bind``: ``{"the unit's parameter": slot name, number or expression of slot values}`` (a unit
+      profile, :mod:`scfmu.scenario.profile`), evaluated when the scenario is resolved;
+    * ``unused``: slot names the unit is declared not to take (no "not passed" warning for them).
+    ``bind`` and ``unused`` belong to the model like ``params``: a swap drops them.
     """
 
     name: str
@@ -54,6 +60,8 @@ class Component:
     params: dict = field(default_factory=dict)
     slot: dict = field(default_factory=dict)
     ports: dict = field(default_factory=dict)
+    bind: dict = field(default_factory=dict)
+    unused: list = field(default_factory=list)
 
 
 @dataclass
@@ -95,7 +103,12 @@ class Scenario:
         return self.with_overrides({p: int(seed) for p in self.seed_params})
 
     def to_dict(self) -> dict:
-        return asdict(self)
+        d = asdict(self)
+        for c in d["components"]:  # empty bindings left out: the plain data (and campaign ids) of scenarios
+            for k in ("bind", "unused"):  # without them are what they were before they existed
+                if not c[k]:
+                    del c[k]
+        return d
 
     def to_json(self) -> str:
         return json.dumps(self.to_dict(), sort_keys=True)
@@ -130,6 +143,8 @@ class Scenario:
                 c.model = str(model)
                 c.params = {}
                 c.ports = {}
+                c.bind = {}
+                c.unused = []
                 if inst not in s.swapped:
                     s.swapped.append(inst)
         return s

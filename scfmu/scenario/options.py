@@ -3,7 +3,12 @@
   SCENARIO                     a registered name, or a scenario file (.toml / .json)
   --fmu INSTANCE=PATH          put any FMI 2.0 Co-Simulation FMU (or another model name) in that place;
                                the old model's parameters are dropped (one notice lists them)
-  --map INSTANCE.THEIRS=OURS   the unit's port THEIRS plays the scenario's port OURS
+  --map INSTANCE.THEIRS=OURS   the unit's port THEIRS plays the scenario's port OURS; a vector stem renames
+                               every element (--map controller.omega=w); a parameter THEIRS takes the
+                               place's slot value OURS (--map controller.J1=inertia_xx)
+  --profile [INSTANCE=]FILE    the unit's profile (TOML: [params] J1 = "inertia_xx", [ports], unused = [...]);
+                               INSTANCE defaults to the one given with --fmu
+  --strict                     refuse to run when a slot value of the place reaches no parameter of the unit
   --set INSTANCE.VAR=VALUE     a parameter or fixed input
   --params FILE                more --set values from a TOML or JSON table {"instance.var": value}
   --t-end, --dt                stop time and communication step
@@ -12,10 +17,11 @@
 from __future__ import annotations
 
 import json
+import sys
 import tomllib
 from pathlib import Path
 
-from . import files
+from . import files, profile
 from .model import Scenario
 from ..registry import REGISTRY
 
@@ -51,7 +57,12 @@ def add_arguments(ap) -> None:
     ap.add_argument("--fmu", action="append", default=[], metavar="INSTANCE=PATH",
                     help="use this FMU (a path to any FMI 2.0 CS FMU, or a model name) for INSTANCE (repeatable)")
     ap.add_argument("--map", action="append", default=[], metavar="INSTANCE.THEIRS=OURS",
-                    help="the unit's port THEIRS plays the scenario's port OURS (repeatable)")
+                    help="the unit's port (or vector stem) THEIRS plays the scenario's port OURS; a parameter "
+                         "THEIRS takes the place's slot value OURS (repeatable)")
+    ap.add_argument("--profile", action="append", default=[], metavar="[INSTANCE=]FILE",
+                    help="unit profile (TOML) binding the unit's parameters to the place's slot values")
+    ap.add_argument("--strict", action="store_true",
+                    help="refuse to run when a slot value (e.g. the nominal inertia) reaches no parameter of a unit")
     ap.add_argument("--set", action="append", default=[], metavar="INSTANCE.VAR=VALUE",
                     help="parameter or fixed input for every run (repeatable)")
     ap.add_argument("--params", metavar="FILE", help="TOML or JSON table of INSTANCE.VAR = value")
@@ -114,6 +125,21 @@ def build(args, notice=print) -> Scenario:
     for inst, names in dropped.items():
         notice(f"notice: {inst} is now {Path(models[inst]).name}; the parameters of its old model are not "
                f"passed on: {', '.join(names)} (set the new unit's own with --set {inst}.NAME=VALUE)")
+    for item in getattr(args, "profile", None) or []:
+        inst, sep, path = item.partition("=")
+        if not sep:
+            inst, path = "", item
+        if not inst:
+            if len(models) != 1:
+                _fail(f"--profile {item}: say which instance it is for (--profile INSTANCE={item}); "
+                      f"units given with --fmu: {', '.join(models) or 'none'}")
+            inst = next(iter(models))
+        try:
+            sc = profile.apply(sc, inst, profile.load(path))
+        except profile.ProfileError as e:
+            _fail(str(e))
+        except KeyError as e:
+            _fail(f"--profile {item}: {e.args[0]}")
     try:
         sc = sc.with_port_map(pairs(args.map, "--map"))
     except KeyError as e:
@@ -126,3 +152,21 @@ def build(args, notice=print) -> Scenario:
         except KeyError as e:
             raise SystemExit(f"--set: {e.args[0]}") from None
     return sc
+
+
+def binding_report(sc: Scenario, prog: str, strict: bool, warn) -> list[str]:
+    """The slot values that reach no parameter of a swapped unit, each passed to ``warn("warning: …")``;
+    with ``strict`` raises SystemExit(2) with one line naming the first (and how many more)."""
+    from .resolve import unbound_slots
+    texts = [u.text() for u in unbound_slots(sc)]
+    if strict and texts:
+        _fail(f"{prog}: --strict: {texts[0]}" + (f" (and {len(texts) - 1} more)" if len(texts) > 1 else ""))
+    for t in texts:
+        warn(f"warning: {t}")
+    return texts
+
+
+def _fail(line: str):
+    """A user's mistake: one line on stderr, exit code 2."""
+    print(line, file=sys.stderr)
+    raise SystemExit(2)

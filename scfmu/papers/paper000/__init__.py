@@ -5,7 +5,7 @@ from __future__ import annotations
 
 
 def register(reg) -> None:
-    from . import scenarios
+    from . import envelope, scenarios
     reg.scenarios("default", scenarios.build,
                   lambda: [("default", "paper 000 run 000-6: quaternion PD, large command (40, -40, -60) deg")],
                   exported=("default",))
@@ -18,7 +18,8 @@ def register(reg) -> None:
                                  ("MracController", "MRAC (quaternion)", {"coordinates": 0}),
                                  ("FuzzyPdController", "fuzzy PD", {}),
                                  ("AdaptiveFuzzyController", "adaptive fuzzy", {})):
-        reg.controller("attitude", model, label, params)
+        reg.controller("attitude", model, label, params, home=envelope.HOME,
+                       retune="scfmu.papers.paper000.envelope:retune", unused=envelope.UNUSED)
     reg.paper("000", "EULERINT-based design of an adaptive-fuzzy attitude controller",
               commands={"study": ("runs 000-1 … 000-11 and the robustness runs R1/R2: table, CSV and PNG per run",
                                   "scfmu.papers.paper000.study:main")},

@@ -20,8 +20,11 @@ def register(reg) -> None:
         reg.benchmark("attitude", f"paper003/SMC/{case}", f"003-{case}: {text} (paper 003)", primary="ise")
     reg.benchmark("attitude", "paper003/SMC/U", "003-U: inertia uncertainty, Monte Carlo (paper 003)", primary="ise",
                   seeds=100, monte_carlo="scfmu.papers.paper003.model:mc_draws")
-    reg.controller("attitude", "SlidingModeController", "GA-tuned SMC", tuned["SMC"])
-    reg.controller("attitude", "Type2FuzzySmcController", "type-2 fuzzy SMC", tuned["T2FSMC"])
+    home = ("paper003/*", "wheel_fault", "sensing/paper003/*")  # paper 003's plant (the sensing variant too)
+    reg.controller("attitude", "SlidingModeController", "GA-tuned SMC", tuned["SMC"], home=home,
+                   retune="scfmu.papers.paper003.envelope:retune_smc")
+    reg.controller("attitude", "Type2FuzzySmcController", "type-2 fuzzy SMC", tuned["T2FSMC"], home=home,
+                   retune="scfmu.papers.paper003.envelope:retune_t2fsmc")
     reg.paper("003", "Type-2 fuzzy sliding-mode attitude control of a LEO satellite",
               commands={"tune": ("GA tuning of the SMC gain, then the type-2 fuzzy coefficients",
                                  "scfmu.papers.paper003.commands:main_tune"),
