@@ -46,7 +46,9 @@ def plan(quick: bool) -> dict:
 def gain_rows(gains: dict, reported: dict) -> list:
     """The paper's Table 4 gains beside our PSO-tuned ones: each damaged entry is compared with its nearest
     candidate reading; reproduced within 5 % of it (or its printed precision), otherwise not reproduced (the
-    plant is not the paper's: its torque limit and wheel gain are our choices)."""
+    plant is not the paper's: its torque limit and wheel gain are our choices). Every row carries the PSO
+    search box of its gain (``model.BOUNDS``) as bounds: a tuned gain on an edge of the box is fixed by
+    construction (the search put it there), never an independent reproduction."""
     from ...report.types import NumberRow
     out = []
     for g in reported["gains"]:
@@ -63,7 +65,8 @@ def gain_rows(gains: dict, reported: dict) -> list:
                              note=(f"nearest of {len(cands)} candidate readings" if len(cands) > 1 else "")
                              + ("; " if len(cands) > 1 else "") + "ours: PSO on our plant (paper002/data/gains.json)",
                              paper_text=" / ".join(g["candidates"]) if len(cands) <= 4 else
-                             f"{g['candidates'][0]} … {g['candidates'][-1]} ({len(cands)} readings)"))
+                             f"{g['candidates'][0]} … {g['candidates'][-1]} ({len(cands)} readings)",
+                             bounds=p2.BOUNDS[g["gain"]]))
     return out
 
 
