@@ -9,9 +9,16 @@ PAPER001_CASES = {"a": (5.0, 5.0), "b": (25.0, 5.0), "c": (25.0, 25.0), "d": (25
 PAPER001_REF = (50.0, 40.0, 60.0)
 
 
-def paper001(case: str = "a", dist: float = 0.0, stop_time: float = 300.0, step: float = 0.001) -> Scenario:
+PLANT_STEP = 0.001     # the plant's RK4 step (s); the communication step is the controller's sample step
+
+
+def paper001(case: str = "a", dist: float = 0.0, stop_time: float = 300.0, step: float = 0.001,
+             internal_step: float | None = None) -> Scenario:
     """RelativePositionCommand → PredictivePidController → RelativeOrbitPlant; step to (50, 40, 60) m,
-    T1 = 0, (T2, c) of the case, RK4 internal step = Δ, constant disturbance ``dist`` N per axis."""
+    T1 = 0, (T2, c) of the case, constant disturbance ``dist`` N per axis. ``step`` = Δ is the controller's
+    sample step (the force is held over it); the plant integrates with RK4 at ``internal_step`` (default
+    min(Δ, 1 ms)), so Δ = 1 ms is the continuous reading and e.g. Δ = 0.0125 s a sampled controller."""
+    internal = min(step, PLANT_STEP) if internal_step is None else internal_step
     t2, c = PAPER001_CASES[case]
     log = {}
     for a in "xyz":
@@ -25,12 +32,13 @@ def paper001(case: str = "a", dist: float = 0.0, stop_time: float = 300.0, step:
         components=[
             Component("command", "RelativePositionCommand", {f"target_pos_{a}": v for a, v in zip("xyz", PAPER001_REF)}),
             Component("controller", "PredictivePidController", {"T1": 0.0, "T2": t2, "c": c}),
-            Component("plant", "RelativeOrbitPlant", {"max_internal_step": step, "integrator": 0}),
+            Component("plant", "RelativeOrbitPlant", {"max_internal_step": internal, "integrator": 0}),
         ],
         stop_time=stop_time, step=step, log=log,
         inputs={f"plant.dist_{a}": dist for a in "xyz"},
         metrics="formation",
-        description=f"paper 001 case {case}: T2 = {t2:g} s, c = {c:g} 1/s, dist = {dist:g} N per axis",
+        description=f"paper 001 case {case}: T2 = {t2:g} s, c = {c:g} 1/s, dist = {dist:g} N per axis"
+                    + ("" if step == 0.001 else f", controller sampled every {step:g} s"),
     )
 
 
