@@ -28,7 +28,7 @@ def paper001(case: str = "a", dist: float = 0.0, stop_time: float = 300.0, step:
         log[f"force_{a}"] = f"controller.force_{a}"
         log[f"dist_est_{a}"] = f"controller.dist_est_{a}"
     return Scenario(
-        name=f"paper001/{case}/dist{dist:g}",
+        name=f"paper001/{case}/dist{dist:g}" + ("" if step == 0.001 else f"/step{step:g}"),
         components=[
             Component("command", "RelativePositionCommand", {f"target_pos_{a}": v for a, v in zip("xyz", PAPER001_REF)}),
             Component("controller", "PredictivePidController", {"T1": 0.0, "T2": t2, "c": c}),
@@ -45,11 +45,23 @@ def paper001(case: str = "a", dist: float = 0.0, stop_time: float = 300.0, step:
 
 
 def build(name: str, **kw) -> Scenario:
+    """``paper001/<case>[/dist<N>][/step<Δ>]``: Δ the controller's sample step (default 0.001 s)."""
     parts = name.split("/")
-    if len(parts) not in (2, 3) or parts[1] not in PAPER001_CASES:
-        raise KeyError(f"unknown scenario {name!r}: expected paper001/<a|b|c|d>[/dist<N>]")
-    dist = float(parts[2][4:]) if len(parts) == 3 else kw.pop("dist", 0.0)
-    return paper001(parts[1], dist, **kw)
+    bad = KeyError(f"unknown scenario {name!r}: expected paper001/<a|b|c|d>[/dist<N>][/step<seconds>]")
+    if len(parts) not in (2, 3, 4) or parts[1] not in PAPER001_CASES:
+        raise bad
+    opts = {"dist": kw.pop("dist", 0.0)}
+    for p in parts[2:]:
+        key = "dist" if p.startswith("dist") else "step" if p.startswith("step") else None
+        try:
+            opts[key] = float(p[4:])
+        except (TypeError, ValueError):
+            raise bad from None
+        if key is None or not opts[key] >= 0 or (key == "step" and not opts[key] > 0):
+            raise bad
+    if "step" in opts:
+        kw["step"] = opts["step"]
+    return paper001(parts[1], opts["dist"], **kw)
 
 
 def names() -> list[tuple[str, str]]:
