@@ -435,7 +435,7 @@ def build(ctx) -> PaperSection:
                   "Full mode: 9 initial-attitude scales, 8 effectiveness values, 5 onset times, 4 re-optimised starts, "
                   "3 optimiser margins.")),
         runtime_s=time.time() - t0,
-        tables=[tab_cal],
+        tables=[tab_cal], doc_tables={"cases": main},
         numbers=number_rows({"1": t1, "2": t2, "3": t3}),
         calibrations=(f"Calibration: paper 004 does not give the initial attitude. The start is the project's "
                       f"direction (yaw, pitch, roll) = (6, −4, 8) deg scaled by s = {S0:g}, the value of the grid "
