@@ -18,7 +18,7 @@ from scfmu.report import cli as report_cli
 from scfmu.report import docs, render, rules
 from scfmu.report.types import (BY_CONSTRUCTION, CALIBRATED, CHOSEN, CONFIRMED, DEPENDS, INDEPENDENT, NOT_CHECKABLE,
                                 NOT_CONFIRMED, NOT_REPRODUCED, REPRODUCED, SAME_ORDERING, Claim, Figure, NumberRow,
-                                PaperSection, Sensitivity, Table)
+                                PaperSection, Sensitivity, Table, on_bound)
 
 # The verdicts of the last full build (`scfmu report --workers 2`), claims and reported numbers: the quick
 # build must reach every one of them (it may run fewer points, never another set-up).
@@ -345,12 +345,38 @@ def test_report_quick_end_to_end(tmp_path):
     papers_full = {k: v for k, v in full["claims"].items() if k.split("-")[0][1:] in CI_PAPERS}
     assert quick["claims"] == papers_full
     assert quick["numbers"] == {k: v for k, v in full["numbers"].items() if k.split("/")[0] in CI_PAPERS}
-    # the docs pages open with the table this build computes (quick and full compute the same numbers)
+    # the docs pages open with the table this build computes (quick and full compute the same numbers), and
+    # every generated block (claims, results tables) equals what this build wrote
     rows = render.read_numbers_csv(out / "numbers.csv")
+    tables = json.loads((out / "doc_tables.json").read_text(encoding="utf-8"))
     for p in CI_PAPERS:
         page = (ROOT / "docs" / f"paper{p}.md").read_text(encoding="utf-8")
         assert 0 <= page.find(render.DOC_BEGIN) < 1000, f"docs/paper{p}.md does not open with its numbers table"
         assert render.doc_block(page) == render.docs_table(rows, p), f"docs/paper{p}.md: table is stale"
+        assert "claims" in docs.table_blocks(page), f"docs/paper{p}.md has no generated claims table"
+        assert docs.stale_blocks(page, p, rows, tables) == [], f"docs/paper{p}.md: stale blocks (scfmu report --docs docs)"
+    # no row whose value sits on one of its bounds (search bound, optimiser constraint) counts as independent,
+    # checked on the data written, and the rows named in the audit are not evidence
+    for r in rows:
+        bounds = [float(b) for b in r["bounds"].split(";") if b]
+        if r["our value"] and on_bound(float(r["our value"]), bounds) is not None:
+            assert r["obtained"] != INDEPENDENT, r
+    by = {(r["paper"], r["item"]): r for r in rows}
+    assert by[("002", "Table 4 PID K_D")]["obtained"] == BY_CONSTRUCTION
+    assert all(r["obtained"] == BY_CONSTRUCTION for k, r in by.items() if k[0] == "004" and "case 3" in k[1])
+    assert by[("000", "Table 3 EULERINT: Adaptive (MRAC)")]["obtained"] == INDEPENDENT   # the paper's plant mode
+    assert any(k[0] == "003" and r["paper value"].startswith("1.0611") and r["obtained"] == INDEPENDENT
+               for k, r in by.items())
+    # `scfmu run` scenarios reproduce the report's numbers (same set-up, same calibration)
+    from scfmu import scenario as scenarios
+    from scfmu.engines import simulate
+    from scfmu.metrics import compute as metrics_of
+    r2 = simulate(scenarios.get("paper004/2"), engine="native")
+    e2 = max(abs(math.degrees(r2[a][-1])) for a in ("roll", "pitch", "yaw"))
+    assert f"{e2:.6g}" == by[("004", "case 2 faulty (a = 0.1), uncorrected: max |Euler angle (t_f)|")]["our value"]
+    sc9 = scenarios.get("paper000/000-9L")
+    m9 = metrics_of(sc9.metrics, simulate(sc9, engine="native"))
+    assert f"{m9['eulerint_deg_s']:.6g}" == by[("000", "Table 3 EULERINT: Adaptive (MRAC)")]["our value"]
 
 
 def test_report_missing_paper_is_an_error(tmp_path):
