@@ -69,3 +69,18 @@ def test_claim_verdict_names_the_readings():
     mixed = {**none, r[0]: {"C": (4, 4)}, r[1]: {"C": (1, 4)}}
     v, ev, some = P.claim_verdict(mixed, "C")
     assert v == DEPENDS and ev == [P.name(r[0])] and some == [P.name(r[1])]
+
+
+def test_shares_count_candidate_combinations():
+    """Synthetic results: FOPD better than PD for one of two FOPD sets, FOPID better than PID everywhere."""
+    from scfmu.papers.paper002 import report as r2
+
+    def m(x):
+        return {"mae_deg": x, "settling_s": x, "overshoot_pct": x}
+    res = {"PD": [m(2.0)], "PID": [m(3.0), m(3.0)], "FOPD": [m(1.0), m(5.0)], "FOPID": [m(1.0)]}
+    results = {c: {rd: v for rd in P.readings()} for c, v in res.items()}
+    s = P.shares(results, r2.pair_rule, r2.phase_rule, r2.PAIRS)[P.DEFAULT]
+    assert s["FOPD vs PD"] == (1, 2) and s["FOPID vs PID"] == (2, 2)
+    assert s["C002-1"] == (2, 4) and s["C002-2"] == (2, 4)        # PD (2) not worse than PID (3)
+    t = P.table({rd: s for rd in P.readings()}, results)
+    assert t.rows[0][1:5] == ["1 / 2", "2 / 2", "2 / 4", "2 / 4"]
