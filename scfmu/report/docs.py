@@ -3,7 +3,7 @@ same data as the report:
 
 * the "paper vs ours" block (between ``DOC_BEGIN`` and ``DOC_END``) from ``numbers.csv``;
 * named blocks ``<!-- table:NAME:begin … -->`` … ``<!-- table:NAME:end -->`` from ``doc_tables.json``: every
-  paper's claims table ("claims": claim, verdict, the readings under which it holds) and the tables a
+  paper's claims table ("claims": claim, verdict, statement) and the tables a
   section lists in ``PaperSection.doc_tables`` (results at the defaults, …).
 
 A test builds the report (--quick) and fails when a page's block differs from what the build wrote.
@@ -67,9 +67,10 @@ def table_lines(t: Table) -> list[str]:
 
 
 def claims_table(sec: PaperSection) -> Table:
-    """A paper's claims for its docs page: id, verdict, where it holds (the readings named)."""
-    return Table("claims", ["claim", "verdict", "readings examined"],
-                 [[c.id, MD_MARK.get(c.verdict, c.verdict), ", ".join(c.sensitive_to) or "–"] for c in sec.claims])
+    """A paper's claims for its docs page: id, verdict and the claim in our words (what quick and full builds
+    share; the readings each verdict names, swept on mode-dependent grids, are in the report)."""
+    return Table("claims", ["claim", "verdict", "claim in our words"],
+                 [[c.id, MD_MARK.get(c.verdict, c.verdict), c.statement] for c in sec.claims])
 
 
 def section_doc_tables(sec: PaperSection) -> dict[str, str]:
