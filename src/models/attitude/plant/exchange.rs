@@ -42,7 +42,7 @@ const fn concat_names<const N: usize>(a: &[&'static str], b: &[&'static str]) ->
 
 /// The published continuous states, in the order of the internal state vector.
 pub const STATES: [StateDecl; super::kinematics::N] = [
-    s("state_att_1", "", "Continuous state: attitude entry 1 (q_w for kinematics 0; A column-major for 1; roll phi for 2, 3)", &["state_att_2", "state_att_3", "state_att_4", "state_w_x", "state_w_y", "state_w_z"]),
+    s("state_att_1", "", "Continuous state: attitude entry 1 (q_w for kinematics 0, 4; A column-major for 1; roll phi for 2, 3)", &["state_att_2", "state_att_3", "state_att_4", "state_w_x", "state_w_y", "state_w_z"]),
     s("state_att_2", "", "Continuous state: attitude entry 2 (q_x; A; pitch theta)", &["state_att_1", "state_att_3", "state_att_4", "state_w_x", "state_w_y", "state_w_z"]),
     s("state_att_3", "", "Continuous state: attitude entry 3 (q_y; A; yaw psi)", &["state_att_1", "state_att_2", "state_att_3", "state_att_4", "state_w_x", "state_w_y", "state_w_z"]),
     s("state_att_4", "", "Continuous state: attitude entry 4 (q_z; A; unused)", &["state_att_1", "state_att_2", "state_att_3", "state_att_5", "state_att_6", "state_w_x", "state_w_y", "state_w_z"]),
