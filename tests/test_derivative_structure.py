@@ -31,7 +31,7 @@ ATTITUDE_FEATURES = [
     {"actuator_mode": 1, "mtq_enable": 1, "gg_enable": 0, "wheel_time_constant": 0.0, **FULL_INERTIA},
 ]
 CASES = {
-    "AttitudePlant": [dict(p, kinematics=k) for k in (0, 1, 2, 3) for p in ATTITUDE_FEATURES],
+    "AttitudePlant": [dict(p, kinematics=k) for k in (0, 1, 2, 3, 4) for p in ATTITUDE_FEATURES],
     "SingleAxisPlant": [{}],
     "RelativeOrbitPlant": [{}, {"eccentricity": 0.1}],
     "AttitudeMetrics": [{}],

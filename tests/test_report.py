@@ -15,9 +15,10 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 
 from scfmu.report import cli as report_cli
-from scfmu.report import render, rules
-from scfmu.report.types import (CONFIRMED, DEPENDS, NOT_CHECKABLE, NOT_CONFIRMED, NOT_REPRODUCED, REPRODUCED,
-                                SAME_ORDERING, Claim, Figure, NumberRow, PaperSection, Sensitivity, Table)
+from scfmu.report import docs, render, rules
+from scfmu.report.types import (BY_CONSTRUCTION, CALIBRATED, CHOSEN, CONFIRMED, DEPENDS, INDEPENDENT, NOT_CHECKABLE,
+                                NOT_CONFIRMED, NOT_REPRODUCED, REPRODUCED, SAME_ORDERING, Claim, Figure, NumberRow,
+                                PaperSection, Sensitivity, Table, on_bound)
 
 # The verdicts of the last full build (`scfmu report --workers 2`), claims and reported numbers: the quick
 # build must reach every one of them (it may run fewer points, never another set-up).
@@ -227,33 +228,61 @@ def test_numbers_csv_summary_and_docs_table(tmp_path):
     secs = synthetic_sections(tmp_path)
     secs[0].numbers = [NumberRow("901", "EULERINT <a>", "deg·s", 156.1, 156.4, REPRODUCED, paper_text="156.1"),
                        NumberRow("901", "effort", "N·m·s", 2954.0, 772.1, SAME_ORDERING),
-                       NumberRow("901", "fitted", "deg", 0.7, 0.7455, REPRODUCED, calibration=True)]
+                       NumberRow("901", "fitted", "deg", 0.7, 0.7455, REPRODUCED, calibration=True),
+                       NumberRow("901", "gain", "-", 19.08, 20.0, REPRODUCED, bounds=(0.0, 20.0))]
     secs[1].numbers = [NumberRow("902", "lost", "–", None, None, NOT_CHECKABLE, note="no table survives")]
+    secs[0].doc_tables = {"defaults": Table("results", ["run", "x"], [["a", 1.5]])}
     h, _ = render.render(secs, tmp_path, {"quick": False})
     import csv as csv_
     with open(tmp_path / "numbers.csv", newline="", encoding="utf-8") as f:
         rows = list(csv_.reader(f))
-    assert rows[0][:8] == ["paper", "item", "unit", "paper value", "our value", "relative difference", "verdict",
-                           "used for calibration"]
-    assert rows[1][:8] == ["901", "EULERINT <a>", "deg·s", "156.1", "156.4", f"{0.3 / 156.1:.6g}", REPRODUCED, "no"]
-    assert rows[3][6:8] == [REPRODUCED, "yes"] and rows[4][3:8] == ["", "", "", NOT_CHECKABLE, "no"]
+    assert rows[0][:9] == ["paper", "item", "unit", "paper value", "our value", "relative difference", "verdict",
+                           "obtained", "bounds"]
+    assert rows[1][:8] == ["901", "EULERINT <a>", "deg·s", "156.1", "156.4", f"{0.3 / 156.1:.6g}", REPRODUCED,
+                           INDEPENDENT]
+    assert rows[3][6:8] == [REPRODUCED, CALIBRATED] and rows[5][3:8] == ["", "", "", NOT_CHECKABLE, INDEPENDENT]
+    assert rows[4][6:9] == [REPRODUCED, BY_CONSTRUCTION, "0;20"]        # on the search bound: no evidence
     text = h.read_text(encoding="utf-8")
     assert "EULERINT &lt;a&gt;" in text and 'id="glance"' in text and 'href="#numbers901"' in text
-    # the first page's counts per paper: 901 has 2 reproduced, 1 same ordering, 2 independent checks of 3
+    # the first page counts independent rows only: 901 has 1 reproduced, 1 same ordering, 2 not evidence,
+    # 2 independent checks of 4
     glance = text[text.index('id="glance"'):text.index("</table>", text.index('id="glance"'))]
     row901 = glance[glance.index(">901<"):glance.index("</tr>", glance.index(">901<"))]
-    assert [c.split(">")[-1] for c in row901.split("</td>") if 'class="num"' in c][:4] == ["2", "1", "0", "0"]
-    assert "2 of 3</a>" in row901
+    assert [c.split(">")[-1] for c in row901.split("</td>") if 'class="num"' in c][:5] == ["1", "1", "0", "0", "2"]
+    assert "2 of 4</a>" in row901
     import json
     v = json.loads((tmp_path / "verdicts.json").read_text())
     assert v["numbers"]["901/effort"] == SAME_ORDERING and v["claims"]["C901-1"] == CONFIRMED
-    # the docs block written from the CSV
+    # the docs blocks written from the CSV and doc_tables.json; a stale block is found
     doc = tmp_path / "paper901.md"
-    doc.write_text(f"# Paper 901\n\n{render.DOC_BEGIN}\nstale\n{render.DOC_END}\n\nrest\n", encoding="utf-8")
+    doc.write_text(f"# Paper 901\n\n{render.DOC_BEGIN}\nstale\n{render.DOC_END}\n\nrest\n"
+                   f"{docs.table_block('defaults', 'old')}\n{docs.table_block('claims', 'old')}\n", encoding="utf-8")
+    tables = json.loads((tmp_path / "doc_tables.json").read_text())
+    nrows = render.read_numbers_csv(tmp_path / "numbers.csv")
+    assert docs.stale_blocks(doc.read_text(), "901", nrows, tables) == ["numbers", "defaults", "claims"]
     render.update_docs(tmp_path, tmp_path / "numbers.csv")
-    block = render.doc_block(doc.read_text(encoding="utf-8"))
-    assert "stale" not in block and "| EULERINT <a> | deg·s | 156.1 | 156.4 | +0.2 % | reproduced | no |" in block
-    assert "independent checks 2 of 3" in block and doc.read_text().endswith("rest\n")
+    page = doc.read_text(encoding="utf-8")
+    block = render.doc_block(page)
+    assert "stale" not in block and "| EULERINT <a> | deg·s | 156.1 | 156.4 | +0.2 % | reproduced | independent |" in block
+    assert "| gain | - | 19.08 | 20 | +4.8 % | reproduced | fixed by construction |" in block
+    assert "independent checks 2 of 4" in block and "rest\n" in page
+    assert "| a | 1.5 |" in page and "| C901-1 | ✅ confirmed | x < y & y > z |" in page
+    assert docs.stale_blocks(page, "901", nrows, tables) == []
+
+
+def test_a_value_on_a_bound_is_never_independent():
+    """A value on one of its row's bounds (search bound, optimiser constraint) is fixed by construction
+    whatever basis the section gave it; one just off the bound (beyond BOUND_REL) stays as given."""
+    for basis in (INDEPENDENT, CHOSEN):
+        n = NumberRow("9", "K_D", "-", 19.08, 20.0, REPRODUCED, basis=basis, bounds=(0.0, 20.0))
+        assert n.basis == BY_CONSTRUCTION and not n.independent and "bound" in n.note
+    n = NumberRow("9", "ω", "deg/s", 0.01, 0.0099 * (1 + 1e-7), REPRODUCED, bounds=(0.0099,))
+    assert n.basis == BY_CONSTRUCTION and not n.independent
+    assert NumberRow("9", "x", "-", 1.0, 0.0, NOT_REPRODUCED, bounds=(0.0,)).basis == BY_CONSTRUCTION
+    assert NumberRow("9", "K_D", "-", 19.08, 19.9, REPRODUCED, bounds=(0.0, 20.0)).independent
+    assert NumberRow("9", "c", "-", 1.0, 1.0, REPRODUCED, calibration=True, bounds=(1.0,)).basis == CALIBRATED
+    with pytest.raises(ValueError):
+        NumberRow("9", "x", "-", 1.0, 1.0, REPRODUCED, basis="trust me")
 
 
 def test_quick_never_changes_the_physical_setup():
@@ -294,7 +323,7 @@ def test_report_quick_end_to_end(tmp_path):
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     r = subprocess.run([sys.executable, "-m", "scfmu", "report", "--quick", "--workers", "2",
                         "--papers", ",".join(CI_PAPERS), "--out", str(out)], capture_output=True, text=True, env=env,
-                       timeout=900)
+                       timeout=1800)
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
     assert "index.html" in r.stdout
     page = parse(out / "index.html")
@@ -310,18 +339,44 @@ def test_report_quick_end_to_end(tmp_path):
         assert cid in r.stdout
     # every reported number has a row; quick agrees with the last full build on every verdict
     import json
+    rows = render.read_numbers_csv(out / "numbers.csv")
     quick = json.loads((out / "verdicts.json").read_text(encoding="utf-8"))
     full = json.loads(FULL_VERDICTS.read_text(encoding="utf-8"))
     assert quick["quick"] and not full["quick"]
     papers_full = {k: v for k, v in full["claims"].items() if k.split("-")[0][1:] in CI_PAPERS}
     assert quick["claims"] == papers_full
     assert quick["numbers"] == {k: v for k, v in full["numbers"].items() if k.split("/")[0] in CI_PAPERS}
-    # the docs pages open with the table this build computes (quick and full compute the same numbers)
-    rows = render.read_numbers_csv(out / "numbers.csv")
+    # no row whose value sits on one of its bounds (search bound, optimiser constraint) counts as independent,
+    # checked on the data written, and the rows named in the audit are not evidence
+    for r in rows:
+        bounds = [float(b) for b in r["bounds"].split(";") if b]
+        if r["our value"] and on_bound(float(r["our value"]), bounds) is not None:
+            assert r["obtained"] != INDEPENDENT, r
+    by = {(r["paper"], r["item"]): r for r in rows}
+    assert by[("002", "Table 4 PID K_D")]["obtained"] == BY_CONSTRUCTION
+    assert all(r["obtained"] == BY_CONSTRUCTION for k, r in by.items() if k[0] == "004" and "case 3" in k[1])
+    assert by[("000", "Table 3 EULERINT: Adaptive (MRAC)")]["obtained"] == INDEPENDENT   # the paper's plant mode
+    assert any(k[0] == "003" and r["paper value"].startswith("1.0611") and r["obtained"] == INDEPENDENT
+               for k, r in by.items())
+    # `scfmu run` scenarios reproduce the report's numbers (same set-up, same calibration)
+    from scfmu import scenario as scenarios
+    from scfmu.engines import simulate
+    from scfmu.metrics import compute as metrics_of
+    r2 = simulate(scenarios.get("paper004/2"), engine="native")
+    e2 = max(abs(math.degrees(r2[a][-1])) for a in ("roll", "pitch", "yaw"))
+    assert f"{e2:.6g}" == by[("004", "case 2 faulty (a = 0.1), uncorrected: max |Euler angle (t_f)|")]["our value"]
+    sc9 = scenarios.get("paper000/000-9L")
+    m9 = metrics_of(sc9.metrics, simulate(sc9, engine="native"))
+    assert f"{m9['eulerint_deg_s']:.6g}" == by[("000", "Table 3 EULERINT: Adaptive (MRAC)")]["our value"]
+    # the docs pages open with the table this build computes (quick and full compute the same numbers), and
+    # every generated block (claims, results tables) equals what this build wrote
+    tables = json.loads((out / "doc_tables.json").read_text(encoding="utf-8"))
     for p in CI_PAPERS:
         page = (ROOT / "docs" / f"paper{p}.md").read_text(encoding="utf-8")
         assert 0 <= page.find(render.DOC_BEGIN) < 1000, f"docs/paper{p}.md does not open with its numbers table"
         assert render.doc_block(page) == render.docs_table(rows, p), f"docs/paper{p}.md: table is stale"
+        assert "claims" in docs.table_blocks(page), f"docs/paper{p}.md has no generated claims table"
+        assert docs.stale_blocks(page, p, rows, tables) == [], f"docs/paper{p}.md: stale blocks (scfmu report --docs docs)"
 
 
 def test_report_missing_paper_is_an_error(tmp_path):

@@ -98,7 +98,8 @@ def main(argv=None) -> int:
     ap.add_argument("--papers", default=None, help="comma-separated paper numbers (default: every paper with a report section)")
     ap.add_argument("--out", type=Path, default=Path("out") / "report", help="output folder (index.html goes here)")
     ap.add_argument("--docs", type=Path, default=None,
-                    help="also rewrite the 'paper vs ours' table that opens each DOCS/paperNNN.md from numbers.csv")
+                    help="also rewrite the generated blocks of each DOCS/paperNNN.md (the 'paper vs ours' table from "
+                         "numbers.csv, the claims and results tables from doc_tables.json)")
     args = ap.parse_args(argv)
 
     papers = parse_papers(args.papers)
@@ -134,8 +135,10 @@ def main(argv=None) -> int:
             "quick": args.quick, "workers": args.workers, "runs": dict(ctx.runs),
             "runtime_s": time.time() - t_all,
             "intro": "Each paper section opens with the paper's reported numbers beside ours (verdicts: reproduced, "
-                     "same ordering only, not reproduced, not checkable; calibrated numbers are marked and are no "
-                     "independent check). Each claim below is one of the papers' stated conclusions, in our words. "
+                     "same ordering only, not reproduced, not checkable), each row saying how ours was obtained: "
+                     "independent, calibrated (fitted to this number), fixed by construction (a search bound or an "
+                     "optimiser constraint puts it there) or chosen among readings after comparing with the paper; "
+                     "only independent rows are evidence. Each claim below is one of the papers' stated conclusions, in our words. "
                      "Its verdict is decided by an explicit rule in the code of the paper's section (stated with the "
                      "evidence): confirmed (holds with today's set-up and every other plausible reading checked), "
                      "not confirmed, or depends on a reading (named). A reading under which a claim holds only by "
@@ -143,7 +146,7 @@ def main(argv=None) -> int:
                      "Sensitivity blocks show the values tried and where the claim holds."}
     html_path, md_path = render.render(sections, args.out, meta)
     if args.docs is not None:
-        for p in render.update_docs(args.docs, args.out / "numbers.csv"):
+        for p in render.update_docs(args.docs, args.out / "numbers.csv", args.out / "doc_tables.json"):
             print(f"updated {p}")
     print("\n" + render.numbers_text(sections))
     print("\n" + render.claims_text(sections))

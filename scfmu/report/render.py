@@ -13,24 +13,15 @@ Markdown copy, table cells have their ``|`` escaped and line breaks folded.
 
 from __future__ import annotations
 
-import html
-import math
+import json
 from pathlib import Path
 
-import csv
-import json
-
-from .types import (CONFIRMED, DEPENDS, NOT_CHECKABLE, NOT_CONFIRMED, NOT_REPRODUCED, NUMBER_VERDICTS, REPRODUCED,
-                    SAME_ORDERING, Claim, NumberRow, PaperSection, Sensitivity, Table)
-
-BADGE = {CONFIRMED: ("#1a7f37", "#ffffff"), NOT_CONFIRMED: ("#cf222e", "#ffffff"), DEPENDS: ("#bf8700", "#ffffff")}
-BADGE.update({REPRODUCED: ("#1a7f37", "#ffffff"), SAME_ORDERING: ("#bf8700", "#ffffff"),
-              NOT_REPRODUCED: ("#cf222e", "#ffffff"), NOT_CHECKABLE: ("#57606a", "#ffffff")})
-MD_MARK = {CONFIRMED: "✅ confirmed", NOT_CONFIRMED: "❌ not confirmed", DEPENDS: "⚠️ depends on a reading"}
-
-# numbers.csv: one row per reported number (the same table as the report's "paper vs ours" tables)
-CSV_COLUMNS = ["paper", "item", "unit", "paper value", "our value", "relative difference", "verdict",
-               "used for calibration", "note"]
+from . import docs as _docs
+from .docs import DOC_BEGIN, DOC_END, doc_block, docs_table, update_docs  # noqa: F401 (the docs blocks)
+from .fmt import BADGE, MD_MARK, _e, _is_num, _md, _paras, badge, fmt_cell  # noqa: F401
+from .numbers import (CSV_COLUMNS, counts_text, fmt_num, fmt_rel, number_cells, number_counts,  # noqa: F401
+                      numbers_csv_rows, numbers_html, numbers_md, numbers_text, read_numbers_csv, write_numbers_csv)
+from .types import (CONFIRMED, DEPENDS, NOT_CONFIRMED, NUMBER_VERDICTS, Claim, PaperSection, Sensitivity, Table)
 
 CSS = """
 body{font-family:-apple-system,Segoe UI,Helvetica,Arial,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;
@@ -54,124 +45,6 @@ figcaption{color:#57606a;font-size:.9em;margin-top:.3em}
 .sens{background:#f6f8fa;padding:.4em .8em;border-radius:6px;margin:.6em 0}
 pre{white-space:pre-wrap}
 """
-
-
-# ----- cell formatting ------------------------------------------------------------------------------
-def fmt_cell(v, digits: int = 4) -> str:
-    """Plain text of one table cell: floats with ``digits`` significant digits, NaN as "–"."""
-    if isinstance(v, bool):
-        return "yes" if v else "no"
-    if isinstance(v, float):
-        if math.isnan(v):
-            return "–"
-        if math.isinf(v):
-            return "∞" if v > 0 else "−∞"
-        return f"{v:.{digits}g}"
-    if v is None:
-        return "–"
-    return str(v)
-
-
-def _is_num(v) -> bool:
-    return isinstance(v, (int, float)) and not isinstance(v, bool)
-
-
-def _e(text) -> str:
-    return html.escape(str(text), quote=True)
-
-
-def _md(text) -> str:
-    """Markdown table cell: one line, pipes escaped."""
-    return str(text).replace("\\", "\\\\").replace("|", "\\|").replace("\r", " ").replace("\n", " ")
-
-
-def badge(verdict: str) -> str:
-    bg, fg = BADGE.get(verdict, ("#57606a", "#ffffff"))
-    return f'<span class="badge" style="background:{bg};color:{fg}">{_e(verdict)}</span>'
-
-
-def _paras(text: str) -> str:
-    parts = [p.strip() for p in str(text).split("\n\n") if p.strip()]
-    return "".join(f"<p>{_e(p)}</p>" for p in parts)
-
-
-# ----- the papers' numbers beside ours -----------------------------------------------------------------
-def fmt_num(v, digits: int = 4) -> str:
-    if v is None:
-        return "–"
-    return fmt_cell(float(v), digits) if _is_num(v) else str(v)
-
-
-def fmt_rel(x: float) -> str:
-    """Relative difference as a signed percentage ("+0.7 %"), "–" when undefined."""
-    if x is None or not isinstance(x, float) or math.isnan(x):
-        return "–"
-    return f"{100 * x:+.1f} %"
-
-
-def number_cells(n: NumberRow) -> list[str]:
-    """[item, unit, paper value, our value, relative difference, verdict, calibration, note] as plain text."""
-    paper = n.paper_text or fmt_num(n.paper_value)
-    return [n.item, n.unit, paper, fmt_num(n.ours), fmt_rel(n.rel_diff), n.verdict,
-            "yes" if n.calibration else "no", n.note]
-
-
-def number_counts(numbers: list[NumberRow]) -> dict:
-    """{verdict: count} over NUMBER_VERDICTS (zeros included)."""
-    return {v: sum(1 for n in numbers if n.verdict == v) for v in NUMBER_VERDICTS}
-
-
-def numbers_csv_rows(sections: list[PaperSection]) -> list[list[str]]:
-    """The rows of numbers.csv (CSV_COLUMNS), every section's numbers in order. Numbers are written with
-    6 significant digits, the relative difference as a fraction (empty when undefined)."""
-    out = []
-    for s in sections:
-        for n in s.numbers:
-            rd = n.rel_diff
-            out.append([s.paper, n.item, n.unit,
-                        n.paper_text or ("" if n.paper_value is None else f"{float(n.paper_value):.6g}"),
-                        "" if n.ours is None else (f"{float(n.ours):.6g}" if _is_num(n.ours) else str(n.ours)),
-                        "" if math.isnan(rd) else f"{rd:.6g}", n.verdict, "yes" if n.calibration else "no", n.note])
-    return out
-
-
-def write_numbers_csv(sections: list[PaperSection], path: Path) -> Path:
-    with open(path, "w", newline="", encoding="utf-8") as f:
-        w = csv.writer(f)
-        w.writerow(CSV_COLUMNS)
-        w.writerows(numbers_csv_rows(sections))
-    return path
-
-
-def numbers_md(numbers: list[NumberRow], digits: int = 4) -> list[str]:
-    """The paper-vs-ours table in Markdown (the docs pages open with it)."""
-    out = ["| item | unit | paper | ours | difference | verdict | calibration | note |",
-           "|---|---|---:|---:|---:|---|---|---|"]
-    for n in numbers:
-        out.append("| " + " | ".join(_md(c) for c in number_cells(n)) + " |")
-    return out
-
-
-def numbers_html(sec: PaperSection) -> str:
-    if not sec.numbers:
-        return ""
-    rows = []
-    for n in sec.numbers:
-        c = number_cells(n)
-        rows.append(f"<tr><td>{_e(c[0])}</td><td>{_e(c[1])}</td><td class=\"num\">{_e(c[2])}</td>"
-                    f"<td class=\"num\">{_e(c[3])}</td><td class=\"num\">{_e(c[4])}</td><td>{badge(n.verdict)}</td>"
-                    f"<td>{_e(c[6])}</td><td>{_e(c[7])}</td></tr>")
-    counts = number_counts(sec.numbers)
-    indep = [n for n in sec.numbers if n.independent]
-    cal = [n.item for n in sec.numbers if n.calibration]
-    head = (f"<h3 id=\"numbers{_e(sec.paper)}\">The paper's numbers beside ours</h3><p>"
-            + " · ".join(f"{badge(v)} {k}" for v, k in counts.items())
-            + f"</p><p>Independent checks (not used for a calibration, and checkable): {len(indep)} of "
-              f"{len(sec.numbers)}" + (f"; used for a calibration: {_e(', '.join(cal))}" if cal else "") + ".</p>")
-    cal_txt = _paras(sec.calibrations) if sec.calibrations else ""
-    return (head + "<table class=\"numbers\"><thead><tr><th>item</th><th>unit</th><th>paper</th><th>ours</th>"
-            "<th>difference</th><th>verdict</th><th>used for calibration</th><th>note</th></tr></thead><tbody>"
-            + "".join(rows) + "</tbody></table>" + cal_txt)
 
 
 # ----- HTML pieces ------------------------------------------------------------------------------------
@@ -244,6 +117,7 @@ def paper_summary(sec: PaperSection) -> dict:
     d["numbers"] = len(sec.numbers)
     d["independent"] = sum(1 for n in sec.numbers if n.independent)
     d["calibration"] = sum(1 for n in sec.numbers if n.calibration)
+    d["other"] = d["not evidence"]
     for v in (CONFIRMED, DEPENDS, NOT_CONFIRMED):
         d[v] = sum(1 for c in sec.claims if c.verdict == v)
     return d
@@ -259,18 +133,21 @@ def summary_html(sections: list[PaperSection]) -> str:
         rows.append(f"<tr><td><a href=\"#paper{_e(s.paper)}\">{_e(s.paper)}</a></td>"
                     f"<td title=\"{_e(s.title)}\">{_e(short)}</td>"
                     + "".join(f"<td class=\"num\">{d[v]}</td>" for v in NUMBER_VERDICTS)
+                    + f"<td class=\"num\">{d['other']}</td>"
                     + f"<td class=\"num\"><a href=\"#numbers{_e(s.paper)}\">{d['independent']} of {d['numbers']}</a></td>"
                     + "".join(f"<td class=\"num\">{d[v]}</td>" for v in (CONFIRMED, DEPENDS, NOT_CONFIRMED))
                     + "</tr>")
     return ("<h2 id=\"at-a-glance\">At a glance</h2><table id=\"glance\"><thead><tr><th>paper</th><th>title</th>"
             + "".join(f"<th>{badge(v)}</th>" for v in NUMBER_VERDICTS)
-            + "<th>independent checks</th>"
+            + "<th>not evidence</th><th>independent checks</th>"
             + "".join(f"<th>claims {badge(v)}</th>" for v in (CONFIRMED, DEPENDS, NOT_CONFIRMED))
             + "</tr></thead><tbody>" + "".join(rows) + "</tbody></table>"
-            + "<p class=\"meta\">Reported numbers: reproduced = within 5 % of the paper's value (or its printed "
+            + "<p class=\"meta\">Reported numbers, counted over the independent rows only: reproduced = within 5 % of the paper's value (or its printed "
               "precision); same ordering only = off, but ranked among the paper's numbers as the paper ranks it; "
-              "not checkable = the paper lacks what is needed. A number used for a calibration is no independent "
-              "check. The full table is <a href=\"numbers.csv\">numbers.csv</a>.</p>")
+              "not checkable = the paper lacks what is needed. Not evidence = a row whose value was calibrated to "
+              "the paper's number, is fixed by construction (a search bound or optimiser constraint puts it there) "
+              "or was chosen among readings after comparing with the paper: shown, labelled, never counted. The "
+              "full table is <a href=\"numbers.csv\">numbers.csv</a>.</p>")
 
 
 def render_html(sections: list[PaperSection], out_dir: Path, meta: dict) -> str:
@@ -339,12 +216,14 @@ def render_md(sections: list[PaperSection], out_dir: Path, meta: dict) -> str:
     out = [f"# {meta.get('title', 'Reproduction report')}", "",
            f"Built {meta.get('built', '?')} · git commit {meta.get('commit', '?')} · mode: {mode} · Dask workers: "
            f"{meta.get('workers', '?')} · total runtime {fmt_cell(float(meta.get('runtime_s', 0.0)), 4)} s", ""]
-    out += ["## At a glance", "", "| paper | " + " | ".join(NUMBER_VERDICTS) + " | independent checks | claims "
-            "confirmed | depends | not confirmed |", "|---|" + "---:|" * (len(NUMBER_VERDICTS) + 4)]
+    out += ["## At a glance", "", "Reported numbers counted over the independent rows only; *not evidence* = "
+            "calibrated, fixed by construction or chosen among readings (shown, never counted).", "",
+            "| paper | " + " | ".join(NUMBER_VERDICTS) + " | not evidence | independent checks | claims "
+            "confirmed | depends | not confirmed |", "|---|" + "---:|" * (len(NUMBER_VERDICTS) + 5)]
     for s in sections:
         d = paper_summary(s)
         out.append(f"| [{s.paper}](#paper-{s.paper}) | " + " | ".join(str(d[v]) for v in NUMBER_VERDICTS)
-                   + f" | {d['independent']} of {d['numbers']} | {d[CONFIRMED]} | {d[DEPENDS]} | {d[NOT_CONFIRMED]} |")
+                   + f" | {d['other']} | {d['independent']} of {d['numbers']} | {d[CONFIRMED]} | {d[DEPENDS]} | {d[NOT_CONFIRMED]} |")
     out.append("")
     if meta.get("intro"):
         out += [meta["intro"], ""]
@@ -391,23 +270,6 @@ def render_md(sections: list[PaperSection], out_dir: Path, meta: dict) -> str:
     return "\n".join(out) + "\n"
 
 
-def numbers_text(sections: list[PaperSection]) -> str:
-    """The paper-vs-ours rows and the per-paper counts as plain text for the terminal."""
-    lines = [f"{'paper':5s} {'item':44s} {'paper':>14s} {'ours':>11s} {'diff':>9s} verdict"]
-    for s in sections:
-        for n in s.numbers:
-            c = number_cells(n)
-            item = c[0] if len(c[0]) <= 44 else c[0][:43] + "…"
-            lines.append(f"{s.paper:5s} {item:44s} {c[2][:14]:>14s} {c[3]:>11s} {c[4]:>9s} {n.verdict}"
-                         + (" (calibration)" if n.calibration else ""))
-    lines.append("")
-    for s in sections:
-        d = paper_summary(s)
-        lines.append(f"paper {s.paper}: " + ", ".join(f"{v} {d[v]}" for v in NUMBER_VERDICTS)
-                     + f"; independent checks {d['independent']} of {d['numbers']}")
-    return "\n".join(lines)
-
-
 def claims_text(sections: list[PaperSection], width: int = 70) -> str:
     """The summary table as plain text for the terminal."""
     rows = summary_rows(sections)
@@ -432,6 +294,7 @@ def render(sections: list[PaperSection], out_dir: str | Path, meta: dict | None 
     h.write_text(render_html(sections, out_dir, meta), encoding="utf-8")
     m.write_text(render_md(sections, out_dir, meta), encoding="utf-8")
     write_numbers_csv(sections, out_dir / "numbers.csv")
+    _docs.write_doc_tables(sections, out_dir / "doc_tables.json")
     write_verdicts(sections, out_dir / "verdicts.json", meta)
     return h, m
 
@@ -448,62 +311,3 @@ def write_verdicts(sections: list[PaperSection], path: Path, meta: dict | None =
     path.write_text(json.dumps(d, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
     return path
 
-
-# ----- the docs pages' "paper vs ours" tables -------------------------------------------------------------
-DOC_BEGIN = "<!-- numbers:begin (written by `scfmu report --docs docs`; do not edit by hand) -->"
-DOC_END = "<!-- numbers:end -->"
-
-
-def read_numbers_csv(path: Path) -> list[dict]:
-    with open(path, newline="", encoding="utf-8") as f:
-        return list(csv.DictReader(f))
-
-
-def _g4(text: str) -> str:
-    """A CSV number with 4 significant digits (text that is not a number unchanged)."""
-    try:
-        return f"{float(text):.4g}"
-    except ValueError:
-        return text
-
-
-def docs_table(rows: list[dict], paper: str) -> str:
-    """The Markdown table a docs/paperNNN.md page opens with, from numbers.csv rows of one paper."""
-    out = [DOC_BEGIN, "", "| item | unit | paper | ours | difference | verdict | calibration |", "|---|---|---:|---:|---:|---|---|"]
-    for r in rows:
-        if r["paper"] != paper:
-            continue
-        rd = r["relative difference"]
-        rd = f"{100 * float(rd):+.1f} %" if rd else "–"
-        out.append("| " + " | ".join(_md(x) for x in (r["item"], r["unit"], r["paper value"] or "–",
-                                                      _g4(r["our value"]) or "–", rd, r["verdict"],
-                                                      r["used for calibration"])) + " |")
-    n = [r for r in rows if r["paper"] == paper]
-    counts = {v: sum(1 for r in n if r["verdict"] == v) for v in NUMBER_VERDICTS}
-    out += ["", "Counts: " + ", ".join(f"{v} {k}" for v, k in counts.items())
-            + f"; independent checks {sum(1 for r in n if r['used for calibration'] == 'no' and r['verdict'] != NOT_CHECKABLE)}"
-            f" of {len(n)}.", "", DOC_END]
-    return "\n".join(out)
-
-
-def doc_block(text: str) -> str | None:
-    """The generated block of a docs page (None when the page has none)."""
-    i, j = text.find(DOC_BEGIN), text.find(DOC_END)
-    return None if i < 0 or j < i else text[i:j + len(DOC_END)]
-
-
-def update_docs(docs_dir: Path, csv_path: Path) -> list[Path]:
-    """Rewrites the generated block of every docs/paperNNN.md that has one (papers present in the CSV)."""
-    rows = read_numbers_csv(csv_path)
-    done = []
-    for paper in sorted({r["paper"] for r in rows}):
-        p = Path(docs_dir) / f"paper{paper}.md"
-        if not p.exists():
-            continue
-        text = p.read_text(encoding="utf-8")
-        old = doc_block(text)
-        if old is None:
-            continue
-        p.write_text(text.replace(old, docs_table(rows, paper)), encoding="utf-8")
-        done.append(p)
-    return done

@@ -23,6 +23,33 @@ NOT_REPRODUCED = "not reproduced"
 NOT_CHECKABLE = "not checkable"       # the paper lacks what is needed to compute ours (the row says what)
 NUMBER_VERDICTS = (REPRODUCED, SAME_ORDERING, NOT_REPRODUCED, NOT_CHECKABLE)
 
+# how a row's "ours" was obtained (``NumberRow.basis``); only an independent row is evidence
+INDEPENDENT = "independent"              # computed under the paper's stated set-up, nothing fitted or chosen
+CALIBRATED = "calibrated"                # a value the paper lacks was fitted to this very number
+BY_CONSTRUCTION = "fixed by construction"  # a constraint or a search bound puts the value where it is
+CHOSEN = "chosen among readings"         # the set-up was picked among several after comparing with the paper
+BASES = (INDEPENDENT, CALIBRATED, BY_CONSTRUCTION, CHOSEN)
+# a value within this relative distance of one of its row's bounds (search bounds, optimiser constraints)
+# sits on that bound
+BOUND_REL = 1e-3
+
+
+def on_bound(value, bounds, rel: float = BOUND_REL):
+    """The first of ``bounds`` that ``value`` sits on (within ``rel`` of it, relative to the bound; absolute
+    ``rel`` for a bound of 0), or None."""
+    import math
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        return None
+    if not math.isfinite(v):
+        return None
+    for b in bounds or ():
+        b = float(b)
+        if abs(v - b) <= rel * (abs(b) if b != 0 else 1.0):
+            return b
+    return None
+
 
 @dataclass
 class Figure:
@@ -73,9 +100,12 @@ class NumberRow:
 
     ``paper_value`` is the number as printed (None when the paper prints none, e.g. a lost table);
     ``paper_text`` how it is printed ("≈ 0.16", "> 50×", "1.44 / 3.44 / 5.44"); ``ours`` our value under the
-    paper's stated set-up (None when it cannot be computed); ``calibration`` is True when the number was used
-    to fit a value the paper does not give (it is then no independent check); ``note`` says what was
-    compared, which reading, or what is missing."""
+    paper's stated set-up (None when it cannot be computed); ``basis`` how ours was obtained (``BASES``:
+    independent, calibrated, fixed by construction, chosen among readings); ``calibration=True`` is the
+    older spelling of ``basis=CALIBRATED``; ``bounds`` the search bounds and optimiser constraints that could
+    hold ours in place: a row whose value sits on one of them (``on_bound``) is fixed by construction
+    whatever basis it was given, so a bound-hitting value is never counted as evidence; ``note`` says what
+    was compared, which reading, or what is missing."""
     paper: str
     item: str
     unit: str
@@ -85,10 +115,22 @@ class NumberRow:
     calibration: bool = False
     note: str = ""
     paper_text: str = ""
+    basis: str = INDEPENDENT
+    bounds: tuple = ()
 
     def __post_init__(self):
         if self.verdict not in NUMBER_VERDICTS:
             raise ValueError(f"{self.item}: number verdict {self.verdict!r} is not one of {NUMBER_VERDICTS}")
+        if self.basis not in BASES:
+            raise ValueError(f"{self.item}: basis {self.basis!r} is not one of {BASES}")
+        if self.calibration and self.basis == INDEPENDENT:
+            self.basis = CALIBRATED
+        self.calibration = self.basis == CALIBRATED
+        self.bounds = tuple(float(b) for b in self.bounds)
+        b = on_bound(self.ours, self.bounds)
+        if b is not None and self.basis in (INDEPENDENT, CHOSEN):
+            self.basis = BY_CONSTRUCTION
+            self.note = (self.note + "; " if self.note else "") + f"ours sits on the bound/constraint {b:g}"
 
     @property
     def rel_diff(self) -> float:
@@ -103,8 +145,9 @@ class NumberRow:
 
     @property
     def independent(self) -> bool:
-        """An independent check: not used for a calibration and something to compare."""
-        return not self.calibration and self.verdict != NOT_CHECKABLE
+        """An independent check: obtained independently (not calibrated, not fixed by a bound or a
+        constraint, not chosen after comparison) and something to compare."""
+        return self.basis == INDEPENDENT and self.verdict != NOT_CHECKABLE
 
 
 @dataclass
@@ -119,6 +162,7 @@ class PaperSection:
     runtime_s: float = 0.0
     numbers: list[NumberRow] = field(default_factory=list)   # the paper's reported numbers beside ours
     calibrations: str = ""    # which values were fitted to which reported number (plain text)
+    doc_tables: dict = field(default_factory=dict)   # {block name: Table} the docs page shows (docs.py)
 
 
 @dataclass

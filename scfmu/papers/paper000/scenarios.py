@@ -17,7 +17,7 @@ COMMANDS = {
     "L": (D(40.0), D(-40.0), D(-60.0)),
     "L2": (D(40.0), D(40.0), D(60.0)),
 }
-KIN_NAMES = {0: "quat", 1: "dcm", 2: "eul213", 3: "linear"}
+KIN_NAMES = {0: "quat", 1: "dcm", 2: "eul213", 3: "linear", 4: "quat-lindyn"}
 
 # The fuzzy PD's reference settling time T_r. The paper defines it as the settling time of the model "with
 # the actuators at most 50 % active" but gives neither its value nor an actuator limit, so the definition
@@ -56,10 +56,13 @@ def paper000_runs() -> list[Paper000Run]:
         R("000-8S", "PolePlacementController", "S", 3, label="PolePl"),
         R("000-8L", "PolePlacementController", "L", 0, label="PolePl"),
         R("000-9S", "MracController", "S", 3, {"coordinates": 1}, label="MRAC lin"),
-        # the paper's large-angle MRAC: linear dynamics (the small-angle model, I·ẍ = τ per axis) with the MRAC in
-        # its linear coordinates; 000-9Lq is the earlier set-up (quaternion feedback linearisation on the
-        # quaternion plant), 000-9Lc the linear-coordinate MRAC on the quaternion plant (gyroscopic terms kept)
-        R("000-9L", "MracController", "L", 3, {"coordinates": 1}, label="MRAC lin"),
+        # the paper's large-angle MRAC as it states it: linear (gyroscope-free, decoupled) dynamics with nonlinear
+        # quaternion kinematics (AttitudePlant.kinematics = 4), the MRAC in its linear coordinates. Readings
+        # beside it: 000-9Ll the linear kinematics too (the small-angle model, kinematics 3), 000-9Lc the
+        # linear-coordinate MRAC on the full quaternion plant (gyroscopic terms kept), 000-9Lq the quaternion
+        # feedback-linearising MRAC on the quaternion plant
+        R("000-9L", "MracController", "L", 4, {"coordinates": 1}, label="MRAC lin"),
+        R("000-9Ll", "MracController", "L", 3, {"coordinates": 1}, label="MRAC lin/lin"),
         R("000-9Lq", "MracController", "L", 0, {"coordinates": 0}, label="MRAC quat"),
         R("000-9Lc", "MracController", "L", 0, {"coordinates": 1}, label="MRAC lin/q"),
         R("000-10L", "FuzzyPdController", "L", 0, {"t_r": T_R_CALIBRATED}, label="FuzzyPD"),

@@ -29,7 +29,7 @@ import time
 import numpy as np
 
 from . import model as p3
-from ...report import common
+from ...report import common, rules
 from ...campaign import Campaign, read_timeseries
 from ...report.types import CONFIRMED, DEPENDS, NOT_CONFIRMED, Claim, Figure, PaperSection, Sensitivity, Table
 
@@ -57,6 +57,11 @@ def claim1(summary: dict) -> tuple[bool, dict]:
 
 
 ISF_BODY = {"N": "SMC", "C": "SMC", "S": "SMC", "W": "T2FSMC", "U": "T2FSMC"}
+
+
+def examined(flips: list) -> list[str]:
+    """Every swept reading (name, results per value), the ones that move the verdict marked."""
+    return [f"{p} (moves the verdict)" if len(set(h)) > 1 else f"{p} (verdict unchanged)" for p, h in flips]
 
 
 def isf_winners(summary: dict) -> dict:
@@ -293,6 +298,8 @@ def build(ctx) -> PaperSection:
     t_results = Table(f"Steady-state error per Euler angle (deg, mean |error| over the last 10 % of the run), ISE "
                       f"(rad² s) and ISF (N² m² s); 003-U: means over {n_mc} runs.",
                       ["scenario", "controller", "sse roll", "sse pitch", "sse yaw", "sse mean", "ISE", "ISF"], res_rows)
+    doc_results = Table("Steady-state error per Euler angle (deg), ISE (rad² s) and ISF (N² m² s) of the deterministic "
+                        "scenarios", t_results.columns, [r for r in res_rows if r[0] != "003-U"])
     mc_tab = Table(f"003-U Monte Carlo ({n_mc} runs): mean and standard deviation.",
                    ["controller", "ISE mean", "ISE std", "ISF mean", "ISF std", "runs ok", "failed"],
                    [[LABEL[c], summary[(c, "U")]["ise"], summary[(c, "U")].get("ise_std", math.nan),
@@ -404,7 +411,7 @@ def build(ctx) -> PaperSection:
     claim_1 = Claim("C003-1", "The type-2 fuzzy SMC has the smaller steady-state error and the smaller ISE in every "
                               "scenario (nominal, constant, sinusoidal and white-noise disturbance, inertia uncertainty).",
                     v1, ev1, tables=[t_results, mc_tab], figures=[overview],
-                    sensitive_to=[p for p, h in flips1 if len(set(h)) > 1],
+                    sensitive_to=examined(flips1),
                     sensitivity=sens1)
     v2 = verdict(c2_body, sweep_holds2_body)
     win_txt = ", ".join(f"003-{c}: {LABEL.get(w, w)}" for c, w in c2_w.items())
@@ -425,7 +432,7 @@ def build(ctx) -> PaperSection:
                               "the type-2 fuzzy SMC is better with uncertainty and with white noise (the body's "
                               "statement). The abstract instead says the type-2 fuzzy SMC is better in all situations.",
                     v2, ev2, tables=[isf_tab], figures=[overview],
-                    sensitive_to=[p for p, h in flips2 if len(set(h)) > 1],
+                    sensitive_to=examined(flips2),
                     sensitivity=sens2)
     setup = (f"AttitudePlant with the paper 003 inertia, three reaction wheels with magnetorquer dumping and gravity "
              f"gradient on a 700 km / 98° orbit; command roll 20°, pitch −15°, yaw 0° from rest; Δ = 0.01 s, "
@@ -444,12 +451,43 @@ def build(ctx) -> PaperSection:
     return PaperSection("003", "Sliding mode (GA-tuned) vs sliding mode with an interval type-2 fuzzy gain, LEO "
                                "satellite with reaction wheels and magnetorquers (title lost)",
                         setup, [claim_1, claim_2], figures=figures, tables=[t_torque], notes=notes,
-                        runtime_s=round(time.time() - t_start, 1), numbers=number_rows())
+                        runtime_s=round(time.time() - t_start, 1), numbers=number_rows(summary),
+                        doc_tables={"results": doc_results})
 
 
-def number_rows() -> list:
-    """Paper 003 has no surviving table: one row that says so (not checkable)."""
-    from ...report.types import NOT_CHECKABLE, NumberRow
+# Named readings of the ISF's scale (none is documented by the paper; each is shown, labelled, never counted):
+# the torque read in another unit multiplies ISF by the square of the factor.
+ISF_UNIT_READINGS = {"N·cm": 1e2, "mN·m": 1e3}
+
+
+def number_rows(summary: dict | None = None) -> list:
+    """Paper 003's one surviving number, ISF = 1.0611 for the GA-tuned SMC in the nominal case, beside ours
+    (``summary[(controller, case)]["isf"]`` in N²·m²·s). Our value under today's set-up is the independent row;
+    the torque-unit readings of ``ISF_UNIT_READINGS`` are extra rows labelled "chosen among readings" (a unit
+    picked after seeing the paper's number is no evidence), with the torque scale that would match."""
+    from ...report.types import CHOSEN, NOT_CHECKABLE, NumberRow
     rep = common.reported("scfmu.papers.paper003")
-    return [NumberRow("003", "any reported number (steady-state error, ISE, ISF per scenario)", "–", None, None,
-                      NOT_CHECKABLE, note=rep["source"], paper_text="none survives")] if not rep["numbers"] else []
+    out = []
+    for n in rep["numbers"]:
+        paper = float(n["value"])
+        ours = (summary or {}).get((n["controller"], n["case"]), {}).get("isf")
+        if ours is None or not rules.finite(ours):
+            out.append(NumberRow("003", n["label"], "N²·m²·s", paper, None, NOT_CHECKABLE, paper_text=n["value"],
+                                 note="our run is missing"))
+            continue
+        scale = math.sqrt(paper / ours)
+        v = rules.number_verdict(ours, paper, rules.printed_precision(n["value"]))
+        out.append(NumberRow("003", n["label"], "N²·m²·s", paper, ours, v, paper_text=f"{n['value']} (no unit)",
+                             note=(f"{n['text']}; ours over our horizon and command, ISF = ∫‖τ‖² dt of the applied "
+                                   f"torque: {paper / ours:.4g}× smaller, i.e. a torque scale {scale:.3g}× apart")))
+        for unit, f in ISF_UNIT_READINGS.items():
+            o = ours * f * f
+            out.append(NumberRow("003", f"{n['label']}, torque read in {unit}", f"{unit}²·s", paper, o,
+                                 rules.number_verdict(o, paper, rules.printed_precision(n["value"])), basis=CHOSEN,
+                                 paper_text=n["value"],
+                                 note=f"reading: the paper's torques in {unit} (ISF × {f * f:g}); no unit is printed, "
+                                      f"so this is a reading picked by comparing, not evidence"))
+    if not out:
+        out.append(NumberRow("003", "any reported number (steady-state error, ISE, ISF per scenario)", "–", None,
+                             None, NOT_CHECKABLE, note=rep["source"], paper_text="none survives"))
+    return out

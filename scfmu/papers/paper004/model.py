@@ -41,6 +41,15 @@ W_REQ_DEG_S = 0.01
 EULER_REQ_DEG = 0.1
 INIT_DEFAULT_DEG = {"yaw": 6.0, "pitch": -4.0, "roll": 8.0}
 INIT_STRESS_DEG = {"yaw": 15.0, "pitch": -10.0, "roll": 20.0}
+# CALIBRATION (paper 004 gives no initial attitude): the default direction scaled by this factor is the start
+# whose case-2 run ends closest to the paper's case-2 largest final Euler angle (≈ 0.7 deg); the report
+# recomputes it on its grid and stops if it no longer agrees. The standard scenarios paper004/<1|2|3> start there.
+INIT_SCALE_CALIBRATED = 1.25
+
+
+def init_deg_scaled(scale: float) -> dict:
+    """The default initial direction (yaw, pitch, roll) scaled by ``scale`` (deg)."""
+    return {k: v * scale for k, v in INIT_DEFAULT_DEG.items()}
 K_Q, K_QDOT = 0.5, 2.0
 BUDGET = 300
 MARGIN = 0.01   # project choice: the optimiser's terminal bounds are 1 % inside the requirements

@@ -91,20 +91,23 @@ def bang_bang_bound_deg() -> list[float]:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--initial", choices=["default", "stress"], default="default",
-                    help="default (6, -4, 8) deg or the stress run 004-X (15, -10, 20) deg (yaw, pitch, roll)")
+    ap.add_argument("--initial", choices=["default", "calibrated", "stress"], default="default",
+                    help="default (6, -4, 8) deg, calibrated (the report's start, model.INIT_SCALE_CALIBRATED × the "
+                         "default) or the stress run 004-X (15, -10, 20) deg (yaw, pitch, roll)")
     ap.add_argument("--json", type=Path, default=None,
                     help=f"output JSON (default {DEFAULT_JSON} for the default initial state, none for stress)")
     ap.add_argument("--margin", type=float, default=P.MARGIN)
     ap.add_argument("--budget", type=int, default=P.BUDGET)
     args = ap.parse_args(argv)
-    init = P.INIT_DEFAULT_DEG if args.initial == "default" else P.INIT_STRESS_DEG
+    init = {"default": P.INIT_DEFAULT_DEG, "calibrated": P.init_deg_scaled(P.INIT_SCALE_CALIBRATED),
+            "stress": P.INIT_STRESS_DEG}[args.initial]
     res = P.optimise(init, budget=args.budget, margin=args.margin)
     rep = report(res, init, args.margin)
     print_report(rep, f"paper 004 spline optimisation ({args.initial})")
     print(f"({res.seconds:.1f} s; single-axis bang-bang reach in {P.T_F:g} s at 1 N m: "
           + ", ".join(f"{a} {d:.1f} deg" for a, d in zip(P.AXES, bang_bang_bound_deg())) + ")")
-    path = args.json if args.json is not None else (DEFAULT_JSON if args.initial == "default" else None)
+    path = args.json if args.json is not None else {"default": DEFAULT_JSON, "calibrated": data_file(
+        "nodes_calibrated.json")}.get(args.initial)
     if path is not None:
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(json.dumps(rep, indent=1) + "\n")

@@ -26,3 +26,18 @@ def test_number_rows_precision_ordering_and_calibration_flag():
     # a case-2 angle ten times milder than the paper's: neither reproduced nor in the paper's order
     rows = r.number_rows({"1": term(0.0122, 0.0416), "2": term(0.016, 0.07), "3": term(0.0099, 0.099)})
     assert [x.verdict for x in rows if x.item.startswith("case 2") and x.unit == "deg"] == [NOT_REPRODUCED]
+
+
+def test_case3_values_on_the_optimiser_constraints_are_no_evidence():
+    """The optimiser constrains the case-3 terminal values to (1 − MARGIN) × requirement: values there are
+    fixed by construction (detected from the values, not from the case label); case 1 and case 2's ω stay
+    independent, case 2's angle is calibrated. A case-3 value clear of its bounds would be independent."""
+    from scfmu.papers.paper004 import model as P
+    from scfmu.report.types import BY_CONSTRUCTION, CALIBRATED, INDEPENDENT
+    on = term(P.W_REQ_DEG_S * (1 - P.MARGIN), P.EULER_REQ_DEG * (1 - P.MARGIN))
+    rows = r.number_rows({"1": term(0.0122, 0.0416), "2": term(0.1595, 0.7455), "3": on})
+    assert [x.basis for x in rows] == [INDEPENDENT, INDEPENDENT, BY_CONSTRUCTION,
+                                       INDEPENDENT, CALIBRATED, BY_CONSTRUCTION]
+    assert sum(x.independent for x in rows) == 3
+    rows = r.number_rows({"1": term(0.0122, 0.0416), "2": term(0.1595, 0.7455), "3": term(0.004, 0.03)})
+    assert [x.basis for x in rows if x.item.startswith("case 3")] == [INDEPENDENT, INDEPENDENT]

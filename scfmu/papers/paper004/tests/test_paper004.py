@@ -223,17 +223,20 @@ def test_case_script_quick(tmp_path):
 
 
 def test_declared_scenario_equals_the_case_runner():
-    """The declared scenario paper004/3 (corrector with the committed nodes, controller, faulty plant,
-    wired by port name) reproduces the case script's closed loop bit for bit on the lean master."""
+    """The declared scenario paper004/3 (corrector with the committed nodes for the calibrated start,
+    controller, faulty plant, wired by port name) reproduces the case script's closed loop bit for bit on
+    the lean master."""
     import json
 
     from scfmu.papers.paper004 import model as p4
     from scfmu import scenario as scenarios
     from scfmu.engines import simulate
 
-    rep = json.loads(NODES_JSON.read_text())
+    rep = json.loads(NODES_JSON.with_name("nodes_calibrated.json").read_text())
+    init = p4.init_deg_scaled(p4.INIT_SCALE_CALIBRATED)
+    assert rep["initial_euler321_deg"] == init
     nodes = np.array([rep["nodes_N_m"][a] for a in p4.AXES])
-    ref = p4.run_closed_loop(1, p4.A_FAULT, p4.INIT_DEFAULT_DEG, nodes=nodes)
+    ref = p4.run_closed_loop(1, p4.A_FAULT, init, nodes=nodes)
     got = simulate(scenarios.get("paper004/3"), engine="lean")
     for k in ["q_w", "q_x", "w_x", "w_y", "w_z", "torque_applied_x", "torque_applied_z"]:
         assert np.array_equal(got[k], ref[k]), k

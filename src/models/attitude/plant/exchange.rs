@@ -1,7 +1,7 @@
 //! Model Exchange for `AttitudePlant`: the published states, the time events and how the invariants
 //! of the attitude representation are kept when the importer's solver integrates.
 //!
-//! - Quaternion (kinematics 0): the solver integrates q̇ = ½ q ⊗ ω freely, which keeps |q| = 1 only
+//! - Quaternion (kinematics 0 and 4): the solver integrates q̇ = ½ q ⊗ ω freely, which keeps |q| = 1 only
 //!   up to its tolerance. After an accepted step whose |q| is off by more than [`NORM_TOLERANCE`] the
 //!   plant asks for an event (`fmi2CompletedIntegratorStep` → enterEventMode) and renormalises q in
 //!   the event update (valuesOfContinuousStatesChanged); every time event renormalises too.
@@ -42,7 +42,7 @@ const fn concat_names<const N: usize>(a: &[&'static str], b: &[&'static str]) ->
 
 /// The published continuous states, in the order of the internal state vector.
 pub const STATES: [StateDecl; super::kinematics::N] = [
-    s("state_att_1", "", "Continuous state: attitude entry 1 (q_w for kinematics 0; A column-major for 1; roll phi for 2, 3)", &["state_att_2", "state_att_3", "state_att_4", "state_w_x", "state_w_y", "state_w_z"]),
+    s("state_att_1", "", "Continuous state: attitude entry 1 (q_w for kinematics 0, 4; A column-major for 1; roll phi for 2, 3)", &["state_att_2", "state_att_3", "state_att_4", "state_w_x", "state_w_y", "state_w_z"]),
     s("state_att_2", "", "Continuous state: attitude entry 2 (q_x; A; pitch theta)", &["state_att_1", "state_att_3", "state_att_4", "state_w_x", "state_w_y", "state_w_z"]),
     s("state_att_3", "", "Continuous state: attitude entry 3 (q_y; A; yaw psi)", &["state_att_1", "state_att_2", "state_att_3", "state_att_4", "state_w_x", "state_w_y", "state_w_z"]),
     s("state_att_4", "", "Continuous state: attitude entry 4 (q_z; A; unused)", &["state_att_1", "state_att_2", "state_att_3", "state_att_5", "state_att_6", "state_w_x", "state_w_y", "state_w_z"]),
@@ -75,7 +75,7 @@ pub fn next_time_event(v: &AttitudePlantVars, t: f64) -> Option<f64> {
 impl AttitudePlant {
     fn drift(&self, v: &AttitudePlantVars) -> f64 {
         match self.kin {
-            Kinematics::Quaternion => (self.x.fixed_rows::<4>(ATT).norm() - 1.0).abs(),
+            Kinematics::Quaternion | Kinematics::QuaternionLinearDynamics => (self.x.fixed_rows::<4>(ATT).norm() - 1.0).abs(),
             Kinematics::Dcm if v.dcm_orthonormalize == 1 => {
                 let a = Matrix3::from_column_slice(&self.x.as_slice()[ATT..ATT + 9]);
                 (a.transpose() * a - Matrix3::identity()).abs().max()
@@ -98,7 +98,7 @@ impl AttitudePlant {
     pub(super) fn project(&mut self, v: &AttitudePlantVars, t: f64) -> Result<bool, String> {
         let before = self.x;
         match self.kin {
-            Kinematics::Quaternion => post_step(Kinematics::Quaternion, false, &mut self.q_dcm, &mut self.x, t)?,
+            Kinematics::Quaternion | Kinematics::QuaternionLinearDynamics => post_step(self.kin, false, &mut self.q_dcm, &mut self.x, t)?,
             Kinematics::Dcm if v.dcm_orthonormalize == 1 => {
                 let a = orthonormalize(&Matrix3::from_column_slice(&self.x.as_slice()[ATT..ATT + 9]));
                 self.x.as_mut_slice()[ATT..ATT + 9].copy_from_slice(a.as_slice());

@@ -17,13 +17,28 @@ crate::param_enum! {
         Euler213Rates = 2,
         /// 3: linear small-angle double integrator per axis.
         LinearSmallAngle = 3,
+        /// 4: quaternion kinematics with linear, decoupled dynamics I_ii ω̇_i = τ_i (paper 000's
+        /// large-angle MRAC set-up: linear dynamics, nonlinear kinematics).
+        QuaternionLinearDynamics = 4,
+    }
+}
+
+impl Kinematics {
+    /// Whether the attitude state is a quaternion (modes 0 and 4).
+    pub fn is_quaternion(self) -> bool {
+        matches!(self, Kinematics::Quaternion | Kinematics::QuaternionLinearDynamics)
+    }
+
+    /// Whether the dynamics are the linear decoupled I_ii ẋ_i = τ_i (modes 3 and 4).
+    pub fn linear_dynamics(self) -> bool {
+        matches!(self, Kinematics::LinearSmallAngle | Kinematics::QuaternionLinearDynamics)
     }
 }
 
 /// Length of the state vector. Layout (unused entries stay 0):
-/// - `ATT..ATT+9`: attitude — quaternion (w, x, y, z) in mode 0, the DCM A column-major in mode 1,
+/// - `ATT..ATT+9`: attitude — quaternion (w, x, y, z) in modes 0 and 4, the DCM A column-major in mode 1,
 ///   the angles (φ, θ, ψ) in modes 2 and 3;
-/// - `W..W+3`: body rate ω (kinematics 0–2) or the angle rates (φ̇, θ̇, ψ̇) (kinematics 3);
+/// - `W..W+3`: body rate ω (kinematics 0–2, 4) or the angle rates (φ̇, θ̇, ψ̇) (kinematics 3);
 /// - `HW..HW+3`: wheel momentum h_w (actuator mode 1);
 /// - `TW..TW+3`: lagged wheel torque τ_w (actuator mode 1 with T_w > 0).
 pub const N: usize = 18;
@@ -41,7 +56,7 @@ pub fn v3(x: &State, i: usize) -> Vector3<f64> {
 pub fn initial_attitude(kin: Kinematics, x: &mut State, (r0, p0, y0): (f64, f64, f64)) -> Result<(), String> {
     let q0 = quat_from_euler321(r0, p0, y0);
     match kin {
-        Kinematics::Quaternion => x.as_mut_slice()[ATT..ATT + 4].copy_from_slice(&wxyz(&q0)),
+        Kinematics::Quaternion | Kinematics::QuaternionLinearDynamics => x.as_mut_slice()[ATT..ATT + 4].copy_from_slice(&wxyz(&q0)),
         Kinematics::Dcm => x.as_mut_slice()[ATT..ATT + 9].copy_from_slice(attitude_matrix(&q0).as_slice()),
         Kinematics::Euler213Rates | Kinematics::LinearSmallAngle => {
             if kin == Kinematics::Euler213Rates && r0.cos().abs() < 1e-9 {
@@ -58,7 +73,7 @@ impl AttitudePlant {
     /// A321 of the state angles in modes 2 and 3 (paper 000 reads its angles as 321).
     pub(super) fn attitude(&self, x: &State) -> Matrix3<f64> {
         match self.kin {
-            Kinematics::Quaternion => attitude_matrix(&quat(x[ATT], x[ATT + 1], x[ATT + 2], x[ATT + 3])),
+            Kinematics::Quaternion | Kinematics::QuaternionLinearDynamics => attitude_matrix(&quat(x[ATT], x[ATT + 1], x[ATT + 2], x[ATT + 3])),
             Kinematics::Dcm => Matrix3::from_column_slice(&x.as_slice()[ATT..ATT + 9]),
             Kinematics::Euler213Rates | Kinematics::LinearSmallAngle => attitude_matrix(&quat_from_euler321(x[ATT], x[ATT + 1], x[ATT + 2])),
         }
@@ -67,7 +82,7 @@ impl AttitudePlant {
     /// Output quaternion of a state (never sign-flipped in mode 0; sign-continuous in mode 1).
     pub(super) fn quaternion(&self, x: &State) -> Quaternion<f64> {
         match self.kin {
-            Kinematics::Quaternion => quat(x[ATT], x[ATT + 1], x[ATT + 2], x[ATT + 3]),
+            Kinematics::Quaternion | Kinematics::QuaternionLinearDynamics => quat(x[ATT], x[ATT + 1], x[ATT + 2], x[ATT + 3]),
             // Shepperd's quaternion of the state's A with the sign of the last accepted step's (equal to
             // q_dcm itself right after a step; a Model Exchange solver also evaluates in between)
             Kinematics::Dcm => {
@@ -79,10 +94,10 @@ impl AttitudePlant {
     }
 }
 
-/// Attitude rates into `d` for body rate w (kinematics 0–2; mode 3 is handled with the dynamics).
+/// Attitude rates into `d` for body rate w (kinematics 0–2 and 4; in mode 3 w is the angle rate).
 pub fn attitude_rates(kin: Kinematics, x: &State, w: &Vector3<f64>, d: &mut State) {
     match kin {
-        Kinematics::Quaternion => {
+        Kinematics::Quaternion | Kinematics::QuaternionLinearDynamics => {
             let qdot = quat_derivative(&quat(x[ATT], x[ATT + 1], x[ATT + 2], x[ATT + 3]), w);
             // nalgebra stores (i, j, k, w); the state holds (w, x, y, z)
             (d[ATT], d[ATT + 1], d[ATT + 2], d[ATT + 3]) = (qdot.w, qdot.i, qdot.j, qdot.k);
@@ -102,11 +117,11 @@ pub fn attitude_rates(kin: Kinematics, x: &State, w: &Vector3<f64>, d: &mut Stat
     }
 }
 
-/// Projection after every internal step: quaternion renormalisation (mode 0), optional DCM
+/// Projection after every internal step: quaternion renormalisation (modes 0 and 4), optional DCM
 /// re-orthonormalisation (mode 1); also updates the sign-continuous DCM quaternion.
 pub fn post_step(kin: Kinematics, orthonormalize_dcm: bool, q_dcm: &mut [f64; 4], x: &mut State, t: f64) -> Result<(), String> {
     match kin {
-        Kinematics::Quaternion => {
+        Kinematics::Quaternion | Kinematics::QuaternionLinearDynamics => {
             let n = x.fixed_rows::<4>(ATT).norm();
             if !(n > 0.0) {
                 return Err(format!("quaternion norm became zero at t = {t}"));

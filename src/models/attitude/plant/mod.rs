@@ -1,5 +1,6 @@
 //! `AttitudePlant`: three-axis rigid body (gyrostat) with full inertia, selectable kinematics
-//! (quaternion, DCM, paper 000's Euler-angle rates, linear small-angle model), ideal torque actuators
+//! (quaternion, DCM, paper 000's Euler-angle rates, linear small-angle model, quaternion kinematics
+//! with linear decoupled dynamics), ideal torque actuators
 //! or reaction wheels with magnetorquers, actuator faults, disturbance generator and gravity
 //! gradient on a circular orbit.
 //!
@@ -66,8 +67,8 @@ impl AttitudePlant {
             d.fixed_rows_mut::<3>(TW).copy_from(&act.lag_rate);
         }
         attitude_rates(self.kin, x, &w, &mut d);
-        if self.kin == Kinematics::LinearSmallAngle {
-            // per-axis double integrator with the diagonal of I_true (paper 000 Eq. 1)
+        if self.kin.linear_dynamics() {
+            // per-axis I_ii ẇ_i = τ_i with the diagonal of I_true (paper 000 Eq. 1; mode 4: w is the body rate)
             d.fixed_rows_mut::<3>(W).copy_from(&tau.component_div(&self.inertia.diagonal()));
             return d;
         }
@@ -138,7 +139,7 @@ impl Model for AttitudePlant {
         let w = v3(&x, W);
         let hw = v3(&x, HW);
         let [rl, pt, yw] = match self.kin {
-            Kinematics::Quaternion => euler321_from_quat(&q),
+            Kinematics::Quaternion | Kinematics::QuaternionLinearDynamics => euler321_from_quat(&q),
             Kinematics::Dcm => euler321_from_dcm(&a),
             Kinematics::Euler213Rates | Kinematics::LinearSmallAngle => [x[ATT], x[ATT + 1], x[ATT + 2]],
         };
@@ -185,7 +186,7 @@ impl Model for AttitudePlant {
         check_derived("inertia", &(self.inertia, self.inertia_inv), &(fresh.inertia, fresh.inertia_inv))?;
         check_derived("derived limits and orbit", &self.d, &fresh.d)?;
         check_finite_state("state vector", self.x.iter().chain(&self.q_dcm))?;
-        if self.kin == Kinematics::Quaternion && (self.x.fixed_rows::<4>(ATT).norm() - 1.0).abs() > 1e-6 {
+        if self.kin.is_quaternion() && (self.x.fixed_rows::<4>(ATT).norm() - 1.0).abs() > 1e-6 {
             return Err("restored state: attitude quaternion is not of unit norm".into());
         }
         Ok(())

@@ -46,7 +46,7 @@ declare_variables! {
         131 => fault_stuck_value: Vec3 = [0.0; 3], Parameter, "N.m", "Stuck fault: the torque command is replaced by this value after fault_time where fault_stuck_* = 1";
         // Integer parameters
         140 => integrator: Integer = 0, Parameter, "", "Internal integrator: 0 = classical RK4, 1 = explicit Euler, 2 = adaptive Dormand-Prince 5(4) (tolerance from fmi2SetupExperiment, default 1e-8)", Choice(Method::CODES);
-        141 => kinematics: Integer = 0, Parameter, "", "Kinematics: 0 = quaternion, 1 = DCM, 2 = [Navabi-2019] Euler-angle rates (213 rates, angles output as 321), 3 = linear small-angle double integrator", Choice(Kinematics::CODES);
+        141 => kinematics: Integer = 0, Parameter, "", "Kinematics: 0 = quaternion, 1 = DCM, 2 = [Navabi-2019] Euler-angle rates (213 rates, angles output as 321), 3 = linear small-angle double integrator, 4 = quaternion kinematics with linear decoupled dynamics I_ii dw_i/dt = tau_i (no gyroscopic or wheel coupling; [Navabi-2019] large-angle MRAC set-up)", Choice(Kinematics::CODES);
         142 => actuator_mode: Integer = 0, Parameter, "", "Actuators: 0 = ideal torque with saturation and fault, 1 = three reaction wheels (+ magnetorquers if mtq_enable = 1)", Choice(SWITCH);
         143 => dcm_orthonormalize: Integer = 0, Parameter, "", "Kinematics 1 only: 1 = re-orthonormalise the DCM after every internal step, 0 = never", Choice(SWITCH);
         144 => mtq_enable: Integer = 0, Parameter, "", "Actuator mode 1: 1 = magnetorquers dump wheel momentum, 0 = off", Choice(SWITCH);
