@@ -30,6 +30,7 @@ from ..registry import REGISTRY, resolve
 from ..scenario import get
 from ..scenario.check import IncompatibleUnit, require
 from ..scenario.ssp import file_stem
+from . import engineering
 
 COLUMNS = [("eulerint_deg_s", "EULERINT [deg·s]"), ("ise", "ISE"), ("isf", "ISF"), ("settling_s", "settling [s]"),
            ("effort_abs", "effort ∫Σ abs(u) dt"), ("final_error", "final error")]
@@ -90,7 +91,9 @@ def run(unit: str | None, family: str, out: str | Path, label: str | None = None
     if own:
         client, cluster = campaign._client(None, workers)
     entries: list[Entry] = []
+    pairs: dict = {}  # (case, controller) -> scenario, for the Monte Carlo and the margins
     t0 = time.time()
+    studies = None
     try:
         for case in cases:
             sets, seeds = _case_overrides(case, quick)
@@ -109,8 +112,9 @@ def run(unit: str | None, family: str, out: str | Path, label: str | None = None
                     log(f"  {case.label} / {name}: {e.status}")
                     continue
                 every = max(1, sc.n_steps // 1500)
-                c = campaign.Campaign(sc, sets, seeds, timeseries=[case.signal] if case.signal in sc.log else None,
-                                      ts_every=every)
+                pairs[(case.label, name)] = sc
+                sc, ts_keys = engineering.instrument(sc, case.signal)  # effort, saturation, pointing signals
+                c = campaign.Campaign(sc, sets, seeds, timeseries=ts_keys, ts_every=every)
                 folder = out / "runs" / file_stem(case.scenario + ("_" + "_".join(f"{k}{v}" for k, v in case.overrides.items())
                                                                    if case.overrides else "")) / _slug(name)
                 table = campaign.run(c, folder, client=client, progress=False, overwrite=True)
@@ -123,12 +127,15 @@ def run(unit: str | None, family: str, out: str | Path, label: str | None = None
                 for k, _ in COLUMNS + [(case.primary, "")]:
                     v = np.array([r.get(k, math.nan) for r in good], dtype=float)
                     e.means[k] = float(np.mean(v)) if v.size and np.all(np.isfinite(v)) else math.nan
+                engineering.entry_metrics(e, sc, folder, good)
                 if c.timeseries and good:
                     try:
                         e.series = campaign.read_timeseries(folder, good[0]["run"])
                     except OSError:
                         e.series = None
                 log(f"  {case.label} / {name}: {e.ok}/{e.runs} ok, {case.primary} = {e.means.get(case.primary, math.nan):.6g}")
+        if family == "attitude":  # robustness Monte Carlo and stability margins (scfmu.benchmark.engineering)
+            studies = engineering.studies(cases, pairs, entries, out, client, quick, log)
     finally:
         if own:
             client.close()
@@ -136,6 +143,8 @@ def run(unit: str | None, family: str, out: str | Path, label: str | None = None
                 cluster.close()
     write_page(out, family, cases, entries, unit_label=(label or UNIT) if unit is not None else None,
                quick=quick, seconds=time.time() - t0)
+    if family == "attitude":
+        engineering.append_to_page(out, cases, entries, ranks(cases, entries), (label or UNIT) if unit is not None else None, studies)
     return entries
 
 
