@@ -159,7 +159,7 @@ def _margins_task(sc_dict: dict, fmu_dir: str | None):
     if fmu_dir:
         fmu_access.set_fmu_dir(fmu_dir)
     try:
-        ms = loop_margins(Scenario.from_dict(sc_dict), horizon=20.0, n_freq=800)
+        ms = loop_margins(Scenario.from_dict(sc_dict), horizon=20.0, n_freq=800, max_horizon=200.0)
         return [dict(axis=m.axis, gm_db=m.gm_db, gm_low_db=m.gm_low_db, pm_deg=m.pm_deg, wc=m.wc, wpc=m.wpc,
                      dm_s=m.dm_s, sample_time=m.sample_time, note=m.note, omega=m.omega, loop=m.loop) for m in ms]
     except Exception as err:  # a unit that cannot be linearised: reported, never a lost benchmark
@@ -384,8 +384,8 @@ def append_to_page(out: Path, cases, entries, rk: dict, unit_label, res: dict | 
             prim = items[0][1]["primary_name"]
             md.extend([f"#### {lab}", ""])
             h.append(f"<h4>{html.escape(lab)}</h4>")
-            head = ["controller", "pass", *[f"{prim if k == 'primary' else dict(COLS).get(k, k + ' [s]')} "
-                                             f"median / p95 / p99" for k in MC_COLS]]
+            names = {**dict(COLS), "primary": prim, "settling_s": "settling [s]"}
+            head = ["controller", "pass", *[f"{names.get(k, k)} median / p95 / p99" for k in MC_COLS]]
             rows, bold = [], []
             for ctrl, v in items:
                 rows.append([ctrl, f"{100 * v['pass']:.0f} % of {v['runs']}",

@@ -144,6 +144,12 @@ def _sample_steps(resp: np.ndarray, tol: float) -> tuple[int, int]:
     return max(1, m), int(idx[0] % max(1, m))
 
 
+def _decayed(r: np.ndarray) -> bool:
+    """The last tenth of the response below 10⁻⁴ of its peak."""
+    peak = float(np.max(np.abs(r))) if r.size else 0.0
+    return peak == 0.0 or float(np.max(np.abs(r[-max(1, r.size // 10):]))) <= 1e-4 * peak
+
+
 def _dtft(r: np.ndarray, w: np.ndarray, T: float) -> np.ndarray:
     k = np.arange(r.size)
     out = np.empty(w.size, dtype=complex)
@@ -184,14 +190,17 @@ def margins_of(L: np.ndarray, w: np.ndarray, T: float) -> dict:
 
 
 def loop_margins(scenario: Scenario, plant: str = "plant", ports=tuple(f"torque_cmd_{a}" for a in AXES),
-                 horizon: float = 30.0, eps: float | None = None, n_freq: int = 1500) -> list[AxisMargins]:
+                 horizon: float = 20.0, eps: float | None = None, n_freq: int = 1500,
+                 max_horizon: float = 200.0) -> list[AxisMargins]:
     """Per-axis margins of the scenario's loop broken at ``plant``'s inputs ``ports`` (see the module
-    docstring). ``horizon``: how long the pulse response is recorded [s] (it must have decayed by then;
-    the page notes a response that has not)."""
+    docstring). The pulse response is recorded in pieces of ``horizon`` [s] until it has decayed (its last
+    tenth below 10⁻⁴ of its peak), at most ``max_horizon`` [s]; a response that has not decayed by then is
+    noted (margins approximate)."""
     h = scenario.step
     n_op = scenario.n_steps
     n_h = int(round(horizon / h))
-    sc = scenario.with_overrides(stop_time=scenario.stop_time + (n_h + 2) * h)
+    n_max = int(round(max(horizon, max_horizon) / h))
+    sc = scenario.with_overrides(stop_time=scenario.stop_time + (n_max + 2) * h)
     sc.log = {}
     drv = _Driver(sc, plant, ports)
     try:
@@ -211,11 +220,20 @@ def loop_margins(scenario: Scenario, plant: str = "plant", ports=tuple(f"torque_
                 drv.run(n_op)
 
         def response(i, pulse):
-            fresh()
-            rp = drv.run(n_h, i, pulse)[:, i]
-            fresh()
-            rm = drv.run(n_h, i, -pulse)[:, i]
-            return (rp - rm) / (2 * eps)
+            """Central difference of the ± pulse runs, extended by ``n_h`` steps at a time (up to
+            ``max_horizon``) until the response has decayed."""
+            runs = []
+            for sign in (1.0, -1.0):
+                fresh()
+                runs.append([drv.run(n_h, i, sign * pulse)[:, i], drv.save() if saved is not None else None])
+            r = (runs[0][0] - runs[1][0]) / (2 * eps)
+            while not _decayed(r) and r.size + n_h <= n_max and saved is not None:
+                for run in runs:
+                    drv.restore(run[1])
+                    run[0] = np.concatenate([run[0], drv.run(n_h)[:, i]])
+                    run[1] = drv.save()
+                r = (runs[0][0] - runs[1][0]) / (2 * eps)
+            return r
 
         out = []
         for i, ax in enumerate(AXES[:len(ports)]):
@@ -232,9 +250,8 @@ def loop_margins(scenario: Scenario, plant: str = "plant", ports=tuple(f"torque_
                 r = r[start::m]
             T = m * h
             n = r.size
-            tail = float(np.max(np.abs(r[-max(1, n // 10):])))
-            if tail > 1e-4 * max(1e-300, float(np.max(np.abs(r)))):
-                note.append(f"pulse response not decayed within {horizon:g} s (tail {tail:.1e} of peak): margins approximate")
+            if not _decayed(r):
+                note.append(f"pulse response not decayed within {r.size * T:g} s: margins approximate")
             w = np.logspace(math.log10(1e-3 / T), math.log10(math.pi / T), n_freq)
             Tf = -_dtft(r, w, T)
             with np.errstate(divide="ignore", invalid="ignore"):
