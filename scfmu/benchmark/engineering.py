@@ -189,37 +189,42 @@ def studies(cases, pairs: dict, entries, out: Path, client, quick: bool, log=pri
                 futs[(lab, ctrl)] = client.submit(_margins_task, sc.to_dict(), fmu_dir, pure=False)
             elif lab == case.label:  # a foreign unit: in this process, where its file is
                 futs[(lab, ctrl)] = None
+    jobs = []
     for case in mc_cases:
-        base = first[case.label]
-        draws = robustness.dispersions(base, n, seed=0)
-        for (lab, ctrl), sc in pairs.items():
-            if lab != case.label:
-                continue
-            e = next(x for x in entries if x.case == lab and x.controller == ctrl)
-            sc_i, keys = instrument(sc, case.signal)
-            c = campaign.Campaign(sc_i, draws, [None], timeseries=keys, ts_every=max(1, sc_i.n_steps // 600))
-            folder = out / "runs" / "robustness" / file_stem(case.scenario) / _slug(ctrl)
-            table = campaign.run(c, folder, client=client, progress=False, overwrite=True)
-            rows = sorted(table.to_pylist(), key=lambda r: r["run"])
-            per = {k: [] for k in MC_COLS}
-            passed = 0
-            for r in rows:
-                ok = r["status"] == "ok"
-                settled = ok and math.isfinite(r.get("settling_s", math.nan))
-                passed += settled
-                extra = {}
-                if ok:
-                    try:
-                        extra = run_metrics(sc_i, campaign.read_timeseries(folder, r["run"]))
-                    except (OSError, KeyError):
-                        extra = {}
-                for k in MC_COLS:
-                    src = case.primary if k == "primary" else k
-                    per[k].append(extra.get(src, r.get(src, math.nan)) if ok else math.nan)
-            res["mc"][(lab, ctrl)] = {**{k: robustness.percentiles(v) for k, v in per.items()},
-                                      "pass": passed / len(rows) if rows else math.nan, "runs": len(rows),
-                                      "primary_name": case.primary}
-            log(f"  robustness {lab} / {ctrl}: {passed}/{len(rows)} pass")
+        draws = robustness.dispersions(first[case.label], n, seed=0)
+        jobs += [(case, lab, ctrl, sc, draws) for (lab, ctrl), sc in pairs.items() if lab == case.label]
+
+    def one(job):
+        case, lab, ctrl, sc, draws = job
+        sc_i, keys = instrument(sc, case.signal)
+        c = campaign.Campaign(sc_i, draws, [None], timeseries=keys, ts_every=max(1, sc_i.n_steps // 600))
+        folder = out / "runs" / "robustness" / file_stem(case.scenario) / _slug(ctrl)
+        table = campaign.run(c, folder, client=client, progress=False, overwrite=True)
+        rows = sorted(table.to_pylist(), key=lambda r: r["run"])
+        per = {k: [] for k in MC_COLS}
+        passed = 0
+        for r in rows:
+            ok = r["status"] == "ok"
+            passed += ok and math.isfinite(r.get("settling_s", math.nan))
+            extra = {}
+            if ok:
+                try:
+                    extra = run_metrics(sc_i, campaign.read_timeseries(folder, r["run"]))
+                except (OSError, KeyError):
+                    extra = {}
+            for k in MC_COLS:
+                src = case.primary if k == "primary" else k
+                per[k].append(extra.get(src, r.get(src, math.nan)) if ok else math.nan)
+        return (lab, ctrl), {**{k: robustness.percentiles(v) for k, v in per.items()},
+                             "pass": passed / len(rows) if rows else math.nan, "runs": len(rows),
+                             "primary_name": case.primary}
+
+    # every Monte Carlo campaign at once (threads only wait on the Dask workers): the workers stay busy
+    from concurrent.futures import ThreadPoolExecutor
+    with ThreadPoolExecutor(max_workers=max(1, min(8, len(jobs)))) as pool:
+        for key, v in pool.map(one, jobs):  # results in the order of the jobs (deterministic page)
+            res["mc"][key] = v
+            log(f"  robustness {key[0]} / {key[1]}: {round(v['pass'] * v['runs'])}/{v['runs']} pass")
     for key, fut in futs.items():
         if fut is None:
             res["margins"][key] = _margins_task(pairs[key].to_dict(), None)

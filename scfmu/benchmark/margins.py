@@ -65,12 +65,26 @@ class AxisMargins:
 
 
 class _Driver:
-    """The scenario's loop under the lean master's plan, stepped by hand with an optional pulse on one
-    plant input."""
+    """The scenario's loop under the lean master's plan: steps with a pulse are made from Python, the long
+    stretches without one by the compiled loop when its library is available (the same calls, no Python
+    per step), else from Python too."""
 
     def __init__(self, sc: Scenario, plant: str, ports):
+        sc = sc.with_overrides({})
+        sc.log = {f"_in{i}": f"{plant}.{p}" for i, p in enumerate(ports)}  # what feeds the plant, read each step
         self.sc = sc
-        self.m = LeanMaster(sc)
+        self.compiled = False
+        try:
+            from ..engines.compiled import CompiledLoop, available
+            if available():
+                self.m = CompiledLoop(sc, reuse=False)
+                LeanMaster._build_calls(self.m)  # the Python form of the same plan, for the pulse steps
+                CompiledLoop._build_calls(self.m)
+                self.compiled = True
+        except Exception:
+            self.compiled = False
+        if not self.compiled:
+            self.m = LeanMaster(sc)
         self.plant = plant
         pl = self.m.fmus[plant]
         vr = {v.name: v.valueReference for v in pl.md.modelVariables}
@@ -98,8 +112,16 @@ class _Driver:
     def run(self, n: int, axis: int = -1, pulse=None) -> np.ndarray:
         """n communication steps from the current one; returns the signals feeding the plant's inputs
         (n, 3) at each step, before the pulse ``pulse[j]`` (added to input ``axis`` at step j) is applied."""
-        sc, ops, steps = self.sc, self.m._ops, self.m._steps
+        last = int(np.max(np.nonzero(pulse)[0])) + 1 if axis >= 0 and pulse is not None and np.any(pulse) else 0
         out = np.empty((n, len(self.read_at)))
+        py = n if not self.compiled else min(n, last)
+        self._python(out, py, axis, pulse)
+        if py < n:
+            self._compiled(out[py:])
+        return out
+
+    def _python(self, out, n, axis, pulse) -> None:
+        sc, ops, steps = self.sc, self.m._ops, self.m._steps
         for j in range(n):
             t = sc.start_time + self.k * sc.step
             st = 0
@@ -116,7 +138,19 @@ class _Driver:
             if st > 1:
                 self.m._fail(t)
             self.k += 1
-        return out
+
+    def _compiled(self, out) -> None:
+        """len(out) steps in the compiled loop: it propagates, logs (the plant's inputs) and steps at each
+        t_k; one more propagation and log at the end (no step), which the next call repeats unchanged."""
+        sc, m = self.sc, self.m
+        n = out.shape[0]
+        buf = np.empty((n + 1, len(self.read_at)))
+        st = m._lib.scfmu_loop_run(*m._args, n, sc.start_time + self.k * sc.step, sc.step, buf.ctypes.data, buf.size,
+                                   1, m._fail_at)
+        if st < 0 or st > 1:
+            m._fail(sc.start_time + self.k * sc.step, f"compiled loop status {st}")
+        out[:] = buf[:n]
+        self.k += n
 
     def save(self):
         try:
@@ -129,6 +163,15 @@ class _Driver:
         for n, s in states.items():
             self.m.fmus[n].slave.setFMUState(s)
         self.k = k
+
+    def free(self, saved) -> None:
+        if saved is None:
+            return
+        for n, s in saved[0].items():
+            try:
+                self.m.fmus[n].slave.freeFMUState(s)
+            except Exception:
+                pass
 
     def close(self):
         self.m.close()
@@ -151,11 +194,9 @@ def _decayed(r: np.ndarray) -> bool:
 
 
 def _dtft(r: np.ndarray, w: np.ndarray, T: float) -> np.ndarray:
-    k = np.arange(r.size)
-    out = np.empty(w.size, dtype=complex)
-    for s in range(0, w.size, 256):  # chunks keep the exp matrix small
-        out[s:s + 256] = np.exp(-1j * np.outer(w[s:s + 256] * T, k)) @ r
-    return out
+    """Σ_k r_k e^{-jωTk} (Horner's scheme in e^{-jωT}: scipy.signal.freqz of the FIR r)."""
+    from scipy.signal import freqz
+    return freqz(r, [1.0], worN=w * T)[1]
 
 
 def margins_of(L: np.ndarray, w: np.ndarray, T: float) -> dict:
@@ -201,7 +242,6 @@ def loop_margins(scenario: Scenario, plant: str = "plant", ports=tuple(f"torque_
     n_h = int(round(horizon / h))
     n_max = int(round(max(horizon, max_horizon) / h))
     sc = scenario.with_overrides(stop_time=scenario.stop_time + (n_max + 2) * h)
-    sc.log = {}
     drv = _Driver(sc, plant, ports)
     try:
         nominal = drv.run(n_op)
@@ -230,9 +270,12 @@ def loop_margins(scenario: Scenario, plant: str = "plant", ports=tuple(f"torque_
             while not _decayed(r) and r.size + n_h <= n_max and saved is not None:
                 for run in runs:
                     drv.restore(run[1])
+                    drv.free(run[1])
                     run[0] = np.concatenate([run[0], drv.run(n_h)[:, i]])
                     run[1] = drv.save()
                 r = (runs[0][0] - runs[1][0]) / (2 * eps)
+            for run in runs:
+                drv.free(run[1])
             return r
 
         out = []
@@ -251,12 +294,15 @@ def loop_margins(scenario: Scenario, plant: str = "plant", ports=tuple(f"torque_
             T = m * h
             n = r.size
             if not _decayed(r):
-                note.append(f"pulse response not decayed within {r.size * T:g} s: margins approximate")
+                note.append(f"pulse response not decayed within {r.size * T:g} s (a limit cycle, or a loop unstable "
+                            f"at this operating point): margins unreliable")
             w = np.logspace(math.log10(1e-3 / T), math.log10(math.pi / T), n_freq)
             Tf = -_dtft(r, w, T)
             with np.errstate(divide="ignore", invalid="ignore"):
                 L = Tf / (1.0 - Tf)
             res = margins_of(L, w, T)
+            if not math.isfinite(res["wc"]):
+                note.append("no gain crossover: |L| never reaches 1 below the Nyquist frequency")
             out.append(AxisMargins(ax, sample_time=T, note="; ".join(note), omega=w, loop=L, **res))
         return out
     finally:
