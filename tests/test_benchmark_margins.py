@@ -99,3 +99,32 @@ def test_sampled_flight_computer():
         assert m.pm_deg == pytest.approx(ref["pm_deg"], rel=1e-4), m.axis
         assert m.wc == pytest.approx(ref["wc"], rel=1e-4), m.axis
         assert m.gm_db == pytest.approx(ref["gm_db"], rel=1e-3), m.axis
+
+
+def test_benchmark_page_margins_effort_pointing(tmp_path):
+    """End to end (--quick, the large slew, PD and LQR): the page's margins of the PD at the slew's final
+    attitude equal python-control's on the closed form (body-frame quaternion error, rest: decoupled axes,
+    L = (1 + 2s)/s² for wn = ζ = 1, sampled at 0.01 s); the Monte Carlo and pointing columns are filled."""
+    import csv
+
+    from scfmu import benchmark
+
+    benchmark.run(None, "attitude", tmp_path, quick=True, controllers=["PdController", "LqrController"],
+                  cases=["default"], log=lambda *a: None)
+    s = control.tf("s")
+    _, pm, _, _, wc, _ = control.stability_margins(control.c2d((1 + 2 * s) / s**2, 0.01, "zoh"))
+    rows = list(csv.DictReader(open(tmp_path / "margins.csv")))
+    pd_rows = [r for r in rows if r["controller"].startswith("PD")]
+    assert len(pd_rows) == 3
+    for r in pd_rows:
+        assert float(r["pm_deg"]) == pytest.approx(pm, rel=1e-4)
+        assert float(r["crossover_rad_s"]) == pytest.approx(wc, rel=1e-4)
+        assert float(r["delay_margin_s"]) == pytest.approx(math.radians(pm) / wc, rel=1e-4)
+    eng = list(csv.DictReader(open(tmp_path / "engineering.csv")))
+    assert eng and all(math.isfinite(float(r["ape_deg"])) and float(r["ape_deg"]) < 0.01 for r in eng)
+    rob = list(csv.DictReader(open(tmp_path / "robustness.csv")))
+    assert {r["controller"] for r in rob} == {r["controller"] for r in eng}
+    assert all(float(r["pass_fraction"]) == 1.0 and int(r["runs"]) == 8 for r in rob)
+    page = (tmp_path / "benchmark.md").read_text()
+    assert "### Stability margins" in page and "### Robustness Monte Carlo" in page
+    assert (tmp_path / "figures").glob("bode_*.png") and list((tmp_path / "figures").glob("effort_*.png"))

@@ -171,6 +171,8 @@ def studies(cases, pairs: dict, entries, out: Path, client, quick: bool, log=pri
     of the pairs that ran. Returns {"mc": {(case, controller): {metric: percentiles, "pass": fraction}},
     "margins": {(case, controller): [axis dicts] or "reason"}, "mc_cases": [...], "margin_cases": [...]}."""
     from .. import fmu as fmu_access
+    import time
+    t_start = time.perf_counter()
     res = {"mc": {}, "margins": {}, "mc_cases": [], "margin_cases": [], "mc_runs": 0}
     first = {}
     for (lab, _ctrl), sc in pairs.items():
@@ -225,6 +227,7 @@ def studies(cases, pairs: dict, entries, out: Path, client, quick: bool, log=pri
         for key, v in pool.map(one, jobs):  # results in the order of the jobs (deterministic page)
             res["mc"][key] = v
             log(f"  robustness {key[0]} / {key[1]}: {round(v['pass'] * v['runs'])}/{v['runs']} pass")
+    res["seconds_mc"] = time.perf_counter() - t_start
     for key, fut in futs.items():
         if fut is None:
             res["margins"][key] = _margins_task(pairs[key].to_dict(), None)
@@ -235,6 +238,7 @@ def studies(cases, pairs: dict, entries, out: Path, client, quick: bool, log=pri
                 res["margins"][key] = f"{type(err).__name__}: {err}"[:300]
         if isinstance(res["margins"][key], str):
             log(f"  margins {key[0]} / {key[1]}: {res['margins'][key]}")
+    res["seconds"] = time.perf_counter() - t_start
     return res
 
 
@@ -372,6 +376,9 @@ def append_to_page(out: Path, cases, entries, rk: dict, unit_label, res: dict | 
     # robustness
     md.extend(["### Robustness Monte Carlo", ""])
     h.append("<h3>Robustness Monte Carlo</h3>")
+    if "seconds" in res:
+        para(f"Monte Carlo and margins: {res['seconds']:.0f} s of wall time (the margins run on the workers "
+             f"beside the Monte Carlo).")
     para(f"{res['mc_runs']} seeded runs per controller (seed 0; the same draws for every controller) on "
          f"{', '.join(res['mc_cases']) or 'no scenario'}: principal inertias ±20 % (uniform) with principal "
          f"axes turned up to 10° (products of inertia; every draw positive definite and meeting the triangle "
