@@ -4,7 +4,8 @@ its default size, the margins) against the run cost of the same scenarios on the
 Measures, in this process: the benchmark's wall time and its CPU time (this process + its Dask workers,
 ``getrusage`` of the children after the cluster closed), then the CPU time of simulating every run the
 benchmark simulates (the registered scenarios' runs and the robustness draws, every controller) on the
-native engine (``simulate(sc, "native", log_every=0)``, no Python per step) in this process. The machine
+native engine (``simulate(sc, "native", log_every=0)``, no Python per step; ``--engines native,compiled``
+adds the compiled engine, which logs every step) in this process. The machine
 may be shared: CPU times are the numbers to compare, wall times depend on the load (printed).
 
     .venv/bin/python benches/benchmark_attitude.py [--unit PdController] [--quick] [--skip-benchmark]
@@ -66,6 +67,7 @@ def main() -> None:
     ap.add_argument("--unit", default="PdController")
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--skip-benchmark", action="store_true")
+    ap.add_argument("--engines", default="native", help="comma-separated engines for the run cost (native, compiled)")
     a = ap.parse_args()
     print(f"load average before: {os.getloadavg()}")
     if not a.skip_benchmark:
@@ -79,13 +81,16 @@ def main() -> None:
               f"{cpu_children() - c0:.1f} s); load average after: {os.getloadavg()}")
     from scfmu.engines import simulate
     runs = all_runs(a.unit, a.quick)
-    c0, t0 = cpu_self(), time.perf_counter()
-    for sc, o, seed in runs:
-        s = sc.with_overrides(o)
-        if seed is not None:
-            s = s.with_seed(seed)
-        simulate(s, "native", log_every=0)
-    print(f"native engine, the same {len(runs)} runs: wall {time.perf_counter() - t0:.1f} s, CPU {cpu_self() - c0:.1f} s")
+    for engine in a.engines.split(","):
+        kw = {"log_every": 0} if engine == "native" else {}
+        c0, t0 = cpu_self(), time.perf_counter()
+        for sc, o, seed in runs:
+            s = sc.with_overrides(o)
+            if seed is not None:
+                s = s.with_seed(seed)
+            simulate(s, engine, **kw)
+        print(f"{engine} engine, the same {len(runs)} runs: wall {time.perf_counter() - t0:.1f} s, "
+              f"CPU {cpu_self() - c0:.1f} s")
 
 
 if __name__ == "__main__":
