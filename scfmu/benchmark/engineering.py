@@ -133,23 +133,21 @@ def _faulted(sc) -> bool:
 
 def pick(cases, scenarios: dict, with_units: bool) -> list:
     """One nominal (not Monte Carlo, no actuator fault) case per distinct plant (and, for the margins, set
-    of units in the loop); the linear small-angle plant only when nothing else has its plant (it uses the
-    diagonal of the inertia only)."""
-    chosen, seen = [], {}
+    of units in the loop). Among the cases of one plant: the first with the full (not the linear
+    small-angle) kinematics, which uses the whole inertia matrix; for the Monte Carlo (``with_units``
+    False) preferably one with disturbance torques, whose amplitude the dispersions scale."""
+    chosen: dict = {}
     for case in cases:
         sc = scenarios.get(case.label)
         if sc is None or case.seeds or case.monte_carlo or not applies(sc) or _faulted(sc):
             continue
+        p = sc.component(PLANT).params
+        score = (int(p.get("kinematics", 0)) != 3,
+                 (not with_units) and any(p.get(k) for k in robustness.DIST_PARAMS))
         sig = _signature(sc, with_units)
-        linear = int(sc.component(PLANT).params.get("kinematics", 0)) == 3
-        if sig in seen:
-            if seen[sig][1] and not linear:
-                chosen[chosen.index(seen[sig][0])] = case
-                seen[sig] = (case, False)
-            continue
-        seen[sig] = (case, linear)
-        chosen.append(case)
-    return chosen
+        if sig not in chosen or score > chosen[sig][0]:
+            chosen[sig] = (score, case)
+    return [c for _, c in chosen.values()]
 
 
 def _margins_task(sc_dict: dict, fmu_dir: str | None):
