@@ -35,7 +35,8 @@ COLS = [("effort_abs", "effort ∫Σ|u| dt [N·m·s]"), ("sat_frac", "time in sa
         ("ape_deg", "APE [deg]"), ("mpe_deg", "MPE [deg]"), ("rpe_deg", "RPE [deg]"), ("pde_deg", "PDE [deg]"),
         ("jitter_deg", "jitter RMS [deg]")]
 MC_COLS = ("primary", "effort_abs", "sat_frac", "ape_deg", "rpe_deg", "settling_s")
-MC_MIN_RUNS = 1
+PRIMARY_NAMES = {"eulerint_deg_s": "EULERINT [deg·s]", "ise": "ISE [rad²·s]", "final_error": "final error [deg]",
+                 "euler_end_max_deg": "largest final angle [deg]", "settling_s": "settling time [s]"}
 
 
 def applies(sc) -> bool:
@@ -266,9 +267,8 @@ def _scatter(out: Path, case, entries, unit_label) -> str | None:
                    edgecolors="k" if me else "none", zorder=3)
         ax.annotate(e.controller, (e.means["effort_abs"], e.means[case.primary]), fontsize=7,
                     xytext=(4, 3), textcoords="offset points", fontweight="bold" if me else "normal")
-    from . import NAMES
     ax.set_xlabel("control effort ∫Σ|u| dt [N·m·s]")
-    ax.set_ylabel(NAMES.get(case.primary, case.primary) + " (lower is better)")
+    ax.set_ylabel(PRIMARY_NAMES.get(case.primary, case.primary) + " (lower is better)")
     if max(e.means["effort_abs"] for e in es) > 20 * max(1e-300, min(e.means["effort_abs"] for e in es)):
         ax.set_xscale("log")
     ax.set_title(f"Effort vs performance: {case.label}" + (f"\nunit under test: {unit_label}" if unit_label else ""),
