@@ -261,12 +261,15 @@ def _scatter(out: Path, case, entries, unit_label) -> str | None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    groups: dict = {}  # controllers at the same point (to 4 significant digits) share one label
     for e in es:
         me = e.controller == unit_label
-        ax.scatter(e.means["effort_abs"], e.means[case.primary], s=70 if me else 35, marker="*" if me else "o",
-                   edgecolors="k" if me else "none", zorder=3)
-        ax.annotate(e.controller, (e.means["effort_abs"], e.means[case.primary]), fontsize=7,
-                    xytext=(4, 3), textcoords="offset points", fontweight="bold" if me else "normal")
+        x, y = e.means["effort_abs"], e.means[case.primary]
+        ax.scatter(x, y, s=90 if me else 35, marker="*" if me else "o", edgecolors="k" if me else "none", zorder=3)
+        groups.setdefault((f"{x:.4g}", f"{y:.4g}"), [x, y, []])[2].append(e.controller)
+    for x, y, names in groups.values():
+        ax.annotate(" = ".join(names), (x, y), fontsize=7, xytext=(4, 3), textcoords="offset points",
+                    fontweight="bold" if unit_label in names else "normal")
     ax.set_xlabel("control effort ∫Σ|u| dt [N·m·s]")
     ax.set_ylabel(PRIMARY_NAMES.get(case.primary, case.primary) + " (lower is better)")
     if max(e.means["effort_abs"] for e in es) > 20 * max(1e-300, min(e.means["effort_abs"] for e in es)):
