@@ -209,3 +209,90 @@ def logs_needed(name: str) -> tuple | None:
     if not name:
         return ()
     return REGISTRY.metric_set(name).logs
+
+
+# ----- pointing errors (in the spirit of the ECSS pointing error engineering handbook) ----------------------
+# The error signal e(t) is a vector (here the small-rotation vector of the body relative to the reference,
+# in degrees) or a scalar, sampled at times t. The *evaluation period* is [t_start, t_end] (the pointing
+# phase); it is cut into consecutive windows of length ``window`` (the last, shorter remainder is dropped).
+# With ē_k the mean of e over window k and ē the mean over the whole evaluation period:
+#   APE   absolute pointing error      max_t ‖e(t)‖
+#   MPE   mean pointing error          ‖ē‖
+#   RPE   relative pointing error      max_k max_{t in k} ‖e(t) − ē_k‖      (stability within a window)
+#   PDE   pointing drift error         max_k ‖ē_{k+1} − ē_k‖                (drift between consecutive windows)
+#   jitter                             sqrt(mean_k mean_{t in k} ‖e(t) − ē_k‖²)   (RMS of the within-window part)
+# Means are sample means over the samples of a window (equal spacing assumed); ‖·‖ is the Euclidean norm
+# over the axes (the absolute value for a scalar signal).
+POINTING = ("ape", "mpe", "rpe", "pde", "jitter")
+
+
+def error_rotation_deg(q: np.ndarray, q_ref: np.ndarray) -> np.ndarray:
+    """The small-rotation vector [deg] of the reference seen from the body, per sample: the error quaternion
+    q_E = q* ⊗ q_ref (scalar-first, shape (n, 4) or (4, n)), rotation vector 2 atan2(|v|, w) v/|v| with w ≥ 0
+    (shortest rotation). Returns shape (n, 3)."""
+    q = np.asarray(q, dtype=float)
+    r = np.asarray(q_ref, dtype=float)
+    if q.shape[0] == 4 and q.ndim == 2 and q.shape[1] != 4:
+        q, r = q.T, r.T
+    w1, v1 = q[:, 0], -q[:, 1:]  # conjugate of q
+    w2, v2 = r[:, 0], r[:, 1:]
+    w = w1 * w2 - np.sum(v1 * v2, axis=1)
+    v = w1[:, None] * v2 + w2[:, None] * v1 + np.cross(v1, v2)
+    sign = np.where(w < 0.0, -1.0, 1.0)
+    w, v = w * sign, v * sign[:, None]
+    n = np.linalg.norm(v, axis=1)
+    angle = 2.0 * np.arctan2(n, w)
+    scale = np.where(n > 0.0, angle / np.where(n > 0.0, n, 1.0), 2.0)
+    return np.degrees(v * scale[:, None])
+
+
+def pointing_errors(t, e, window: float, t_start: float | None = None, t_end: float | None = None) -> dict:
+    """APE, MPE, RPE, PDE and jitter (see the definitions above) of the error ``e`` (shape (n,) or (n, axes))
+    sampled at ``t`` over the evaluation period [t_start, t_end] (default: the whole record) with windows of
+    length ``window`` [s]. RPE and jitter need one window, PDE two (NaN otherwise)."""
+    t = np.asarray(t, dtype=float)
+    e = np.asarray(e, dtype=float)
+    if e.ndim == 1:
+        e = e[:, None]
+    if not window > 0.0:
+        raise ValueError(f"pointing window {window!r}: must be > 0 s")
+    t0 = t[0] if t_start is None else float(t_start)
+    t1 = t[-1] if t_end is None else float(t_end)
+    sel = (t >= t0 - 1e-9) & (t <= t1 + 1e-9)
+    t, e = t[sel], e[sel]
+    out = {k: math.nan for k in POINTING}
+    if t.size == 0:
+        return out
+    out["ape"] = float(np.max(np.linalg.norm(e, axis=1)))
+    out["mpe"] = float(np.linalg.norm(np.mean(e, axis=0)))
+    # window index of each sample: windows [t0 + k w, t0 + (k+1) w); samples on the final boundary go to the
+    # last full window (the boundary is tolerant to summed floating-point time)
+    k = np.floor((t - t0) / window + 1e-9).astype(int)
+    n_full = int(math.floor((t1 - t0) / window + 1e-9))
+    k = np.where((k == n_full) & (np.abs(t - (t0 + n_full * window)) < 1e-9 * max(1.0, abs(t1))), n_full - 1, k)
+    keep = (k >= 0) & (k < n_full)
+    if n_full < 1 or not np.any(keep):
+        return out
+    k, e = k[keep], e[keep]
+    means = np.stack([np.mean(e[k == i], axis=0) for i in range(n_full)])
+    dev = np.linalg.norm(e - means[k], axis=1)
+    out["rpe"] = float(np.max(dev))
+    out["jitter"] = float(np.sqrt(np.mean([np.mean(dev[k == i] ** 2) for i in range(n_full)])))
+    if n_full >= 2:
+        out["pde"] = float(np.max(np.linalg.norm(np.diff(means, axis=0), axis=1)))
+    return out
+
+
+def saturation_fraction(t, u, limit, tol: float = 1e-9) -> float:
+    """Fraction of the run's time [0, 1] in which any axis of the command ``u`` (shape (n, axes)) is at or beyond
+    its limit ``limit`` (shape (axes,) or (n, axes)): |u_i| ≥ (1 − tol) limit_i. Each sample holds until the next
+    (left rectangle, as the effort integrals)."""
+    t = np.asarray(t, dtype=float)
+    u = np.abs(np.asarray(u, dtype=float))
+    if u.ndim == 1:
+        u = u[:, None]
+    lim = np.broadcast_to(np.asarray(limit, dtype=float), u.shape)
+    sat = np.any(u >= (1.0 - tol) * lim, axis=1)[:-1]
+    dt = np.diff(t)
+    total = float(np.sum(dt))
+    return float(np.sum(dt[sat]) / total) if total > 0 else math.nan

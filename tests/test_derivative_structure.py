@@ -22,13 +22,16 @@ from scfmu.fmu import fmu_path
 # Parameter sets per model, written out here so that together they switch on every term of the
 # equations (each option of the model's documentation), plus a scale for random states and inputs.
 FULL_INERTIA = {"inertia_xy": 20.0, "inertia_xz": -15.0, "inertia_yz": 10.0}
+# actuator misalignment and scale factor couple every actuator axis into every body axis
+MISALIGNED = {"actuator_misalignment_x": 0.02, "actuator_misalignment_y": -0.03, "actuator_misalignment_z": 0.01,
+              "actuator_scale_x": 1.05}
 ATTITUDE_FEATURES = [
     # ideal actuators, full inertia, gravity gradient
     {"actuator_mode": 0, "gg_enable": 1, **FULL_INERTIA},
     # reaction wheels with lag and magnetorquers, gravity gradient
-    {"actuator_mode": 1, "mtq_enable": 1, "gg_enable": 1, "wheel_time_constant": 0.5, **FULL_INERTIA},
+    {"actuator_mode": 1, "mtq_enable": 1, "gg_enable": 1, "wheel_time_constant": 0.5, **FULL_INERTIA, **MISALIGNED},
     # reaction wheels without lag: the wheel torque follows the command directly
-    {"actuator_mode": 1, "mtq_enable": 1, "gg_enable": 0, "wheel_time_constant": 0.0, **FULL_INERTIA},
+    {"actuator_mode": 1, "mtq_enable": 1, "gg_enable": 0, "wheel_time_constant": 0.0, **FULL_INERTIA, **MISALIGNED},
 ]
 CASES = {
     "AttitudePlant": [dict(p, kinematics=k) for k in (0, 1, 2, 3, 4) for p in ATTITUDE_FEATURES],

@@ -111,4 +111,5 @@ def test_plant_state_outputs_do_not_depend_on_torque_inputs():
             for u in root.find("ModelStructure").find("InitialUnknowns")}
     for n in ("q_w", "q_x", "w_x", "w_z"):
         assert deps[index[n]] & inputs == set(), n
-    assert deps[index["torque_applied_x"]] & inputs == {index["torque_cmd_x"]}
+    # every command: the actuator misalignment (actuator_misalignment_*) couples the axes
+    assert deps[index["torque_applied_x"]] & inputs == {index[f"torque_cmd_{a}"] for a in "xyz"}

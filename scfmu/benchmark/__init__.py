@@ -42,6 +42,7 @@ from ..scenario import get
 from ..scenario import profile as profiles
 from ..scenario.check import IncompatibleUnit, require
 from ..scenario.resolve import unbound_slots
+from . import engineering
 
 UNIT = "unit under test"
 
@@ -227,7 +228,9 @@ def run(unit: str | None, family: str, out: str | Path, label: str | None = None
     if own:
         client, cluster = campaign._client(None, workers)
     entries: list[Entry] = []
+    pairs: dict = {}  # (case, controller) -> scenario, for the Monte Carlo and the margins
     t0 = time.time()
+    studies = None
     try:
         for case in cases:
             sets, seeds = _case_overrides(case, quick)
@@ -263,8 +266,10 @@ def run(unit: str | None, family: str, out: str | Path, label: str | None = None
                 keys = [case.signal] + [k for k in ("alpha_deg", "roll", "pitch", "yaw", "roll_ref", "pitch_ref",
                                                     "yaw_ref", "theta", "theta_ref") if k in sc.log and k != case.signal]
                 every = max(1, sc.n_steps // 1500)
-                c = campaign.Campaign(sc, sets, seeds, timeseries=[k for k in keys if k in sc.log] or None,
-                                      ts_every=every)
+                pairs[(case.label, name)] = sc
+                sc, ts_keys = engineering.instrument(sc, case.signal)  # effort, saturation, pointing signals
+                ts = list(dict.fromkeys([k for k in keys if k in sc.log] + (ts_keys or [])))
+                c = campaign.Campaign(sc, sets, seeds, timeseries=ts or None, ts_every=every)
                 folder = out / "runs" / _slug(case.label) / _slug(name)  # one folder per case (two cases may share a scenario)
                 table = campaign.run(c, folder, client=client, progress=False, overwrite=True)
                 rows = sorted(table.to_pylist(), key=lambda r: r["run"])
@@ -277,6 +282,7 @@ def run(unit: str | None, family: str, out: str | Path, label: str | None = None
                 for k in dict.fromkeys([k for k, _ in COLUMNS] + [case.primary]):
                     v = np.array([r.get(k, math.nan) for r in good], dtype=float)
                     e.means[k] = float(np.mean(v)) if v.size and np.all(np.isfinite(v)) else math.nan
+                engineering.entry_metrics(e, sc, folder, good)
                 if c.timeseries and good:
                     try:
                         e.series = campaign.read_timeseries(folder, good[0]["run"])
@@ -285,12 +291,16 @@ def run(unit: str | None, family: str, out: str | Path, label: str | None = None
                 _check_error_growth(e)
                 log(f"  {case.label} / {name}: {e.ok}/{e.runs} ok, {case.primary} = {e.means.get(case.primary, math.nan):.6g}"
                     + (f"; {e.config}" if e.envelope == "retuned" else ""))
+        if family == "attitude":  # robustness Monte Carlo and stability margins (scfmu.benchmark.engineering)
+            studies = engineering.studies(cases, pairs, entries, out, client, quick, log)
     finally:
         if own:
             client.close()
             if cluster is not None:
                 cluster.close()
     write_page(out, family, cases, entries, unit_label=unit_label, quick=quick, seconds=time.time() - t0)
+    if family == "attitude":
+        engineering.append_to_page(out, cases, entries, ranks(cases, entries), unit_label, studies)
     return entries
 
 

@@ -48,7 +48,7 @@ impl AttitudePlant {
         let u = faulty_cmd(v, seg.faulted);
         let eff = if seg.faulted { v.effectiveness } else { Vector3::repeat(1.0) };
         if !Self::wheels(v) {
-            return Actuation { torque: clamp3(u, v.u_max.component_mul(&eff)), ..Default::default() };
+            return Actuation { torque: self.d.actuator_map * clamp3(u, v.u_max.component_mul(&eff)), ..Default::default() };
         }
         let hw = v3(x, HW);
         // magnetorquers: momentum dumping m = k (h_w × B)/|B|², uniformly scaled into ±m_max
@@ -79,6 +79,8 @@ impl AttitudePlant {
                 tau_rw[i] = 0.0;
             }
         }
+        // misalignment and scale factor between the wheels' axes and the body (the limits act on the wheels' axes)
+        let tau_rw = self.d.actuator_map * tau_rw;
         Actuation { torque: tau_rw + tau_mtq, wheel: tau_rw, lag_rate, dipole }
     }
 }

@@ -36,6 +36,11 @@ const WHEEL_X: [&str; 14] = concat_names(&ATT_ALL, &["state_h_wheel_x", "state_h
 const WHEEL_Y: [&str; 14] = concat_names(&ATT_ALL, &["state_h_wheel_x", "state_h_wheel_y", "state_h_wheel_z", "state_wheel_torque_y", "torque_cmd_y"]);
 const WHEEL_Z: [&str; 14] = concat_names(&ATT_ALL, &["state_h_wheel_x", "state_h_wheel_y", "state_h_wheel_z", "state_wheel_torque_z", "torque_cmd_z"]);
 
+// the wheel momenta: ḣ_w = −M τ_rw with M = R(δ) diag(k) (actuator misalignment and scale factor) couples
+// every wheel axis into every body axis
+const H_WHEEL: [&str; 18] = concat_names(&ATT_ALL, &["state_h_wheel_x", "state_h_wheel_y", "state_h_wheel_z", "state_wheel_torque_x",
+    "state_wheel_torque_y", "state_wheel_torque_z", "torque_cmd_x", "torque_cmd_y", "torque_cmd_z"]);
+
 const fn concat_names<const N: usize>(a: &[&'static str], b: &[&'static str]) -> [&'static str; N] {
     crate::model::concat(&[a, b], "")
 }
@@ -54,9 +59,9 @@ pub const STATES: [StateDecl; super::kinematics::N] = [
     StateDecl::new("state_w_x", "rad/s", "Continuous state: body rate x (angle rate for kinematics 3)"),
     StateDecl::new("state_w_y", "rad/s", "Continuous state: body rate y (angle rate for kinematics 3)"),
     StateDecl::new("state_w_z", "rad/s", "Continuous state: body rate z (angle rate for kinematics 3)"),
-    s("state_h_wheel_x", "N.m.s", "Continuous state: wheel momentum x (actuator mode 1)", &WHEEL_X),
-    s("state_h_wheel_y", "N.m.s", "Continuous state: wheel momentum y (actuator mode 1)", &WHEEL_Y),
-    s("state_h_wheel_z", "N.m.s", "Continuous state: wheel momentum z (actuator mode 1)", &WHEEL_Z),
+    s("state_h_wheel_x", "N.m.s", "Continuous state: wheel momentum x (actuator mode 1)", &H_WHEEL),
+    s("state_h_wheel_y", "N.m.s", "Continuous state: wheel momentum y (actuator mode 1)", &H_WHEEL),
+    s("state_h_wheel_z", "N.m.s", "Continuous state: wheel momentum z (actuator mode 1)", &H_WHEEL),
     s("state_wheel_torque_x", "N.m", "Continuous state: lagged wheel torque x (actuator mode 1, wheel lag > 0)", &WHEEL_X),
     s("state_wheel_torque_y", "N.m", "Continuous state: lagged wheel torque y (actuator mode 1, wheel lag > 0)", &WHEEL_Y),
     s("state_wheel_torque_z", "N.m", "Continuous state: lagged wheel torque z (actuator mode 1, wheel lag > 0)", &WHEEL_Z),

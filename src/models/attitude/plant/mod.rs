@@ -37,6 +37,8 @@ struct Derived {
     wheel_torque_max: f64,
     wheel_momentum_max: f64,
     dipole_max: f64,
+    /// Actuator-to-body map M = R(δ) diag(k) (misalignment δ, scale factor k).
+    actuator_map: Matrix3<f64>,
 }
 
 #[derive(Clone, Serialize, Deserialize)]
@@ -89,10 +91,11 @@ impl Model for AttitudePlant {
         source: "rigid-body attitude dynamics and kinematics of [Navabi-2019], [T2FSMC-LEO] and [Moradi-FTC]; reaction-wheel lag of [Khatoonabadi-FO]",
         equations_html: include_str!("docs.html"),
         feedthrough: Feedthrough::Some(&[
-            // per axis also in wheel mode: τ_applied,i = sat(K_w (u_i − τ_mtq,i)) + τ_mtq,i with τ_mtq from the state
-            ("torque_applied_x", &["torque_cmd_x"]),
-            ("torque_applied_y", &["torque_cmd_y"]),
-            ("torque_applied_z", &["torque_cmd_z"]),
+            // every axis on every command: τ_applied = M sat(u) (mode 0) or M sat(K_w (u − τ_mtq)) + τ_mtq (mode 1),
+            // M = R(δ) diag(k) couples the axes when the actuators are misaligned
+            ("torque_applied_x", &["torque_cmd_x", "torque_cmd_y", "torque_cmd_z"]),
+            ("torque_applied_y", &["torque_cmd_x", "torque_cmd_y", "torque_cmd_z"]),
+            ("torque_applied_z", &["torque_cmd_x", "torque_cmd_y", "torque_cmd_z"]),
             ("torque_ext_x", &["torque_dist_x"]),
             ("torque_ext_y", &["torque_dist_y"]),
             ("torque_ext_z", &["torque_dist_z"]),
@@ -116,6 +119,7 @@ impl Model for AttitudePlant {
             wheel_torque_max: v.wheel_torque_coeff * v.wheel_max_current,
             wheel_momentum_max: v.wheel_inertia * v.wheel_max_speed,
             dipole_max: v.mtq_turns * v.mtq_coil_area * v.mtq_max_current,
+            actuator_map: nalgebra::Rotation3::new(v.actuator_misalignment).into_inner() * Matrix3::from_diagonal(&v.actuator_scale),
         };
         let angles = (v.init_euler321_roll, v.init_euler321_pitch, v.init_euler321_yaw);
         let mut x = State::zeros();

@@ -1,4 +1,4 @@
-//! The declared variables of `AttitudePlant` (ports 0–43, parameters 100–183, calculated 200–203).
+//! The declared variables of `AttitudePlant` (ports 0–43, parameters 100–189, calculated 200–203).
 
 use super::kinematics::Kinematics;
 use crate::declare_variables;
@@ -80,6 +80,9 @@ declare_variables! {
         177 => dist_sin_phase: Vec3 = [0.0; 3], Parameter, "rad", "Sinusoidal disturbance phase phi";
         180 => dist_noise_std: Vec3 = [0.0; 3], Parameter, "N.m", "White-noise standard deviation sigma (zero-order held)", NonNegative;
         183 => dist_noise_hold: Real = 0.1, Parameter, "s", "Hold interval T_n of the noise (PSD about sigma^2 T_n)", Positive;
+        // actuator errors (both actuator modes; project choice, for Monte Carlo dispersions)
+        184 => actuator_scale: Vec3 = [1.0; 3], Parameter, "", "Actuator scale factor k: actuator i delivers k_i times its limited torque (tau_body = R(delta) diag(k) tau_actuators)", Positive;
+        187 => actuator_misalignment: Vec3 = [0.0; 3], Parameter, "rad", "Actuator-triad misalignment: rotation vector delta of the actuator axes relative to the body axes (R(delta) = exp([delta x]))";
         // calculated parameters
         200 => wheel_torque_max: Real = 0.05, CalculatedParameter, "N.m", "Wheel torque limit k_t i_max before faults";
         201 => wheel_momentum_max: Real = 0.504, CalculatedParameter, "N.m.s", "Wheel momentum limit J_w Omega_max";

@@ -173,3 +173,39 @@ fn noise_is_reproducible_and_step_independent() {
     p.outputs(10.0).unwrap();
     assert!((p.v.w.x - sum / 1000.0).abs() < 1e-15, "{} vs {}", p.v.w.x, sum / 1000.0);
 }
+
+#[test]
+fn actuator_misalignment_and_scale_factor_closed_form() {
+    // spherical inertia J (no gyroscopic torque), constant command u = (50, 0, 0) N·m limited to 10 N·m,
+    // scale k_x = 1.1, misalignment δ = (0, 0, 0.1) rad (a rotation about z): the body torque is
+    // τ = R_z(0.1) (1.1 · 10, 0, 0) = 11 (cos 0.1, sin 0.1, 0) N·m and ω(t) = τ t / J exactly
+    let j = 800.0;
+    let mut p = plant(|v| {
+        (v.inertia.x, v.inertia.y, v.inertia.z) = (j, j, j);
+        (v.u_max.x, v.u_max.y, v.u_max.z) = (10.0, 10.0, 10.0);
+        v.actuator_scale.x = 1.1;
+        v.actuator_misalignment.z = 0.1;
+        v.torque_cmd.x = 50.0;
+    });
+    let tau = Vector3::new(11.0 * 0.1f64.cos(), 11.0 * 0.1f64.sin(), 0.0);
+    assert!((p.v.torque_applied - tau).norm() < 1e-12, "{:?}", p.v.torque_applied);
+    for k in 0..20 {
+        p.step(k as f64 * 0.1, 0.1).unwrap();
+    }
+    p.outputs(2.0).unwrap();
+    let w = Vector3::new(p.v.w.x, p.v.w.y, p.v.w.z);
+    assert!((w - tau * (2.0 / j)).norm() < 1e-14, "{w:?} vs {:?}", tau * (2.0 / j));
+    // a general rotation vector: R(δ) is the Rodrigues rotation (|δ| about δ/|δ|), checked on its axis and angle
+    let d = Vector3::new(0.03, -0.02, 0.04);
+    let mut q = plant(|v| {
+        (v.actuator_misalignment.x, v.actuator_misalignment.y, v.actuator_misalignment.z) = (d.x, d.y, d.z);
+        (v.torque_cmd.x, v.torque_cmd.y, v.torque_cmd.z) = (1.0, 2.0, 3.0);
+    });
+    let u = Vector3::new(1.0, 2.0, 3.0);
+    let th = d.norm();
+    let e = d / th;
+    let rod = u * th.cos() + e.cross(&u) * th.sin() + e * e.dot(&u) * (1.0 - th.cos());
+    let out = Vector3::new(q.v.torque_applied.x, q.v.torque_applied.y, q.v.torque_applied.z);
+    assert!((out - rod).norm() < 1e-14, "{out:?} vs {rod:?}");
+    q.outputs(0.0).unwrap();
+}

@@ -1,0 +1,451 @@
+"""What engineers compare on, beside every rank of the controller benchmark (attitude family): control
+effort, time in actuator saturation, pointing errors (APE, MPE, RPE, PDE, jitter; definitions in
+:mod:`scfmu.metrics`), an effort-vs-performance scatter per scenario, a robustness Monte Carlo
+(:mod:`.robustness`) and the stability margins per axis (:mod:`.margins`).
+
+Hooks used by :func:`scfmu.benchmark.run`: :func:`instrument` (extra logged signals and the time-series
+keys), :func:`entry_metrics` (per controller and scenario, from the runs' time series), :func:`studies`
+(Monte Carlo and margins, on the benchmark's Dask client) and :func:`append_to_page`.
+
+Pointing metrics are evaluated over the *pointing phase*, the last third of the run, with windows of a
+quarter of it (both project choices, stated in seconds on the page), on the logged response (every
+``ts_every``-th communication step, about 1500 points per run).
+"""
+
+from __future__ import annotations
+
+import html
+import math
+from pathlib import Path
+
+import numpy as np
+
+from .. import campaign
+from .. import metrics as M
+from ..scenario.ssp import file_stem
+from . import robustness
+
+PLANT = "plant"
+EXTRA_LOG = {**{f"eng_q_{c}": f"{PLANT}.q_{c}" for c in "wxyz"},
+             **{f"eng_u_{a}": f"{PLANT}.torque_cmd_{a}" for a in "xyz"},
+             **{f"eng_h_{a}": f"{PLANT}.h_wheel_{a}" for a in "xyz"}}
+EVAL_FRACTION = 1 / 3
+WINDOWS = 4
+COLS = [("effort_abs", "effort ∫Σ|u| dt [N·m·s]"), ("sat_frac", "time in saturation [%]"),
+        ("ape_deg", "APE [deg]"), ("mpe_deg", "MPE [deg]"), ("rpe_deg", "RPE [deg]"), ("pde_deg", "PDE [deg]"),
+        ("jitter_deg", "jitter RMS [deg]")]
+MC_COLS = ("primary", "effort_abs", "sat_frac", "ape_deg", "rpe_deg", "settling_s")
+PRIMARY_NAMES = {"eulerint_deg_s": "EULERINT [deg·s]", "ise": "ISE [rad²·s]", "final_error": "final error [deg]",
+                 "euler_end_max_deg": "largest final angle [deg]", "settling_s": "settling time [s]"}
+
+
+def applies(sc) -> bool:
+    try:
+        c = sc.component(PLANT)
+    except KeyError:
+        return False
+    return c.model == "AttitudePlant" and any(x.model == "AttitudeCommand" for x in sc.components)
+
+
+def instrument(sc, signal: str):
+    """(scenario with the extra logged signals, time-series keys) for a benchmark pair."""
+    if not applies(sc):
+        return sc, ([signal] if signal in sc.log else None)
+    sc = sc.with_overrides({})
+    cmd = next(x.name for x in sc.components if x.model == "AttitudeCommand")
+    sc.log.update(EXTRA_LOG)
+    sc.log.update({f"eng_qr_{c}": f"{cmd}.q_ref_{c}" for c in "wxyz"})
+    keys = [k for k in dict.fromkeys([signal, *EXTRA_LOG, *(f"eng_qr_{c}" for c in "wxyz")]) if k in sc.log]
+    return sc, keys
+
+
+def limits(sc, t: np.ndarray) -> tuple[np.ndarray, float]:
+    """(torque limit per sample and axis (n, 3) [N·m], wheel momentum limit [N·m·s] or inf)."""
+    p = robustness.plant_values(sc, PLANT)
+    eff = np.array([p.get(f"effectiveness_{a}", 1.0) for a in "xyz"])
+    faulted = (t >= p.get("fault_time", 0.0))[:, None]
+    if int(p.get("actuator_mode", 0)) == 1:
+        base = np.full(3, p["wheel_torque_coeff"] * p["wheel_max_current"])
+        hmax = p["wheel_inertia"] * p["wheel_max_speed"]
+    else:
+        base = np.array([p.get(f"u_max_{a}", 1e30) for a in "xyz"])
+        hmax = math.inf
+    return np.where(faulted, base * eff, base), hmax
+
+
+def run_metrics(sc, r: dict) -> dict:
+    """Saturation fraction and pointing errors of one run's time series ``r``."""
+    t = np.asarray(r["time"], dtype=float)
+    out = {}
+    u = np.stack([r[f"eng_u_{a}"] for a in "xyz"], axis=1)
+    lim, hmax = limits(sc, t)
+    sat = np.any(np.abs(u) >= (1 - 1e-9) * lim, axis=1)
+    if math.isfinite(hmax):
+        h = np.stack([r[f"eng_h_{a}"] for a in "xyz"], axis=1)
+        sat |= np.any(np.abs(h) >= hmax * (1 - 1e-9), axis=1)
+    dt = np.diff(t)
+    out["sat_frac"] = 100.0 * float(np.sum(dt[sat[:-1]]) / np.sum(dt)) if dt.size else math.nan
+    q = np.stack([r[f"eng_q_{c}"] for c in "wxyz"], axis=1)
+    qr = np.stack([r[f"eng_qr_{c}"] for c in "wxyz"], axis=1)
+    e = M.error_rotation_deg(q, qr)
+    t0, t1 = t[0] + (1 - EVAL_FRACTION) * (t[-1] - t[0]), t[-1]
+    pe = M.pointing_errors(t, e, window=(t1 - t0) / WINDOWS, t_start=t0, t_end=t1)
+    out.update({f"{k}_deg": v for k, v in pe.items()})
+    return out
+
+
+def eval_text(sc) -> str:
+    T = sc.stop_time - sc.start_time
+    return (f"pointing phase {sc.stop_time - EVAL_FRACTION * T:g}–{sc.stop_time:g} s, "
+            f"RPE/PDE/jitter window {EVAL_FRACTION * T / WINDOWS:g} s")
+
+
+def entry_metrics(e, sc, folder, good_rows) -> None:
+    """Means over the runs that succeeded of the saturation fraction and pointing errors (into ``e.means``)."""
+    if not applies(sc) or not good_rows:
+        return
+    vals = []
+    for row in good_rows:
+        try:
+            vals.append(run_metrics(sc, campaign.read_timeseries(folder, row["run"])))
+        except (OSError, KeyError):
+            continue
+    for k, _ in COLS:
+        if k == "effort_abs":
+            continue
+        v = np.array([x.get(k, math.nan) for x in vals], dtype=float)
+        e.means[k] = float(np.mean(v)) if v.size and np.all(np.isfinite(v)) else math.nan
+    e.eval_text = eval_text(sc)
+
+
+# ----- Monte Carlo and margins ----------------------------------------------------------------------------
+def _signature(sc, with_units: bool) -> str:
+    p = sc.component(PLANT).params
+    keep = {k: v for k, v in sorted(p.items()) if not k.startswith(("dist_", "init_", "max_internal", "integrator",
+                                                                        "kinematics"))}
+    units = sorted(c.model for c in sc.components if c.name not in ("controller", "metrics")) if with_units else []
+    return repr((keep, units))
+
+
+def _faulted(sc) -> bool:
+    p = sc.component(PLANT).params
+    return any(k.startswith(("fault_", "effectiveness_")) for k in p)
+
+
+def pick(cases, scenarios: dict, with_units: bool) -> list:
+    """One nominal (not Monte Carlo, no actuator fault) case per distinct plant (and, for the margins, set
+    of units in the loop). Among the cases of one plant: the first with the full (not the linear
+    small-angle) kinematics, which uses the whole inertia matrix; for the Monte Carlo (``with_units``
+    False) preferably one with disturbance torques, whose amplitude the dispersions scale."""
+    chosen: dict = {}
+    for case in cases:
+        sc = scenarios.get(case.label)
+        if sc is None or case.seeds or case.monte_carlo or not applies(sc) or _faulted(sc):
+            continue
+        p = sc.component(PLANT).params
+        score = (int(p.get("kinematics", 0)) != 3,
+                 (not with_units) and any(p.get(k) for k in robustness.DIST_PARAMS))
+        sig = _signature(sc, with_units)
+        if sig not in chosen or score > chosen[sig][0]:
+            chosen[sig] = (score, case)
+    return [c for _, c in chosen.values()]
+
+
+def _margins_task(sc_dict: dict, fmu_dir: str | None):
+    from .. import fmu as fmu_access
+    from ..scenario.model import Scenario
+    from .margins import loop_margins
+    if fmu_dir:
+        fmu_access.set_fmu_dir(fmu_dir)
+    try:
+        ms = loop_margins(Scenario.from_dict(sc_dict), horizon=20.0, n_freq=800, max_horizon=200.0)
+        return [dict(axis=m.axis, gm_db=m.gm_db, gm_low_db=m.gm_low_db, pm_deg=m.pm_deg, wc=m.wc, wpc=m.wpc,
+                     dm_s=m.dm_s, sample_time=m.sample_time, note=m.note, omega=m.omega, loop=m.loop) for m in ms]
+    except Exception as err:  # a unit that cannot be linearised: reported, never a lost benchmark
+        return f"{type(err).__name__}: {err}"[:300]
+
+
+def studies(cases, pairs: dict, entries, out: Path, client, quick: bool, log=print) -> dict:
+    """Runs the robustness Monte Carlo and the margins. ``pairs``: {(case label, controller): scenario}
+    of the pairs that ran. Returns {"mc": {(case, controller): {metric: percentiles, "pass": fraction}},
+    "margins": {(case, controller): [axis dicts] or "reason"}, "mc_cases": [...], "margin_cases": [...]}."""
+    from .. import fmu as fmu_access
+    import time
+    t_start = time.perf_counter()
+    res = {"mc": {}, "margins": {}, "mc_cases": [], "margin_cases": [], "mc_runs": 0}
+    first = {}
+    for (lab, _ctrl), sc in pairs.items():
+        first.setdefault(lab, sc)
+    n = robustness.QUICK_RUNS if quick else robustness.DEFAULT_RUNS
+    res["mc_runs"] = n
+    mc_cases = pick(cases, first, with_units=False)
+    mg_cases = pick(cases, first, with_units=True)
+    res["mc_cases"], res["margin_cases"] = [c.label for c in mc_cases], [c.label for c in mg_cases]
+    # margins: one task per pair on the workers, submitted first so that they overlap the Monte Carlo
+    fmu_dir = str(fmu_access.fmu_dir().resolve())
+    futs = {}
+    for case in mg_cases:
+        for (lab, ctrl), sc in pairs.items():
+            if lab == case.label and not any(fmu_access.is_path(c.model) for c in sc.components):
+                futs[(lab, ctrl)] = client.submit(_margins_task, sc.to_dict(), fmu_dir, pure=False)
+            elif lab == case.label:  # a foreign unit: in this process, where its file is
+                futs[(lab, ctrl)] = None
+    jobs = []
+    for case in mc_cases:
+        draws = robustness.dispersions(first[case.label], n, seed=0)
+        jobs += [(case, lab, ctrl, sc, draws) for (lab, ctrl), sc in pairs.items() if lab == case.label]
+
+    def one(job):
+        case, lab, ctrl, sc, draws = job
+        sc_i, keys = instrument(sc, case.signal)
+        c = campaign.Campaign(sc_i, draws, [None], timeseries=keys, ts_every=max(1, sc_i.n_steps // 600))
+        folder = out / "runs" / "robustness" / file_stem(case.scenario) / _slug(ctrl)
+        table = campaign.run(c, folder, client=client, progress=False, overwrite=True)
+        rows = sorted(table.to_pylist(), key=lambda r: r["run"])
+        per = {k: [] for k in MC_COLS}
+        passed = 0
+        for r in rows:
+            ok = r["status"] == "ok"
+            passed += ok and math.isfinite(r.get("settling_s", math.nan))
+            extra = {}
+            if ok:
+                try:
+                    extra = run_metrics(sc_i, campaign.read_timeseries(folder, r["run"]))
+                except (OSError, KeyError):
+                    extra = {}
+            for k in MC_COLS:
+                src = case.primary if k == "primary" else k
+                per[k].append(extra.get(src, r.get(src, math.nan)) if ok else math.nan)
+        return (lab, ctrl), {**{k: robustness.percentiles(v) for k, v in per.items()},
+                             "pass": passed / len(rows) if rows else math.nan, "runs": len(rows),
+                             "primary_name": case.primary}
+
+    # every Monte Carlo campaign at once (threads only wait on the Dask workers): the workers stay busy
+    from concurrent.futures import ThreadPoolExecutor
+    with ThreadPoolExecutor(max_workers=max(1, min(8, len(jobs)))) as pool:
+        for key, v in pool.map(one, jobs):  # results in the order of the jobs (deterministic page)
+            res["mc"][key] = v
+            log(f"  robustness {key[0]} / {key[1]}: {round(v['pass'] * v['runs'])}/{v['runs']} pass")
+    res["seconds_mc"] = time.perf_counter() - t_start
+    for key, fut in futs.items():
+        if fut is None:
+            res["margins"][key] = _margins_task(pairs[key].to_dict(), None)
+        else:
+            try:
+                res["margins"][key] = fut.result()
+            except Exception as err:
+                res["margins"][key] = f"{type(err).__name__}: {err}"[:300]
+        if isinstance(res["margins"][key], str):
+            log(f"  margins {key[0]} / {key[1]}: {res['margins'][key]}")
+    res["seconds"] = time.perf_counter() - t_start
+    return res
+
+
+def _slug(text: str) -> str:
+    return "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in text)[:80]
+
+
+# ----- the page -------------------------------------------------------------------------------------------
+def _fmt(v, pct=False) -> str:
+    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+        return "–" if not (isinstance(v, float) and v == math.inf) else "∞"
+    return f"{v:.4g}"
+
+
+def _scatter(out: Path, case, entries, unit_label) -> str | None:
+    es = [e for e in entries if e.case == case.label and not e.status
+          and math.isfinite(e.means.get("effort_abs", math.nan)) and math.isfinite(e.means.get(case.primary, math.nan))]
+    if not es:
+        return None
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    groups: dict = {}  # controllers at the same point (to 4 significant digits) share one label
+    for e in es:
+        me = e.controller == unit_label
+        x, y = e.means["effort_abs"], e.means[case.primary]
+        ax.scatter(x, y, s=90 if me else 35, marker="*" if me else "o", edgecolors="k" if me else "none", zorder=3)
+        groups.setdefault((f"{x:.4g}", f"{y:.4g}"), [x, y, []])[2].append(e.controller)
+    for x, y, names in groups.values():
+        ax.annotate(" = ".join(names), (x, y), fontsize=7, xytext=(4, 3), textcoords="offset points",
+                    fontweight="bold" if unit_label in names else "normal")
+    ax.set_xlabel("control effort ∫Σ|u| dt [N·m·s]")
+    ax.set_ylabel(PRIMARY_NAMES.get(case.primary, case.primary) + " (lower is better)")
+    if max(e.means["effort_abs"] for e in es) > 20 * max(1e-300, min(e.means["effort_abs"] for e in es)):
+        ax.set_xscale("log")
+    ax.set_title(f"Effort vs performance: {case.label}" + (f"\nunit under test: {unit_label}" if unit_label else ""),
+                 fontsize=9)
+    ax.grid(True, alpha=0.3)
+    fig.tight_layout()
+    name = f"figures/effort_{_slug(case.label)}.png"
+    fig.savefig(out / name, dpi=110)
+    plt.close(fig)
+    return name
+
+
+def _bode(out: Path, label: str, margins: dict, unit_label) -> str | None:
+    rows = [(ctrl, m) for (lab, ctrl), m in margins.items() if lab == label and isinstance(m, list)]
+    if not rows:
+        return None
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axs = plt.subplots(2, 3, figsize=(12, 6), sharex="col")
+    for ctrl, ms in rows:
+        me = ctrl == unit_label
+        for j, m in enumerate(ms):
+            w, L = np.asarray(m["omega"]), np.asarray(m["loop"])
+            ok = np.isfinite(L)
+            axs[0, j].semilogx(w[ok], 20 * np.log10(np.abs(L[ok])), lw=2.0 if me else 0.9, label=ctrl)
+            axs[1, j].semilogx(w[ok], np.degrees(np.unwrap(np.angle(L[ok]))), lw=2.0 if me else 0.9)
+    for j, a in enumerate("xyz"):
+        axs[0, j].axhline(0, color="k", lw=0.6)
+        axs[1, j].axhline(-180, color="k", lw=0.6)
+        axs[0, j].set_title(f"axis {a}: loop L(e^jωT) broken at torque_cmd_{a}", fontsize=9)
+        axs[0, j].set_ylabel("|L| [dB]")
+        axs[1, j].set_ylabel("phase of L [deg]")
+        axs[1, j].set_xlabel("frequency ω [rad/s]")
+        for k in range(2):
+            axs[k, j].grid(True, which="both", alpha=0.3)
+    axs[0, 0].legend(fontsize=6)
+    fig.suptitle(f"Bode plots of the per-axis loop transfer: {label}" + (f" (unit under test: {unit_label})" if unit_label else ""),
+                 fontsize=10)
+    fig.tight_layout()
+    name = f"figures/bode_{_slug(label)}.png"
+    fig.savefig(out / name, dpi=100)
+    plt.close(fig)
+    return name
+
+
+def append_to_page(out: Path, cases, entries, rk: dict, unit_label, res: dict | None) -> None:
+    """Appends the section "Effort, saturation, pointing, robustness and margins" to ``benchmark.md`` and
+    ``index.html`` and writes ``engineering.csv``, ``robustness.csv`` and ``margins.csv``."""
+    import csv
+    out = Path(out)
+    res = res or {"mc": {}, "margins": {}, "mc_cases": [], "margin_cases": [], "mc_runs": 0}
+    md, h = [], []
+
+    def table(head, rows, bold):
+        md.extend(["| " + " | ".join(head) + " |", "|" + "---|" * len(head)])
+        h.append("<table border=1 cellspacing=0 cellpadding=3><tr>" + "".join(f"<th>{html.escape(x)}</th>" for x in head) + "</tr>")
+        for r, b in zip(rows, bold):
+            md.append("| " + " | ".join((f"**{x}**" if b and i == 0 else str(x)).replace("|", "/") for i, x in enumerate(r)) + " |")
+            h.append(f"<tr{' style=font-weight:bold' if b else ''}>" + "".join(f"<td>{html.escape(str(x))}</td>" for x in r) + "</tr>")
+        md.append("")
+        h.append("</table>")
+
+    def para(text):
+        md.extend([text, ""])
+        h.append(f"<p>{html.escape(text)}</p>")
+
+    title = "Effort, saturation, pointing, robustness and stability margins"
+    md.extend([f"## {title}", ""])
+    h.append(f"<h2>{html.escape(title)}</h2>")
+    para("Effort: ∫Σ|u_i| dt of the applied torque [N·m·s]. Time in saturation: share of the run in which any "
+         "axis of the commanded torque is at or beyond the actuator's torque limit (wheels: or a wheel at its "
+         "momentum limit). Pointing errors of the small-rotation error vector e(t) of the body against the "
+         "reference [deg], over the pointing phase (last third of the run) cut into 4 windows: APE = max ‖e‖; "
+         "MPE = ‖mean e‖; RPE = max over windows of max ‖e − window mean‖; PDE = max ‖difference of "
+         "consecutive window means‖; jitter = RMS of e − window mean. Values are means over the runs of a "
+         "scenario that succeeded, computed from the logged response.")
+    with open(out / "engineering.csv", "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["scenario", "controller", "rank", *[k for k, _ in COLS]])
+        for case in cases:
+            es = [e for e in entries if e.case == case.label]
+            if not any(math.isfinite(e.means.get("ape_deg", math.nan)) for e in es):
+                continue
+            ev = next((getattr(e, "eval_text", "") for e in es if getattr(e, "eval_text", "")), "")
+            md.extend([f"### {case.label}", ""])
+            h.append(f"<h3>{html.escape(case.label)}</h3>")
+            para(f"Primary metric {case.primary}; {ev}.")
+            rows, bold = [], []
+            for e in es:
+                if e.status:
+                    continue
+                rank = rk.get(case.label, {}).get(e.controller, "–")
+                rows.append([e.controller, rank, _fmt(e.means.get(case.primary, math.nan)),
+                             *[_fmt(e.means.get(k, math.nan)) for k, _ in COLS]])
+                bold.append(e.controller == unit_label)
+                w.writerow([case.label, e.controller, rank, *[e.means.get(k, math.nan) for k, _ in COLS]])
+            table(["controller", "rank", case.primary, *[n for _, n in COLS]], rows, bold)
+            fig = _scatter(out, case, entries, unit_label)
+            if fig:
+                md.extend([f"![effort vs performance, {case.label}]({fig})", ""])
+                h.append(f"<p><img src='{fig}' alt='effort vs performance' style='max-width:100%'></p>")
+    # robustness
+    md.extend(["### Robustness Monte Carlo", ""])
+    h.append("<h3>Robustness Monte Carlo</h3>")
+    if "seconds" in res:
+        para(f"Monte Carlo and margins: {res['seconds']:.0f} s of wall time (the margins run on the workers "
+             f"beside the Monte Carlo).")
+    para(f"{res['mc_runs']} seeded runs per controller (seed 0; the same draws for every controller) on "
+         f"{', '.join(res['mc_cases']) or 'no scenario'}: principal inertias ±20 % (uniform) with principal "
+         f"axes turned up to 10° (products of inertia; every draw positive definite and meeting the triangle "
+         f"inequalities), actuator misalignment N(0, 0.5°) per axis, actuator scale factor 1 ± 5 % (uniform), "
+         f"initial attitude + N(0, 2°) per 3-2-1 angle, initial rate + N(0, 0.1 °/s) per axis, disturbance "
+         f"torques × U(0.5, 2). Pass: the run succeeded and settled (2 % band) before its end. Percentiles: "
+         f"NumPy linear interpolation over the runs that succeeded.")
+    with open(out / "robustness.csv", "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["scenario", "controller", "runs", "pass_fraction", *[f"{k}_{s}" for k in MC_COLS for s in ("median", "p95", "p99")]])
+        for lab in res["mc_cases"]:
+            items = [(ctrl, v) for (l2, ctrl), v in res["mc"].items() if l2 == lab]
+            if not items:
+                continue
+            prim = items[0][1]["primary_name"]
+            md.extend([f"#### {lab}", ""])
+            h.append(f"<h4>{html.escape(lab)}</h4>")
+            names = {**dict(COLS), "primary": prim, "settling_s": "settling [s]"}
+            head = ["controller", "pass", *[f"{names.get(k, k)} median / p95 / p99" for k in MC_COLS]]
+            rows, bold = [], []
+            for ctrl, v in items:
+                rows.append([ctrl, f"{100 * v['pass']:.0f} % of {v['runs']}",
+                             *[" / ".join(_fmt(v[k][s]) for s in ("median", "p95", "p99")) for k in MC_COLS]])
+                bold.append(ctrl == unit_label)
+                w.writerow([lab, ctrl, v["runs"], v["pass"], *[v[k][s] for k in MC_COLS for s in ("median", "p95", "p99")]])
+            table(head, rows, bold)
+    # margins
+    md.extend(["### Stability margins", ""])
+    h.append("<h3>Stability margins</h3>")
+    para("Per axis, loop broken at the plant's torque input (the other two axes closed), at the state of every "
+         "unit at the end of the scenario's nominal run; the discrete loop at its sample time T (the "
+         "communication step, or the flight computer's period when the torque reaching the plant is held "
+         "longer), identified from pulse responses through FMU state save/restore; margins by python-control "
+         "on its frequency response. GM: gain margin [dB] (∞: no phase crossover below the Nyquist frequency), "
+         "PM: phase margin [deg] at the crossover ω_c [rad/s], DM = PM/ω_c: delay margin [s].")
+    with open(out / "margins.csv", "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["scenario", "controller", "axis", "sample_time_s", "gm_db", "gm_reduction_db", "pm_deg",
+                    "crossover_rad_s", "delay_margin_s", "note"])
+        for lab in res["margin_cases"]:
+            items = [(ctrl, v) for (l2, ctrl), v in res["margins"].items() if l2 == lab]
+            if not items:
+                continue
+            md.extend([f"#### {lab}", ""])
+            h.append(f"<h4>{html.escape(lab)}</h4>")
+            head = ["controller", "T [s]", *[f"{a}: GM [dB] / PM [deg] / ω_c [rad/s] / DM [s]" for a in "xyz"], "note"]
+            rows, bold = [], []
+            for ctrl, v in items:
+                if isinstance(v, str):
+                    rows.append([ctrl, "–", "–", "–", "–", "not linearised: " + v])
+                    w.writerow([lab, ctrl, "", "", "", "", "", "", "", "not linearised: " + v])
+                else:
+                    rows.append([ctrl, _fmt(v[0]["sample_time"]),
+                                 *[" / ".join(_fmt(m[k]) for k in ("gm_db", "pm_deg", "wc", "dm_s")) for m in v],
+                                 "; ".join(dict.fromkeys(m["note"] for m in v if m["note"]))])
+                    for m in v:
+                        w.writerow([lab, ctrl, m["axis"], m["sample_time"], m["gm_db"], m["gm_low_db"], m["pm_deg"],
+                                    m["wc"], m["dm_s"], m["note"]])
+                bold.append(ctrl == unit_label)
+            table(head, rows, bold)
+            fig = _bode(out, lab, res["margins"], unit_label)
+            if fig:
+                md.extend([f"![Bode plots, {lab}]({fig})", ""])
+                h.append(f"<p><img src='{fig}' alt='Bode plots' style='max-width:100%'></p>")
+    with open(out / "benchmark.md", "a", encoding="utf-8") as f:
+        f.write("\n" + "\n".join(md) + "\n")
+    page = (out / "index.html").read_text(encoding="utf-8")
+    page = page.replace("</body>", "\n".join(h) + "</body>", 1)
+    (out / "index.html").write_text(page, encoding="utf-8")
