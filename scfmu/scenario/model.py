@@ -40,13 +40,17 @@ class Component:
     """One FMU instance in a place of the loop.
 
     * ``name``: instance name, unique in the scenario;
-    * ``model``: a model name (``<FMU folder>/<model>.fmu``) or a path to any FMI 2.0 Co-Simulation FMU;
+    * ``model``: a model name (``<FMU folder>/<model>.fmu``) or a path to any FMI 2.0 or 3.0 FMU;
     * ``params``: parameters of *that model* (set in initialization mode; an unknown name is an error).
       They belong to the model: swapping the model (:meth:`Scenario.with_models`) drops them;
     * ``slot``: parameters that any unit in this place is given *if it declares them* (e.g. the nominal
       inertia an attitude controller should assume); they survive a swap;
     * ``ports``: renames ``{"the unit's port name": "the scenario's port name"}`` for a unit whose port
-      names differ from the family's (``--map``).
+      names differ from the family's (``--map``);
+    * ``interface``: ``"cs"`` (Co-Simulation), ``"me"`` (Model Exchange, integrated by the engine) or
+      ``""`` (default: Co-Simulation when the unit offers it, else Model Exchange);
+    * ``solver``: for a Model Exchange instance, ``{"method": ..., "rtol": ..., "atol": ...}`` (default
+      DOP853, 1e-10, 1e-12; see :mod:`scfmu.scenario.plan`).
     """
 
     name: str
@@ -54,6 +58,8 @@ class Component:
     params: dict = field(default_factory=dict)
     slot: dict = field(default_factory=dict)
     ports: dict = field(default_factory=dict)
+    interface: str = ""
+    solver: dict = field(default_factory=dict)
 
 
 @dataclass
