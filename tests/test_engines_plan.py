@@ -223,3 +223,25 @@ def test_ssp_1_0_and_libcosim_refuse_fmi3_units_with_a_message(tmp_path):
         write_ssp(sc, tmp_path / "x.ssp")
     with pytest.raises(ValueError, match=r"libcosim runs FMI 2.0 units only: \['controller'\]"):
         run_libcosim(sc)
+
+
+def _cli(*args, timeout=900):
+    import subprocess
+    import sys
+    return subprocess.run([sys.executable, "-m", "scfmu", *map(str, args)], capture_output=True, text=True,
+                          timeout=timeout)
+
+
+def test_cli_run_and_benchmark_take_the_fmi3_controller(tmp_path):
+    """The issue's first complaint: `scfmu run default --fmu controller=fmus/fmi3/PdController.fmu` was refused
+    ("FMI 3.0, not FMI 2.0"); now it runs, and the benchmark ranks the FMI 3.0 unit exactly as the FMI 2.0 one."""
+    p = FMUS / "fmi3" / "PdController.fmu"
+    r = _cli("run", "default", "--t-end", "5", "--fmu", f"controller={p}", "--out", tmp_path / "run")
+    assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
+    r = _cli("benchmark", p, "--family", "attitude", "--controllers", "PdController", "--cases", "default",
+             "--out", tmp_path / "b")
+    assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
+    md = (tmp_path / "b" / "benchmark.md").read_text()
+    mine = [x for x in md.splitlines() if x.startswith("| **PdController**")][0]
+    pd = [x for x in md.splitlines() if x.startswith("| PD, quaternion error")][0]
+    assert mine.split("|")[3:] == pd.split("|")[3:], (mine, pd)

@@ -111,7 +111,7 @@ def build_container(scenario, starts: dict | None = None) -> Path:
     me = sorted(plan.model_exchange)
     if me:
         raise PlanError(f"{', '.join(me)}: Model Exchange instances cannot be nested in fmpy's container FMU "
-                        f"(Co-Simulation units only)")
+                        f"(Co-Simulation units only): run the scenario on the 'compiled', 'lean' or 'reference' engine")
     starts = dict(starts or {})
     h = container_key(plan, starts)
     path = CACHE / f"loop_{h}.fmu"
