@@ -68,16 +68,58 @@ def run_reference(scenario, path_of=None, model_exchange=frozenset()) -> dict[st
 
 class Result(dict):
     """The logged signals of one run: ``{"time": t_k, <log key>: values at t_k}`` (NumPy arrays), plus
-    :meth:`to_pandas` and :meth:`to_csv`."""
+
+    * ``units``: ``{key: unit}`` of every logged signal as its unit declares it ("" when it declares none;
+      ``time`` is in s);
+    * ``metrics``: the run's metrics of the scenario's metric set (:mod:`scfmu.metrics`), the same numbers
+      ``scfmu run`` prints (EULERINT, ISE, settling time, overshoot, final error, ...), and
+      ``metric_units``;
+    * ``scenario``: the resolved scenario that ran; ``units_of_instances``: ``{instance: model}``;
+    * :meth:`to_pandas` (the ``pandas`` extra: ``pip install 'scfmu[pandas]'``) and :meth:`to_csv`."""
+
+    scenario = None
+    units: dict = {}
+
+    @property
+    def metrics(self) -> dict:
+        cached = self.__dict__.get("_metrics")
+        if cached is None:
+            from .. import metrics as run_metrics
+            sc = self.scenario
+            cached = self.__dict__["_metrics"] = dict(run_metrics.compute(sc.metrics, self)) if sc is not None and sc.metrics else {}
+        return cached
+
+    @property
+    def metric_units(self) -> dict:
+        from ..results import metric_unit
+        return {k: metric_unit(k, self.units, self.scenario.metrics if self.scenario else "") for k in self.metrics}
+
+    @property
+    def units_of_instances(self) -> dict:
+        return {c.name: c.model for c in self.scenario.components} if self.scenario is not None else {}
 
     def to_pandas(self):
-        """A pandas DataFrame indexed by time (pandas is not a dependency of scfmu: install it to use this)."""
-        import pandas as pd
+        """A pandas DataFrame indexed by time (column names carry no units; see ``units``)."""
+        try:
+            import pandas as pd
+        except ImportError:
+            raise ImportError("Result.to_pandas needs pandas: pip install 'scfmu[pandas]'") from None
         return pd.DataFrame({k: v for k, v in self.items() if k != "time"}, index=pd.Index(self["time"], name="time"))
 
     def to_csv(self, path, keys=None, every: int = 1) -> None:
         from ..results import write_csv
         write_csv(path, self, keys, every)
+
+
+def log_units(plan: Plan) -> dict:
+    """``{log key: unit}`` of a plan's logged signals as their units declare them ("" for none)."""
+    from ..results import declared_unit
+    out = {"time": "s"}
+    for g in plan.log:
+        u = plan.unit(g.inst)
+        for key, name in zip(g.keys, g.names):
+            out[key] = declared_unit(u.vars[name])
+    return out
 
 
 def simulate(scenario, engine: str = "native", *, fmus: dict | None = None, overrides: dict | None = None,
@@ -123,4 +165,7 @@ def simulate(scenario, engine: str = "native", *, fmus: dict | None = None, over
         if not np.all(np.isfinite(v)):
             i = int(np.argmin(np.isfinite(v)))
             raise SimulationError("nonfinite", f"{k} is not finite at t = {out['time'][i]}", float(out["time"][i]))
-    return Result(out)
+    res = Result(out)
+    res.scenario = plan.scenario
+    res.units = log_units(plan)
+    return res

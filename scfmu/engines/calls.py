@@ -58,6 +58,15 @@ NAMES = {2: {"get": {"Real": "fmi2GetReal", "Integer": "fmi2GetInteger", "Boolea
              "step": "fmi3DoStep"}}
 
 
+def raw_calls(fmu) -> "RawCalls":
+    """The instance's :class:`RawCalls`, made once per instance (kept across reset and reuse: the library,
+    its functions and the instance pointer do not change)."""
+    rc = getattr(fmu, "_raw_calls", None)
+    if rc is None:
+        rc = fmu._raw_calls = RawCalls(fmu)
+    return rc
+
+
 class RawCalls:
     """Raw typed calls of one instance (an :class:`scfmu.fmu.Fmu`), made once per instance:
 

@@ -132,7 +132,7 @@ _POOL: dict[tuple, list[dict]] = {}  # reset FMU instance sets ready for the nex
 
 def _identity(name: str, model: str, path: Path, interface: str) -> tuple:
     st = path.stat()  # a rebuilt FMU file is another structure: its old instances are not reused
-    return name, model, str(path.resolve()), st.st_mtime_ns, st.st_size, interface
+    return name, model, str(path), st.st_mtime_ns, st.st_size, interface
 
 
 _SLOT_KEYS = ("get:Real", "set:Real", "get:Integer", "set:Integer", "get:Boolean", "set:Boolean", "step")
@@ -199,11 +199,14 @@ class CompiledLoop(LeanMaster):
             f, u = self.fmus[n], self.plan.unit(n)
             me_unit = u.interface == "me"
             info += [f.fmi, 1 if me_unit else 0, f.nx if me_unit else 0, f.nz if me_unit else 0]
-            table = [_fn_address(self.calls[n], i, fn) for i, fn in enumerate(_FN_NAMES[f.fmi])]
-            if me_unit:
-                table[6] = None
-            else:
-                table[7:] = [None] * (FN_SLOTS - 7)
+            table = getattr(f, "_fn_table", None)
+            if table is None:  # per instance, once (kept across reset and reuse)
+                names_ = _FN_NAMES[f.fmi] if me_unit else _FN_NAMES[f.fmi][:7]
+                table = [_fn_address(self.calls[n], i, fn) for i, fn in enumerate(names_)]
+                table += [None] * (FN_SLOTS - len(table))
+                if me_unit:
+                    table[6] = None
+                f._fn_table = table
             fns += table
             nxt = f.next_event if me_unit and f.next_event is not None else float("nan")
             me += [u.solver.get("rtol", 1e-10), u.solver.get("atol", 1e-12), nxt] if me_unit else [0.0, 0.0, float("nan")]

@@ -24,7 +24,7 @@ import numpy as np
 
 from ..fmu import Fmu
 from ..scenario.plan import Plan
-from .calls import C_TYPES, STATUS as _STATUS, RawCalls, SimulationError, fmu_messages, raw_fn  # noqa: F401
+from .calls import C_TYPES, STATUS as _STATUS, RawCalls, SimulationError, fmu_messages, raw_calls, raw_fn  # noqa: F401
 from .instances import as_plan, build_fmus, initialize_fmus, ports_of  # noqa: F401
 
 
@@ -67,7 +67,7 @@ class LeanMaster:
     def _prepare(self) -> None:
         plan = self.plan
         self.links = plan.links
-        self.calls = {name: RawCalls(f) for name, f in self.fmus.items()}
+        self.calls = {name: raw_calls(f) for name, f in self.fmus.items()}
         self._keep = []  # ctypes objects that must live as long as the master
         self.plan_ops, self.plan_buffers = flat_ops(plan)
         self.plan_log = [(g.inst, g.type, g.keys, g.vrs) for g in plan.log]

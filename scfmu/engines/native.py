@@ -45,7 +45,7 @@ import numpy as np
 from ..fmu import Fmu, fmu_digest, scalar_type, unpacked
 from ..scenario.model import Scenario
 from ..scenario.plan import Plan, PlanError
-from .calls import RawCalls, SimulationError
+from .calls import SimulationError, raw_calls
 from .instances import as_plan
 
 CACHE = Path(os.environ.get("SCFMU_CONTAINER_DIR", Path.home() / ".cache" / "scfmu" / "containers"))
@@ -292,7 +292,7 @@ class NativeLoop:
         vr = plan["vr"]
         raw = getattr(f, "_scfmu_raw", None)
         if raw is None:  # the container's raw calls, kept with the instance
-            raw = f._scfmu_raw = RawCalls(f)
+            raw = f._scfmu_raw = raw_calls(f)
         # one link at a time, in order: get the source output, set the destination input
         one = (c_int32 * 2)()  # room for a double or an int32
         pv, addr = ctypes.addressof(plan["pairs"]), ctypes.addressof(one)

@@ -180,9 +180,37 @@ def build_plan(scenario: Scenario, path_of=None, model_exchange=frozenset(), res
     if unknown:
         raise KeyError(f"model_exchange names no instance of {scenario.name}: {sorted(unknown)}")
     sc = scenario if resolved else resolve(scenario)
+    paths = [Path(path_of(c.model)) if path_of else fmu_path(c.model) for c in sc.components]
+    sig = _signature(sc, paths, model_exchange)
+    hit = _SKELETONS.get(sig)
+    if hit is not None:  # the same structure as a plan made before (e.g. the runs of a campaign)
+        return Plan(sc, *hit)
+    plan = _build(sc, paths, model_exchange)
+    if len(_SKELETONS) > 256:
+        _SKELETONS.clear()
+    _SKELETONS[sig] = (plan.units, plan.links, plan.groups, plan.log)
+    return plan
+
+
+_SKELETONS: dict = {}  # structure of a resolved scenario -> (units, links, groups, log), per process
+
+
+def _signature(sc: Scenario, paths, model_exchange) -> tuple:
+    """Everything a plan depends on except parameter and input values: instances, models and their FMU
+    files (path, modification time, size), interfaces and solvers, port renames, wiring declaration,
+    fixed-input names, logged signals."""
+    comps = []
+    for c, p in zip(sc.components, paths):
+        st = p.stat()
+        comps.append((c.name, c.model, str(p), st.st_mtime_ns, st.st_size, c.interface,
+                      tuple(sorted((k, repr(v)) for k, v in c.solver.items())), tuple(sorted(c.ports.items()))))
+    return (tuple(comps), tuple(sorted(sc.connections.items())), tuple(sc.unconnected), tuple(sorted(sc.inputs)),
+            sc.auto_connect, tuple(sc.log.items()), frozenset(model_exchange))
+
+
+def _build(sc: Scenario, paths, model_exchange) -> Plan:
     units = []
-    for c in sc.components:
-        p = Path(path_of(c.model)) if path_of else fmu_path(c.model)
+    for c, p in zip(sc.components, paths):
         md = unpacked(p)[0]
         fmi = int(str(md.fmiVersion).split(".")[0])
         if fmi not in (2, 3):

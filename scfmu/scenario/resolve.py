@@ -6,19 +6,53 @@ resolved scenario; resolving twice changes nothing."""
 from __future__ import annotations
 
 import copy
+import dataclasses
 
 from ..fmu import fmu_path, unpacked
-from .model import Scenario
+from .model import Component, Scenario
+
+_DECLARED: dict = {}
 
 
 def declared(model: str) -> dict:
     """``{name: ScalarVariable}`` of a model's FMU (the model description is read once per process)."""
-    md = unpacked(fmu_path(model))[0]
-    return {v.name: v for v in md.modelVariables}
+    p = fmu_path(model)
+    st = p.stat()
+    key = (str(p), st.st_mtime_ns, st.st_size)
+    hit = _DECLARED.get(key)
+    if hit is None:
+        md = unpacked(p)[0]
+        hit = _DECLARED[key] = {v.name: v for v in md.modelVariables}
+    return hit
+
+
+def _plain(x):
+    """A copy of a value of a scenario's tables (numbers and strings shared, containers copied)."""
+    if isinstance(x, (int, float, str, bool, type(None))):
+        return x
+    return copy.deepcopy(x)
+
+
+def copy_scenario(scenario: Scenario) -> Scenario:
+    """A deep copy of a scenario, without ``copy.deepcopy``'s cost on its plain tables."""
+    comps = [Component(c.name, c.model, {k: _plain(v) for k, v in c.params.items()},
+                       {k: _plain(v) for k, v in c.slot.items()}, dict(c.ports), c.interface,
+                       {k: _plain(v) for k, v in c.solver.items()}) for c in scenario.components]
+    out = {}
+    for f in dataclasses.fields(scenario):
+        v = getattr(scenario, f.name)
+        if f.name == "components":
+            v = comps
+        elif isinstance(v, dict):
+            v = {k: _plain(x) for k, x in v.items()}
+        elif isinstance(v, list):
+            v = [_plain(x) for x in v]
+        out[f.name] = v
+    return type(scenario)(**out)
 
 
 def resolve(scenario: Scenario) -> Scenario:
-    s = copy.deepcopy(scenario)
+    s = copy_scenario(scenario)
     for inst in s.swapped:  # the old model's own signals (diagnostics) are not logged from its replacement
         names = declared(s.component(inst).model)
         s.log = {k: q for k, q in s.log.items()
