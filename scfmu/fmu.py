@@ -158,14 +158,15 @@ class Fmu:
     events and at its state events (a sign change of an event indicator, located by solve_ivp's event
     detection), and runs the event iteration where the unit asks for it (after
     ``completedIntegratorStep``, e.g. a quaternion renormalisation). ``me_method`` and
-    ``me_rtol``/``me_atol`` choose the solver (default DOP853, 1e-10/1e-12). ``fmi`` is the FMI major
-    version (2 or 3)."""
+    ``me_rtol``/``me_atol`` choose the solver (default DOP853, 1e-10/1e-12); ``me_method="RK4"`` is the
+    classic Runge–Kutta 4 with a fixed step (the communication step, or ``me_max_step`` when smaller; state
+    events located by bisection on re-integrated partial steps). ``fmi`` is the FMI major version (2 or 3)."""
 
     def __init__(self, model: str, params: dict | None = None, name: str | None = None,
                  start_time: float = 0.0, stop_time: float | None = None, tolerance: float | None = None,
                  path: Path | None = None, initialize: bool = True, logging_on: bool = False,
                  unpacked: tuple | None = None, interface: str = "cs", me_method: str = "DOP853",
-                 me_rtol: float = 1e-10, me_atol: float = 1e-12):
+                 me_rtol: float = 1e-10, me_atol: float = 1e-12, me_max_step: float = 0.0):
         self.model = model
         self.path = Path(path) if path else fmu_path(model)
         if unpacked is None:  # (model description, unzip directory) shared by instances; kept on close
@@ -193,6 +194,7 @@ class Fmu:
             self.nx = sum(1 for v in self.md.modelVariables if v.derivative is not None)
             self.nz = int(self.md.numberOfEventIndicators or 0)
             self.me_method, self.me_rtol, self.me_atol = me_method, me_rtol, me_atol
+            self.me_max_step = me_max_step
             self.next_event: float | None = None
         else:
             if self.md.coSimulation is None:
@@ -283,6 +285,52 @@ class Fmu:
             return f
         return [ev(i) for i in range(self.nz)]
 
+    def _rk4(self, t: float, x: np.ndarray, h: float, k1: np.ndarray) -> np.ndarray:
+        k2 = self._rhs(t + 0.5 * h, x + 0.5 * h * k1)
+        k3 = self._rhs(t + 0.5 * h, x + 0.5 * h * k2)
+        k4 = self._rhs(t + h, x + h * k3)
+        return x + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+
+    def _rk4_interval(self, t: float, t_stop: float, dt: float, eps: float) -> tuple[float, bool]:
+        """Fixed-step RK4 from t towards t_stop; stops early at a state event or when the unit asks for an
+        event after ``completedIntegratorStep``. Returns (time reached, event to handle)."""
+        h_fix = min(self.me_max_step, dt) if self.me_max_step > 0 else dt
+        x = self._states()
+        z = self._indicators() if self.nz else None
+        while t < t_stop - eps:
+            h = min(h_fix, t_stop - t)
+            if t + h > t_stop - eps:
+                h = t_stop - t
+            k1 = self._rhs(t, x)
+            xn = self._rk4(t, x, h, k1)
+            tn = t_stop if abs(t + h - t_stop) <= eps else t + h
+            self._rhs(tn, xn)
+            crossed = False
+            if self.nz:
+                zn = self._indicators()
+                crossed = bool(np.any((z > 0) != (zn > 0)))
+                if crossed:  # bisection on the step size
+                    lo, hi, x_hi = 0.0, 1.0, xn
+                    while (hi - lo) * h > eps:
+                        mid = 0.5 * (lo + hi)
+                        xm = self._rk4(t, x, mid * h, k1)
+                        self._rhs(t + mid * h, xm)
+                        if np.any((z > 0) != (self._indicators() > 0)):
+                            hi, x_hi = mid, xm
+                        else:
+                            lo = mid
+                    tn, xn = t + hi * h, x_hi
+                    self._rhs(tn, xn)
+                else:
+                    z = zn
+            t, x = tn, xn
+            enter, terminate = self.slave.completedIntegratorStep()
+            if terminate:
+                raise RuntimeError(f"{self.model}: the unit asked to terminate at t = {t}")
+            if crossed or enter:
+                return t, True
+        return t, False
+
     def _me_step(self, t: float, dt: float) -> None:
         t_end = t + dt
         eps = 1e-12 * max(1.0, abs(t_end))
@@ -290,6 +338,16 @@ class Fmu:
         while t < t_end - eps:
             t_stop = t_end if self.next_event is None or self.next_event >= t_end - eps else self.next_event
             state_event = False
+            if self.me_method == "RK4" and self.nx:
+                t_stop, event = self._rk4_interval(t, t_stop, dt, eps)
+                at_event = self.next_event is not None and abs(t_stop - self.next_event) <= eps
+                if event or at_event:
+                    self.time = t_stop
+                    self.slave.enterEventMode()
+                    self._event_iteration()
+                    self.slave.enterContinuousTimeMode()
+                t = t_stop
+                continue
             if self.nx:
                 sol = solve_ivp(self._rhs, (t, t_stop), self._states(), method=self.me_method,
                                 rtol=self.me_rtol, atol=self.me_atol, events=events)

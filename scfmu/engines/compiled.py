@@ -209,7 +209,8 @@ class CompiledLoop(LeanMaster):
                 f._fn_table = table
             fns += table
             nxt = f.next_event if me_unit and f.next_event is not None else float("nan")
-            me += [u.solver.get("rtol", 1e-10), u.solver.get("atol", 1e-12), nxt] if me_unit else [0.0, 0.0, float("nan")]
+            me += ([u.solver["rtol"], u.solver["atol"], nxt, 1.0 if u.solver["method"] == "RK4" else 0.0,
+                    u.solver["max_step"]] if me_unit else [0.0, 0.0, float("nan"), 0.0, 0.0])
         base = {}
         n_real = n_int = 0
         for b, (t, m) in enumerate(self.plan_buffers):

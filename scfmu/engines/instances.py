@@ -29,7 +29,8 @@ def build_fmus(plan, path_of=None, reuse: bool = False, model_exchange=frozenset
         for u in plan.units:
             kw = {}
             if u.interface == "me":
-                kw = {"me_method": u.solver["method"], "me_rtol": u.solver["rtol"], "me_atol": u.solver["atol"]}
+                kw = {"me_method": u.solver["method"], "me_rtol": u.solver["rtol"], "me_atol": u.solver["atol"],
+                      "me_max_step": u.solver["max_step"]}
             fmus[u.name] = Fmu(u.model, name=u.name, start_time=plan.scenario.start_time, path=u.path,
                                initialize=False, unpacked=unpacked(u.path) if reuse else None,
                                interface=u.interface, **kw)

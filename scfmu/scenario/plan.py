@@ -29,7 +29,9 @@ from .model import Scenario
 from .resolve import resolve
 
 LINK_TYPES = ("Real", "Integer", "Boolean")
-ME_SOLVERS = ("DOP853", "RK45", "Radau", "BDF", "LSODA")  # SciPy solve_ivp methods for ME instances
+# solvers of a Model Exchange instance: SciPy solve_ivp's methods (the compiled engine runs its own
+# Dormand–Prince 5(4) for each of them), and "RK4": classic Runge–Kutta 4 with a fixed step (every engine)
+ME_SOLVERS = ("DOP853", "RK45", "Radau", "BDF", "LSODA", "RK4")
 
 
 class PlanError(ValueError):
@@ -141,11 +143,15 @@ def _interface(c, md, model_exchange) -> str:
 
 def solver_of(c) -> dict:
     """The solve settings of a Model Exchange instance (``Component.solver``, defaults filled in)."""
-    s = {"method": "DOP853", "rtol": 1e-10, "atol": 1e-12}
+    s = {"method": "DOP853", "rtol": 1e-10, "atol": 1e-12, "max_step": 0.0}
     for k, v in (c.solver or {}).items():
         if k not in s:
-            raise PlanError(f"{c.name}: solver option {k!r} is unknown (allowed: method, rtol, atol)")
+            raise PlanError(f"{c.name}: solver option {k!r} is unknown (allowed: method, rtol, atol, max_step)")
         s[k] = v
+    if not (isinstance(s["max_step"], (int, float)) and s["max_step"] >= 0):
+        raise PlanError(f"{c.name}: solver max_step = {s['max_step']!r} must be a number >= 0 (0: the "
+                        f"communication step; RK4's fixed step)")
+    s["max_step"] = float(s["max_step"])
     if s["method"] not in ME_SOLVERS:
         raise PlanError(f"{c.name}: solver method {s['method']!r} is unknown (allowed: {', '.join(ME_SOLVERS)})")
     for k in ("rtol", "atol"):

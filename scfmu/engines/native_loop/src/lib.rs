@@ -89,8 +89,10 @@ pub const F_ENTER_CONT_MODE: usize = 15; // fmi2EnterContinuousTimeMode / fmi3En
 /// Exchange), number of continuous states, number of event indicators.
 pub const INFO_FIELDS: usize = 4;
 /// Entries per FMU in `me_params` (Model Exchange units; ignored otherwise): relative tolerance,
-/// absolute tolerance, next time event after initialization (NaN: none).
-pub const ME_FIELDS: usize = 3;
+/// absolute tolerance, next time event after initialization (NaN: none), method (0: Dormand–Prince 5(4)
+/// adaptive, 1: classic Runge–Kutta 4 with a fixed step), the fixed step's largest size (RK4; 0: the
+/// communication step).
+pub const ME_FIELDS: usize = 5;
 
 type Gs2F64 = unsafe extern "C" fn(*mut c_void, *const u32, usize, *mut f64) -> i32;
 type Gs2I32 = unsafe extern "C" fn(*mut c_void, *const u32, usize, *mut i32) -> i32;
@@ -354,10 +356,14 @@ unsafe fn run(a: &Args, where_: &mut [i64; 3]) -> i32 {
         fmus.push(Fmu { comp: comps[i], v3: version == 3, fns: table, scratch: Vec::new(), tmp: Vec::new() });
         solvers.push(if interface == 1 {
             let p = &me_params[i * ME_FIELDS..(i + 1) * ME_FIELDS];
-            if !(p[0] > 0.0 && p[1] > 0.0) {
+            if !(p[0] > 0.0 && p[1] > 0.0) || !(p[3] == 0.0 || p[3] == 1.0) || !(p[4] >= 0.0) {
                 return ERR_SIZE;
             }
-            Some(me::Solver::new(nx, nz, p[0], p[1], if p[2].is_nan() { None } else { Some(p[2]) }))
+            let mut s = me::Solver::new(nx, nz, p[0], p[1], if p[2].is_nan() { None } else { Some(p[2]) });
+            if p[3] == 1.0 {
+                s.fixed_rk4(p[4]);
+            }
+            Some(s)
         } else {
             None
         });
@@ -706,6 +712,15 @@ mod tests {
 
     #[test]
     fn model_exchange_unit_is_integrated_with_its_time_and_state_events() {
+        toy_me(&[1e-10, 1e-12, 1.0, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn model_exchange_unit_under_fixed_step_rk4() {
+        toy_me(&[1e-10, 1e-12, 1.0, 1.0, 1e-3]);
+    }
+
+    fn toy_me(params: &[f64; 5]) {
         // x(0) = 1, a = 1: x reaches 0.5 at ln 2 (state event; x halves to 0.25); at t_ev = 1.0 the rate
         // becomes a2 = 3; closed form at t = 2: 0.25·e^{-(1 - ln 2)}·e^{-3·1}
         let mut m = MeToy {
@@ -726,7 +741,6 @@ mod tests {
         t[F_ENTER_EVENT_MODE] = me_plain as *const c_void;
         t[F_UPDATE_DISCRETE] = me_update as *const c_void;
         t[F_ENTER_CONT_MODE] = me_plain as *const c_void;
-        let params = [1e-10, 1e-12, 1.0];
         let (n, dt) = (20usize, 0.1);
         let log_fmu = [0usize];
         let log_vr = [0u32];

@@ -2,6 +2,10 @@
 //! Dormand–Prince 5(4) pair with local extrapolation, adaptive step size and its fourth-order
 //! continuous extension (the method of SciPy's `RK45`, written here from the published coefficients).
 //!
+//! Or, chosen per instance, the classic fourth-order Runge–Kutta method with a fixed step (the
+//! communication step, or `max_step` when smaller): four derivative evaluations per step, like a
+//! Co-Simulation unit's own RK4 (state events located by bisection on re-integrated partial steps).
+//!
 //! One communication step of an ME unit from t to t + h, its inputs held (as a co-simulation step):
 //! integrate the continuous states, stopping at the unit's next time event; after every accepted
 //! solver step call `completedIntegratorStep` and look for a sign change of an event indicator (a state
@@ -84,6 +88,10 @@ pub struct Solver {
     pub accepted: usize,
     pub rejected: usize,
     pub events: usize,
+    rk4: bool,
+    max_step: f64,
+    /// Some(t) when the unit is known to be at (t, self.x): its time and states need not be set again
+    at: Option<f64>,
 }
 
 fn ok(st: i32) -> Result<i32, Fail> {
@@ -115,7 +123,51 @@ impl Solver {
             accepted: 0,
             rejected: 0,
             events: 0,
+            rk4: false,
+            max_step: 0.0,
+            at: None,
         }
+    }
+
+    /// dx = f(t, x) where the unit already is at (t, x): only the derivatives are read.
+    unsafe fn derivatives_here(&self, f: &Fmu, dx: &mut [f64]) -> Result<i32, Fail> {
+        if self.nx == 0 {
+            return Ok(0);
+        }
+        ok(transmute::<*const c_void, Vector>(f.fns[F_GET_DERIVATIVES])(f.comp, dx.as_mut_ptr(), self.nx))
+    }
+
+    /// Classic Runge–Kutta 4 with a fixed step of at most `max_step` (0: the communication step).
+    pub fn fixed_rk4(&mut self, max_step: f64) {
+        self.rk4 = true;
+        self.max_step = max_step;
+    }
+
+    /// One RK4 step of size h from (t, self.x) with k1 = self.k[0] into `self.x_new` (uses k[1..4], y).
+    unsafe fn rk4_step(&mut self, f: &Fmu, t: f64, h: f64) -> Result<i32, Fail> {
+        let mut w = 0;
+        let n = self.nx;
+        for (s, c) in [(1usize, 0.5f64), (2, 0.5), (3, 1.0)] {
+            for i in 0..n {
+                self.y[i] = self.x[i] + c * h * self.k[s - 1][i];
+            }
+            let y = std::mem::take(&mut self.y);
+            let mut ks = std::mem::take(&mut self.k[s]);
+            let r = if s == 2 {
+                // the same time as stage 2: only the states are set
+                ok(transmute::<*const c_void, Vector>(f.fns[F_SET_STATES])(f.comp, y.as_ptr() as *mut f64, n))
+                    .and_then(|a| self.derivatives_here(f, &mut ks).map(|b| a.max(b)))
+            } else {
+                self.rhs(f, t + c * h, &y, &mut ks)
+            };
+            self.y = y;
+            self.k[s] = ks;
+            w = w.max(r?);
+        }
+        for i in 0..n {
+            self.x_new[i] = self.x[i] + h / 6.0 * (self.k[0][i] + 2.0 * self.k[1][i] + 2.0 * self.k[2][i] + self.k[3][i]);
+        }
+        Ok(w)
     }
 
     unsafe fn set(&self, f: &Fmu, t: f64, x: &[f64]) -> Result<i32, Fail> {
@@ -253,10 +305,14 @@ impl Solver {
         let t_end = t + dt;
         let eps = 1e-12 * t_end.abs().max(1.0);
         let mut t = t;
-        let mut w = self.read_states(f)?;
+        let here = self.at == Some(t); // left at (t, x) by the previous step: nothing to read or set
+        let mut w = if here { 0 } else { self.read_states(f)? };
         if self.nz > 0 {
             let x = self.x.clone();
-            w = w.max(self.set(f, t, &x)?);
+            if !here {
+                w = w.max(self.set(f, t, &x)?);
+                self.at = Some(t);
+            }
             let mut z = std::mem::take(&mut self.z);
             w = w.max(self.indicators(f, &mut z)?);
             self.z = z;
@@ -275,16 +331,24 @@ impl Solver {
             let mut steps = 0usize;
             let mut stop_event = false;
             let mut k0 = std::mem::take(&mut self.k[0]);
-            let x = self.x.clone();
-            w = w.max(self.rhs(f, t, &x, &mut k0)?);
+            let r = if self.at == Some(t) {
+                self.derivatives_here(f, &mut k0)
+            } else {
+                let x = self.x.clone();
+                self.rhs(f, t, &x, &mut k0)
+            };
             self.k[0] = k0;
-            if self.h <= 0.0 && self.nx > 0 {
+            w = w.max(r?);
+            self.at = Some(t);
+            if self.h <= 0.0 && self.nx > 0 && !self.rk4 {
                 self.h = self.initial_step(f, t, t_stop - t)?;
+                self.at = None;
             }
             while t < t_stop - eps {
                 if self.nx == 0 {
                     t = t_stop;
                     w = w.max(self.set(f, t, &[])?);
+                    self.at = Some(t);
                     let (enter, st) = self.completed(f)?;
                     w = w.max(st);
                     stop_event = enter;
@@ -294,6 +358,83 @@ impl Solver {
                 if steps > MAX_STEPS_PER_INTERVAL {
                     return Err((3, PHASE_SOLVER));
                 }
+                if self.rk4 {
+                    let h_fix = if self.max_step > 0.0 { self.max_step.min(dt) } else { dt };
+                    let mut h = h_fix.min(t_stop - t);
+                    if t + h > t_stop - eps {
+                        h = t_stop - t;
+                    }
+                    if steps > 1 {
+                        let mut k0 = std::mem::take(&mut self.k[0]);
+                        let r = if self.at == Some(t) {
+                            self.derivatives_here(f, &mut k0)
+                        } else {
+                            let x = self.x.clone();
+                            self.rhs(f, t, &x, &mut k0)
+                        };
+                        self.k[0] = k0;
+                        w = w.max(r?);
+                    }
+                    self.at = None;
+                    w = w.max(self.rk4_step(f, t, h)?);
+                    self.accepted += 1;
+                    let mut t_new = if (t + h - t_stop).abs() <= eps { t_stop } else { t + h };
+                    let xn = self.x_new.clone();
+                    if t_new == t + h {
+                        // the unit's time is already t + h (the last stage): only the states are set
+                        let st = transmute::<*const c_void, Vector>(f.fns[F_SET_STATES])(f.comp, xn.as_ptr() as *mut f64, self.nx);
+                        w = w.max(ok(st)?);
+                    } else {
+                        w = w.max(self.set(f, t_new, &xn)?);
+                    }
+                    let mut crossed = false;
+                    if self.nz > 0 {
+                        let mut zn = std::mem::take(&mut self.z_new);
+                        w = w.max(self.indicators(f, &mut zn)?);
+                        self.z_new = zn;
+                        crossed = self.z.iter().zip(&self.z_new).any(|(a, b)| (*a > 0.0) != (*b > 0.0));
+                    }
+                    if crossed {
+                        // bisection on the step size: x(t + θh) by one RK4 step of θh from (t, x)
+                        let (mut lo, mut hi) = (0.0f64, 1.0f64);
+                        let mut x_hi = self.x_new.clone();
+                        for _ in 0..200 {
+                            if (hi - lo) * h <= eps {
+                                break;
+                            }
+                            let mid = 0.5 * (lo + hi);
+                            w = w.max(self.rk4_step(f, t, mid * h)?);
+                            let xm = self.x_new.clone();
+                            w = w.max(self.set(f, t + mid * h, &xm)?);
+                            let mut zi = std::mem::take(&mut self.zi);
+                            w = w.max(self.indicators(f, &mut zi)?);
+                            self.zi = zi;
+                            if self.z.iter().zip(&self.zi).any(|(a, b)| (*a > 0.0) != (*b > 0.0)) {
+                                hi = mid;
+                                x_hi = xm;
+                            } else {
+                                lo = mid;
+                            }
+                        }
+                        t_new = t + hi * h;
+                        self.x_new = x_hi;
+                        let xn = self.x_new.clone();
+                        w = w.max(self.set(f, t_new, &xn)?);
+                    } else if self.nz > 0 {
+                        std::mem::swap(&mut self.z, &mut self.z_new);
+                    }
+                    std::mem::swap(&mut self.x, &mut self.x_new);
+                    t = t_new;
+                    self.at = Some(t); // set just above (x_new, now x)
+                    let (enter, st) = self.completed(f)?;
+                    w = w.max(st);
+                    if crossed || enter {
+                        stop_event = true;
+                        break;
+                    }
+                    continue;
+                }
+                self.at = None;
                 let mut h = self.h.min(t_stop - t);
                 if t + h > t_stop - eps {
                     h = t_stop - t;
@@ -409,9 +550,11 @@ impl Solver {
             let at_time_event = self.next_event.is_some_and(|te| (t - te).abs() <= eps);
             if stop_event || at_time_event {
                 w = w.max(self.event(f)?);
+                self.at = None; // the event iteration may have changed the states (read again)
                 if self.nz > 0 {
                     let x = self.x.clone();
                     w = w.max(self.set(f, t, &x)?);
+                    self.at = Some(t);
                     let mut z = std::mem::take(&mut self.z);
                     w = w.max(self.indicators(f, &mut z)?);
                     self.z = z;
@@ -419,8 +562,11 @@ impl Solver {
             }
         }
         // leave the unit exactly at (t_end, x(t_end)) for the outputs read at the next communication point
-        let x = self.x.clone();
-        w = w.max(self.set(f, t_end, &x)?);
+        if self.at != Some(t_end) {
+            let x = self.x.clone();
+            w = w.max(self.set(f, t_end, &x)?);
+            self.at = Some(t_end);
+        }
         Ok(w)
     }
 }
