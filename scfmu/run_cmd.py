@@ -19,6 +19,7 @@ import sys
 
 from .engines import ENGINES, SimulationError, simulate
 from .fmu import is_path
+from .scenario.plan import PlanError, build_plan
 from .results import write_csv
 from .scenario import options
 from .scenario.check import IncompatibleUnit, require
@@ -134,7 +135,9 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="scfmu run", description=__doc__ + "\n" + options.__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     options.add_arguments(ap)
-    ap.add_argument("--engine", default="native", choices=ENGINES, help="engine (all give bit-identical results)")
+    ap.add_argument("--engine", default=None, choices=ENGINES,
+                    help="engine (all give bit-identical results on Co-Simulation units); default native, or, "
+                         "when a unit runs as Model Exchange, compiled (else lean)")
     ap.add_argument("--out", default=None, help="output folder (default out/<scenario>[+<unit>...]: its own folder "
                                                 "per run; another run's folder gets a -2, -3, ... suffix)")
     ap.add_argument("--no-plot", action="store_true")
@@ -145,6 +148,16 @@ def main(argv=None) -> int:
     except IncompatibleUnit as e:
         print(f"scfmu run: {e}", file=sys.stderr)
         return 2
+    try:
+        plan = build_plan(sc)
+    except (PlanError, KeyError, ValueError) as e:
+        print(f"scfmu run: {e}", file=sys.stderr)
+        return 2
+    if args.engine is None:
+        args.engine = "native"
+        if plan.model_exchange:  # fmpy's container (native) hosts Co-Simulation units only
+            from .engines.compiled import available
+            args.engine = "compiled" if available() else "lean"
     stem = file_stem(sc.name)
     ident = run_identity(sc, args.engine)
     out, notice = choose_folder(Path(args.out) if args.out else Path("out") / run_folder_name(sc), ident,
@@ -152,7 +165,10 @@ def main(argv=None) -> int:
     if notice:
         print(notice, file=sys.stderr)
     try:
-        r = simulate(sc, args.engine)
+        r = simulate(plan, args.engine)
+    except PlanError as e:
+        print(f"scfmu run: {e}", file=sys.stderr)
+        return 2
     except SimulationError as e:
         print(f"scfmu run: the run failed ({e.status}): {e}", file=sys.stderr)
         return 1

@@ -259,3 +259,14 @@ def test_cli_run_and_benchmark_take_the_fmi3_controller(tmp_path):
     mine = [x for x in md.splitlines() if x.startswith("| **PdController**")][0]
     pd = [x for x in md.splitlines() if x.startswith("| PD, quaternion error")][0]
     assert mine.split("|")[3:] == pd.split("|")[3:], (mine, pd)
+
+
+def test_cli_run_with_a_model_exchange_only_unit_picks_an_engine_that_runs_it(units, tmp_path):
+    p = units.c3("C3AxisBody")
+    r = _cli("run", "paper002/PD", "--t-end", "1", "--no-plot", "--fmu", f"plant={p}", "--out", tmp_path / "a")
+    assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
+    assert "on the compiled engine" in r.stdout
+    r = _cli("run", "paper002/PD", "--t-end", "1", "--no-plot", "--engine", "native", "--fmu", f"plant={p}",
+             "--out", tmp_path / "b")
+    assert r.returncode == 2 and "Traceback" not in r.stderr
+    assert r.stderr.strip().endswith("run the scenario on the 'compiled', 'lean' or 'reference' engine"), r.stderr

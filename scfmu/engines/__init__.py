@@ -10,6 +10,10 @@
   ``cargo build --release`` in a source checkout);
 * ``"auto"`` (the campaigns' default): ``"compiled"`` when available, else ``"native"``.
 
+Every engine executes one :class:`~scfmu.scenario.plan.Plan` (built once by :func:`simulate`): units of FMI
+2.0 or 3.0; Co-Simulation units everywhere, Model Exchange units in the reference, lean and compiled
+engines (fmpy's container, hence the native engine and loop FMUs, hosts Co-Simulation units only).
+
 A run that fails (FMU error status, non-finite logged value) raises ``SimulationError`` with a status
 code and the FMUs' log messages.
 """

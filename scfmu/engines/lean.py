@@ -1,17 +1,19 @@
-"""Lean fixed-step Gauss–Seidel master: the same algorithm as ``master.CoSimulation``, without per-step
+"""Lean fixed-step Gauss–Seidel master: the same algorithm as ``reference.CoSimulation``, without per-step
 Python object churn.
 
-Set-up (once per run): every FMU is instantiated and initialized through fmpy (``master.Fmu``), the
-scenario's wiring is resolved by port name to value references, and for every destination instance
-the master preallocates one ctypes ``double`` buffer for its connected inputs and the value-reference
-arrays of each source group. Per communication point t_k = t0 + k·Δ it calls, in Gauss–Seidel order,
-``fmi2GetReal`` of each source group into a slice of the destination's buffer and one ``fmi2SetReal``
-of the whole buffer; logged variables are read with one ``fmi2GetReal`` per instance straight into a
-preallocated NumPy row; then ``fmi2DoStep(t_k, Δ)`` on every instance. The FMI functions are called as
-raw ctypes function pointers taken from the FMU's shared library (arguments are plain ints: handles
-and buffer addresses), and their status codes are checked once per step.
+Set-up (once per run): every FMU of the plan (:mod:`scfmu.scenario.plan`; FMI 2.0 or 3.0, Co-Simulation
+or Model Exchange) is instantiated and initialized through fmpy (:class:`scfmu.fmu.Fmu`), and the plan's
+link groups become flat operations (:func:`flat_ops`): per destination and type one preallocated ctypes
+buffer (Real ``double``, Integer and Boolean ``int32``) for its connected inputs and the value-reference
+arrays of each source group. Per communication point t_k = t0 + k·Δ it calls, in Gauss–Seidel order, the
+get of each source group into a slice of the destination's buffer and one set of each of the
+destination's buffers; logged variables are read with one get per instance and type straight into a
+preallocated NumPy row; then every instance steps from t_k to t_k + Δ (``doStep``, or for a Model Exchange
+instance its solver). The FMI functions are raw ctypes function pointers taken from the FMU's shared
+library (:class:`scfmu.engines.calls.RawCalls`: arguments are plain ints, handles and buffer addresses),
+and their status codes are checked once per step.
 
-The value sequence seen by the FMUs is the one of ``master.CoSimulation`` (same reads, same writes, same
+The value sequence seen by the FMUs is the one of ``reference.CoSimulation`` (same reads, same writes, same
 order, same communication points), so results are bit-identical (tests/test_campaign.py checks it).
 """
 
