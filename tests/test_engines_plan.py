@@ -270,3 +270,36 @@ def test_cli_run_with_a_model_exchange_only_unit_picks_an_engine_that_runs_it(un
              "--out", tmp_path / "b")
     assert r.returncode == 2 and "Traceback" not in r.stderr
     assert r.stderr.strip().endswith("run the scenario on the 'compiled', 'lean' or 'reference' engine"), r.stderr
+
+
+def test_array_ports_and_other_fmi3_types_are_refused_by_the_one_rule():
+    from fmpy.model_description import Dimension, ModelVariable
+    from scfmu.scenario.plan import Unit, link_problem
+
+    def unit(name, v):
+        return Unit(name, "M", None, None, 3, "cs", {}, {v.name: v})
+    arr = ModelVariable(name="tau", type="Float64", causality="output", valueReference=1)
+    arr.dimensions = [Dimension(start="3", valueReference=None)]
+    scalar = ModelVariable(name="tau", type="Float64", causality="input", valueReference=2)
+    f32 = ModelVariable(name="tau", type="Float32", causality="output", valueReference=3)
+    assert "a.tau is an FMI 3.0 array" in link_problem(unit("b", scalar), "tau", unit("a", arr), "tau")
+    assert "only Real, Integer, Boolean connections" in link_problem(unit("b", scalar), "tau", unit("a", f32), "tau")
+    assert link_problem(unit("b", scalar), "tau", unit("a", scalar), "tau") is None
+
+
+def test_preflight_checks_the_fmi3_binary_folder_and_the_interface(units, tmp_path):
+    import zipfile
+    from scfmu.scenario.check import check
+    src = units.c3("C3PdController")
+    nobin = tmp_path / "C3PdController_nobin.fmu"
+    with zipfile.ZipFile(src) as zi, zipfile.ZipFile(nobin, "w") as zo:
+        zo.writestr("modelDescription.xml", zi.read("modelDescription.xml"))
+    base = get("default", stop_time=T)
+    base = base.with_overrides(unconnected=base.unconnected + ["controller.enable", "controller.count_in"])
+    assert check(base.with_models({"controller": str(src)})).ok
+    rep = check(base.with_models({"controller": str(nobin)}))
+    assert rep.errors and "binaries/x86_64-linux/C3PdController.so missing" in rep.errors[0], rep.errors
+    me = base.with_models({"controller": str(src)})
+    me.component("controller").interface = "me"
+    rep = check(me)
+    assert rep.errors and "no Model Exchange interface (Co-Simulation only)" in rep.errors[0], rep.errors
