@@ -142,6 +142,9 @@ def simulate(scenario, engine: str = "native", *, fmus: dict | None = None, over
     if isinstance(scenario, str):
         from ..scenario import get
         scenario = get(scenario)
+    if isinstance(scenario, Plan) and (fmus or overrides or seed is not None or model_exchange):
+        raise ValueError("simulate(plan, ...): a plan is fixed; give fmus, overrides, seed and model_exchange "
+                         "with a scenario")
     if fmus:
         scenario = scenario.with_models(fmus)
     if overrides:
