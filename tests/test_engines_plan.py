@@ -307,3 +307,17 @@ def test_preflight_checks_the_fmi3_binary_folder_and_the_interface(units, tmp_pa
     me.component("controller").interface = "me"
     rep = check(me)
     assert rep.errors and "no Model Exchange interface (Co-Simulation only)" in rep.errors[0], rep.errors
+
+
+def test_scenario_files_carry_the_interface_and_solver_of_an_instance():
+    from scfmu.scenario import files
+    data = files.to_data(get("default", stop_time=2.0))
+    plant = [c for c in data["components"] if c["name"] == "plant"][0]
+    plant["interface"], plant["solver"] = "me", {"method": "RK4"}
+    sc = files.from_data(data, "mine.toml")
+    assert (sc.component("plant").interface, sc.component("plant").solver) == ("me", {"method": "RK4"})
+    assert build_plan(sc).model_exchange == {"plant"}
+    assert worst_rel(simulate(get("default", stop_time=2.0), "reference"), simulate(sc, "compiled")) < 1e-6
+    plant["interface"] = "modelexchange"
+    with pytest.raises(files.ScenarioFileError, match=r"interface = 'modelexchange'; allowed: \"cs\""):
+        files.from_data(data, "mine.toml")
