@@ -401,8 +401,8 @@ def test_campaign_metrics_equal_those_of_a_full_log_reference_run(name, t, overr
     seen = []
     real_simulate = campaign.simulate
 
-    def spy(sc, *a, **kw):
-        seen.append(dict(sc.log))
+    def spy(sc, *a, **kw):  # a campaign run hands simulate its plan (the scenario resolved once)
+        seen.append(dict(getattr(sc, "scenario", sc).log))
         return real_simulate(sc, *a, **kw)
 
     campaign.simulate = spy
