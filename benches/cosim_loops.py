@@ -25,7 +25,8 @@ the 30 s run 000-6 on the native path, warm workers) with 1 and 2 Dask workers.
 
 With --run-cost, the cost of one campaign run (campaign.run_one, as a worker runs it, on the compiled and
 on the native engine) against the native stepping of the same run without logging, side by side in this
-process (issue 20).
+process (issue 20), and the compiled loop's run with FMI 3.0 and Model Exchange units against the FMI 2.0
+Co-Simulation units they replace (issue 34).
 
 Usage: .venv/bin/python benches/cosim_loops.py [--repeat 5] [--campaign] [--run-cost] [--runs 40]
 """
@@ -85,13 +86,24 @@ def t_lean(sc, log=True):
         return time.perf_counter() - t
 
 
+def raw_ops(m: LeanMaster):
+    """The lean master's propagation as (raw FMI 2.0 function, component, vr array, n, buffer) and its steps
+    as (raw fmi2DoStep, component)."""
+    ops = []
+    for (kind, typ, inst, _v, _b, _o), (_fn, vrs, n, buf) in zip(m.plan_ops, m._ops):
+        c = m.calls[inst]
+        ops.append((c.fn[f"{kind}:{typ}"], c.comp, vrs, n, buf))
+    return ops, [(m.calls[name].fn["step"], m.calls[name].comp) for name in m.fmus]
+
+
 def unrolled(m: LeanMaster):
     """Straight-line Python for one communication step of the lean master's call list."""
     lines, env = [], {}
-    for i, (fn, comp, vrs, n, buf) in enumerate(m._ops):
+    ops, steps = raw_ops(m)
+    for i, (fn, comp, vrs, n, buf) in enumerate(ops):
         env[f"f{i}"] = fn
         lines.append(f"f{i}({comp}, {vrs}, {n}, {buf})")
-    for j, (fn, comp) in enumerate(m._steps):
+    for j, (fn, comp) in enumerate(steps):
         env[f"s{j}"] = fn
         lines.append(f"s{j}({comp}, t, dt, 1)")
     src = "def loop(n, t0, dt):\n    for k in range(n):\n        t = t0 + k * dt\n" + "".join(
@@ -133,8 +145,9 @@ class Op(ctypes.Structure):
 def t_floor(sc):
     lib = floor_lib()
     with LeanMaster(sc.with_overrides(log={})) as m:
-        ops = [Op(0, ctypes.cast(fn, c_void_p).value, comp, vrs, n, buf) for fn, comp, vrs, n, buf in m._ops]
-        ops += [Op(2, ctypes.cast(fn, c_void_p).value, comp, None, 0, None) for fn, comp in m._steps]
+        raw, steps = raw_ops(m)
+        ops = [Op(0, ctypes.cast(fn, c_void_p).value, comp, vrs, n, buf) for fn, comp, vrs, n, buf in raw]
+        ops += [Op(2, ctypes.cast(fn, c_void_p).value, comp, None, 0, None) for fn, comp in steps]
         arr = (Op * len(ops))(*ops)
         t = time.perf_counter()
         st = lib.run_loop(arr, len(ops), m.n, sc.start_time, sc.step)
@@ -229,31 +242,101 @@ def campaign_cost(n_runs: int, repeat: int):
     specs = {e: campaign.Campaign(sc, sets, seeds=[None], engine=e).runs() for e in engines}
     for e in engines:
         campaign.run_one(specs[e][0])  # container built, unpacked, instances pooled
-    step = float("inf")
-    run = dict.fromkeys(engines, float("inf"))
-    stepc = float("inf")
+    inf = (float("inf"), float("inf"))
+    step, stepc = inf, inf
+    run = dict.fromkeys(engines, inf)
+
+    def best(a, b):
+        return min(a[0], b[0]), min(a[1], b[1])
+
+    def timed(f):
+        w, c = time.perf_counter(), time.process_time()
+        f()
+        return time.perf_counter() - w, time.process_time() - c
+
+    def native_step():
+        with NativeLoop(sc, log_every=0) as m:
+            return timed(m.run)
+
+    def compiled_alone():
+        from scfmu.engines.compiled import CompiledLoop
+        with CompiledLoop(sc) as m:
+            return timed(m.run)
+
+    def runs(e):
+        for s in specs[e]:
+            row, _ = campaign.run_one(s)
+            assert row["status"] == "ok", row["message"]
+
     for _ in range(repeat):
-        step = min(step, t_native(sc, 0))
+        step = best(step, native_step())
         if compiled.available():
-            stepc = min(stepc, t_compiled(sc))
+            stepc = best(stepc, compiled_alone())
         for e in engines:
-            t = time.perf_counter()
-            for s in specs[e]:
-                row, _ = campaign.run_one(s)
-                assert row["status"] == "ok", row["message"]
-            run[e] = min(run[e], (time.perf_counter() - t) / n_runs)
-    print(f"\n| run 000-6 (3,000 steps), one process | ms per run | µs per step |")
-    print("|---|---:|---:|")
-    print(f"| native stepping, log_every=0 | {step * 1e3:.2f} | {step / sc.n_steps * 1e6:.2f} |")
+            w, c = timed(lambda: runs(e))
+            run[e] = best(run[e], (w / n_runs, c / n_runs))
+    print(f"\n| run 000-6 (3,000 steps), one process | wall ms per run | CPU ms per run | wall µs per step |")
+    print("|---|---:|---:|---:|")
+    print(f"| native stepping, log_every=0 | {step[0] * 1e3:.2f} | {step[1] * 1e3:.2f} | {step[0] / sc.n_steps * 1e6:.2f} |")
     if compiled.available():
-        print(f"| compiled loop alone, all 22 signals logged every step | {stepc * 1e3:.2f} | "
-              f"{stepc / sc.n_steps * 1e6:.2f} |")
+        print(f"| compiled loop alone, all 22 signals logged every step | {stepc[0] * 1e3:.2f} | {stepc[1] * 1e3:.2f} | "
+              f"{stepc[0] / sc.n_steps * 1e6:.2f} |")
     for e in engines:
-        print(f"| campaign run on the {e} engine (run_one, 1 worker's work) | {run[e] * 1e3:.2f} "
-              f"({1 / run[e]:.1f} runs/s) | {run[e] / sc.n_steps * 1e6:.2f} |")
+        print(f"| campaign run on the {e} engine (run_one, 1 worker's work) | {run[e][0] * 1e3:.2f} "
+              f"({1 / run[e][0]:.1f} runs/s) | {run[e][1] * 1e3:.2f} | {run[e][0] / sc.n_steps * 1e6:.2f} |")
     for e in engines:
-        print(f"| ratio campaign run ({e}) / native stepping | {run[e] / step:.2f}× | |")
+        print(f"| ratio campaign run ({e}) / native stepping | {run[e][0] / step[0]:.2f}× (wall) | "
+              f"{run[e][1] / step[1]:.2f}× (CPU) | |")
     return step, run
+
+
+def unit_cost(repeat: int):
+    """Side by side in this process, the compiled loop's run 000-6 (3,000 steps, every signal logged) with
+    the FMI 2.0 Co-Simulation PdController and AttitudePlant, with their FMI 3.0 Co-Simulation FMUs, and
+    with the plant as a Model Exchange unit (FMI 2.0 and 3.0) under the loop's Dormand–Prince 5(4)
+    (rtol 1e-10) and under its fixed-step RK4 (the communication step, as the Co-Simulation plant's own
+    integrator); each the minimum over interleaved repetitions, wall and CPU time, and the largest
+    deviation of any logged signal from the FMI 2.0 Co-Simulation run (relative to the signal's range)."""
+    import numpy as np
+    from scfmu.engines.compiled import CompiledLoop, available
+    from scfmu.scenario.plan import build_plan
+    if not available():
+        print("compiled loop library not available: cargo build --release")
+        return
+    f = ROOT / "fmus"
+    base = scenarios.get("default")
+    variants = {}
+    for label, ver, me, method in [("FMI 2.0 CS (reference)", "", False, None), ("FMI 3.0 CS", "fmi3", False, None),
+                                   ("FMI 2.0 plant ME, DP5(4) rtol 1e-10", "", True, "DOP853"),
+                                   ("FMI 3.0 plant ME, DP5(4) rtol 1e-10", "fmi3", True, "DOP853"),
+                                   ("FMI 2.0 plant ME, RK4 fixed step", "", True, "RK4"),
+                                   ("FMI 3.0 plant ME, RK4 fixed step", "fmi3", True, "RK4")]:
+        d = f / ver if ver else f
+        sc = base.with_models({"controller": str(d / "PdController.fmu"), "plant": str(d / "AttitudePlant.fmu")})
+        if method:
+            sc.component("plant").solver = {"method": method}
+        variants[label] = build_plan(sc, model_exchange={"plant"} if me else frozenset())
+    results = {}
+    for label, plan in variants.items():
+        with CompiledLoop(plan) as m:
+            results[label] = m.run()
+    ref = results["FMI 2.0 CS (reference)"]
+    dev = {k: max(float(np.max(np.abs(ref[s] - r[s])) / max(1e-300, np.max(np.abs(ref[s])))) for s in ref if s != "time")
+           for k, r in results.items()}
+    best = {k: [float("inf"), float("inf")] for k in variants}
+    for _ in range(repeat):
+        for label, plan in variants.items():
+            with CompiledLoop(plan) as m:
+                w, c = time.perf_counter(), time.process_time()
+                m.run()
+                w, c = time.perf_counter() - w, time.process_time() - c
+            best[label] = [min(best[label][0], w), min(best[label][1], c)]
+    w0, c0 = best["FMI 2.0 CS (reference)"]
+    print("\n| run 000-6 in the compiled loop (3,000 steps, 22 signals logged) | wall ms | CPU ms | "
+          "ratio (wall) | ratio (CPU) | max deviation |")
+    print("|---|---:|---:|---:|---:|---:|")
+    for label, (w, c) in best.items():
+        print(f"| {label} | {w * 1e3:.2f} | {c * 1e3:.2f} | {w / w0:.2f}× | {c / c0:.2f}× | {dev[label]:.1e} |")
 
 
 def main() -> int:
@@ -272,6 +355,7 @@ def main() -> int:
         loops(args.repeat)
     if args.run_cost:
         campaign_cost(args.runs, args.repeat)
+        unit_cost(args.repeat)
     if args.campaign:
         campaign_throughput(args.runs)
     return 0

@@ -22,7 +22,7 @@ except _metadata.PackageNotFoundError:  # imported from a source tree that is no
 _LAZY = {
     "simulate": ("scfmu.engines", "simulate"),
     "Result": ("scfmu.engines", "Result"),
-    "SimulationError": ("scfmu.engines.lean", "SimulationError"),
+    "SimulationError": ("scfmu.engines.calls", "SimulationError"),
     "Scenario": ("scfmu.scenario.model", "Scenario"),
     "Component": ("scfmu.scenario.model", "Component"),
     "get_scenario": ("scfmu.scenario", "get"),

@@ -1,6 +1,6 @@
 """FMU access: where the FMUs are, unpacking, digests, and :class:`Fmu`, one instantiated FMU with
-name-based access (fmpy's FMU2Slave underneath, or FMU2Model with SciPy's solve_ivp for a unit run as
-Model Exchange).
+name-based access: FMI 2.0 or FMI 3.0, Co-Simulation (fmpy's FMU2Slave / FMU3Slave underneath) or Model
+Exchange (FMU2Model / FMU3Model, integrated by SciPy's solve_ivp between communication points).
 
 Where the FMUs are is decided here and nowhere else (:func:`fmu_dir`), first match wins:
 
@@ -25,6 +25,7 @@ from ctypes import POINTER, c_double
 
 import numpy as np
 from fmpy.fmi2 import FMU2Model, FMU2Slave, defaultCallbacks, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
+from fmpy.fmi3 import FMU3Model, FMU3Slave
 from scipy.integrate import solve_ivp
 
 _FMU_DIR_OVERRIDE: Path | None = None
@@ -133,23 +134,39 @@ def recording_callbacks(messages: list) -> fmi2CallbackFunctions:
     return cb
 
 
-class Fmu:
-    """One instantiated FMU with name-based access. With `initialize=True` (default) it is set up,
-    given `params` in initialization mode, and ready to step at `start_time`. Every logger message is
-    kept in `messages` as (status, category, text).
+# FMI 3.0 scalar types that stand for the scenario's (FMI 2.0) types; every other FMI 3.0 type is refused
+FMI3_TYPES = {"Float64": "Real", "Int32": "Integer", "Boolean": "Boolean"}
 
-    ``interface="cs"`` (default) runs the unit as FMI 2.0 Co-Simulation. ``interface="me"`` runs a
-    unit that offers Model Exchange under SciPy's ``solve_ivp`` instead: :meth:`do_step` integrates its
-    continuous states from t to t + dt with the inputs held (like a co-simulation step), stops at the
-    unit's time events, and runs the event iteration where the unit asks for it (after
-    ``fmi2CompletedIntegratorStep``, e.g. a quaternion renormalisation). ``me_method`` and
-    ``me_rtol``/``me_atol`` choose the solver (default DOP853, 1e-10/1e-12)."""
+
+def scalar_type(v) -> str | None:
+    """The scenario type (``"Real"``, ``"Integer"``, ``"Boolean"``) of a model variable of either FMI version,
+    or None for any other type (strings, enumerations, FMI 3.0 Float32/Int8/..., and arrays)."""
+    if getattr(v, "dimensions", None):
+        return None
+    t = FMI3_TYPES.get(v.type, v.type)
+    return t if t in ("Real", "Integer", "Boolean") else None
+
+
+class Fmu:
+    """One instantiated FMU (FMI 2.0 or 3.0) with name-based access. With `initialize=True` (default) it is
+    set up, given `params` in initialization mode, and ready to step at `start_time`. Every logger message
+    is kept in `messages` as (status, category, text).
+
+    ``interface="cs"`` (default) runs the unit as Co-Simulation. ``interface="me"`` runs a unit that
+    offers Model Exchange under SciPy's ``solve_ivp`` instead: :meth:`do_step` integrates its continuous
+    states from t to t + dt with the inputs held (like a co-simulation step), stops at the unit's time
+    events and at its state events (a sign change of an event indicator, located by solve_ivp's event
+    detection), and runs the event iteration where the unit asks for it (after
+    ``completedIntegratorStep``, e.g. a quaternion renormalisation). ``me_method`` and
+    ``me_rtol``/``me_atol`` choose the solver (default DOP853, 1e-10/1e-12); ``me_method="RK4"`` is the
+    classic Runge–Kutta 4 with a fixed step (the communication step, or ``me_max_step`` when smaller; state
+    events located by bisection on re-integrated partial steps). ``fmi`` is the FMI major version (2 or 3)."""
 
     def __init__(self, model: str, params: dict | None = None, name: str | None = None,
                  start_time: float = 0.0, stop_time: float | None = None, tolerance: float | None = None,
                  path: Path | None = None, initialize: bool = True, logging_on: bool = False,
                  unpacked: tuple | None = None, interface: str = "cs", me_method: str = "DOP853",
-                 me_rtol: float = 1e-10, me_atol: float = 1e-12):
+                 me_rtol: float = 1e-10, me_atol: float = 1e-12, me_max_step: float = 0.0):
         self.model = model
         self.path = Path(path) if path else fmu_path(model)
         if unpacked is None:  # (model description, unzip directory) shared by instances; kept on close
@@ -159,32 +176,60 @@ class Fmu:
         else:
             self.md, self.unzipdir = unpacked
             self._owns_dir = False
+        self.fmi = int(str(self.md.fmiVersion).split(".")[0])
+        if self.fmi not in (2, 3):
+            raise ValueError(f"{model}: FMI {self.md.fmiVersion} is not supported (FMI 2.0 or 3.0)")
         self.vars = {v.name: v for v in self.md.modelVariables}
         self.messages: list[tuple[int, str, str]] = []
-        self.callbacks = recording_callbacks(self.messages)
         if interface not in ("cs", "me"):
             raise ValueError(f"{model}: interface {interface!r} is neither 'cs' nor 'me'")
         self.interface = interface
+        iname = name or model
         if interface == "me":
             if self.md.modelExchange is None:
                 raise ValueError(f"{model} offers no Model Exchange interface (Co-Simulation only)")
-            self.slave = FMU2Model(guid=self.md.guid, unzipDirectory=self.unzipdir,
-                                   modelIdentifier=self.md.modelExchange.modelIdentifier, instanceName=name or model)
+            cls = FMU2Model if self.fmi == 2 else FMU3Model
+            self.slave = cls(guid=self.md.guid, unzipDirectory=self.unzipdir,
+                             modelIdentifier=self.md.modelExchange.modelIdentifier, instanceName=iname)
             self.nx = sum(1 for v in self.md.modelVariables if v.derivative is not None)
+            self.nz = int(self.md.numberOfEventIndicators or 0)
             self.me_method, self.me_rtol, self.me_atol = me_method, me_rtol, me_atol
+            self.me_max_step = me_max_step
             self.next_event: float | None = None
         else:
-            self.slave = FMU2Slave(guid=self.md.guid, unzipDirectory=self.unzipdir,
-                                   modelIdentifier=self.md.coSimulation.modelIdentifier,
-                                   instanceName=name or model)
-        self.slave.instantiate(callbacks=self.callbacks, loggingOn=logging_on)
+            if self.md.coSimulation is None:
+                raise ValueError(f"{model} offers no Co-Simulation interface (Model Exchange only): run it as "
+                                 f"Model Exchange")
+            cls = FMU2Slave if self.fmi == 2 else FMU3Slave
+            self.slave = cls(guid=self.md.guid, unzipDirectory=self.unzipdir,
+                             modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=iname)
+        if self.fmi == 2:
+            self.callbacks = recording_callbacks(self.messages)
+            self.slave.instantiate(callbacks=self.callbacks, loggingOn=logging_on)
+        else:
+            msgs = self.messages
+
+            def log3(_env, status, category, message):
+                msgs.append((int(status), (category or b"").decode(), (message or b"").decode()))
+
+            self.callbacks = log3
+            self.slave.instantiate(loggingOn=logging_on, logMessage=log3)
         self.time = start_time
         if initialize:
-            self.slave.setupExperiment(tolerance=tolerance, startTime=start_time, stopTime=stop_time)
-            self.slave.enterInitializationMode()
+            self.enter_initialization_mode(start_time, tolerance, stop_time)
             for k, v in (params or {}).items():
                 self.set(k, v)
             self.exit_initialization_mode()
+
+    def enter_initialization_mode(self, start_time: float = 0.0, tolerance: float | None = None,
+                                  stop_time: float | None = None) -> None:
+        """Sets up the experiment (FMI 2.0 ``setupExperiment``) and enters initialization mode."""
+        self.time = start_time
+        if self.fmi == 2:
+            self.slave.setupExperiment(tolerance=tolerance, startTime=start_time, stopTime=stop_time)
+            self.slave.enterInitializationMode()
+        else:
+            self.slave.enterInitializationMode(tolerance=tolerance, startTime=start_time, stopTime=stop_time)
 
     def exit_initialization_mode(self) -> None:
         """Leaves initialization mode; a Model Exchange unit then runs its first event iteration and
@@ -197,7 +242,10 @@ class Fmu:
     # ----- Model Exchange ------------------------------------------------------------------
     def _event_iteration(self) -> None:
         while True:
-            needed, terminate, _, _, defined, t_next = self.slave.newDiscreteStates()
+            if self.fmi == 2:
+                needed, terminate, _, _, defined, t_next = self.slave.newDiscreteStates()
+            else:
+                needed, terminate, _, _, defined, t_next = self.slave.updateDiscreteStates()
             if terminate:
                 raise RuntimeError(f"{self.model}: the unit asked to terminate at t = {self.time}")
             if not needed:
@@ -215,19 +263,98 @@ class Fmu:
         self.slave.setTime(t)
         self.slave.setContinuousStates(x.ctypes.data_as(POINTER(c_double)), self.nx)
         dx = np.zeros(self.nx)
-        self.slave.getDerivatives(dx.ctypes.data_as(POINTER(c_double)), self.nx)
+        if self.fmi == 2:
+            self.slave.getDerivatives(dx.ctypes.data_as(POINTER(c_double)), self.nx)
+        else:
+            self.slave.getContinuousStateDerivatives(dx.ctypes.data_as(POINTER(c_double)), self.nx)
         return dx
+
+    def _indicators(self) -> np.ndarray:
+        z = np.zeros(self.nz)
+        if self.nz:
+            self.slave.getEventIndicators(z.ctypes.data_as(POINTER(c_double)), self.nz)
+        return z
+
+    def _state_events(self):
+        """solve_ivp event functions, one per event indicator: a sign change stops the integration."""
+        def ev(i):
+            def f(t, x):
+                self._rhs(t, x)
+                return self._indicators()[i]
+            f.terminal = True
+            return f
+        return [ev(i) for i in range(self.nz)]
+
+    def _rk4(self, t: float, x: np.ndarray, h: float, k1: np.ndarray) -> np.ndarray:
+        k2 = self._rhs(t + 0.5 * h, x + 0.5 * h * k1)
+        k3 = self._rhs(t + 0.5 * h, x + 0.5 * h * k2)
+        k4 = self._rhs(t + h, x + h * k3)
+        return x + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+
+    def _rk4_interval(self, t: float, t_stop: float, dt: float, eps: float) -> tuple[float, bool]:
+        """Fixed-step RK4 from t towards t_stop; stops early at a state event or when the unit asks for an
+        event after ``completedIntegratorStep``. Returns (time reached, event to handle)."""
+        h_fix = min(self.me_max_step, dt) if self.me_max_step > 0 else dt
+        x = self._states()
+        z = self._indicators() if self.nz else None
+        while t < t_stop - eps:
+            h = min(h_fix, t_stop - t)
+            if t + h > t_stop - eps:
+                h = t_stop - t
+            k1 = self._rhs(t, x)
+            xn = self._rk4(t, x, h, k1)
+            tn = t_stop if abs(t + h - t_stop) <= eps else t + h
+            self._rhs(tn, xn)
+            crossed = False
+            if self.nz:
+                zn = self._indicators()
+                crossed = bool(np.any((z > 0) != (zn > 0)))
+                if crossed:  # bisection on the step size
+                    lo, hi, x_hi = 0.0, 1.0, xn
+                    while (hi - lo) * h > eps:
+                        mid = 0.5 * (lo + hi)
+                        xm = self._rk4(t, x, mid * h, k1)
+                        self._rhs(t + mid * h, xm)
+                        if np.any((z > 0) != (self._indicators() > 0)):
+                            hi, x_hi = mid, xm
+                        else:
+                            lo = mid
+                    tn, xn = t + hi * h, x_hi
+                    self._rhs(tn, xn)
+                else:
+                    z = zn
+            t, x = tn, xn
+            enter, terminate = self.slave.completedIntegratorStep()
+            if terminate:
+                raise RuntimeError(f"{self.model}: the unit asked to terminate at t = {t}")
+            if crossed or enter:
+                return t, True
+        return t, False
 
     def _me_step(self, t: float, dt: float) -> None:
         t_end = t + dt
         eps = 1e-12 * max(1.0, abs(t_end))
+        events = self._state_events() if self.nz else None
         while t < t_end - eps:
             t_stop = t_end if self.next_event is None or self.next_event >= t_end - eps else self.next_event
+            state_event = False
+            if self.me_method == "RK4" and self.nx:
+                t_stop, event = self._rk4_interval(t, t_stop, dt, eps)
+                at_event = self.next_event is not None and abs(t_stop - self.next_event) <= eps
+                if event or at_event:
+                    self.time = t_stop
+                    self.slave.enterEventMode()
+                    self._event_iteration()
+                    self.slave.enterContinuousTimeMode()
+                t = t_stop
+                continue
             if self.nx:
                 sol = solve_ivp(self._rhs, (t, t_stop), self._states(), method=self.me_method,
-                                rtol=self.me_rtol, atol=self.me_atol)
+                                rtol=self.me_rtol, atol=self.me_atol, events=events)
                 if not sol.success:
                     raise RuntimeError(f"{self.model}: solve_ivp failed from t = {t} to {t_stop}: {sol.message}")
+                if sol.status == 1:  # an event indicator changed sign: stop there
+                    state_event, t_stop = True, float(sol.t[-1])
                 self._rhs(t_stop, sol.y[:, -1])  # leaves the unit at (t_stop, x(t_stop))
             else:
                 self.slave.setTime(t_stop)
@@ -235,7 +362,8 @@ class Fmu:
             if terminate:
                 raise RuntimeError(f"{self.model}: the unit asked to terminate at t = {t_stop}")
             at_event = self.next_event is not None and abs(t_stop - self.next_event) <= eps
-            if enter or at_event:
+            if enter or at_event or state_event:
+                self.time = t_stop
                 self.slave.enterEventMode()
                 self._event_iteration()
                 self.slave.enterContinuousTimeMode()
@@ -256,37 +384,67 @@ class Fmu:
 
     def set(self, name: str, value) -> None:
         v = self.var(name)
-        if v.type == "Real":
-            self.slave.setReal([v.valueReference], [float(value)])
-        elif v.type == "Integer":
-            self.slave.setInteger([v.valueReference], [int(value)])
-        elif v.type == "Boolean":
+        t = scalar_type(v)
+        if t == "Real":
+            self.set_reals([name], [value])
+        elif t == "Integer":
+            (self.slave.setInteger if self.fmi == 2 else self.slave.setInt32)([v.valueReference], [int(value)])
+        elif t == "Boolean":
             self.slave.setBoolean([v.valueReference], [bool(value)])
         else:
-            raise TypeError(f"{name}: unsupported type {v.type}")
+            raise TypeError(f"{name}: unsupported type {v.type}" + (" (an array)" if v.dimensions else ""))
 
     def get(self, name: str):
         v = self.var(name)
-        if v.type == "Real":
-            return self.slave.getReal([v.valueReference])[0]
-        if v.type == "Integer":
-            return self.slave.getInteger([v.valueReference])[0]
-        if v.type == "Boolean":
+        t = scalar_type(v)
+        if t == "Real":
+            return self.get_reals([name])[0]
+        if t == "Integer":
+            return (self.slave.getInteger if self.fmi == 2 else self.slave.getInt32)([v.valueReference])[0]
+        if t == "Boolean":
             return self.slave.getBoolean([v.valueReference])[0]
-        raise TypeError(f"{name}: unsupported type {v.type}")
+        raise TypeError(f"{name}: unsupported type {v.type}" + (" (an array)" if v.dimensions else ""))
+
+    def get_values(self, names: list[str]) -> list:
+        """Values of variables of one scenario type (all Real, all Integer or all Boolean)."""
+        if names and scalar_type(self.var(names[0])) == "Real":
+            return self.get_reals(names)
+        return [self.get(n) for n in names]
+
+    def set_values(self, names: list[str], values) -> None:
+        if names and scalar_type(self.var(names[0])) == "Real":
+            self.set_reals(names, values)
+            return
+        for n, x in zip(names, values):
+            self.set(n, x)
 
     def get_reals(self, names: list[str]) -> list[float]:
-        return self.slave.getReal([self.var(n).valueReference for n in names])
+        vrs = [self.var(n).valueReference for n in names]
+        return self.slave.getReal(vrs) if self.fmi == 2 else self.slave.getFloat64(vrs)
 
     def set_reals(self, names: list[str], values) -> None:
-        self.slave.setReal([self.var(n).valueReference for n in names], [float(x) for x in values])
+        vrs = [self.var(n).valueReference for n in names]
+        vals = [float(x) for x in values]
+        if self.fmi == 2:
+            self.slave.setReal(vrs, vals)
+        else:
+            self.slave.setFloat64(vrs, vals)
 
     def do_step(self, t: float, dt: float) -> None:
         if self.interface == "me":
             self._me_step(t, dt)
-        else:
+        elif self.fmi == 2:
             self.slave.doStep(currentCommunicationPoint=t, communicationStepSize=dt)
+        else:
+            _, terminate, early, _ = self.slave.doStep(currentCommunicationPoint=t, communicationStepSize=dt)
+            if terminate:
+                raise RuntimeError(f"{self.model}: the unit asked to terminate at t = {t + dt}")
         self.time = t + dt
+
+    def reset(self) -> None:
+        """Terminates and resets the instance (back to its start values, ready for initialization)."""
+        self.slave.terminate()
+        self.slave.reset()
 
     def close(self) -> None:
         try:

@@ -1,4 +1,6 @@
-"""Writing logged signals (the dict returned by CoSimulation.run) to CSV."""
+"""Writing logged signals (the dict returned by CoSimulation.run) to CSV, and the units of signals and
+metrics (as the units declare them; a metric's unit follows from the signal it is read from or from its
+name's suffix)."""
 
 from __future__ import annotations
 
@@ -24,3 +26,34 @@ def write_csv(path: Path, signals: dict, keys: list[str] | None = None, every: i
             w.writerows(table.tolist())
         else:
             w.writerows([[format(x, fmt) for x in row] for row in table])
+
+
+def declared_unit(v) -> str:
+    """The unit a model variable declares (its own, else its declared type's), "" when none."""
+    unit = getattr(v, "unit", None)
+    if not unit:
+        unit = getattr(getattr(v, "declaredType", None), "unit", None)
+    return unit or ""
+
+
+# final_error of each metric set: the final value of the set's main error signal
+_FINAL_ERROR = {"attitude": "deg", "attitude_nometrics": "deg", "single_axis": "deg", "paper002": "deg",
+                "formation": "m"}
+_SUFFIX = (("_deg_s", "deg.s"), ("_pct", "%"), ("_deg", "deg"), ("_s", "s"), ("_m", "m"))
+_NAMED = {"peak_torque": "N.m", "peak_force": "N"}
+
+
+def metric_unit(key: str, units: dict, metric_set: str = "") -> str:
+    """The unit of a metric: that of the logged signal of the same name when there is one (e.g. ise,
+    effort_abs), else from the name (…_s seconds, …_pct percent, …_deg degrees, …_m metres), "" when
+    neither tells (a dimensionless number or one whose unit the metric set does not state)."""
+    if units.get(key):
+        return units[key]
+    if key == "final_error":
+        return _FINAL_ERROR.get(metric_set, "")
+    if key in _NAMED:
+        return _NAMED[key]
+    for suffix, unit in _SUFFIX:
+        if key.endswith(suffix):
+            return unit
+    return ""

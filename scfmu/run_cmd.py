@@ -17,8 +17,9 @@ import numpy as np
 
 import sys
 
-from . import metrics
 from .engines import ENGINES, SimulationError, simulate
+from .fmu import is_path
+from .scenario.plan import PlanError, build_plan
 from .results import write_csv
 from .scenario import options
 from .scenario.check import IncompatibleUnit, require
@@ -33,7 +34,7 @@ def _groups(keys: list[str]) -> dict[str, list[str]]:
     for k in keys:
         base = k[:-4] if k.endswith("_ref") else k
         if base in ANGLES:
-            name = "321 angles [deg]"
+            name = "321 angles"
         elif len(base) > 2 and base[-2] == "_" and base[-1] in "wxyz":
             name = base[:-2]
         else:
@@ -42,39 +43,103 @@ def _groups(keys: list[str]) -> dict[str, list[str]]:
     return g
 
 
-def plot(r: dict, path: Path, title: str) -> None:
+_LABELS = {"321 angles": "321 angles", "alpha_deg": "attitude error α", "w": "body rates ω",
+           "torque_applied": "applied torque", "torque_cmd": "commanded torque", "q": "attitude quaternion"}
+
+
+def plot(r: dict, path: Path, title: str, units: dict | None = None) -> None:
+    """The run's figure: up to four panels, the preferred ones first (321 angles with their references,
+    α on a log axis, body rates, applied torque), each axis labelled with its unit."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    units = units or {}
     groups = _groups([k for k in r if k != "time"])
-    prefer = ["321 angles [deg]", "alpha_deg", "theta", "pos", "torque_applied", "torque_cmd", "force", "u",
+    prefer = ["321 angles", "alpha_deg", "w", "torque_applied", "theta", "pos", "torque_cmd", "force", "u",
               "applied_torque"]
     chosen = [n for n in prefer if n in groups][:4]
     chosen += [n for n in groups if n not in chosen][: max(0, 3 - len(chosen))]
-    fig, axs = plt.subplots(len(chosen), 1, figsize=(8, 2.6 * len(chosen) + 0.6), sharex=True, squeeze=False)
+    fig, axs = plt.subplots(len(chosen), 1, figsize=(8, 2.6 * len(chosen) + 0.8), sharex=True, squeeze=False)
     t = r["time"]
     for ax, name in zip(axs[:, 0], chosen):
+        unit = "deg" if name == "321 angles" else units.get(groups[name][0], "")
         for k in groups[name]:
-            y = np.asarray(r[k])
-            if name.startswith("321"):
+            y = np.asarray(r[k], dtype=float)
+            if name == "321 angles" and units.get(k, "rad") == "rad":
                 y = np.degrees(y)
+            if name == "alpha_deg":
+                pos = y[y > 0]
+                y = np.clip(y, pos.min() if pos.size else 1e-12, None)  # log axis: α = 0 exactly is not drawn
             ax.plot(t, y, ls=":" if k.endswith("_ref") else "-", label=k)
-        ax.set_ylabel(name)
-        ax.grid(True, alpha=0.3)
+        if name == "alpha_deg":
+            ax.set_yscale("log")
+        label = _LABELS.get(name, name)
+        ax.set_ylabel(f"{label} [{unit}]" if unit else f"{label} [-]", fontsize=9)
+        ax.grid(True, alpha=0.3, which="both")
         ax.legend(fontsize=8, ncol=3)
     axs[-1, 0].set_xlabel("time [s]")
-    fig.suptitle(title, fontsize=10)
+    fig.suptitle(title, fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def unit_label(model: str) -> str:
+    """A model's name, or for a unit given by path its folder and file (``fmi3/PdController.fmu``)."""
+    if not is_path(model):
+        return model
+    p = Path(model)
+    return f"{p.parent.name}/{p.name}" if p.parent.name else p.name
+
+
+def run_folder_name(sc) -> str:
+    """``<scenario>`` plus ``+<unit>`` for every instance whose unit was swapped (``--fmu``)."""
+    name = file_stem(sc.name)
+    for inst in sc.swapped:
+        name += "+" + Path(sc.component(inst).model).stem
+    return name
+
+
+def run_identity(sc, engine: str) -> dict:
+    """What makes a run this run: the scenario (models, parameters, wiring, times), the engine and the FMU
+    files' SHA-256 (a rebuilt unit is another run)."""
+    from .fmu import fmu_digest, fmu_path
+    return {"scenario": json.loads(sc.to_json()), "engine": engine,
+            "fmus": {c.model: fmu_digest(fmu_path(c.model)) for c in sc.components}}
+
+
+def choose_folder(base: Path, ident: dict, chosen: bool) -> tuple[Path, str | None]:
+    """The folder to write a run to and a notice (None when there is nothing to say): ``base`` when it is
+    new or holds this same run (its ``run.json``); otherwise, when the folder was not chosen with
+    ``--out``, the first free ``base-2``, ``base-3``, ... (another run's files are never overwritten);
+    with ``--out`` the files are replaced, with a notice."""
+    def holds_other(p: Path) -> bool:
+        if not p.exists() or not any(p.iterdir()):
+            return False
+        try:
+            return json.loads((p / "run.json").read_text()) != ident
+        except (OSError, ValueError):
+            return True  # files of something else
+    if not holds_other(base):
+        return base, None
+    if chosen:
+        return base, f"note: {base} held the files of another run; files of the same names are replaced"
+    i = 2
+    while holds_other(base.with_name(f"{base.name}-{i}")):
+        i += 1
+    p = base.with_name(f"{base.name}-{i}")
+    return p, f"note: {base} holds another run; this one is written to {p}"
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="scfmu run", description=__doc__ + "\n" + options.__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     options.add_arguments(ap)
-    ap.add_argument("--engine", default="native", choices=ENGINES, help="engine (all give bit-identical results)")
-    ap.add_argument("--out", default=None, help="output folder (default out/<scenario>)")
+    ap.add_argument("--engine", default=None, choices=ENGINES,
+                    help="engine (all give bit-identical results on Co-Simulation units); default native, or, "
+                         "when a unit runs as Model Exchange, compiled (else lean)")
+    ap.add_argument("--out", default=None, help="output folder (default out/<scenario>[+<unit>...]: its own folder "
+                                                "per run; another run's folder gets a -2, -3, ... suffix)")
     ap.add_argument("--no-plot", action="store_true")
     args = ap.parse_args(argv)
     sc = options.build(args, notice=lambda t: print(t, file=sys.stderr))
@@ -84,36 +149,56 @@ def main(argv=None) -> int:
         print(f"scfmu run: {e}", file=sys.stderr)
         return 2
     unbound = options.binding_report(sc, "scfmu run", args.strict, lambda t: print(t, file=sys.stderr))
-    stem = file_stem(sc.name)
-    out = Path(args.out or Path("out") / stem)
-    out.mkdir(parents=True, exist_ok=True)
     try:
-        r = simulate(sc, args.engine)
+        plan = build_plan(sc)
+    except (PlanError, KeyError, ValueError) as e:
+        print(f"scfmu run: {e}", file=sys.stderr)
+        return 2
+    if args.engine is None:
+        args.engine = "native"
+        if plan.model_exchange:  # fmpy's container (native) hosts Co-Simulation units only
+            from .engines.compiled import available
+            args.engine = "compiled" if available() else "lean"
+    stem = file_stem(sc.name)
+    ident = run_identity(sc, args.engine)
+    out, notice = choose_folder(Path(args.out) if args.out else Path("out") / run_folder_name(sc), ident,
+                                chosen=args.out is not None)
+    if notice:
+        print(notice, file=sys.stderr)
+    try:
+        r = simulate(plan, args.engine)
+    except PlanError as e:
+        print(f"scfmu run: {e}", file=sys.stderr)
+        return 2
     except SimulationError as e:
         print(f"scfmu run: the run failed ({e.status}): {e}", file=sys.stderr)
         return 1
-    m = metrics.compute(sc.metrics, r)
+    out.mkdir(parents=True, exist_ok=True)
+    m, mu = r.metrics, r.metric_units
     print(f"{sc.name}: {sc.description or ''}".rstrip(": "))
     models = ", ".join(f"{c.name}={Path(c.model).name}" for c in sc.components)
     print(f"  {len(r['time']) - 1} steps of {sc.step:g} s to t = {sc.stop_time:g} s on the {args.engine} engine; "
           f"units {models}; metric set {sc.metrics or '(none)'}")
     for k, v in m.items():
         if isinstance(v, float) and math.isfinite(v):
-            print(f"  {k:24s} {v:14.6g}")
+            print(f"  {k:24s} {v:14.6g} {mu.get(k, '')}".rstrip())
     csv = out / f"{stem}.csv"
     write_csv(csv, r)
+    (out / "run.json").write_text(json.dumps(ident, indent=1, sort_keys=True))
     manifest = out / f"{stem}.manifest.json"  # what ran: the scenario as plain data, units, metrics, warnings
     manifest.write_text(json.dumps({"scenario": sc.to_dict(), "engine": args.engine, "metrics": m,
                                     "unbound_slot_values": unbound}, indent=1, default=str))
     written = [csv, manifest]
     if not args.no_plot:
         png = out / f"{stem}.png"
-        title = sc.name + (f": EULERINT = {m['eulerint_deg_s']:.2f} deg·s"
-                           if math.isfinite(m.get("eulerint_deg_s", math.nan)) else "")
+        units = ", ".join(f"{c.name} = {unit_label(c.model)}" for c in sc.components)
+        title = f"{sc.name} ({args.engine} engine)\n{units}"
+        if math.isfinite(m.get("eulerint_deg_s", math.nan)):
+            title += f"\nEULERINT = {m['eulerint_deg_s']:.2f} deg·s"
         if unbound:
             title += f"\n⚠ {len(unbound)} slot value(s) not passed to the unit: " + ", ".join(
                 t.split("slot value ")[1].split(" not passed")[0] for t in unbound)
-        plot(r, png, title)
+        plot(r, png, title, r.units)
         written.append(png)
     print("wrote " + " and ".join(str(p) for p in written))
     return 0

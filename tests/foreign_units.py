@@ -4,6 +4,10 @@ tests themselves, to plug into our scenarios in place of `PdController` (issue 2
 - `build_c_pd(dest, variant)`: a quaternion PD controller written by hand in C against the FMI 2.0 headers
   that fmpy ships (tests/foreign/c_pd/c_pd.c) with a hand-written modelDescription
   (tests/foreign/c_pd/modelDescription.xml), compiled with gcc; healthy or broken on purpose (`C_VARIANTS`).
+- `build_c3(dest, model)`: FMI 3.0 units written by hand in C against the FMI 3.0 headers that fmpy ships
+  (tests/foreign/c3/c3_units.c, modelDescription written here): "C3PdController" (Co-Simulation only, the PD
+  law plus Int32/Boolean ports) and "C3AxisBody" (Model Exchange only, a one-axis rigid body with a state event
+  and a time event).
 - `build_python_pd(dest)`: the same law as a PythonFMU (tests/foreign/python_pd/PyPdController.py).
 - `python_fmu_loadable(path)`: whether this host can run a PythonFMU, with the reason when it cannot.
 - `pd_law(...)`: the PD law in numpy, the tests' independent oracle.
@@ -149,6 +153,118 @@ def build_c_pd(dest, variant: str = "ok", *, fail_time: float = 0.5) -> Path:
         with zipfile.ZipFile(part, "w", zipfile.ZIP_DEFLATED) as z:
             for name, data in files.items():
                 z.writestr(name, data)
+        os.replace(part, fmu)
+    return fmu
+
+
+# ------------------------------------------------------------------------------------------------ FMI 3.0 C units
+
+C3_DIR = FOREIGN / "c3"
+C3_MODELS = ("C3PdController", "C3AxisBody")
+_C3_UNITS = """  <UnitDefinitions>
+    <Unit name="rad"><BaseUnit rad="1"/></Unit>
+    <Unit name="deg"><BaseUnit rad="1" factor="0.017453292519943295"/></Unit>
+    <Unit name="s"><BaseUnit s="1"/></Unit>
+    <Unit name="rad/s"><BaseUnit s="-1" rad="1"/></Unit>
+    <Unit name="kg.m2"><BaseUnit kg="1" m="2"/></Unit>
+    <Unit name="N.m"><BaseUnit kg="1" m="2" s="-2"/></Unit>
+  </UnitDefinitions>
+"""
+
+
+def _c3_variables(model: str) -> tuple[list[str], list[str]]:
+    """(variable elements, ModelStructure elements) of a C3 unit (value references of c3_units.c)."""
+    v = ['<Float64 name="time" valueReference="999" causality="independent" variability="continuous"/>']
+    if model == "C3PdController":
+        names = ["q_w", "q_x", "q_y", "q_z", "w_x", "w_y", "w_z", "q_ref_w", "q_ref_x", "q_ref_y", "q_ref_z",
+                 "w_ref_x", "w_ref_y", "w_ref_z"]
+        for i, n in enumerate(names):
+            unit = ' unit="rad/s"' if n.startswith("w") else ""
+            start = "1" if n in ("q_w", "q_ref_w") else "0"
+            v.append(f'<Float64 name="{n}" valueReference="{i}" causality="input"{unit} start="{start}"/>')
+        for i, a in enumerate("xyz"):
+            v.append(f'<Float64 name="torque_cmd_{a}" valueReference="{14 + i}" causality="output" unit="N.m"/>')
+        v.append('<Float64 name="wn" valueReference="17" causality="parameter" variability="fixed" unit="rad/s" start="1"/>')
+        v.append('<Float64 name="zeta" valueReference="18" causality="parameter" variability="fixed" start="1"/>')
+        for i, (a, x) in enumerate(zip(("xx", "yy", "zz"), ("1000", "500", "700"))):
+            v.append(f'<Float64 name="inertia_{a}" valueReference="{19 + i}" causality="parameter" variability="fixed" '
+                     f'unit="kg.m2" start="{x}"/>')
+        v += ['<Boolean name="enable" valueReference="22" causality="input" start="true"/>',
+              '<Int32 name="count_in" valueReference="23" causality="input" start="0"/>',
+              '<Int32 name="step_count" valueReference="24" causality="output"/>',
+              '<Boolean name="active" valueReference="25" causality="output"/>',
+              '<Int32 name="count_echo" valueReference="26" causality="output"/>',
+              '<Boolean name="enable_echo" valueReference="27" causality="output"/>']
+        outs = [14, 15, 16, 24, 25, 26, 27]
+        structure = [f'<Output valueReference="{r}"/>' for r in outs] + [f'<InitialUnknown valueReference="{r}"/>' for r in outs]
+    else:
+        v += ['<Float64 name="u" valueReference="0" causality="input" start="0"/>',
+              '<Float64 name="torque_dist" valueReference="1" causality="input" unit="N.m" start="0"/>',
+              '<Float64 name="theta" valueReference="2" causality="output" unit="rad" initial="exact" start="0"/>',
+              '<Float64 name="omega" valueReference="3" causality="output" unit="rad/s" initial="exact" start="0"/>',
+              '<Float64 name="applied_torque" valueReference="4" causality="output" unit="N.m"/>',
+              '<Float64 name="theta_deg" valueReference="5" causality="output" unit="deg"/>',
+              '<Float64 name="inertia" valueReference="6" causality="parameter" variability="fixed" unit="kg.m2" start="7.7"/>',
+              '<Float64 name="torque_limit" valueReference="7" causality="parameter" variability="fixed" unit="N.m" start="1"/>',
+              '<Float64 name="theta_mark" valueReference="8" causality="parameter" variability="fixed" unit="rad" start="0.1"/>',
+              '<Float64 name="kick_time" valueReference="9" causality="parameter" variability="fixed" unit="s" start="-1"/>',
+              '<Float64 name="kick_domega" valueReference="10" causality="parameter" variability="fixed" unit="rad/s" start="0"/>',
+              '<Float64 name="t_cross" valueReference="11" causality="output" variability="discrete" unit="s"/>',
+              '<Float64 name="der(theta)" valueReference="12" causality="local" derivative="2"/>',
+              '<Float64 name="der(omega)" valueReference="13" causality="local" derivative="3"/>',
+              '<Int32 name="crossings" valueReference="14" causality="output"/>',
+              '<Float64 name="z_mark" valueReference="15" causality="local"/>']
+        structure = ([f'<Output valueReference="{r}"/>' for r in (2, 3, 4, 5, 11, 14)]
+                     + ['<ContinuousStateDerivative valueReference="12"/>', '<ContinuousStateDerivative valueReference="13"/>']
+                     + [f'<InitialUnknown valueReference="{r}"/>' for r in (4, 5, 11, 12, 13, 14)]
+                     + ['<EventIndicator valueReference="15"/>'])
+    return v, structure
+
+
+def c3_token(model: str) -> str:
+    return "{%s}" % uuid.uuid5(uuid.NAMESPACE_URL, f"spacecraft_fmus/tests/foreign/{model}")
+
+
+def c3_model_description(model: str) -> str:
+    if model not in C3_MODELS:
+        raise ValueError(f"unknown C3 model {model!r}: one of {C3_MODELS}")
+    variables, structure = _c3_variables(model)
+    itf = (f'<CoSimulation modelIdentifier="{model}" canHandleVariableCommunicationStepSize="true" '
+           f'canBeInstantiatedOnlyOncePerProcess="false"/>' if model == "C3PdController" else
+           f'<ModelExchange modelIdentifier="{model}" canBeInstantiatedOnlyOncePerProcess="false" '
+           f'needsCompletedIntegratorStep="true"/>')
+    return (f'<?xml version="1.0" encoding="UTF-8"?>\n'
+            f'<fmiModelDescription fmiVersion="3.0" modelName="{model}" instantiationToken="{c3_token(model)}" '
+            f'description="written by hand in C (a foreign FMI 3.0 unit for the tests)" '
+            f'generationTool="hand-written (tests/foreign/c3)" variableNamingConvention="structured">\n'
+            f'  {itf}\n{_C3_UNITS}'
+            f'  <LogCategories>\n    <Category name="logStatusError"/>\n  </LogCategories>\n'
+            f'  <DefaultExperiment startTime="0" stopTime="10" stepSize="0.01"/>\n'
+            f'  <ModelVariables>\n' + "".join(f"    {x}\n" for x in variables) + '  </ModelVariables>\n'
+            f'  <ModelStructure>\n' + "".join(f"    {x}\n" for x in structure) + '  </ModelStructure>\n'
+            '</fmiModelDescription>\n')
+
+
+def build_c3(dest, model: str) -> Path:
+    """Build the FMI 3.0 C unit `model` (C3_MODELS) into dest/<model>.fmu (binary under
+    binaries/x86_64-linux, FMI 3.0's platform folder) and return its path."""
+    if shutil.which("gcc") is None:
+        raise RuntimeError("gcc is needed to build the C foreign units (scripts/setup.sh installs it)")
+    dest = Path(dest)
+    dest.mkdir(parents=True, exist_ok=True)
+    fmu = dest / f"{model}.fmu"
+    with tempfile.TemporaryDirectory(prefix="c3_") as tmp:
+        so = Path(tmp) / f"{model}.so"
+        cmd = ["gcc", "-O2", "-shared", "-fPIC", "-fvisibility=hidden", "-std=gnu11", "-Wall", "-Wextra", "-Werror",
+               f"-I{fmi_headers_dir()}", f"-DMODEL={C3_MODELS.index(model) + 1}", f'-DMODEL_TOKEN="{c3_token(model)}"',
+               "-o", str(so), str(C3_DIR / "c3_units.c"), "-lm"]
+        p = subprocess.run(cmd, capture_output=True, text=True)
+        if p.returncode != 0:
+            raise RuntimeError(f"gcc failed for {model}:\n{p.stderr}")
+        part = fmu.with_suffix(".part")
+        with zipfile.ZipFile(part, "w", zipfile.ZIP_DEFLATED) as z:
+            z.writestr("modelDescription.xml", c3_model_description(model))
+            z.writestr(f"binaries/x86_64-linux/{model}.so", so.read_bytes())
         os.replace(part, fmu)
     return fmu
 
@@ -307,6 +423,9 @@ class ForeignUnits:
     def c_pd(self, variant: str = "ok", fail_time: float = 0.5) -> Path:
         return self._get(("c", variant, fail_time),
                          lambda: build_c_pd(self.root / f"c_{fail_time!r}", variant, fail_time=fail_time))
+
+    def c3(self, model: str) -> Path:
+        return self._get(("c3", model), lambda: build_c3(self.root / "c3", model))
 
     def python_pd(self, units: bool = False) -> Path:
         return self._get(("py", units), lambda: build_python_pd(self.root / "py", units=units))

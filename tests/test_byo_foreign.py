@@ -145,7 +145,13 @@ def test_units_and_interfaces_are_checked(units):
     assert rep.ok and any("no unit declared on controller.w_x" in x for x in rep.warnings), rep.warnings
     rep = check(base.with_models({"controller": str(units.c_pd("no_binary"))}))
     assert rep.errors and "no binary for this platform" in rep.errors[0]
-    rep = check(base.with_models({"controller": str(units.c_pd("me_only"))}))
+    # a unit that declares Model Exchange only runs as Model Exchange (issue 34): this one's binary has no
+    # Model Exchange functions, which the instantiation finds; asked to run as Co-Simulation, it is refused
+    me_only = base.with_models({"controller": str(units.c_pd("me_only"))})
+    rep = check(me_only)
+    assert rep.errors and "fmi2Instantiate failed" in rep.errors[0] and "undefined symbol" in rep.errors[0], rep.errors
+    me_only.component("controller").interface = "cs"
+    rep = check(me_only)
     assert rep.errors and "no Co-Simulation interface" in rep.errors[0]
 
 

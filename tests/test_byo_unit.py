@@ -128,7 +128,9 @@ def test_scenario_file_round_trip_runs_like_the_declaration(tmp_path):
     a = scfmu("run", f, "--t-end", "3", "--out", tmp_path / "a")
     b = scfmu("run", "default", "--t-end", "3", "--out", tmp_path / "b")
     assert a.returncode == 0, a.stderr
-    assert re.findall(r"^\s+\w+\s+\S+$", a.stdout, re.M) == re.findall(r"^\s+\w+\s+\S+$", b.stdout, re.M)
+    metric_lines = r"^\s+\w+\s+\S+(?: \S+)?$"  # name, value, unit
+    assert re.findall(metric_lines, a.stdout, re.M) == re.findall(metric_lines, b.stdout, re.M)
+    assert len(re.findall(metric_lines, a.stdout, re.M)) > 10
     j = scfmu("scenarios", "--show", "paper001/a", "--json")
     assert json.loads(j.stdout)["components"][1]["model"] == "PredictivePidController"
 

@@ -129,10 +129,10 @@ def test_compiled_nonfinite_logged_value_raises(monkeypatch):
     NaN for its first value from its 40th call on (a ctypes callback around the real function). The
     compiled loop logs it like the lean master, and the run fails with status ``nonfinite`` at the same time."""
     from ctypes import CFUNCTYPE, c_double, c_int, c_size_t, c_void_p
-    from scfmu.engines import lean
+    from scfmu.engines import calls
     from scfmu.engines.lean import SimulationError
     need_compiled()
-    real_raw = lean._raw
+    real_raw = calls.raw_fn
     proto = CFUNCTYPE(c_int, c_void_p, c_void_p, c_size_t, c_void_p)
     keep = []
 
@@ -153,7 +153,7 @@ def test_compiled_nonfinite_logged_value_raises(monkeypatch):
         keep.append(cb)
         return cb
 
-    monkeypatch.setattr(lean, "_raw", raw)
+    monkeypatch.setattr(calls, "raw_fn", raw)
     errs = {}
     for engine in ("lean", "compiled"):
         with pytest.raises(SimulationError) as e:
@@ -401,8 +401,8 @@ def test_campaign_metrics_equal_those_of_a_full_log_reference_run(name, t, overr
     seen = []
     real_simulate = campaign.simulate
 
-    def spy(sc, *a, **kw):
-        seen.append(dict(sc.log))
+    def spy(sc, *a, **kw):  # a campaign run hands simulate its plan (the scenario resolved once)
+        seen.append(dict(getattr(sc, "scenario", sc).log))
         return real_simulate(sc, *a, **kw)
 
     campaign.simulate = spy

@@ -49,6 +49,7 @@ import numpy as np
 from .. import fmu as fmu_access
 from .. import metrics as run_metrics
 from ..engines import SimulationError, resolve_engine, simulate
+from ..scenario.plan import build_plan
 from ..scenario.model import Scenario
 from ..scenario.resolve import unbound_slots
 
@@ -263,10 +264,12 @@ def _run_body(spec: dict, fmu_dir: str | None = None) -> tuple[dict, dict | None
         sc.log = _log_kept(sc, spec["timeseries"])
         every = max(1, int(spec.get("log_every", 1)))
         engine = spec["engine"]
-        if engine == "auto":  # the compiled loop logs every step; a coarser log grid is the native engine's
-            engine = resolve_engine("auto") if every == 1 else "native"
+        plan = build_plan(sc)  # the run's one plan (the scenario resolved once)
+        if engine == "auto":  # the compiled loop logs every step; a coarser log grid is the native engine's,
+            # which hosts Co-Simulation units only
+            engine = resolve_engine("auto") if every == 1 or plan.model_exchange else "native"
         kw = {"log_every": every} if engine == "native" else {}
-        r = simulate(sc, engine, **kw)
+        r = simulate(plan, engine, **kw)
         m = run_metrics.compute(sc.metrics, r)
         for k in metric_cols:
             row[k] = float(m.get(k, math.nan))

@@ -10,6 +10,10 @@
   ``cargo build --release`` in a source checkout);
 * ``"auto"`` (the campaigns' default): ``"compiled"`` when available, else ``"native"``.
 
+Every engine executes one :class:`~scfmu.scenario.plan.Plan` (built once by :func:`simulate`): units of FMI
+2.0 or 3.0; Co-Simulation units everywhere, Model Exchange units in the reference, lean and compiled
+engines (fmpy's container, hence the native engine and loop FMUs, hosts Co-Simulation units only).
+
 A run that fails (FMU error status, non-finite logged value) raises ``SimulationError`` with a status
 code and the FMUs' log messages.
 """
@@ -18,9 +22,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from .lean import LeanMaster, SimulationError, build_fmus, ports_of
 from ..scenario.model import Scenario
-from ..scenario.resolve import resolve
+from ..scenario.plan import Plan, PlanError, build_plan
+from .calls import SimulationError
+from .instances import as_plan, build_fmus, ports_of  # noqa: F401
+from .lean import LeanMaster
 from .reference import CoSimulation, _Link
 
 ENGINES = ("reference", "lean", "native", "compiled")
@@ -35,34 +41,28 @@ def resolve_engine(engine: str) -> str:
     return engine
 
 
-def reference_master(scenario: Scenario, path_of=None, model_exchange=frozenset()) -> tuple[CoSimulation, dict, dict]:
-    """(CoSimulation, {instance: Fmu}, log spec) for the scenario; the caller runs and closes it.
+def reference_master(scenario, path_of=None, model_exchange=frozenset()) -> tuple[CoSimulation, dict, dict]:
+    """(CoSimulation, {instance: Fmu}, log spec) for a scenario or a plan; the caller runs and closes it.
     ``path_of(model)`` gives the FMU file of a model (default ``fmus/<Model>.fmu``). The instances
-    named in ``model_exchange`` run as FMI 2.0 Model Exchange units integrated by SciPy's solve_ivp
-    between communication points (their inputs held over each step)."""
-    if path_of is None:
-        scenario = resolve(scenario)
-    fmus = build_fmus(scenario, path_of=path_of, model_exchange=model_exchange)
-    # the scenario's wiring (explicit exceptions included) replaces the master's own name matching
+    named in ``model_exchange`` (or Model Exchange in the plan) run as Model Exchange units integrated by
+    SciPy's solve_ivp between communication points (their inputs held over each step)."""
+    plan = as_plan(scenario, path_of, model_exchange)
+    fmus = build_fmus(plan)
+    # the plan's wiring (explicit exceptions included) replaces the master's own name matching
     sim = CoSimulation(list(fmus.values()), unconnected={n for f in fmus.values() for n in f.inputs()})
-    sim.links = []
-    groups: dict[tuple[str, str], _Link] = {}
-    for d, di, s, so in scenario.wiring(ports_of(fmus)):
-        link = groups.get((d, s))
-        if link is None:
-            link = groups[(d, s)] = _Link(fmus[d], [], fmus[s], [])
-            sim.links.append(link)
-        link.dst_names.append(di)
-        link.src_names.append(so)
-    log = {key: (fmus[inst], var) for key, inst, var in scenario.log_items()}
+    sim.links = [_Link(fmus[g.dst], list(g.dst_names), fmus[g.src], list(g.src_names)) for g in plan.groups]
+    log = {key: (fmus[g.inst], var) for g in plan.log for key, var in zip(g.keys, g.names)}
+    log = {k: log[k] for k in plan.scenario.log}
     return sim, fmus, log
 
 
-def run_reference(scenario: Scenario, path_of=None, model_exchange=frozenset()) -> dict[str, np.ndarray]:
-    sim, fmus, log = reference_master(scenario, path_of, model_exchange)
+def run_reference(scenario, path_of=None, model_exchange=frozenset()) -> dict[str, np.ndarray]:
+    plan = as_plan(scenario, path_of, model_exchange)
+    sim, fmus, log = reference_master(plan)
+    sc = plan.scenario
     try:
         try:
-            return sim.run(scenario.stop_time, scenario.step, log, t0=scenario.start_time)
+            return sim.run(sc.stop_time, sc.step, log, t0=sc.start_time)
         except Exception as e:
             msgs = [f"{n}: {m[2]}" for n, f in fmus.items() for m in f.messages if m[0] >= 2]
             raise SimulationError("fmu_error", "; ".join(msgs) or str(e)) from e
@@ -72,11 +72,42 @@ def run_reference(scenario: Scenario, path_of=None, model_exchange=frozenset()) 
 
 class Result(dict):
     """The logged signals of one run: ``{"time": t_k, <log key>: values at t_k}`` (NumPy arrays), plus
-    :meth:`to_pandas` and :meth:`to_csv`."""
+
+    * ``units``: ``{key: unit}`` of every logged signal as its unit declares it ("" when it declares none;
+      ``time`` is in s);
+    * ``metrics``: the run's metrics of the scenario's metric set (:mod:`scfmu.metrics`), the same numbers
+      ``scfmu run`` prints (EULERINT, ISE, settling time, overshoot, final error, ...), and
+      ``metric_units``;
+    * ``scenario``: the resolved scenario that ran; ``units_of_instances``: ``{instance: model}``;
+    * :meth:`to_pandas` (the ``pandas`` extra: ``pip install 'scfmu[pandas]'``) and :meth:`to_csv`."""
+
+    scenario = None
+    units: dict = {}
+
+    @property
+    def metrics(self) -> dict:
+        cached = self.__dict__.get("_metrics")
+        if cached is None:
+            from .. import metrics as run_metrics
+            sc = self.scenario
+            cached = self.__dict__["_metrics"] = dict(run_metrics.compute(sc.metrics, self)) if sc is not None and sc.metrics else {}
+        return cached
+
+    @property
+    def metric_units(self) -> dict:
+        from ..results import metric_unit
+        return {k: metric_unit(k, self.units, self.scenario.metrics if self.scenario else "") for k in self.metrics}
+
+    @property
+    def units_of_instances(self) -> dict:
+        return {c.name: c.model for c in self.scenario.components} if self.scenario is not None else {}
 
     def to_pandas(self):
-        """A pandas DataFrame indexed by time (pandas is not a dependency of scfmu: install it to use this)."""
-        import pandas as pd
+        """A pandas DataFrame indexed by time (column names carry no units; see ``units``)."""
+        try:
+            import pandas as pd
+        except ImportError:
+            raise ImportError("Result.to_pandas needs pandas: pip install 'scfmu[pandas]'") from None
         return pd.DataFrame({k: v for k, v in self.items() if k != "time"}, index=pd.Index(self["time"], name="time"))
 
     def to_csv(self, path, keys=None, every: int = 1) -> None:
@@ -84,19 +115,36 @@ class Result(dict):
         write_csv(path, self, keys, every)
 
 
+def log_units(plan: Plan) -> dict:
+    """``{log key: unit}`` of a plan's logged signals as their units declare them ("" for none)."""
+    from ..results import declared_unit
+    out = {"time": "s"}
+    for g in plan.log:
+        u = plan.unit(g.inst)
+        for key, name in zip(g.keys, g.names):
+            out[key] = declared_unit(u.vars[name])
+    return out
+
+
 def simulate(scenario, engine: str = "native", *, fmus: dict | None = None, overrides: dict | None = None,
-             seed: int | None = None, **kw) -> Result:
+             seed: int | None = None, model_exchange=frozenset(), **kw) -> Result:
     """Runs a scenario (a :class:`~scfmu.scenario.Scenario` or a registered name such as ``"default"``) on
     one of the engines (``"native"``, default; ``"compiled"``; ``"auto"``; ``"lean"``; ``"reference"``) and
     returns the logged signals.
 
-    ``fmus``: ``{instance: model name or path to an .fmu}`` replaces components' models; ``overrides``:
-    ``{"instance.parameter": value}``; ``seed``: sets the scenario's seed parameters. Engine options
-    (``log_every``, ``reuse`` for native) pass through. A failing run raises :class:`SimulationError`
-    with a status (``fmu_error``, ``nonfinite``, ...) and the FMUs' messages."""
+    ``fmus``: ``{instance: model name or path to an .fmu}`` replaces components' models (FMI 2.0 or 3.0,
+    Co-Simulation or Model Exchange); ``overrides``: ``{"instance.parameter": value}``; ``seed``: sets the
+    scenario's seed parameters; ``model_exchange``: instances to run as Model Exchange units (also
+    ``Component.interface = "me"``; a unit that offers Model Exchange only always is). Engine options
+    (``log_every``, ``reuse`` for native) pass through. The scenario is resolved once, into one
+    :class:`~scfmu.scenario.plan.Plan` that the engine executes. A failing run raises
+    :class:`SimulationError` with a status (``fmu_error``, ``nonfinite``, ...) and the FMUs' messages."""
     if isinstance(scenario, str):
         from ..scenario import get
         scenario = get(scenario)
+    if isinstance(scenario, Plan) and (fmus or overrides or seed is not None or model_exchange):
+        raise ValueError("simulate(plan, ...): a plan is fixed; give fmus, overrides, seed and model_exchange "
+                         "with a scenario")
     if fmus:
         scenario = scenario.with_models(fmus)
     if overrides:
@@ -104,23 +152,27 @@ def simulate(scenario, engine: str = "native", *, fmus: dict | None = None, over
     if seed is not None:
         scenario = scenario.with_seed(seed)
     engine = resolve_engine(engine)
+    if engine not in ENGINES:
+        raise ValueError(f"engine {engine!r}: expected one of {ENGINES} or 'auto'")
+    plan = scenario if isinstance(scenario, Plan) else build_plan(scenario, model_exchange=model_exchange)
     if engine == "reference":
-        out = run_reference(scenario)
+        out = run_reference(plan)
     elif engine == "lean":
-        with LeanMaster(scenario) as m:
+        with LeanMaster(plan) as m:
             out = m.run()
     elif engine == "native":
         from .native import NativeLoop
-        with NativeLoop(scenario, **kw) as m:
-            out = m.run()
-    elif engine == "compiled":
-        from .compiled import CompiledLoop
-        with CompiledLoop(scenario, **kw) as m:
+        with NativeLoop(plan, **kw) as m:
             out = m.run()
     else:
-        raise ValueError(f"engine {engine!r}: expected one of {ENGINES} or 'auto'")
+        from .compiled import CompiledLoop
+        with CompiledLoop(plan, **kw) as m:
+            out = m.run()
     for k, v in out.items():
         if not np.all(np.isfinite(v)):
             i = int(np.argmin(np.isfinite(v)))
             raise SimulationError("nonfinite", f"{k} is not finite at t = {out['time'][i]}", float(out["time"][i]))
-    return Result(out)
+    res = Result(out)
+    res.scenario = plan.scenario
+    res.units = log_units(plan)
+    return res

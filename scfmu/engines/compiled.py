@@ -2,21 +2,27 @@
 library (the Rust crate ``scfmu/engines/native_loop``), so a whole run with every step logged needs no
 Python call per communication step.
 
-How. :class:`CompiledLoop` instantiates and initializes the FMUs and resolves the wiring exactly as
-:class:`~scfmu.engines.lean.LeanMaster` (whose plan it reuses: the same gets and sets, grouped and
-ordered the same way, the same logged groups), then hands the plan to ``scfmu_loop_run`` as flat
-arrays: per FMU its component pointer and its ``fmi2GetReal`` / ``fmi2SetReal`` / ``fmi2DoStep``
-function pointers (taken from the FMU's loaded shared library with ctypes), the propagation operations,
-the logged (FMU, value reference) pairs, n_steps, t0, Δ and the output array of (n_steps + 1) rows.
-The library makes, for k = 0..n_steps, the calls ``LeanMaster.run`` makes at t_k = t0 + k·Δ
-(propagate, log row k, ``fmi2DoStep(t_k, Δ)`` of every FMU; at t_end log only) and stops at the first
-status above fmi2Warning, so results are bit-identical to the lean and reference masters
-(tests/test_campaign.py).
+How. :class:`CompiledLoop` instantiates and initializes the FMUs of the scenario's plan
+(:mod:`scfmu.scenario.plan`) exactly as :class:`~scfmu.engines.lean.LeanMaster` (whose flat operations
+it reuses: the same gets and sets, grouped and ordered the same way, the same logged groups), then
+hands them to ``scfmu_loop_run`` as flat arrays: per FMU its instance pointer, FMI version (2.0 or
+3.0), interface and a table of function pointers taken from its loaded shared library with ctypes
+(typed get/set for Real, Integer and Boolean, ``doStep``, and for a Model Exchange unit the functions
+of its continuous-time interface), the propagation operations, the logged (FMU, value reference, type)
+triples, n_steps, t0, Δ and the output array of (n_steps + 1) rows. The library makes, for
+k = 0..n_steps, the calls ``LeanMaster.run`` makes at t_k = t0 + k·Δ (propagate, log row k, step every
+FMU from t_k to t_k + Δ; at t_end log only) and stops at the first status above Warning, so results
+of Co-Simulation units are bit-identical to the lean and reference masters (tests/test_campaign.py).
 
-Reuse. With ``reuse`` (default), after a successful run every FMU is reset (``fmi2Terminate`` +
-``fmi2Reset``) and the instances are kept (up to two sets per structure: components, models and FMU
-files with their modification times and sizes) for the next run, which only sets them up and
-initializes them again; results do not depend on it (tested). Instances of a failed run are freed.
+Model Exchange units are integrated inside the library by its embedded Dormand–Prince 5(4) solver
+with the instance's ``rtol``/``atol`` (``Component.solver``; the ``method`` applies to the Python
+engines only), stopping at time events and located state events, calling ``completedIntegratorStep``
+after every accepted step and running the event iteration where the unit asks for it.
+
+Reuse. With ``reuse`` (default), after a successful run every FMU is reset (terminate + reset) and the
+instances are kept (up to two sets per structure: components, models and FMU files with their
+modification times and sizes, interfaces) for the next run, which only sets them up and initializes
+them again; results do not depend on it (tested). Instances of a failed run are freed.
 
 The library: :func:`library_path` (the package's shipped binary, else a source checkout's
 ``target/release``); :func:`available` says whether it can be loaded. ``simulate(..., "auto")`` and
@@ -35,13 +41,26 @@ from pathlib import Path
 
 import numpy as np
 
-from ..fmu import fmu_path
-from ..scenario.model import Scenario
-from ..scenario.resolve import resolve
-from .lean import LeanMaster, SimulationError, build_fmus, initialize_fmus
+from .calls import SimulationError, fmu_messages, raw_fn
+from .instances import as_plan, build_fmus, initialize_fmus
+from .lean import LeanMaster
 
-ABI_VERSION = 1
-_PHASES = ("fmi2GetReal (propagation)", "fmi2SetReal (propagation)", "fmi2GetReal (logging)", "fmi2DoStep")
+ABI_VERSION = 2
+_PHASES = ("get (propagation)", "set (propagation)", "get (logging)", "step", "a request to terminate",
+           "the Model Exchange solver (step size too small, or too many steps)")
+FN_SLOTS = 16
+_FN_NAMES = {
+    2: ["fmi2GetReal", "fmi2SetReal", "fmi2GetInteger", "fmi2SetInteger", "fmi2GetBoolean", "fmi2SetBoolean",
+        "fmi2DoStep", "fmi2SetTime", "fmi2SetContinuousStates", "fmi2GetContinuousStates", "fmi2GetDerivatives",
+        "fmi2GetEventIndicators", "fmi2CompletedIntegratorStep", "fmi2EnterEventMode", "fmi2NewDiscreteStates",
+        "fmi2EnterContinuousTimeMode"],
+    3: ["fmi3GetFloat64", "fmi3SetFloat64", "fmi3GetInt32", "fmi3SetInt32", "fmi3GetBoolean", "fmi3SetBoolean",
+        "fmi3DoStep", "fmi3SetTime", "fmi3SetContinuousStates", "fmi3GetContinuousStates",
+        "fmi3GetContinuousStateDerivatives", "fmi3GetEventIndicators", "fmi3CompletedIntegratorStep",
+        "fmi3EnterEventMode", "fmi3UpdateDiscreteStates", "fmi3EnterContinuousTimeMode"]}
+_KINDS = {("get", "Real"): 0, ("set", "Real"): 1, ("get", "Integer"): 2, ("set", "Integer"): 3,
+          ("get", "Boolean"): 4, ("set", "Boolean"): 5}
+_LOG_TYPES = {"Real": 0, "Integer": 1, "Boolean": 2}
 
 
 def _platform() -> tuple[str, str] | None:
@@ -92,8 +111,8 @@ def _lib():
                     f = cand.scfmu_loop_run
                     f.restype = c_int
                     f.argtypes = ([c_size_t, c_void_p, c_void_p, c_void_p, c_void_p,  # FMUs
-                                   c_size_t, c_void_p, c_size_t, c_void_p, c_size_t,  # ops, vrs, buffer
-                                   c_size_t, c_void_p, c_void_p,  # logged pairs
+                                   c_size_t, c_void_p, c_size_t, c_void_p, c_size_t, c_size_t,  # ops, buffers
+                                   c_size_t, c_void_p, c_void_p, c_void_p,  # logged triples
                                    c_size_t, c_double, c_double, c_void_p, c_size_t,  # steps, time, output
                                    c_int, POINTER(c_int64)])
                     lib = cand
@@ -111,27 +130,43 @@ def available() -> bool:
 _POOL: dict[tuple, list[dict]] = {}  # reset FMU instance sets ready for the next run, per structure
 
 
-def _identity(name: str, model: str, path: Path) -> tuple:
+def _identity(name: str, model: str, path: Path, interface: str) -> tuple:
     st = path.stat()  # a rebuilt FMU file is another structure: its old instances are not reused
-    return name, model, str(path.resolve()), st.st_mtime_ns, st.st_size
+    return name, model, str(path), st.st_mtime_ns, st.st_size, interface
+
+
+_SLOT_KEYS = ("get:Real", "set:Real", "get:Integer", "set:Integer", "get:Boolean", "set:Boolean", "step")
+
+
+def _fn_address(calls, slot: int, name: str) -> int | None:
+    """Address of the function of a slot: the instance's raw calls (:class:`~scfmu.engines.calls.RawCalls`)
+    for get/set/step, else the unit's exported function (None when it exports none by that name)."""
+    if slot < len(_SLOT_KEYS):
+        f = calls.fn.get(_SLOT_KEYS[slot])
+    else:
+        try:
+            f = raw_fn(calls.fmu.slave, name, None)
+        except AttributeError:  # e.g. no event indicator function in a unit that has none to report
+            f = None
+    return None if f is None else ctypes.cast(f, c_void_p).value
 
 
 class CompiledLoop(LeanMaster):
-    """Runs a Scenario in the compiled loop (see module docstring). Use as a context manager or call
-    ``close()``. ``run()`` returns what ``LeanMaster.run`` returns."""
+    """Runs a Scenario (or a plan) in the compiled loop (see module docstring). Use as a context manager or
+    call ``close()``. ``run()`` returns what ``LeanMaster.run`` returns."""
 
-    def __init__(self, scenario: Scenario, path_of=None, reuse: bool = True):
+    def __init__(self, scenario, path_of=None, reuse: bool = True, model_exchange=frozenset()):
         lib = _lib()
         if lib is None:
             raise RuntimeError("the compiled loop library is not available (cargo build --release in a source "
                                "checkout, or a wheel that ships it): use the 'native' engine")
         self._lib = lib
-        scenario = resolve(scenario)
-        self.scenario = scenario
+        self.plan = as_plan(scenario, path_of, model_exchange)
+        self.scenario = self.plan.scenario
         self.reuse = reuse
         self._ok = False
-        self._key = tuple(_identity(c.name, c.model, Path(path_of(c.model) if path_of else fmu_path(c.model)))
-                          for c in scenario.components)
+        self._key = tuple(_identity(u.name, u.model, u.path, u.interface) + (tuple(sorted(u.solver.items())),)
+                          for u in self.plan.units)
         pool = _POOL.get(self._key) if reuse else None
         if pool:
             fmus = pool.pop()
@@ -139,13 +174,13 @@ class CompiledLoop(LeanMaster):
                 f.messages.clear()
             self.fmus = fmus
             try:
-                initialize_fmus(fmus, scenario)
+                initialize_fmus(fmus, self.plan)
             except Exception:
                 self.reuse = False  # not back into the pool
                 self.close()
                 raise
         else:
-            self.fmus = build_fmus(scenario, path_of, reuse)
+            self.fmus = build_fmus(self.plan, reuse=reuse)
         try:
             self._prepare()
         except Exception:
@@ -158,38 +193,56 @@ class CompiledLoop(LeanMaster):
         names = list(self.fmus)
         index = {n: i for i, n in enumerate(names)}
         nf = len(names)
-
-        def fn_ptr(f):
-            return ctypes.cast(f, c_void_p).value
-
-        comps = (c_void_p * nf)(*[self._comp[n] for n in names])
-        gets = (c_void_p * nf)(*[fn_ptr(self._get[n]) for n in names])
-        sets = (c_void_p * nf)(*[fn_ptr(self._set[n]) for n in names])
-        steps = (c_void_p * nf)(*[fn_ptr(self._step[n]) for n in names])
-        base = np.concatenate([[0], np.cumsum(self.plan_buffers)]).astype(int) if self.plan_buffers else [0]
+        comps = (c_void_p * nf)(*[self.calls[n].comp for n in names])
+        info, fns, me = [], [], []
+        for n in names:
+            f, u = self.fmus[n], self.plan.unit(n)
+            me_unit = u.interface == "me"
+            info += [f.fmi, 1 if me_unit else 0, f.nx if me_unit else 0, f.nz if me_unit else 0]
+            table = getattr(f, "_fn_table", None)
+            if table is None:  # per instance, once (kept across reset and reuse)
+                names_ = _FN_NAMES[f.fmi] if me_unit else _FN_NAMES[f.fmi][:7]
+                table = [_fn_address(self.calls[n], i, fn) for i, fn in enumerate(names_)]
+                table += [None] * (FN_SLOTS - len(table))
+                if me_unit:
+                    table[6] = None
+                f._fn_table = table
+            fns += table
+            nxt = f.next_event if me_unit and f.next_event is not None else float("nan")
+            me += ([u.solver["rtol"], u.solver["atol"], nxt, 1.0 if u.solver["method"] == "RK4" else 0.0,
+                    u.solver["max_step"]] if me_unit else [0.0, 0.0, float("nan"), 0.0, 0.0])
+        base = {}
+        n_real = n_int = 0
+        for b, (t, m) in enumerate(self.plan_buffers):
+            if t == "Real":
+                base[b], n_real = n_real, n_real + m
+            else:
+                base[b], n_int = n_int, n_int + m
         ops, vrs = [], []
-        for kind, inst, v, b, off in self.plan_ops:
-            ops += [0 if kind == "get" else 1, index[inst], len(vrs), len(v), int(base[b]) + off]
+        for kind, t, inst, v, b, off in self.plan_ops:
+            ops += [_KINDS[(kind, t)], index[inst], len(vrs), len(v), base[b] + off]
             vrs += v
-        n_buf = int(base[-1])
-        log_fmu, log_vr = [], []
+        log_fmu, log_vr, log_type = [], [], []
         self._log_keys, self._log_arrays = [], []
-        n_log = sum(len(keys) for _, keys, _ in self.plan_log)
+        n_log = sum(len(keys) for _, _, keys, _ in self.plan_log)
         self._out = np.empty((self.n + 1, n_log))
         col = 0
-        for inst, keys, v in self.plan_log:
+        for inst, t, keys, v in self.plan_log:
             log_fmu += [index[inst]] * len(keys)
             log_vr += v
+            log_type += [_LOG_TYPES[t]] * len(keys)
             self._log_keys.append(keys)
             self._log_arrays.append(self._out[:, col:col + len(keys)])  # views: LeanMaster._result copies columns
             col += len(keys)
-        arrays = (comps, gets, sets, steps, (c_size_t * max(1, len(ops)))(*ops), (c_uint * max(1, len(vrs)))(*vrs),
-                  (c_size_t * max(1, n_log))(*log_fmu), (c_uint * max(1, n_log))(*log_vr))
+        arrays = (comps, (c_size_t * len(info))(*info), (c_void_p * len(fns))(*fns), (c_double * len(me))(*me),
+                  (c_size_t * max(1, len(ops)))(*ops), (c_uint * max(1, len(vrs)))(*vrs),
+                  (c_size_t * max(1, n_log))(*log_fmu), (c_uint * max(1, n_log))(*log_vr),
+                  (c_size_t * max(1, n_log))(*log_type))
         self._keep.extend(arrays)
         self._names = names
         self._fail_at = (c_int64 * 3)()
-        self._args = (nf, *arrays[:4], len(ops) // 5, arrays[4], len(vrs), arrays[5], n_buf, n_log, arrays[6],
-                      arrays[7])
+        self._args = (nf, *arrays[:4], len(ops) // 5, arrays[4], len(vrs), arrays[5], n_real, n_int, n_log,
+                      *arrays[6:])
 
     def run(self) -> dict[str, np.ndarray]:
         """Runs from start_time to stop_time in the compiled loop; returns {"time", log keys...} at every t_k."""
@@ -202,12 +255,13 @@ class CompiledLoop(LeanMaster):
         if st > 1:
             k, phase, i = self._fail_at
             t = sc.start_time + k * sc.step
-            self._fail(t, f"{self._names[i]}: {_PHASES[phase]} returned status {st} at t = {t}")
+            self._fail(t, f"{self._names[i]}: {_PHASES[phase]} returned status {st} at t = {t}"
+                       if phase < 4 else f"{self._names[i]}: {_PHASES[phase]} at t = {t}")
         self._ok = True
         return self._result()
 
     def _fail(self, t: float, what: str | None = None):
-        msgs = [f"{name}: {text}" for name, f in self.fmus.items() for status, _c, text in f.messages if status >= 2]
+        msgs = fmu_messages(self.fmus)
         raise SimulationError("fmu_error", "; ".join(msgs) or what or f"an FMI call failed at t = {t}", t)
 
     def close(self) -> None:
@@ -217,8 +271,7 @@ class CompiledLoop(LeanMaster):
         if self.reuse and self._ok:
             try:
                 for f in fmus.values():
-                    f.slave.terminate()
-                    f.slave.reset()
+                    f.reset()
                 pool = _POOL.setdefault(self._key, [])
                 if len(pool) < 2:
                     pool.append(fmus)

@@ -1,105 +1,65 @@
-"""Lean fixed-step Gauss–Seidel master: the same algorithm as ``master.CoSimulation``, without per-step
+"""Lean fixed-step Gauss–Seidel master: the same algorithm as ``reference.CoSimulation``, without per-step
 Python object churn.
 
-Set-up (once per run): every FMU is instantiated and initialized through fmpy (``master.Fmu``), the
-scenario's wiring is resolved by port name to value references, and for every destination instance
-the master preallocates one ctypes ``double`` buffer for its connected inputs and the value-reference
-arrays of each source group. Per communication point t_k = t0 + k·Δ it calls, in Gauss–Seidel order,
-``fmi2GetReal`` of each source group into a slice of the destination's buffer and one ``fmi2SetReal``
-of the whole buffer; logged variables are read with one ``fmi2GetReal`` per instance straight into a
-preallocated NumPy row; then ``fmi2DoStep(t_k, Δ)`` on every instance. The FMI functions are called as
-raw ctypes function pointers taken from the FMU's shared library (arguments are plain ints: handles
-and buffer addresses), and their status codes are checked once per step.
+Set-up (once per run): every FMU of the plan (:mod:`scfmu.scenario.plan`; FMI 2.0 or 3.0, Co-Simulation
+or Model Exchange) is instantiated and initialized through fmpy (:class:`scfmu.fmu.Fmu`), and the plan's
+link groups become flat operations (:func:`flat_ops`): per destination and type one preallocated ctypes
+buffer (Real ``double``, Integer and Boolean ``int32``) for its connected inputs and the value-reference
+arrays of each source group. Per communication point t_k = t0 + k·Δ it calls, in Gauss–Seidel order, the
+get of each source group into a slice of the destination's buffer and one set of each of the
+destination's buffers; logged variables are read with one get per instance and type straight into a
+preallocated NumPy row; then every instance steps from t_k to t_k + Δ (``doStep``, or for a Model Exchange
+instance its solver). The FMI functions are raw ctypes function pointers taken from the FMU's shared
+library (:class:`scfmu.engines.calls.RawCalls`: arguments are plain ints, handles and buffer addresses),
+and their status codes are checked once per step.
 
-The value sequence seen by the FMUs is the one of ``master.CoSimulation`` (same reads, same writes, same
+The value sequence seen by the FMUs is the one of ``reference.CoSimulation`` (same reads, same writes, same
 order, same communication points), so results are bit-identical (tests/test_campaign.py checks it).
 """
 
 from __future__ import annotations
 
 import ctypes
-from ctypes import c_double, c_int, c_size_t, c_uint, c_void_p
+from ctypes import c_uint
 
 import numpy as np
 
-from ..fmu import Fmu, fmu_path, unpacked
-from ..scenario.model import Scenario
-from ..scenario.resolve import resolve
-
-_STATUS = {0: "OK", 1: "Warning", 2: "Discard", 3: "Error", 4: "Fatal", 5: "Pending"}
-
-
-class SimulationError(RuntimeError):
-    """A run that failed: FMU error status, or a non-finite logged value. ``status`` is a short code."""
-
-    def __init__(self, status: str, message: str, time: float | None = None):
-        super().__init__(message)
-        self.status = status
-        self.time = time
+from ..fmu import Fmu
+from ..scenario.plan import Plan
+from .calls import C_TYPES, STATUS as _STATUS, RawCalls, SimulationError, fmu_messages, raw_calls, raw_fn  # noqa: F401
+from .instances import as_plan, build_fmus, initialize_fmus, ports_of  # noqa: F401
 
 
-def _raw(slave, name: str, argtypes, restype=c_int):
-    f = slave.dll[name]  # a fresh function pointer: fmpy's own (cached) one keeps its argtypes
-    f.argtypes = argtypes
-    f.restype = restype
-    return f
-
-
-def build_fmus(scenario: Scenario, path_of=None, reuse: bool = False, model_exchange=frozenset()) -> dict[str, Fmu]:
-    """Instantiates and initializes every instance of the scenario (parameters in initialization mode),
-    then writes the fixed ``inputs``. Returns {instance name: Fmu} in Gauss–Seidel order. With ``reuse``
-    the FMUs are unpacked once per process (``master.unpacked``). Instances named in ``model_exchange``
-    run as Model Exchange units under SciPy's solver (:class:`scfmu.fmu.Fmu`; the reference master only)."""
-    unknown = set(model_exchange) - {c.name for c in scenario.components}
-    if unknown:
-        raise KeyError(f"model_exchange names no instance of {scenario.name}: {sorted(unknown)}")
-    fmus: dict[str, Fmu] = {}
-    try:
-        for c in scenario.components:
-            p = path_of(c.model) if path_of else fmu_path(c.model)
-            # the same calls as Fmu(initialize=True), keeping the instance to report its log messages
-            fmus[c.name] = Fmu(c.model, name=c.name, start_time=scenario.start_time, path=p, initialize=False,
-                               unpacked=unpacked(p) if reuse else None,
-                               interface="me" if c.name in model_exchange else "cs")
-        initialize_fmus(fmus, scenario)
-    except Exception:
-        for f in fmus.values():
-            f.close()
-        raise
-    return fmus
-
-
-def initialize_fmus(fmus: dict[str, Fmu], scenario: Scenario) -> None:
-    """Initializes instantiated (or reset) FMUs for the scenario: set-up, parameters in initialization
-    mode, then the fixed ``inputs``. Raises SimulationError when an FMU refuses to initialize."""
-    for c in scenario.components:
-        f = fmus[c.name]
-        f.slave.setupExperiment(tolerance=None, startTime=scenario.start_time, stopTime=None)
-        f.slave.enterInitializationMode()
-        for k, v in c.params.items():
-            f.set(k, v)
-        try:
-            f.exit_initialization_mode()
-        except Exception:
-            msgs = "; ".join(m[2] for m in f.messages if m[0] >= 2)
-            raise SimulationError("fmu_error", f"{c.name} ({c.model}): fmi2ExitInitializationMode failed"
-                                  + (f": {msgs}" if msgs else "")) from None
-    for q, value in scenario.inputs.items():
-        inst, _, var = q.partition(".")
-        fmus[inst].set(var, value)
-
-
-def ports_of(fmus: dict[str, Fmu]) -> dict[str, tuple[list[str], list[str]]]:
-    return {name: (f.inputs(), f.outputs()) for name, f in fmus.items()}
+def flat_ops(plan: Plan) -> tuple[list, list]:
+    """The propagation of a plan as flat operations, executed by the lean master and the compiled loop:
+    ``ops`` = [(kind "get"/"set", type, instance, [vr], buffer index, offset)], ``buffers`` = [(type,
+    size)]. Per destination and type one buffer; each link group's get fills a slice of it, in Gauss–Seidel
+    order; then one set of each of the destination's buffers."""
+    ops, buffers = [], []
+    for dst, groups in plan.by_destination():
+        bufs: dict[str, list] = {}  # type -> [buffer index, filled]
+        for g in groups:
+            b = bufs.get(g.type)
+            if b is None:
+                b = bufs[g.type] = [len(buffers), 0, []]
+                buffers.append([g.type, 0])
+            ops.append(("get", g.type, g.src, list(g.src_vrs), b[0], b[1]))
+            b[1] += len(g.src_vrs)
+            b[2] += g.dst_vrs
+            buffers[b[0]][1] = b[1]
+        for t, (bi, _n, dvrs) in bufs.items():
+            ops.append(("set", t, dst, dvrs, bi, 0))
+    return ops, [tuple(b) for b in buffers]
 
 
 class LeanMaster:
-    """Runs a Scenario (see module docstring). Use as a context manager or call ``close()``."""
+    """Runs a Scenario (or a :class:`~scfmu.scenario.plan.Plan`; see module docstring). Use as a context
+    manager or call ``close()``."""
 
-    def __init__(self, scenario: Scenario, path_of=None, reuse: bool = True):
-        scenario = resolve(scenario)
-        self.scenario = scenario
-        self.fmus = build_fmus(scenario, path_of, reuse)
+    def __init__(self, scenario, path_of=None, reuse: bool = True, model_exchange=frozenset()):
+        self.plan = as_plan(scenario, path_of, model_exchange)
+        self.scenario = self.plan.scenario
+        self.fmus = build_fmus(self.plan, reuse=reuse)
         try:
             self._prepare()
         except Exception:
@@ -107,60 +67,21 @@ class LeanMaster:
             raise
 
     def _prepare(self) -> None:
-        sc = self.scenario
-        fmus = self.fmus
-        links = sc.wiring(ports_of(fmus))
-        self.links = links
-        vr = {name: {v.name: v.valueReference for v in f.md.modelVariables} for name, f in fmus.items()}
-        types = {name: {v.name: v.type for v in f.md.modelVariables} for name, f in fmus.items()}
-        for d, di, s, so in links:
-            if types[d][di] != "Real" or types[s][so] != "Real":
-                raise TypeError(f"{d}.{di} <- {s}.{so}: only Real connections are supported")
+        plan = self.plan
+        self.links = plan.links
+        self.calls = {name: raw_calls(f) for name, f in self.fmus.items()}
         self._keep = []  # ctypes objects that must live as long as the master
-        self._get, self._set, self._step, self._comp = {}, {}, {}, {}
-        for name, f in fmus.items():
-            sl = f.slave
-            self._comp[name] = sl.component if isinstance(sl.component, int) else ctypes.cast(sl.component, c_void_p).value
-            self._get[name] = _raw(sl, "fmi2GetReal", [c_void_p, c_void_p, c_size_t, c_void_p])
-            self._set[name] = _raw(sl, "fmi2SetReal", [c_void_p, c_void_p, c_size_t, c_void_p])
-            self._step[name] = _raw(sl, "fmi2DoStep", [c_void_p, c_double, c_double, c_int])
-        # The plan, by instance name (also executed by the compiled engine, scfmu/engines/compiled.py):
-        # per destination one buffer; per (destination, source) group a get into a slice of it, in
-        # Gauss–Seidel order; then the set of the whole buffer.
-        self.plan_ops = []  # ("get", source, [vr], buffer index, offset) / ("set", destination, [vr], buffer index, 0)
-        self.plan_buffers = []  # buffer sizes
-        by_dst: dict[str, list] = {}
-        for d, di, s, so in links:
-            by_dst.setdefault(d, []).append((s, so, di))
-        for d, items in by_dst.items():
-            b = len(self.plan_buffers)
-            self.plan_buffers.append(len(items))
-            i = 0
-            while i < len(items):  # consecutive items of the same source form one get
-                s = items[i][0]
-                j = i
-                while j < len(items) and items[j][0] == s:
-                    j += 1
-                self.plan_ops.append(("get", s, [vr[s][so] for _, so, _ in items[i:j]], b, i))
-                i = j
-            self.plan_ops.append(("set", d, [vr[d][di] for _, _, di in items], b, 0))
-        # logging: per instance one get into a row of a (n + 1, m) array
-        groups: dict[str, list[tuple[str, str]]] = {}
-        for key, inst, var in sc.log_items():
-            if inst not in fmus:
-                raise KeyError(f"log {key!r}: unknown instance {inst!r}")
-            if var not in vr[inst]:
-                raise KeyError(f"log {key!r}: {fmus[inst].model} has no variable {var!r}")
-            if types[inst][var] != "Real":
-                raise TypeError(f"log {key!r}: {inst}.{var} is not Real")
-            groups.setdefault(inst, []).append((key, var))
-        self.plan_log = [(inst, [k for k, _ in items], [vr[inst][v] for _, v in items]) for inst, items in groups.items()]
-        self.n = sc.n_steps
+        self.plan_ops, self.plan_buffers = flat_ops(plan)
+        self.plan_log = [(g.inst, g.type, g.keys, g.vrs) for g in plan.log]
+        for kind, t, inst, _v, _b, _o in self.plan_ops:
+            if t not in getattr(self.calls[inst], kind):
+                raise SimulationError("fmu_error", f"{inst}: the unit's library has no {kind} function for {t}")
+        self.n = plan.n_steps
         self._build_calls()
 
     def _build_calls(self) -> None:
         """The plan as ctypes calls for :meth:`run`."""
-        bufs = [(c_double * m)() for m in self.plan_buffers]
+        bufs = [(C_TYPES[t] * max(1, m))() for t, m in self.plan_buffers]
         self._keep.extend(bufs)
 
         def vr_array(vals):
@@ -168,20 +89,19 @@ class LeanMaster:
             self._keep.append(a)
             return ctypes.addressof(a)
 
-        self._ops = []  # (fn, component, vr array address, n, buffer address at the offset)
-        for kind, inst, vrs, b, off in self.plan_ops:
-            fn = self._get[inst] if kind == "get" else self._set[inst]
-            self._ops.append((fn, self._comp[inst], vr_array(vrs), len(vrs), ctypes.addressof(bufs[b]) + 8 * off))
+        self._ops = []  # (fn, vr array address, n, buffer address at the offset)
+        for kind, t, inst, vrs, b, off in self.plan_ops:
+            fn = getattr(self.calls[inst], kind)[t]
+            self._ops.append((fn, vr_array(vrs), len(vrs), ctypes.addressof(bufs[b]) + ctypes.sizeof(C_TYPES[t]) * off))
         self._log_keys = []
         self._log_arrays = []
         self._log_ops = []
-        for inst, keys, vrs in self.plan_log:
-            arr = np.empty((self.n + 1, len(keys)))
+        for inst, t, keys, vrs in self.plan_log:
+            arr = np.empty((self.n + 1, len(keys)), dtype=np.float64 if t == "Real" else np.int32)
             self._log_arrays.append(arr)
             self._log_keys.append(keys)
-            self._log_ops.append((self._get[inst], self._comp[inst], vr_array(vrs), len(vrs), arr.ctypes.data,
-                                  arr.strides[0]))
-        self._steps = [(self._step[name], self._comp[name]) for name in self.fmus]
+            self._log_ops.append((self.calls[inst].get[t], vr_array(vrs), len(vrs), arr.ctypes.data, arr.strides[0]))
+        self._steps = [self.calls[name].step for name in self.fmus]
 
     # ------------------------------------------------------------------------------------------------
     def run(self) -> dict[str, np.ndarray]:
@@ -192,13 +112,13 @@ class LeanMaster:
         for k in range(n + 1):
             t = t0 + k * dt
             st = 0
-            for fn, comp, vrs, m, buf in ops:
-                st |= fn(comp, vrs, m, buf)
-            for fn, comp, vrs, m, base, stride in log_ops:
-                st |= fn(comp, vrs, m, base + k * stride)
+            for fn, vrs, m, buf in ops:
+                st |= fn(vrs, m, buf)
+            for fn, vrs, m, base, stride in log_ops:
+                st |= fn(vrs, m, base + k * stride)
             if k < n:
-                for fn, comp in steps:
-                    st |= fn(comp, t, dt, 1)
+                for fn in steps:
+                    st |= fn(t, dt)
             if st > 1:
                 self._fail(t)
         return self._result()
@@ -208,16 +128,12 @@ class LeanMaster:
         out = {"time": sc.start_time + np.arange(self.n + 1) * sc.step}
         for keys, arr in zip(self._log_keys, self._log_arrays):
             for i, key in enumerate(keys):
-                out[key] = arr[:, i].copy()
+                out[key] = arr[:, i].astype(np.float64)  # a copy (Integer, Boolean: as numbers)
         order = ["time"] + [k for k in sc.log]
         return {k: out[k] for k in order}
 
     def _fail(self, t: float):
-        msgs = []
-        for name, f in self.fmus.items():
-            for status, _cat, text in f.messages:
-                if status >= 2:
-                    msgs.append(f"{name}: {text}")
+        msgs = fmu_messages(self.fmus)
         raise SimulationError("fmu_error", "; ".join(msgs) or f"an FMI call returned an error status at t = {t}", t)
 
     def close(self) -> None:
@@ -248,10 +164,8 @@ class OpenLoop:
         self.fmu = Fmu(model, params, start_time=start_time, stop_time=stop_time)
         try:
             sl = self.fmu.slave
-            self._comp = sl.component if isinstance(sl.component, int) else ctypes.cast(sl.component, c_void_p).value
-            self._get = _raw(sl, "fmi2GetReal", [c_void_p, c_void_p, c_size_t, c_void_p])
-            self._set = _raw(sl, "fmi2SetReal", [c_void_p, c_void_p, c_size_t, c_void_p])
-            self._step = _raw(sl, "fmi2DoStep", [c_void_p, c_double, c_double, c_int])
+            calls = RawCalls(self.fmu)
+            self._get, self._set, self._step = calls.get["Real"], calls.set["Real"], calls.step
             self.inputs, self.outputs = list(inputs), list(outputs)
             self._vr_in = (c_uint * len(inputs))(*[self.fmu.var(n).valueReference for n in inputs])
             self._vr_out = (c_uint * len(outputs))(*[self.fmu.var(n).valueReference for n in outputs])
@@ -272,16 +186,16 @@ class OpenLoop:
         if u.ndim != 2 or u.shape[1] != n_in:
             raise ValueError(f"input table of shape {u.shape}: expected (steps, {n_in})")
         self.fmu.slave.setFMUstate(self.state0)
-        comp, setr, step = self._comp, self._set, self._step
+        setr, step = self._set, self._step
         vr_in = ctypes.addressof(self._vr_in)
         base, stride, t0 = u.ctypes.data, u.strides[0], self.t0
         for k in range(len(u)):
-            if setr(comp, vr_in, n_in, base + k * stride) != 0:
+            if setr(vr_in, n_in, base + k * stride) != 0:
                 self._fail(f"fmi2SetReal failed at t = {t0 + k * dt}", t0 + k * dt)
-            if step(comp, t0 + k * dt, dt, 1) != 0:
+            if step(t0 + k * dt, dt) != 0:
                 self._fail(f"fmi2DoStep failed at t = {t0 + k * dt}", t0 + k * dt)
         y = np.empty(len(self.outputs))
-        if self._get(comp, ctypes.addressof(self._vr_out), len(self.outputs), y.ctypes.data) != 0:
+        if self._get(ctypes.addressof(self._vr_out), len(self.outputs), y.ctypes.data) != 0:
             self._fail("fmi2GetReal failed")
         self.runs += 1
         return y

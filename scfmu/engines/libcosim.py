@@ -14,17 +14,23 @@ from __future__ import annotations
 
 import time
 
-from ..fmu import fmu_path, unpacked
 from ..scenario.model import Scenario
-from ..scenario.resolve import resolve
+from .instances import as_plan
 
 NS = 10**9
 
 
 def run_libcosim(scenario: Scenario) -> dict:
-    """Runs the scenario to its stop time; returns the final value of every logged key plus
-    ``wall_s`` (the simulate_until call only)."""
-    scenario = resolve(scenario)
+    """Runs the scenario (or its plan) to its stop time; returns the final value of every logged key plus
+    ``wall_s`` (the simulate_until call only). Co-Simulation units only (libcosim hosts no Model Exchange
+    unit); the plan's Real, Integer and Boolean connections."""
+    plan = as_plan(scenario)
+    scenario = plan.scenario
+    if plan.model_exchange:
+        raise ValueError(f"libcosim runs Co-Simulation units only: {sorted(plan.model_exchange)} are Model Exchange")
+    fmi3 = [u.name for u in plan.units if u.fmi == 3]
+    if fmi3:  # the libcosim that libcosimpy ships loads FMI 1.0/2.0 (an FMI 3.0 unit crashes the process)
+        raise ValueError(f"libcosim runs FMI 2.0 units only: {fmi3} are FMI 3.0")
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
     from libcosimpy.CosimObserver import CosimObserver
@@ -36,9 +42,9 @@ def run_libcosim(scenario: Scenario) -> dict:
         raise ValueError("libcosim run: step must be >= 1 ns and start_time 0")
     ex = CosimExecution.from_step_size(step_size=step_ns)
     idx, mds = {}, {}
-    for c in scenario.components:
-        idx[c.name] = ex.add_local_slave(CosimLocalSlave(fmu_path=str(fmu_path(c.model)), instance_name=c.name))
-        mds[c.name] = {v.name: v for v in unpacked(fmu_path(c.model))[0].modelVariables}
+    for u in plan.units:
+        idx[u.name] = ex.add_local_slave(CosimLocalSlave(fmu_path=str(u.path), instance_name=u.name))
+        mds[u.name] = u.vars
     for c in scenario.components:
         for k, v in c.params.items():
             var = mds[c.name][k]
@@ -53,10 +59,11 @@ def run_libcosim(scenario: Scenario) -> dict:
     for q, v in scenario.inputs.items():
         inst, _, var = q.partition(".")
         ex.real_initial_value(idx[inst], mds[inst][var].valueReference, float(v))
-    ports = {n: ([v.name for v in m.values() if v.causality == "input"], [v.name for v in m.values() if v.causality == "output"])
-             for n, m in mds.items()}
-    for d, di, s, so in scenario.wiring(ports):
-        ex.connect_real_variables(idx[s], mds[s][so].valueReference, idx[d], mds[d][di].valueReference)
+    connect = {"Real": ex.connect_real_variables, "Integer": ex.connect_integer_variables,
+               "Boolean": ex.connect_boolean_variables}
+    for g in plan.groups:
+        for so, di in zip(g.src_vrs, g.dst_vrs):
+            connect[g.type](idx[g.src], so, idx[g.dst], di)
     obs = CosimObserver.create_last_value()
     ex.add_observer(obs)
     t = time.perf_counter()

@@ -37,59 +37,46 @@ import os
 import shutil
 import tempfile
 import zipfile
-from ctypes import c_double, c_int, c_size_t, c_uint, c_void_p
+from ctypes import c_int32, c_uint
 from pathlib import Path
 
 import numpy as np
 
-from .lean import SimulationError
-from ..fmu import Fmu, fmu_digest, fmu_path, unpacked
+from ..fmu import Fmu, fmu_digest, scalar_type, unpacked
 from ..scenario.model import Scenario
-from ..scenario.resolve import resolve
+from ..scenario.plan import Plan, PlanError
+from .calls import SimulationError, raw_calls
+from .instances import as_plan
 
 CACHE = Path(os.environ.get("SCFMU_CONTAINER_DIR", Path.home() / ".cache" / "scfmu" / "containers"))
 _KINDS = ("parameter", "calculatedParameter", "input", "output")
-LAYOUT = 4  # version of the container layout below (part of the cache key)
+LAYOUT = 5  # version of the container layout below (part of the cache key)
+_KEYS: dict = {}  # structure of a plan (+ FMU file identities) -> hash, per process
 
 
-def _descriptions(scenario: Scenario):
-    return {c.model: unpacked(fmu_path(c.model))[0] for c in scenario.components}
-
-
-_KEYS: dict = {}  # structure of a scenario (+ FMU file identities) -> (hash, info), per process
-
-
-def _structure(scenario: Scenario, starts: dict | None) -> tuple:
-    """What the container of a scenario depends on, cheaply: instances and models with their FMU files'
-    identity (path, modification time, size), wiring declaration, step and start values."""
+def _structure(plan: Plan, starts: dict | None) -> tuple:
+    """What the container of a plan depends on, cheaply: instances and models with their FMU files'
+    identity (path, modification time, size), the wiring, the step and the start values."""
     files = []
-    for c in scenario.components:
-        p = fmu_path(c.model)
-        st = p.stat()
-        files.append((c.name, c.model, str(p), st.st_mtime_ns, st.st_size))
-    return (tuple(files), repr(scenario.step), tuple(sorted(scenario.connections.items())),
-            tuple(scenario.unconnected), tuple(sorted(scenario.inputs)), scenario.auto_connect,
+    for u in plan.units:
+        st = u.path.stat()
+        files.append((u.name, u.model, str(u.path), st.st_mtime_ns, st.st_size))
+    return (tuple(files), repr(plan.scenario.step), tuple(plan.links),
             tuple(sorted((k, repr(v)) for k, v in starts.items())) if starts else ())
 
 
-def container_key(scenario: Scenario, starts: dict | None = None) -> tuple[str, dict]:
-    sig = _structure(scenario, starts)
+def container_key(plan: Plan, starts: dict | None = None) -> str:
+    sig = _structure(plan, starts)
     hit = _KEYS.get(sig)
     if hit is not None:
         return hit
-    mds = _descriptions(scenario)
-    ports = {c.name: ([v.name for v in mds[c.model].modelVariables if v.causality == "input"],
-                      [v.name for v in mds[c.model].modelVariables if v.causality == "output"])
-             for c in scenario.components}
-    links = scenario.wiring(ports)
-    key = {"components": [(c.name, c.model, mds[c.model].guid, fmu_digest(fmu_path(c.model)))
-                          for c in scenario.components],
-           "links": links, "step": repr(scenario.step), "layout": LAYOUT}
+    key = {"components": [(u.name, u.model, u.md.guid, fmu_digest(u.path)) for u in plan.units],
+           "links": plan.links, "step": repr(plan.scenario.step), "layout": LAYOUT}
     if starts:
         key["starts"] = sorted((k, repr(v)) for k, v in starts.items())
     h = hashlib.sha256(json.dumps(key, sort_keys=True).encode()).hexdigest()[:20]
-    _KEYS[sig] = h, {"mds": mds, "links": links}
-    return _KEYS[sig]
+    _KEYS[sig] = h
+    return h
 
 
 def scenario_starts(scenario: Scenario) -> dict:
@@ -108,8 +95,10 @@ def _start_text(vtype: str, value) -> str:
     return "true" if value in (True, 1, "true") else "false"
 
 
-def build_container(scenario: Scenario, starts: dict | None = None) -> Path:
-    """Path of the container FMU for this scenario's structure (built once, then cached). ``starts``
+def build_container(scenario, starts: dict | None = None) -> Path:
+    """Path of the container FMU for a plan's (or a scenario's) structure (built once, then cached): the
+    one container builder, used by the native engine and the loop-FMU export. Nested units may be
+    FMI 2.0 or FMI 3.0 Co-Simulation FMUs (fmpy's container runtime loads both); ``starts``
     (``"instance.variable" -> value``, e.g. :func:`scenario_starts`) replaces the nested FMUs' start
     values of those container variables (the container applies them at instantiation)."""
     from fmpy.container_fmu import write_configuration
@@ -117,61 +106,63 @@ def build_container(scenario: Scenario, starts: dict | None = None) -> Path:
     from fmpy.model_description import (CoSimulation, DefaultExperiment, ModelDescription, ModelVariable, Unknown,
                                         write_model_description)
 
+    plan = as_plan(scenario)
+    scenario = plan.scenario
+    me = sorted(plan.model_exchange)
+    if me:
+        raise PlanError(f"{', '.join(me)}: Model Exchange instances cannot be nested in fmpy's container FMU "
+                        f"(Co-Simulation units only): run the scenario on the 'compiled', 'lean' or 'reference' engine")
     starts = dict(starts or {})
-    h, info = container_key(scenario, starts)
+    h = container_key(plan, starts)
     path = CACHE / f"loop_{h}.fmu"
     if path.exists():
         return path
-    mds, links = info["mds"], info["links"]
+    mds = {u.name: u.md for u in plan.units}
     guid = "{scfmu-" + h + "}"
     comps, cvars = {}, {}
     container_vars = [ModelVariable(type="Real", variability="continuous", causality="independent", name="time")]
     mappings = {}
     cv_of = {}  # (instance, nested variable name) -> container variable
-    for c in scenario.components:
-        md = mds[c.model]
-        comp = CComponent(name=c.name, filename=fmu_path(c.model), modelDescription=md)
+    for u in plan.units:
+        c = u
+        md = mds[c.name]
+        comp = CComponent(name=c.name, filename=u.path, modelDescription=md)
         comps[c.name] = comp
         cvars[c.name] = {v.name: v for v in md.modelVariables}
         for v in md.modelVariables:
-            if v.causality not in _KINDS or v.type not in ("Real", "Integer", "Boolean"):
+            vt = scalar_type(v)  # FMI 3.0 Float64/Int32/Boolean are the container's Real/Integer/Boolean
+            if v.causality not in _KINDS or vt is None:
                 continue
             if v.causality == "parameter":
-                cv = ModelVariable(type=v.type, variability="tunable" if v.variability == "tunable" else "fixed",
+                cv = ModelVariable(type=vt, variability="tunable" if v.variability == "tunable" else "fixed",
                                    causality="parameter", name=f"{c.name}.{v.name}", start=v.start)
                 cv.initial = "exact"
             elif v.causality == "calculatedParameter":
-                cv = ModelVariable(type=v.type, variability=v.variability, causality="calculatedParameter",
+                cv = ModelVariable(type=vt, variability=v.variability, causality="calculatedParameter",
                                    name=f"{c.name}.{v.name}")
             elif v.causality == "input":
-                cv = ModelVariable(type=v.type, variability=v.variability, causality="input",
+                cv = ModelVariable(type=vt, variability=v.variability, causality="input",
                                    name=f"{c.name}.{v.name}", start=v.start)
             else:
-                cv = ModelVariable(type=v.type, variability=v.variability, causality="output",
+                cv = ModelVariable(type=vt, variability=v.variability, causality="output",
                                    name=f"{c.name}.{v.name}")
             cv.description = v.description
             q = f"{c.name}.{v.name}"
             if q in starts:
                 if v.causality not in ("parameter", "input"):
                     raise KeyError(f"start value for {q}: not a parameter or input")
-                cv.start = _start_text(v.type, starts.pop(q))
+                cv.start = _start_text(vt, starts.pop(q))
             container_vars.append(cv)
             mappings[cv] = [(comp, v)]
             cv_of[(c.name, v.name)] = cv
     if starts:
         raise KeyError(f"start values for unknown variables {sorted(starts)}")
-    connections = []
-    i = 0
-    while i < len(links):  # consecutive links with the same (dst, src) form one connection
-        d, _, s, _ = links[i]
-        j = i
-        while j < len(links) and links[j][0] == d and links[j][2] == s:
-            j += 1
-        connections.append(Connection(comps[s], [cvars[s][so] for _, _, _, so in links[i:j]],
-                                      comps[d], [cvars[d][di] for _, di, _, _ in links[i:j]]))
-        i = j
+    # one connection per link group of the plan (destination, source, type), in Gauss–Seidel order
+    connections = [Connection(comps[g.src], [cvars[g.src][so] for so in g.src_names],
+                              comps[g.dst], [cvars[g.dst][di] for di in g.dst_names]) for g in plan.groups]
     md = ModelDescription(fmiVersion="2.0", modelName=f"scfmu_loop_{h}", instantiationToken=guid,
-                          description=f"closed loop of {[c.model for c in scenario.components]} (scfmu native path)",
+                          description=f"closed loop of {[Path(c.model).stem for c in scenario.components]} "
+                                      f"(scfmu native path)",
                           generationTool="scfmu.native",
                           defaultExperiment=DefaultExperiment(startTime=str(scenario.start_time),
                                                               stopTime=str(scenario.stop_time),
@@ -189,7 +180,7 @@ def build_container(scenario: Scenario, starts: dict | None = None) -> Path:
     for attr in ("outputs", "initialUnknowns"):
         unknowns = []
         for c in scenario.components:
-            for u in getattr(mds[c.model], attr):
+            for u in getattr(mds[c.name], attr):
                 cv = cv_of.get((c.name, u.variable.name))
                 if cv is None:
                     continue
@@ -216,6 +207,8 @@ def build_container(scenario: Scenario, starts: dict | None = None) -> Path:
         data = json.loads(cfg.read_text())
         for conn in data["connections"]:  # fmpy writes FMI 2 type names here; the container wants FMI 3 ones
             conn["variableType"] = {"Real": "Float64", "Integer": "Int32"}.get(conn["variableType"], conn["variableType"])
+        for comp in data["components"]:  # an FMI 3.0 unit without a Co-Simulation element cannot be nested
+            comp["fmiMajorVersion"] = str(comp["fmiMajorVersion"])
         cfg.write_text(json.dumps(data, indent=1))
         import fmpy.container_fmu as cf
         for tuple_, fmi2_platform, lib in (("x86_64-linux", "linux64", "container_fmu.so"),
@@ -240,27 +233,20 @@ _POOL: dict[str, list[Fmu]] = {}  # reset container instances ready for the next
 _PLANS: dict[str, dict] = {}  # per container file: value references and the propagation's link list
 
 
-def _raw_fn(slave, name: str, argtypes, restype=c_int):
-    f = slave.dll[name]
-    f.argtypes = argtypes
-    f.restype = restype
-    return f
-
-
 class NativeLoop:
-    """Runs a Scenario inside its container FMU. ``log_every``: see module docstring.
+    """Runs a Scenario (or a plan) inside its container FMU. ``log_every``: see module docstring.
 
     With ``reuse`` (default) the container is unpacked once per process and, after a run, its instance
     is reset (``fmi2Terminate`` + ``fmi2Reset``: every nested FMU back to its start values) and kept for
     the next run of a scenario with the same structure, which saves the instantiation of every nested
     FMU; an instance whose reset fails is freed. Results do not depend on reuse (tested)."""
 
-    def __init__(self, scenario: Scenario, log_every: int = 1, reuse: bool = True):
-        scenario = resolve(scenario)
-        self.scenario = scenario
+    def __init__(self, scenario, log_every: int = 1, reuse: bool = True):
+        self.plan = as_plan(scenario)
+        self.scenario = scenario = self.plan.scenario
         self.log_every = int(log_every)
         self.reuse = reuse
-        path = build_container(scenario)
+        path = build_container(self.plan)
         self._path = str(path)
         pool = _POOL.get(self._path) if reuse else None
         if pool:
@@ -282,8 +268,7 @@ class NativeLoop:
     def _init(self):
         sc, f = self.scenario, self.fmu
         sl = f.slave
-        sl.setupExperiment(startTime=sc.start_time)
-        sl.enterInitializationMode()
+        f.enter_initialization_mode(sc.start_time)
         for c in sc.components:
             for k, v in c.params.items():
                 try:
@@ -299,37 +284,35 @@ class NativeLoop:
         # repeat the Gauss–Seidel propagation now that every instance has left initialization mode
         plan = _PLANS.get(self._path)
         if plan is None:  # the same for every run of this container (its key includes the wiring)
-            ports = {}
-            for c in sc.components:
-                ins = [n[len(c.name) + 1:] for n, v in f.vars.items() if n.startswith(c.name + ".") and v.causality == "input"]
-                outs = [n[len(c.name) + 1:] for n, v in f.vars.items() if n.startswith(c.name + ".") and v.causality == "output"]
-                ports[c.name] = (ins, outs)
             vr = {n: v.valueReference for n, v in f.vars.items()}
-            pairs = [(vr[f"{s}.{so}"], vr[f"{d}.{di}"]) for d, di, s, so in sc.wiring(ports)]
-            vrs = (c_uint * (2 * len(pairs)))(*[x for p in pairs for x in p])
-            plan = _PLANS[self._path] = {"vr": vr, "pairs": vrs, "n_pairs": len(pairs)}
+            pairs = [(g.type, vr[f"{g.src}.{so}"], vr[f"{g.dst}.{di}"])
+                     for g in self.plan.groups for so, di in zip(g.src_names, g.dst_names)]
+            vrs = (c_uint * (2 * len(pairs)))(*[x for p in pairs for x in p[1:]])
+            plan = _PLANS[self._path] = {"vr": vr, "pairs": vrs, "types": [p[0] for p in pairs]}
         vr = plan["vr"]
         raw = getattr(f, "_scfmu_raw", None)
-        if raw is None:  # fresh function pointers (fmpy's own keep their argtypes), kept with the instance
-            raw = f._scfmu_raw = (_raw_fn(sl, "fmi2GetReal", [c_void_p, c_void_p, c_size_t, c_void_p]),
-                                  _raw_fn(sl, "fmi2SetReal", [c_void_p, c_void_p, c_size_t, c_void_p]),
-                                  _raw_fn(sl, "fmi2DoStep", [c_void_p, c_double, c_double, c_int]))
-        get, setr, step = raw
-        comp = sl.component
+        if raw is None:  # the container's raw calls, kept with the instance
+            raw = f._scfmu_raw = raw_calls(f)
         # one link at a time, in order: get the source output, set the destination input
-        one = c_double()
+        one = (c_int32 * 2)()  # room for a double or an int32
         pv, addr = ctypes.addressof(plan["pairs"]), ctypes.addressof(one)
-        for i in range(plan["n_pairs"]):
-            if get(comp, pv + 8 * i, 1, addr) > 1 or setr(comp, pv + 8 * i + 4, 1, addr) > 1:
+        for i, t in enumerate(plan["types"]):
+            if raw.get[t](pv + 8 * i, 1, addr) > 1 or raw.set[t](pv + 8 * i + 4, 1, addr) > 1:
                 self._fail("propagation after initialization")
-        self._comp = comp
-        self._get, self._step = get, step
-        items = sc.log_items()
-        for key, inst, var in items:
+        self._raw = raw
+        self._get, self._step = raw.get["Real"], raw.step
+        items = [(g.type, key, g.inst, var) for g in self.plan.log for key, var in zip(g.keys, g.names)]
+        for _t, key, inst, var in items:
             if f"{inst}.{var}" not in vr:
                 raise KeyError(f"log {key!r}: no variable {inst}.{var}")
-        self._log_vrs = (c_uint * len(items))(*[vr[f"{i}.{v}"] for _, i, v in items])
-        self._log_keys = [k for k, _, _ in items]
+        real = [x for x in items if x[0] == "Real"]
+        other = [x for x in items if x[0] != "Real"]
+        self._log_vrs = (c_uint * max(1, len(real)))(*[vr[f"{i}.{v}"] for _, _, i, v in real])
+        self._log_keys = [k for _, k, _, _ in real]
+        # Integer and Boolean signals: one read per type after each logged Real row
+        self._log_other = [(t, [k for tt, k, _, _ in other if tt == t],
+                            (c_uint * sum(1 for x in other if x[0] == t))(*[vr[f"{i}.{v}"] for tt, _, i, v in other if tt == t]))
+                           for t in dict.fromkeys(x[0] for x in other)]
 
     def get(self, name: str):
         """Current value of ``"instance.variable"`` (a parameter, calculated parameter, input or output)."""
@@ -349,28 +332,36 @@ class NativeLoop:
         arr = np.empty((len(ks), nl))
         base, stride = arr.ctypes.data, arr.strides[0]
         vrs = ctypes.addressof(self._log_vrs)
-        get, step, comp = self._get, self._step, self._comp
+        get, step = self._get, self._step
         times = t0 + np.asarray(ks, dtype=float) * dt
-        if m == 1 and nl:  # the same calls as the general loop below, with less Python per step
+        other = [(self._raw.get[t], keys, ctypes.addressof(v), len(keys), np.empty((len(ks), len(keys)), np.int32))
+                 for t, keys, v in self._log_other]
+        if m == 1 and nl and not other:  # the same calls as the general loop below, with less Python per step
             for k in range(n):
-                if get(comp, vrs, nl, base + k * stride) > 1:
+                if get(vrs, nl, base + k * stride) > 1:
                     self._fail(f"getReal at t = {t0 + k * dt}", t0 + k * dt)
-                if step(comp, t0 + k * dt, dt, 1) > 1:
+                if step(t0 + k * dt, dt) > 1:
                     self._fail(f"doStep at t = {t0 + k * dt}", t0 + k * dt)
             ks = [n]
         prev = ks[0]
         for j, k in enumerate(ks, len(arr) - len(ks)):
             if k > prev:
                 t = t0 + prev * dt
-                if step(comp, t, (k - prev) * dt, 1) > 1:
+                if step(t, (k - prev) * dt) > 1:
                     self._fail(f"doStep at t = {t}", t)
                 prev = k
-            if nl and get(comp, vrs, nl, base + j * stride) > 1:
+            if nl and get(vrs, nl, base + j * stride) > 1:
                 self._fail(f"getReal at t = {t0 + k * dt}", t0 + k * dt)
+            for fn, _keys, v, cnt, a in other:
+                if fn(v, cnt, a.ctypes.data + j * a.strides[0]) > 1:
+                    self._fail(f"get at t = {t0 + k * dt}", t0 + k * dt)
         out = {"time": times}
         for i, key in enumerate(self._log_keys):
             out[key] = arr[:, i].copy()
-        return out
+        for _fn, keys, _v, _c, a in other:
+            for i, key in enumerate(keys):
+                out[key] = a[:, i].astype(np.float64)
+        return {k: out[k] for k in ["time"] + list(self.scenario.log)}
 
     def close(self):
         f = getattr(self, "fmu", None)

@@ -1,5 +1,6 @@
 """The reference master: a fixed-step Gauss-Seidel co-simulation on :class:`scfmu.fmu.Fmu` (fmpy's
-high-level calls), kept simple and name-based as the tests' oracle for the faster engines.
+high-level calls, FMI 2.0 or 3.0, Co-Simulation or Model Exchange), kept simple and name-based as the
+tests' oracle for the faster engines.
 
 At each communication point t_k the master walks the FMUs in the given order, sets each one's inputs
 from the current outputs of their sources, logs the requested variables, then calls doStep on every
@@ -14,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..fmu import Fmu
+from ..fmu import Fmu, scalar_type
 
 
 @dataclass
@@ -61,7 +62,7 @@ class CoSimulation:
         for dst in self.fmus:
             for link in self.links:
                 if link.dst is dst:
-                    dst.set_reals(link.dst_names, link.src.get_reals(link.src_names))
+                    dst.set_values(link.dst_names, link.src.get_values(link.src_names))
 
     def run(self, t_end: float, dt: float, log: dict[str, tuple[Fmu, str]] | None = None,
             t0: float = 0.0, on_step=None) -> dict[str, np.ndarray]:
@@ -73,9 +74,9 @@ class CoSimulation:
         out = {"time": np.empty(n + 1)}
         for k in log:
             out[k] = np.empty(n + 1)
-        groups: dict[int, tuple[Fmu, list[str], list[str]]] = {}
-        for key, (f, name) in log.items():
-            g = groups.setdefault(id(f), (f, [], []))
+        groups: dict[tuple, tuple[Fmu, list[str], list[str]]] = {}
+        for key, (f, name) in log.items():  # one read per instance and type
+            g = groups.setdefault((id(f), scalar_type(f.var(name))), (f, [], []))
             g[1].append(key)
             g[2].append(name)
         for k in range(n + 1):
@@ -83,7 +84,7 @@ class CoSimulation:
             self.propagate()
             out["time"][k] = t
             for f, keys, names in groups.values():
-                for key, val in zip(keys, f.get_reals(names)):
+                for key, val in zip(keys, f.get_values(names)):
                     out[key][k] = val
             if on_step is not None:
                 on_step(k, t)

@@ -1,4 +1,4 @@
-"""One FMI 2.0 co-simulation FMU per standard closed loop (``fmus/loops/<scenario>.fmu``).
+"""One FMI 2.0 co-simulation FMU per closed loop (its units FMI 2.0 or 3.0) (``fmus/loops/<scenario>.fmu``).
 
 Each file is the scenario's fmpy container FMU (:func:`scfmu.engines.native.build_container`: the scenario's
 FMUs nested under ``resources/``, wired in the scenario's Gauss–Seidel order, one fixed step of
@@ -18,14 +18,16 @@ from pathlib import Path
 
 from ..engines.native import build_container, scenario_starts
 from ..scenario.model import Scenario
-from ..scenario.resolve import resolve
+from ..scenario.plan import build_plan
 
 
 def write_loop_fmu(scenario: Scenario, path: str | Path) -> Path:
-    scenario = resolve(scenario)
+    """Writes the loop FMU of a scenario (its units may be FMI 2.0 or FMI 3.0 Co-Simulation FMUs; the loop
+    FMU itself is FMI 2.0 Co-Simulation)."""
+    plan = build_plan(scenario)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    src = build_container(scenario, scenario_starts(scenario))
+    src = build_container(plan, scenario_starts(plan.scenario))
     tmp = path.with_suffix(".fmu.tmp")
     shutil.copyfile(src, tmp)
     tmp.replace(path)

@@ -1,6 +1,8 @@
-"""Pre-flight check of a scenario before any run: every unit is an FMI 2.0 Co-Simulation FMU with a binary
-for this platform that instantiates, every parameter the scenario sets exists, and every connection joins
-an output to an input of the same type and unit.
+"""Pre-flight check of a scenario before any run: every unit is an FMI 2.0 or FMI 3.0 FMU offering the
+interface it will run with (Co-Simulation, or Model Exchange: ``Component.interface``) with a binary for
+this platform that instantiates, every parameter the scenario sets exists, and every connection joins
+an output to an input of the same type (the plan's one rule, :func:`scfmu.scenario.plan.link_problem`:
+Real, Integer, Boolean; FMI 3.0 Float64, Int32, Boolean; no arrays) and unit.
 
 :func:`check` returns the problems found (``errors``) and what is accepted with a warning (``warnings``,
 e.g. a port without a unit); :func:`require` raises :class:`IncompatibleUnit` with every error at once.
@@ -18,6 +20,7 @@ from fmpy import read_model_description
 
 from ..fmu import fmu_path
 from .model import Scenario
+from .plan import Unit, link_problem
 from .resolve import resolve
 
 
@@ -50,9 +53,19 @@ def _unit(md, v) -> str | None:
     return getattr(dt, "unit", None) or None
 
 
-def check_unit(model: str, instantiate: bool = True) -> tuple[object | None, list[str]]:
-    """(model description or None, errors) of one FMU: FMI 2.0, Co-Simulation, a binary for this platform,
-    and (``instantiate``) ``fmi2Instantiate`` succeeding."""
+def binary_folder(fmi: int) -> str:
+    """The binaries folder of this machine for an FMI major version (FMI 2.0 ``linux64``, FMI 3.0
+    ``x86_64-linux``)."""
+    if fmi == 2:
+        return platform_folder()
+    from fmpy import platform_tuple
+    return platform_tuple
+
+
+def check_unit(model: str, instantiate: bool = True, interface: str = "") -> tuple[object | None, list[str]]:
+    """(model description or None, errors) of one FMU: FMI 2.0 or 3.0, the interface it will run with
+    (``interface``: "cs", "me", or "" for Co-Simulation when offered, else Model Exchange), a binary for
+    this platform, and (``instantiate``) instantiation succeeding."""
     try:
         path = fmu_path(model)
     except FileNotFoundError as e:
@@ -62,15 +75,22 @@ def check_unit(model: str, instantiate: bool = True) -> tuple[object | None, lis
     except Exception as e:  # not a zip, no modelDescription.xml, XML errors
         return None, [f"{model}: cannot read its modelDescription.xml: {e}"]
     errs = []
-    if md.fmiVersion != "2.0":
-        errs.append(f"{model}: FMI {md.fmiVersion}, not FMI 2.0")
-    if md.coSimulation is None:
-        errs.append(f"{model}: no Co-Simulation interface (Model Exchange only)")
+    if md.fmiVersion not in ("2.0", "3.0"):
+        errs.append(f"{model}: FMI {md.fmiVersion}, not FMI 2.0 or 3.0")
+        return md, errs
+    itf = interface or ("cs" if md.coSimulation is not None else "me")
+    if itf == "cs" and md.coSimulation is None:
+        errs.append(f"{model}: no Co-Simulation interface (Model Exchange only: run it as Model Exchange)")
+    if itf == "me" and md.modelExchange is None:
+        errs.append(f"{model}: no Model Exchange interface (Co-Simulation only)")
+    if md.coSimulation is None and md.modelExchange is None:
+        errs.append(f"{model}: neither a Co-Simulation nor a Model Exchange interface")
     if errs:
         return md, errs
-    ident = md.coSimulation.modelIdentifier
+    ident = (md.coSimulation if itf == "cs" else md.modelExchange).modelIdentifier
+    fmi = int(md.fmiVersion[0])
     ext = {"linux": ".so", "win": ".dll", "darwin": ".dylib"}[platform_folder().rstrip("0123456789")]
-    lib = f"binaries/{platform_folder()}/{ident}{ext}"
+    lib = f"binaries/{binary_folder(fmi)}/{ident}{ext}"
     with zipfile.ZipFile(path) as z:
         if lib not in z.namelist():
             have = sorted({n.split("/")[1] for n in z.namelist() if n.startswith("binaries/") and n.count("/") >= 2})
@@ -78,9 +98,9 @@ def check_unit(model: str, instantiate: bool = True) -> tuple[object | None, lis
     if instantiate:
         from ..fmu import Fmu
         try:
-            f = Fmu(str(model), path=path, name="preflight", initialize=False)
+            f = Fmu(str(model), path=path, name="preflight", initialize=False, interface=itf)
         except Exception as e:
-            return md, [f"{model}: fmi2Instantiate failed: {e}"]
+            return md, [f"{model}: fmi{fmi}Instantiate failed: {e}"]
         f.close()
     return md, []
 
@@ -91,7 +111,7 @@ def check(scenario: Scenario, instantiate: bool = True) -> Report:
     for c in scenario.components:
         if c.model in mds:
             continue
-        md, errs = check_unit(c.model, instantiate)
+        md, errs = check_unit(c.model, instantiate, c.interface)
         rep.errors += errs
         mds[c.model] = md if not errs else None
     if rep.errors:
@@ -119,11 +139,13 @@ def check(scenario: Scenario, instantiate: bool = True) -> Report:
             rep.errors.append("wiring: closest names: " + " ".join(hint))
         return rep
     links = sc.wiring(ports)
+    units = {c.name: _unit_of(c, mds[c.model], vars_of[c.name]) for c in sc.components}
     for d, di, s, so in links:
         vd, vs = vars_of[d][di], vars_of[s][so]
         what = f"{s}.{so} -> {d}.{di}"
-        if vd.type != "Real" or vs.type != "Real":
-            rep.errors.append(f"{what}: only Real connections are supported ({vs.type} -> {vd.type})")
+        why = link_problem(units[d], di, units[s], so)
+        if why:
+            rep.errors.append(f"{what}: {why}")
             continue
         ud, us = _unit(mds[sc.component(d).model], vd), _unit(mds[sc.component(s).model], vs)
         if ud and us and ud != us:
@@ -212,6 +234,8 @@ def suggest_maps(sc: Scenario, vars_of: dict, mds: dict) -> list[str]:
         else:
             out.append(f"--map {inst}.{a}={b}")
     return out
+def _unit_of(c, md, variables) -> Unit:
+    return Unit(c.name, c.model, None, md, int(str(md.fmiVersion)[0]), c.interface or "cs", {}, variables)
 
 
 def resolve_safely(scenario: Scenario, rep: Report) -> Scenario:

@@ -8,7 +8,10 @@ file's folder. ``scfmu scenarios --show NAME`` prints any registered scenario in
     metrics = "attitude"              # a registered metric set (optional)
     [[components]]                    # in Gauss–Seidel order
     name = "controller"
-    model = "fmus/MyController.fmu"   # a model name or a path to an FMI 2.0 Co-Simulation FMU
+    model = "fmus/MyController.fmu"   # a model name or a path to an FMI 2.0 or 3.0 FMU
+    interface = "me"                  # optional: "cs" or "me" (default: Co-Simulation when offered)
+    [components.solver]               # optional, Model Exchange: method, rtol, atol
+    rtol = 1e-8
     [components.params]               # parameters of this model
     k = 2.0
     [components.slot]                 # given to any unit in this place that declares them
@@ -29,7 +32,7 @@ from pathlib import Path
 from .model import Component, Scenario
 
 _FIELDS = {f.name for f in fields(Scenario)}
-_COMPONENT = {"name", "model", "params", "slot", "ports", "bind", "unused"}
+_COMPONENT = {"name", "model", "params", "slot", "ports", "bind", "unused", "interface", "solver"}
 _TYPES = {"name": str, "stop_time": (int, float), "step": (int, float), "start_time": (int, float), "log": dict,
           "connections": dict, "unconnected": list, "inputs": dict, "auto_connect": bool, "seed_params": list,
           "metrics": str, "description": str, "components": list}
@@ -64,16 +67,20 @@ def from_data(data: dict, where: str = "scenario", base: Path | None = None) -> 
         for req in ("name", "model"):
             if not isinstance(c.get(req), str) or not c[req]:
                 raise ScenarioFileError(f"{w}: {req!r} must be a non-empty string")
-        for k in ("params", "slot", "ports", "bind"):
+        for k in ("params", "slot", "ports", "bind", "solver"):
             if k in c and not isinstance(c[k], dict):
                 raise ScenarioFileError(f"{w} ({c['name']}): {k!r} must be a table")
         if not isinstance(c.get("unused", []), list):
             raise ScenarioFileError(f"{w} ({c['name']}): 'unused' must be a list of slot names")
+        if c.get("interface", "") not in ("", "cs", "me"):
+            raise ScenarioFileError(f"{w} ({c['name']}): interface = {c['interface']!r}; allowed: \"cs\" "
+                                    f"(Co-Simulation), \"me\" (Model Exchange)")
         model = c["model"]
         if base is not None and (model.endswith(".fmu") or "/" in model) and not Path(model).is_absolute():
             model = str((base / model).resolve())
         comps.append(Component(c["name"], model, dict(c.get("params", {})), dict(c.get("slot", {})),
-                               dict(c.get("ports", {})), dict(c.get("bind", {})), list(c.get("unused", []))))
+                               dict(c.get("ports", {})), dict(c.get("bind", {})), list(c.get("unused", [])),
+                               c.get("interface", ""), dict(c.get("solver", {}))))
     d = {k: v for k, v in data.items() if k != "components"}
     d.setdefault("name", where)
     sc = Scenario(components=comps, **d)
@@ -109,7 +116,7 @@ def to_data(sc: Scenario) -> dict:
     """Plain data of a scenario, empty optional tables left out (the form the files use)."""
     d = sc.to_dict()
     for c in d["components"]:
-        for k in ("params", "slot", "ports"):
+        for k in ("params", "slot", "ports", "interface", "solver"):
             if not c[k]:
                 del c[k]
     for k in ("connections", "inputs", "log", "seed_params", "swapped"):

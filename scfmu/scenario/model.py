@@ -40,7 +40,7 @@ class Component:
     """One FMU instance in a place of the loop.
 
     * ``name``: instance name, unique in the scenario;
-    * ``model``: a model name (``<FMU folder>/<model>.fmu``) or a path to any FMI 2.0 Co-Simulation FMU;
+    * ``model``: a model name (``<FMU folder>/<model>.fmu``) or a path to any FMI 2.0 or 3.0 FMU;
     * ``params``: parameters of *that model* (set in initialization mode; an unknown name is an error).
       They belong to the model: swapping the model (:meth:`Scenario.with_models`) drops them;
     * ``slot``: parameters that any unit in this place is given *if it declares them* (e.g. the nominal
@@ -53,6 +53,10 @@ class Component:
       profile, :mod:`scfmu.scenario.profile`), evaluated when the scenario is resolved;
     * ``unused``: slot names the unit is declared not to take (no "not passed" warning for them).
     ``bind`` and ``unused`` belong to the model like ``params``: a swap drops them.
+    * ``interface``: ``"cs"`` (Co-Simulation), ``"me"`` (Model Exchange, integrated by the engine) or
+      ``""`` (default: Co-Simulation when the unit offers it, else Model Exchange);
+    * ``solver``: for a Model Exchange instance, ``{"method": ..., "rtol": ..., "atol": ...}`` (default
+      DOP853, 1e-10, 1e-12; see :mod:`scfmu.scenario.plan`).
     """
 
     name: str
@@ -62,6 +66,8 @@ class Component:
     ports: dict = field(default_factory=dict)
     bind: dict = field(default_factory=dict)
     unused: list = field(default_factory=list)
+    interface: str = ""
+    solver: dict = field(default_factory=dict)
 
 
 @dataclass

@@ -11,19 +11,53 @@ no binding reads it, not declared unused): the runs, campaigns and the benchmark
 from __future__ import annotations
 
 import copy
+import dataclasses
 from dataclasses import dataclass, field
 
 from ..fmu import fmu_path, is_path, unpacked
-from .model import Scenario
+from .model import Component, Scenario
 from .profile import ProfileError, evaluate, names_in
 
 VECTOR_SUFFIXES = ("w", "x", "y", "z", "xx", "yy", "zz", "xy", "xz", "yz", "1", "2", "3", "4")
+_DECLARED: dict = {}
 
 
 def declared(model: str) -> dict:
     """``{name: ScalarVariable}`` of a model's FMU (the model description is read once per process)."""
-    md = unpacked(fmu_path(model))[0]
-    return {v.name: v for v in md.modelVariables}
+    p = fmu_path(model)
+    st = p.stat()
+    key = (str(p), st.st_mtime_ns, st.st_size)
+    hit = _DECLARED.get(key)
+    if hit is None:
+        md = unpacked(p)[0]
+        hit = _DECLARED[key] = {v.name: v for v in md.modelVariables}
+    return hit
+
+
+def _plain(x):
+    """A copy of a value of a scenario's tables (numbers and strings shared, containers copied)."""
+    if isinstance(x, (int, float, str, bool, type(None))):
+        return x
+    return copy.deepcopy(x)
+
+
+def copy_scenario(scenario: Scenario) -> Scenario:
+    """A deep copy of a scenario, without ``copy.deepcopy``'s cost on its plain tables."""
+    comps = [Component(c.name, c.model, params={k: _plain(v) for k, v in c.params.items()},
+                       slot={k: _plain(v) for k, v in c.slot.items()}, ports=dict(c.ports),
+                       bind={k: _plain(v) for k, v in c.bind.items()}, unused=list(c.unused), interface=c.interface,
+                       solver={k: _plain(v) for k, v in c.solver.items()}) for c in scenario.components]
+    out = {}
+    for f in dataclasses.fields(scenario):
+        v = getattr(scenario, f.name)
+        if f.name == "components":
+            v = comps
+        elif isinstance(v, dict):
+            v = {k: _plain(x) for k, x in v.items()}
+        elif isinstance(v, list):
+            v = [_plain(x) for x in v]
+        out[f.name] = v
+    return type(scenario)(**out)
 
 
 def vector_members(names, stem: str) -> list[str]:
@@ -88,7 +122,7 @@ def _coerce(v, var, where: str):
 
 
 def resolve(scenario: Scenario) -> Scenario:
-    s = copy.deepcopy(scenario)
+    s = copy_scenario(scenario)
     for inst in s.swapped:  # the old model's own signals (diagnostics) are not logged from its replacement
         names = declared(s.component(inst).model)
         s.log = {k: q for k, q in s.log.items()

@@ -98,6 +98,10 @@ def write_ssp(scenario: Scenario, path: str | Path, path_of=None) -> Path:
     path = Path(path)
     path_of = path_of or fmu_path
     mds = {c.model: read_model_description(str(path_of(c.model))) for c in scenario.components}
+    fmi3 = [c.name for c in scenario.components if mds[c.model].fmiVersion.startswith("3")]
+    if fmi3:  # SSP 1.0 components are FMI 1.0/2.0 FMUs (FMI 3.0 comes with SSP 2.0)
+        raise ValueError(f"{', '.join(fmi3)}: FMI 3.0 units cannot be written to an SSP 1.0 file (SSP 1.0 "
+                         f"carries FMI 1.0 and 2.0 FMUs): use the unit's FMI 2.0 FMU, or a loop FMU (scfmu export loop)")
     vars_of = {c.name: {v.name: v for v in mds[c.model].modelVariables} for c in scenario.components}
     ports = {c.name: ([v.name for v in mds[c.model].modelVariables if v.causality == "input"],
                       [v.name for v in mds[c.model].modelVariables if v.causality == "output"])

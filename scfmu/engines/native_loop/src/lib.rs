@@ -1,29 +1,35 @@
 //! Compiled fixed-step Gauss–Seidel co-simulation loop with logging, for scfmu's `"compiled"` engine
 //! (`scfmu/engines/compiled.py`).
 //!
-//! The FMUs are instantiated and initialized by Python (fmpy); Python hands this library, as flat
-//! arrays, the plan that `scfmu.engines.lean.LeanMaster` runs from Python: per FMU its component
-//! pointer and its `fmi2GetReal` / `fmi2SetReal` / `fmi2DoStep` function pointers, the propagation
-//! operations in Gauss–Seidel order (get source outputs into a slice of a work buffer; set destination
-//! inputs from a slice of it), and the logged (FMU, value reference) pairs. [`scfmu_loop_run`] then
-//! executes the whole run without returning to Python: for k = 0..=n_steps, t_k = t0 + k·dt:
-//! propagate, log row k (one `fmi2GetReal` per run of consecutive logged pairs of the same FMU,
-//! straight into the output row), and, for k < n_steps, `fmi2DoStep(t_k, dt)` of every FMU in order.
+//! The FMUs (FMI 2.0 or FMI 3.0) are instantiated and initialized by Python (fmpy); Python hands this
+//! library, as flat arrays, the plan that `scfmu.engines.lean.LeanMaster` runs from Python
+//! (`scfmu.scenario.plan` + `scfmu.engines.lean.flat_ops`): per FMU its instance pointer, its FMI major
+//! version, its interface and a table of [`FN_SLOTS`] function pointers taken from its shared library;
+//! the propagation operations in Gauss–Seidel order (get source outputs into a slice of a work buffer;
+//! set destination inputs from a slice of it), typed Real, Integer or Boolean; and the logged (FMU, value
+//! reference, type) triples. [`scfmu_loop_run`] then executes the whole run without returning to Python:
+//! for k = 0..=n_steps, t_k = t0 + k·dt: propagate, log row k (one get per run of consecutive logged
+//! values of the same FMU and type, straight into the output row for Real), and, for k < n_steps, step
+//! every FMU from t_k to t_k + dt in order: `doStep` of a Co-Simulation unit, or, for a Model Exchange
+//! unit, the integration of its continuous states by the embedded Dormand–Prince 5(4) solver
+//! ([`me`]) with its time events, state events, `completedIntegratorStep` and event iteration.
 //! It stops at the first status above `max_ok` and reports it with the step index.
+//!
+//! Values: Real are `f64`, Integer `i32`, Boolean `i32` 0/1 in the work buffers (FMI 3.0's one-byte
+//! `fmi3Boolean` is converted at the call). FMI 3.0 getters/setters get the value count as their extra
+//! argument (scalars: the number of value references).
 //!
 //! No dependency on the FMU crate; no panic crosses the C boundary (arguments are validated before
 //! the first call, and the body runs under `catch_unwind`).
 
 use std::ffi::c_void;
+use std::mem::transmute;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
-/// `fmi2GetReal` / `fmi2SetReal`: (component, vr[], nvr, value[]) -> fmi2Status.
-pub type GetSetFn = unsafe extern "C" fn(*mut c_void, *const u32, usize, *mut f64) -> i32;
-/// `fmi2DoStep`: (component, currentCommunicationPoint, communicationStepSize, noSetFMUStatePriorToCurrentPoint).
-pub type StepFn = unsafe extern "C" fn(*mut c_void, f64, f64, i32) -> i32;
+pub mod me;
 
 /// Version of the calling convention of [`scfmu_loop_run`] (Python checks it before use).
-pub const ABI_VERSION: u32 = 1;
+pub const ABI_VERSION: u32 = 2;
 
 /// A null pointer where an array or a function was required.
 pub const ERR_NULL: i32 = -1;
@@ -37,25 +43,141 @@ pub const PHASE_GET: i64 = 0;
 pub const PHASE_SET: i64 = 1;
 pub const PHASE_LOG: i64 = 2;
 pub const PHASE_STEP: i64 = 3;
+/// An FMI 3.0 unit's `doStep`, or a Model Exchange unit, asked to terminate the simulation.
+pub const PHASE_TERMINATE: i64 = 4;
+/// The Model Exchange solver failed (step size below its minimum, or too many steps).
+pub const PHASE_SOLVER: i64 = 5;
 
-/// Number of `usize` entries per propagation operation: kind (0 get, 1 set), FMU index, first value
-/// reference (index into `vrs`), count, first buffer element.
+/// Number of `usize` entries per propagation operation: kind (`K_*`), FMU index, first value
+/// reference (index into `vrs`), count, first buffer element (of the Real buffer for `K_GET_REAL` /
+/// `K_SET_REAL`, of the integer buffer otherwise).
 pub const OP_FIELDS: usize = 5;
+pub const K_GET_REAL: usize = 0;
+pub const K_SET_REAL: usize = 1;
+pub const K_GET_INT: usize = 2;
+pub const K_SET_INT: usize = 3;
+pub const K_GET_BOOL: usize = 4;
+pub const K_SET_BOOL: usize = 5;
+
+/// Logged value types (`log_type`).
+pub const T_REAL: usize = 0;
+pub const T_INT: usize = 1;
+pub const T_BOOL: usize = 2;
+
+/// Function table of one FMU: [`FN_SLOTS`] pointers, in this order (the FMI 2.0 / FMI 3.0 names). The
+/// slots of a type never used by the plan, and the Model Exchange slots of a Co-Simulation unit
+/// (and `doStep` of a Model Exchange unit), may be null.
+pub const FN_SLOTS: usize = 16;
+pub const F_GET_REAL: usize = 0; // fmi2GetReal / fmi3GetFloat64
+pub const F_SET_REAL: usize = 1; // fmi2SetReal / fmi3SetFloat64
+pub const F_GET_INT: usize = 2; // fmi2GetInteger / fmi3GetInt32
+pub const F_SET_INT: usize = 3; // fmi2SetInteger / fmi3SetInt32
+pub const F_GET_BOOL: usize = 4; // fmi2GetBoolean / fmi3GetBoolean
+pub const F_SET_BOOL: usize = 5; // fmi2SetBoolean / fmi3SetBoolean
+pub const F_DO_STEP: usize = 6; // fmi2DoStep / fmi3DoStep
+pub const F_SET_TIME: usize = 7; // fmi2SetTime / fmi3SetTime
+pub const F_SET_STATES: usize = 8; // fmi2SetContinuousStates / fmi3SetContinuousStates
+pub const F_GET_STATES: usize = 9; // fmi2GetContinuousStates / fmi3GetContinuousStates
+pub const F_GET_DERIVATIVES: usize = 10; // fmi2GetDerivatives / fmi3GetContinuousStateDerivatives
+pub const F_GET_INDICATORS: usize = 11; // fmi2GetEventIndicators / fmi3GetEventIndicators
+pub const F_COMPLETED_STEP: usize = 12; // fmi2CompletedIntegratorStep / fmi3CompletedIntegratorStep
+pub const F_ENTER_EVENT_MODE: usize = 13; // fmi2EnterEventMode / fmi3EnterEventMode
+pub const F_UPDATE_DISCRETE: usize = 14; // fmi2NewDiscreteStates / fmi3UpdateDiscreteStates
+pub const F_ENTER_CONT_MODE: usize = 15; // fmi2EnterContinuousTimeMode / fmi3EnterContinuousTimeMode
+
+/// Entries per FMU in `info`: FMI major version (2 or 3), interface (0 Co-Simulation, 1 Model
+/// Exchange), number of continuous states, number of event indicators.
+pub const INFO_FIELDS: usize = 4;
+/// Entries per FMU in `me_params` (Model Exchange units; ignored otherwise): relative tolerance,
+/// absolute tolerance, next time event after initialization (NaN: none), method (0: Dormand–Prince 5(4)
+/// adaptive, 1: classic Runge–Kutta 4 with a fixed step), the fixed step's largest size (RK4; 0: the
+/// communication step).
+pub const ME_FIELDS: usize = 5;
+
+type Gs2F64 = unsafe extern "C" fn(*mut c_void, *const u32, usize, *mut f64) -> i32;
+type Gs2I32 = unsafe extern "C" fn(*mut c_void, *const u32, usize, *mut i32) -> i32;
+type Gs3F64 = unsafe extern "C" fn(*mut c_void, *const u32, usize, *mut f64, usize) -> i32;
+type Gs3I32 = unsafe extern "C" fn(*mut c_void, *const u32, usize, *mut i32, usize) -> i32;
+type Gs3Bool = unsafe extern "C" fn(*mut c_void, *const u32, usize, *mut bool, usize) -> i32;
+type Step2 = unsafe extern "C" fn(*mut c_void, f64, f64, i32) -> i32;
+type Step3 = unsafe extern "C" fn(*mut c_void, f64, f64, bool, *mut bool, *mut bool, *mut bool, *mut f64) -> i32;
 
 #[no_mangle]
 pub extern "C" fn scfmu_loop_version() -> u32 {
     ABI_VERSION
 }
 
-struct Fmu {
-    comp: *mut c_void,
-    get: GetSetFn,
-    set: GetSetFn,
-    step: StepFn,
+/// One FMU of the loop: its instance, version and function table.
+pub struct Fmu {
+    pub comp: *mut c_void,
+    pub v3: bool,
+    pub fns: [*const c_void; FN_SLOTS],
+    scratch: Vec<bool>,
+    tmp: Vec<i32>,
+}
+
+/// What a failing call reports: its status and phase.
+pub type Fail = (i32, i64);
+
+impl Fmu {
+    /// # Safety
+    /// The slot must hold the function of that slot (FMI 2.0 or 3.0 signature per `v3`).
+    pub unsafe fn reals(&mut self, set: bool, vr: *const u32, n: usize, buf: *mut f64) -> i32 {
+        let f = self.fns[if set { F_SET_REAL } else { F_GET_REAL }];
+        if self.v3 {
+            transmute::<*const c_void, Gs3F64>(f)(self.comp, vr, n, buf, n)
+        } else {
+            transmute::<*const c_void, Gs2F64>(f)(self.comp, vr, n, buf)
+        }
+    }
+
+    unsafe fn ints(&mut self, set: bool, vr: *const u32, n: usize, buf: *mut i32) -> i32 {
+        let f = self.fns[if set { F_SET_INT } else { F_GET_INT }];
+        if self.v3 {
+            transmute::<*const c_void, Gs3I32>(f)(self.comp, vr, n, buf, n)
+        } else {
+            transmute::<*const c_void, Gs2I32>(f)(self.comp, vr, n, buf)
+        }
+    }
+
+    unsafe fn bools(&mut self, set: bool, vr: *const u32, n: usize, buf: *mut i32) -> i32 {
+        let f = self.fns[if set { F_SET_BOOL } else { F_GET_BOOL }];
+        if !self.v3 {
+            return transmute::<*const c_void, Gs2I32>(f)(self.comp, vr, n, buf);
+        }
+        self.scratch.resize(n, false);
+        let vals = std::slice::from_raw_parts_mut(buf, n);
+        if set {
+            for (s, v) in self.scratch.iter_mut().zip(vals.iter()) {
+                *s = *v != 0;
+            }
+        }
+        let st = transmute::<*const c_void, Gs3Bool>(f)(self.comp, vr, n, self.scratch.as_mut_ptr(), n);
+        if !set {
+            for (v, s) in vals.iter_mut().zip(self.scratch.iter()) {
+                *v = *s as i32;
+            }
+        }
+        st
+    }
+
+    /// `doStep(t, h)` of a Co-Simulation unit; an FMI 3.0 request to terminate is `(3, PHASE_TERMINATE)`.
+    unsafe fn do_step(&mut self, t: f64, h: f64) -> Result<i32, Fail> {
+        let f = self.fns[F_DO_STEP];
+        if !self.v3 {
+            return Ok(transmute::<*const c_void, Step2>(f)(self.comp, t, h, 1));
+        }
+        let (mut ev, mut term, mut early, mut last) = (false, false, false, 0.0f64);
+        let st = transmute::<*const c_void, Step3>(f)(self.comp, t, h, true, &mut ev, &mut term, &mut early, &mut last);
+        if st <= 1 && term {
+            return Err((3, PHASE_TERMINATE));
+        }
+        Ok(st)
+    }
 }
 
 struct Op {
-    set: bool,
+    kind: usize,
     fmu: usize,
     vr: usize,
     n: usize,
@@ -64,6 +186,7 @@ struct Op {
 
 struct LogGroup {
     fmu: usize,
+    ty: usize,
     col: usize,
     n: usize,
 }
@@ -80,15 +203,16 @@ unsafe fn slice<'a, T>(p: *const T, n: usize) -> Option<&'a [T]> {
 
 /// Runs a whole co-simulation (see the crate documentation).
 ///
-/// * `comps`, `get_fns`, `set_fns`, `step_fns`: `n_fmus` component pointers and function pointers;
-/// * `ops`: `n_ops` × [`OP_FIELDS`] entries, in execution order, each `[kind, fmu, vr_start, n, buf_start]`
-///   (kind 0: `get(fmu, vrs[vr_start..][..n]) -> buf[buf_start..][..n]`; kind 1: `set` from the buffer);
-/// * `vrs`: `n_vrs` value references; `n_buf`: length of the work buffer (allocated here, zeroed);
-/// * `log_fmu`, `log_vr`: `n_log` logged pairs, column order of `out`; consecutive pairs of the same
-///   FMU are read by one `fmi2GetReal`;
+/// * `comps`: `n_fmus` instance pointers; `info`: `n_fmus` × [`INFO_FIELDS`]; `fns`: `n_fmus` ×
+///   [`FN_SLOTS`] function pointers; `me_params`: `n_fmus` × [`ME_FIELDS`] (may be null when no FMU
+///   is Model Exchange);
+/// * `ops`: `n_ops` × [`OP_FIELDS`] entries, in execution order, each `[kind, fmu, vr_start, n, buf_start]`;
+/// * `vrs`: `n_vrs` value references; `n_real_buf`, `n_int_buf`: lengths of the work buffers
+///   (allocated here, zeroed);
+/// * `log_fmu`, `log_vr`, `log_type`: `n_log` logged triples, column order of `out`;
 /// * `out`: `out_len` = (`n_steps` + 1) × `n_log` doubles, row k = the logged values at t_k;
-/// * `max_ok`: the highest status that lets the run go on (1: fmi2Warning tolerated);
-/// * `fail`: null, or 3 `i64` set on a failing FMI call to [step k, phase (`PHASE_*`), FMU index]
+/// * `max_ok`: the highest status that lets the run go on (1: Warning tolerated);
+/// * `fail`: null, or 3 `i64` set on a failing call to [step k, phase (`PHASE_*`), FMU index]
 ///   (-1 on argument errors).
 ///
 /// Returns 0 (or the highest tolerated status seen) after a complete run; the first status above
@@ -96,23 +220,25 @@ unsafe fn slice<'a, T>(p: *const T, n: usize) -> Option<&'a [T]> {
 ///
 /// # Safety
 /// Every non-null pointer must point to at least the stated number of valid elements, the function
-/// pointers must have the FMI 2.0 signatures and the components must be valid for them, and `out` must
-/// not alias the other arrays.
+/// pointers must have the FMI signatures of their slot and version, the instances must be valid for
+/// them, and `out` must not alias the other arrays.
 #[no_mangle]
 pub unsafe extern "C" fn scfmu_loop_run(
     n_fmus: usize,
     comps: *const *mut c_void,
-    get_fns: *const Option<GetSetFn>,
-    set_fns: *const Option<GetSetFn>,
-    step_fns: *const Option<StepFn>,
+    info: *const usize,
+    fns: *const *const c_void,
+    me_params: *const f64,
     n_ops: usize,
     ops: *const usize,
     n_vrs: usize,
     vrs: *const u32,
-    n_buf: usize,
+    n_real_buf: usize,
+    n_int_buf: usize,
     n_log: usize,
     log_fmu: *const usize,
     log_vr: *const u32,
+    log_type: *const usize,
     n_steps: usize,
     t0: f64,
     dt: f64,
@@ -123,10 +249,11 @@ pub unsafe extern "C" fn scfmu_loop_run(
 ) -> i32 {
     let mut where_ = [-1i64; 3];
     let r = catch_unwind(AssertUnwindSafe(|| {
-        run(
-            n_fmus, comps, get_fns, set_fns, step_fns, n_ops, ops, n_vrs, vrs, n_buf, n_log, log_fmu,
-            log_vr, n_steps, t0, dt, out, out_len, max_ok, &mut where_,
-        )
+        let a = Args {
+            n_fmus, comps, info, fns, me_params, n_ops, ops, n_vrs, vrs, n_real_buf, n_int_buf, n_log, log_fmu,
+            log_vr, log_type, n_steps, t0, dt, out, out_len, max_ok,
+        };
+        run(&a, &mut where_)
     }));
     let status = r.unwrap_or(ERR_PANIC);
     if !fail.is_null() {
@@ -135,84 +262,151 @@ pub unsafe extern "C" fn scfmu_loop_run(
     status
 }
 
-#[allow(clippy::too_many_arguments)]
-unsafe fn run(
+struct Args {
     n_fmus: usize,
     comps: *const *mut c_void,
-    get_fns: *const Option<GetSetFn>,
-    set_fns: *const Option<GetSetFn>,
-    step_fns: *const Option<StepFn>,
+    info: *const usize,
+    fns: *const *const c_void,
+    me_params: *const f64,
     n_ops: usize,
     ops: *const usize,
     n_vrs: usize,
     vrs: *const u32,
-    n_buf: usize,
+    n_real_buf: usize,
+    n_int_buf: usize,
     n_log: usize,
     log_fmu: *const usize,
     log_vr: *const u32,
+    log_type: *const usize,
     n_steps: usize,
     t0: f64,
     dt: f64,
     out: *mut f64,
     out_len: usize,
     max_ok: i32,
-    where_: &mut [i64; 3],
-) -> i32 {
+}
+
+const CS_SLOTS: [usize; 3] = [F_GET_REAL, F_SET_REAL, F_DO_STEP];
+const ME_SLOTS: [usize; 11] = [
+    F_GET_REAL,
+    F_SET_REAL,
+    F_SET_TIME,
+    F_SET_STATES,
+    F_GET_STATES,
+    F_GET_DERIVATIVES,
+    F_GET_INDICATORS,
+    F_COMPLETED_STEP,
+    F_ENTER_EVENT_MODE,
+    F_UPDATE_DISCRETE,
+    F_ENTER_CONT_MODE,
+];
+
+unsafe fn run(a: &Args, where_: &mut [i64; 3]) -> i32 {
     // ----- validation: nothing is called before every argument has been checked
-    let (Some(comps), Some(gets), Some(sets), Some(steps)) = (
-        slice(comps, n_fmus),
-        slice(get_fns, n_fmus),
-        slice(set_fns, n_fmus),
-        slice(step_fns, n_fmus),
+    let n_fmus = a.n_fmus;
+    let (Some(n_info), Some(n_fns), Some(n_me)) = (
+        n_fmus.checked_mul(INFO_FIELDS),
+        n_fmus.checked_mul(FN_SLOTS),
+        n_fmus.checked_mul(ME_FIELDS),
     ) else {
-        return ERR_NULL;
-    };
-    let Some(n_op_fields) = n_ops.checked_mul(OP_FIELDS) else {
         return ERR_SIZE;
     };
-    let (Some(ops), Some(vrs), Some(log_fmu), Some(log_vr)) =
-        (slice(ops, n_op_fields), slice(vrs, n_vrs), slice(log_fmu, n_log), slice(log_vr, n_log))
+    let (Some(comps), Some(info), Some(fns)) = (slice(a.comps, n_fmus), slice(a.info, n_info), slice(a.fns, n_fns))
     else {
         return ERR_NULL;
     };
+    let Some(n_op_fields) = a.n_ops.checked_mul(OP_FIELDS) else {
+        return ERR_SIZE;
+    };
+    let (Some(ops), Some(vrs), Some(log_fmu), Some(log_vr), Some(log_type)) = (
+        slice(a.ops, n_op_fields),
+        slice(a.vrs, a.n_vrs),
+        slice(a.log_fmu, a.n_log),
+        slice(a.log_vr, a.n_log),
+        slice(a.log_type, a.n_log),
+    ) else {
+        return ERR_NULL;
+    };
+    let any_me = (0..n_fmus).any(|i| info[i * INFO_FIELDS + 1] == 1);
+    let me_params = if any_me {
+        match slice(a.me_params, n_me) {
+            Some(p) => p,
+            None => return ERR_NULL,
+        }
+    } else {
+        &[]
+    };
     let mut fmus = Vec::with_capacity(n_fmus);
+    let mut solvers: Vec<Option<me::Solver>> = Vec::with_capacity(n_fmus);
     for i in 0..n_fmus {
-        let (Some(get), Some(set), Some(step)) = (gets[i], sets[i], steps[i]) else {
-            return ERR_NULL;
-        };
+        let inf = &info[i * INFO_FIELDS..(i + 1) * INFO_FIELDS];
+        let (version, interface, nx, nz) = (inf[0], inf[1], inf[2], inf[3]);
         if comps[i].is_null() {
             return ERR_NULL;
         }
-        fmus.push(Fmu { comp: comps[i], get, set, step });
-    }
-    let mut plan = Vec::with_capacity(n_ops);
-    for o in ops.chunks_exact(OP_FIELDS) {
-        let op = Op { set: o[0] == 1, fmu: o[1], vr: o[2], n: o[3], buf: o[4] };
-        let vr_ok = op.vr.checked_add(op.n).is_some_and(|e| e <= n_vrs);
-        let buf_ok = op.buf.checked_add(op.n).is_some_and(|e| e <= n_buf);
-        if o[0] > 1 || op.fmu >= n_fmus || !vr_ok || !buf_ok {
+        if !(version == 2 || version == 3) || interface > 1 {
             return ERR_SIZE;
+        }
+        let mut table = [std::ptr::null(); FN_SLOTS];
+        table.copy_from_slice(&fns[i * FN_SLOTS..(i + 1) * FN_SLOTS]);
+        let needed: &[usize] = if interface == 1 { &ME_SLOTS } else { &CS_SLOTS };
+        if needed.iter().any(|&s| table[s].is_null()) {
+            return ERR_NULL;
+        }
+        fmus.push(Fmu { comp: comps[i], v3: version == 3, fns: table, scratch: Vec::new(), tmp: Vec::new() });
+        solvers.push(if interface == 1 {
+            let p = &me_params[i * ME_FIELDS..(i + 1) * ME_FIELDS];
+            if !(p[0] > 0.0 && p[1] > 0.0) || !(p[3] == 0.0 || p[3] == 1.0) || !(p[4] >= 0.0) {
+                return ERR_SIZE;
+            }
+            let mut s = me::Solver::new(nx, nz, p[0], p[1], if p[2].is_nan() { None } else { Some(p[2]) });
+            if p[3] == 1.0 {
+                s.fixed_rk4(p[4]);
+            }
+            Some(s)
+        } else {
+            None
+        });
+    }
+    let mut plan = Vec::with_capacity(a.n_ops);
+    for o in ops.chunks_exact(OP_FIELDS) {
+        let op = Op { kind: o[0], fmu: o[1], vr: o[2], n: o[3], buf: o[4] };
+        let n_buf = if op.kind <= K_SET_REAL { a.n_real_buf } else { a.n_int_buf };
+        let vr_ok = op.vr.checked_add(op.n).is_some_and(|e| e <= a.n_vrs);
+        let buf_ok = op.buf.checked_add(op.n).is_some_and(|e| e <= n_buf);
+        if op.kind > K_SET_BOOL || op.fmu >= n_fmus || !vr_ok || !buf_ok {
+            return ERR_SIZE;
+        }
+        let slot = [F_GET_REAL, F_SET_REAL, F_GET_INT, F_SET_INT, F_GET_BOOL, F_SET_BOOL][op.kind];
+        if fmus[op.fmu].fns[slot].is_null() {
+            return ERR_NULL;
         }
         plan.push(op);
     }
-    let Some(rows) = n_steps.checked_add(1) else {
+    let Some(rows) = a.n_steps.checked_add(1) else {
         return ERR_SIZE;
     };
-    if rows.checked_mul(n_log) != Some(out_len) || (out_len > 0 && out.is_null()) {
-        return if out.is_null() && out_len > 0 { ERR_NULL } else { ERR_SIZE };
+    if rows.checked_mul(a.n_log) != Some(a.out_len) || (a.out_len > 0 && a.out.is_null()) {
+        return if a.out.is_null() && a.out_len > 0 { ERR_NULL } else { ERR_SIZE };
     }
     let mut groups: Vec<LogGroup> = Vec::new();
-    for (col, &f) in log_fmu.iter().enumerate() {
-        if f >= n_fmus {
+    for (col, (&f, &ty)) in log_fmu.iter().zip(log_type.iter()).enumerate() {
+        if f >= n_fmus || ty > T_BOOL {
             return ERR_SIZE;
         }
+        let slot = [F_GET_REAL, F_GET_INT, F_GET_BOOL][ty];
+        if fmus[f].fns[slot].is_null() {
+            return ERR_NULL;
+        }
         match groups.last_mut() {
-            Some(g) if g.fmu == f => g.n += 1,
-            _ => groups.push(LogGroup { fmu: f, col, n: 1 }),
+            Some(g) if g.fmu == f && g.ty == ty => g.n += 1,
+            _ => groups.push(LogGroup { fmu: f, ty, col, n: 1 }),
         }
     }
-    let mut buf = vec![0.0f64; n_buf];
-    let bufp = buf.as_mut_ptr();
+    let mut rbuf = vec![0.0f64; a.n_real_buf];
+    let mut ibuf = vec![0i32; a.n_int_buf];
+    let (rp, ip) = (rbuf.as_mut_ptr(), ibuf.as_mut_ptr());
+    let (n_log, max_ok) = (a.n_log, a.max_ok);
 
     // ----- the loop: LeanMaster.run's calls, in its order
     let mut worst = 0;
@@ -229,25 +423,53 @@ unsafe fn run(
         }};
     }
     for k in 0..rows {
-        let t = t0 + (k as f64) * dt;
+        let t = a.t0 + (k as f64) * a.dt;
         for op in &plan {
-            let f = &fmus[op.fmu];
+            let f = &mut fmus[op.fmu];
             let vr = vrs.as_ptr().add(op.vr);
-            let b = bufp.add(op.buf);
-            if op.set {
-                check!((f.set)(f.comp, vr, op.n, b), k, PHASE_SET, op.fmu);
-            } else {
-                check!((f.get)(f.comp, vr, op.n, b), k, PHASE_GET, op.fmu);
-            }
+            let phase = if op.kind % 2 == 1 { PHASE_SET } else { PHASE_GET };
+            let st = match op.kind {
+                K_GET_REAL | K_SET_REAL => f.reals(op.kind == K_SET_REAL, vr, op.n, rp.add(op.buf)),
+                K_GET_INT | K_SET_INT => f.ints(op.kind == K_SET_INT, vr, op.n, ip.add(op.buf)),
+                _ => f.bools(op.kind == K_SET_BOOL, vr, op.n, ip.add(op.buf)),
+            };
+            check!(st, k, phase, op.fmu);
         }
-        let row = out.add(k * n_log);
+        let row = a.out.add(k * n_log);
         for g in &groups {
-            let f = &fmus[g.fmu];
-            check!((f.get)(f.comp, log_vr.as_ptr().add(g.col), g.n, row.add(g.col)), k, PHASE_LOG, g.fmu);
+            let f = &mut fmus[g.fmu];
+            let vr = log_vr.as_ptr().add(g.col);
+            let st = if g.ty == T_REAL {
+                f.reals(false, vr, g.n, row.add(g.col))
+            } else {
+                let mut tmp = std::mem::take(&mut f.tmp);
+                tmp.resize(g.n, 0);
+                let st = if g.ty == T_INT {
+                    f.ints(false, vr, g.n, tmp.as_mut_ptr())
+                } else {
+                    f.bools(false, vr, g.n, tmp.as_mut_ptr())
+                };
+                for (i, v) in tmp.iter().enumerate() {
+                    *row.add(g.col + i) = *v as f64;
+                }
+                f.tmp = tmp;
+                st
+            };
+            check!(st, k, PHASE_LOG, g.fmu);
         }
-        if k < n_steps {
-            for (i, f) in fmus.iter().enumerate() {
-                check!((f.step)(f.comp, t, dt, 1), k, PHASE_STEP, i);
+        if k < a.n_steps {
+            for (i, (f, solver)) in fmus.iter_mut().zip(solvers.iter_mut()).enumerate() {
+                let r = match solver {
+                    None => f.do_step(t, a.dt),
+                    Some(s) => s.step(f, t, a.dt),
+                };
+                match r {
+                    Ok(st) => check!(st, k, PHASE_STEP, i),
+                    Err((st, phase)) => {
+                        *where_ = [k as i64, phase, i as i64];
+                        return st.max(max_ok + 1);
+                    }
+                }
             }
         }
     }
@@ -260,6 +482,10 @@ mod tests {
     //! loop, against the same Gauss–Seidel sequence written out by hand; argument validation; a failing
     //! status stops the run at its step.
     use super::*;
+
+    /// The FMI 2.0 get/set and doStep signatures of the toys.
+    type GetSetFn = unsafe extern "C" fn(*mut c_void, *const u32, usize, *mut f64) -> i32;
+    type StepFn = unsafe extern "C" fn(*mut c_void, f64, f64, i32) -> i32;
 
     #[derive(Default)]
     struct Toy {
@@ -318,21 +544,29 @@ mod tests {
         }
     }
 
+    fn table(get: GetSetFn, set: GetSetFn, st: StepFn) -> [*const c_void; FN_SLOTS] {
+        let mut t = [std::ptr::null(); FN_SLOTS];
+        t[F_GET_REAL] = get as *const c_void;
+        t[F_SET_REAL] = set as *const c_void;
+        t[F_DO_STEP] = st as *const c_void;
+        t
+    }
+
     fn run_toys(plant: &mut Toy, ctl: &mut Toy, n_steps: usize, out: &mut [f64], fail: &mut [i64; 3]) -> i32 {
         let comps = [ctl as *mut Toy as *mut c_void, plant as *mut Toy as *mut c_void];
-        let g: [Option<GetSetFn>; 2] = [Some(get), Some(get)];
-        let s: [Option<GetSetFn>; 2] = [Some(set), Some(set)];
-        let st: [Option<StepFn>; 2] = [Some(step), Some(step)];
+        let info = [2usize, 0, 0, 0, /**/ 2, 0, 0, 0];
+        let fns: Vec<*const c_void> = [table(get, set, step), table(get, set, step)].concat();
         // controller.u <- plant.y; plant.u <- controller.y (Gauss–Seidel: controller first)
         let ops = [0, 1, 0, 1, 0, /**/ 1, 0, 1, 1, 0, /**/ 0, 0, 0, 1, 1, /**/ 1, 1, 2, 1, 1];
         let vrs = [0u32, 1, 1];
         let log_fmu = [1usize, 0];
         let log_vr = [0u32, 0];
+        let log_type = [T_REAL, T_REAL];
         unsafe {
             scfmu_loop_run(
-                2, comps.as_ptr(), g.as_ptr(), s.as_ptr(), st.as_ptr(), 4, ops.as_ptr(), 3, vrs.as_ptr(), 2, 2,
-                log_fmu.as_ptr(), log_vr.as_ptr(), n_steps, 0.0, 0.1, out.as_mut_ptr(), out.len(), 1,
-                fail.as_mut_ptr(),
+                2, comps.as_ptr(), info.as_ptr(), fns.as_ptr(), std::ptr::null(), 4, ops.as_ptr(), 3, vrs.as_ptr(), 2,
+                0, 2, log_fmu.as_ptr(), log_vr.as_ptr(), log_type.as_ptr(), n_steps, 0.0, 0.1, out.as_mut_ptr(),
+                out.len(), 1, fail.as_mut_ptr(),
             )
         }
     }
@@ -381,12 +615,165 @@ mod tests {
         assert!(p.calls.is_empty() && c.calls.is_empty());
         let null = unsafe {
             scfmu_loop_run(
-                1, std::ptr::null(), std::ptr::null(), std::ptr::null(), std::ptr::null(), 0, std::ptr::null(),
-                0, std::ptr::null(), 0, 0, std::ptr::null(), std::ptr::null(), 3, 0.0, 0.1, std::ptr::null_mut(),
-                0, 1, std::ptr::null_mut(),
+                1, std::ptr::null(), std::ptr::null(), std::ptr::null(), std::ptr::null(), 0, std::ptr::null(), 0,
+                std::ptr::null(), 0, 0, 0, std::ptr::null(), std::ptr::null(), std::ptr::null(), 3, 0.0, 0.1,
+                std::ptr::null_mut(), 0, 1, std::ptr::null_mut(),
             )
         };
         assert_eq!(null, ERR_NULL);
         assert_eq!(scfmu_loop_version(), ABI_VERSION);
     }
+
+    // ----- a Model Exchange toy (FMI 2.0 signatures): x' = -a·x + u, output y = x, one event indicator
+    // z = x - level (at the crossing the unit halves x: a state event with a jump), one time event at
+    // t_ev (a sets to a2 there); the loop holds u = 0 (no links).
+    struct MeToy {
+        t: f64,
+        x: f64,
+        a: f64,
+        a2: f64,
+        level: f64,
+        t_ev: f64,
+        time_event_done: bool,
+        crossings: Vec<f64>,
+        time_events: Vec<f64>,
+        completed: usize,
+    }
+
+    unsafe fn me(c: *mut c_void) -> &'static mut MeToy {
+        &mut *(c as *mut MeToy)
+    }
+    unsafe extern "C" fn me_get(c: *mut c_void, _vr: *const u32, n: usize, v: *mut f64) -> i32 {
+        for i in 0..n {
+            *v.add(i) = me(c).x;
+        }
+        0
+    }
+    unsafe extern "C" fn me_set(_c: *mut c_void, _vr: *const u32, _n: usize, _v: *mut f64) -> i32 {
+        0
+    }
+    unsafe extern "C" fn me_set_time(c: *mut c_void, t: f64) -> i32 {
+        me(c).t = t;
+        0
+    }
+    unsafe extern "C" fn me_set_states(c: *mut c_void, x: *mut f64, _n: usize) -> i32 {
+        me(c).x = *x;
+        0
+    }
+    unsafe extern "C" fn me_get_states(c: *mut c_void, x: *mut f64, _n: usize) -> i32 {
+        *x = me(c).x;
+        0
+    }
+    unsafe extern "C" fn me_der(c: *mut c_void, dx: *mut f64, _n: usize) -> i32 {
+        *dx = -me(c).a * me(c).x;
+        0
+    }
+    unsafe extern "C" fn me_ind(c: *mut c_void, z: *mut f64, _n: usize) -> i32 {
+        *z = me(c).x - me(c).level;
+        0
+    }
+    unsafe extern "C" fn me_completed(c: *mut c_void, _no: i32, enter: *mut i32, term: *mut i32) -> i32 {
+        me(c).completed += 1;
+        *enter = 0;
+        *term = 0;
+        0
+    }
+    unsafe extern "C" fn me_plain(_c: *mut c_void) -> i32 {
+        0
+    }
+    #[repr(C)]
+    struct Info2 {
+        needed: i32,
+        term: i32,
+        nom: i32,
+        val: i32,
+        defined: i32,
+        next: f64,
+    }
+    unsafe extern "C" fn me_update(c: *mut c_void, ei: *mut Info2) -> i32 {
+        let m = me(c);
+        let ei = &mut *ei;
+        ei.needed = 0;
+        ei.term = 0;
+        if !m.time_event_done && (m.t - m.t_ev).abs() < 1e-9 {
+            m.time_event_done = true;
+            m.a = m.a2;
+            m.time_events.push(m.t);
+        }
+        if m.x <= m.level && m.crossings.len() < 1 {
+            m.crossings.push(m.t);
+            m.x *= 0.5;
+            ei.val = 1;
+        }
+        ei.defined = (!m.time_event_done) as i32;
+        ei.next = m.t_ev;
+        0
+    }
+
+    #[test]
+    fn model_exchange_unit_is_integrated_with_its_time_and_state_events() {
+        toy_me(&[1e-10, 1e-12, 1.0, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn model_exchange_unit_under_fixed_step_rk4() {
+        toy_me(&[1e-10, 1e-12, 1.0, 1.0, 1e-3]);
+    }
+
+    fn toy_me(params: &[f64; 5]) {
+        // x(0) = 1, a = 1: x reaches 0.5 at ln 2 (state event; x halves to 0.25); at t_ev = 1.0 the rate
+        // becomes a2 = 3; closed form at t = 2: 0.25·e^{-(1 - ln 2)}·e^{-3·1}
+        let mut m = MeToy {
+            t: 0.0, x: 1.0, a: 1.0, a2: 3.0, level: 0.5, t_ev: 1.0, time_event_done: false, crossings: vec![],
+            time_events: vec![], completed: 0,
+        };
+        let comps = [&mut m as *mut MeToy as *mut c_void];
+        let info = [2usize, 1, 1, 1];
+        let mut t = [std::ptr::null(); FN_SLOTS];
+        t[F_GET_REAL] = me_get as *const c_void;
+        t[F_SET_REAL] = me_set as *const c_void;
+        t[F_SET_TIME] = me_set_time as *const c_void;
+        t[F_SET_STATES] = me_set_states as *const c_void;
+        t[F_GET_STATES] = me_get_states as *const c_void;
+        t[F_GET_DERIVATIVES] = me_der as *const c_void;
+        t[F_GET_INDICATORS] = me_ind as *const c_void;
+        t[F_COMPLETED_STEP] = me_completed as *const c_void;
+        t[F_ENTER_EVENT_MODE] = me_plain as *const c_void;
+        t[F_UPDATE_DISCRETE] = me_update as *const c_void;
+        t[F_ENTER_CONT_MODE] = me_plain as *const c_void;
+        let (n, dt) = (20usize, 0.1);
+        let log_fmu = [0usize];
+        let log_vr = [0u32];
+        let log_type = [T_REAL];
+        let mut out = vec![f64::NAN; n + 1];
+        let mut fail = [0i64; 3];
+        let st = unsafe {
+            scfmu_loop_run(
+                1, comps.as_ptr(), info.as_ptr(), t.as_ptr(), params.as_ptr(), 0, std::ptr::null(), 0,
+                std::ptr::null(), 0, 0, 1, log_fmu.as_ptr(), log_vr.as_ptr(), log_type.as_ptr(), n, 0.0, dt,
+                out.as_mut_ptr(), out.len(), 1, fail.as_mut_ptr(),
+            )
+        };
+        assert_eq!(st, 0, "{fail:?}");
+        let ln2 = std::f64::consts::LN_2;
+        assert_eq!(m.crossings.len(), 1);
+        assert!((m.crossings[0] - ln2).abs() < 1e-9, "state event at {} (expected ln 2)", m.crossings[0]);
+        assert_eq!(m.time_events, vec![1.0]);
+        let exact = |t: f64| {
+            if t < ln2 {
+                (-t).exp()
+            } else if t < 1.0 {
+                0.25 * (-(t - ln2)).exp()
+            } else {
+                0.25 * (-(1.0 - ln2)).exp() * (-3.0 * (t - 1.0)).exp()
+            }
+        };
+        for k in 0..=n {
+            let tk = k as f64 * dt;
+            let e = exact(tk);
+            assert!((out[k] - e).abs() <= 1e-8 * e.abs().max(1e-3), "t = {tk}: {} vs {e}", out[k]);
+        }
+        assert!(m.completed >= n);
+    }
 }
+

@@ -1,0 +1,67 @@
+"""Instantiating and initializing the units of a plan, the same way for every engine that holds the
+instances itself (reference, lean, compiled)."""
+
+from __future__ import annotations
+
+from ..fmu import Fmu, unpacked
+from ..scenario.model import Scenario
+from ..scenario.plan import Plan, build_plan
+from .calls import SimulationError
+
+
+def as_plan(scenario, path_of=None, model_exchange=frozenset()) -> Plan:
+    """A :class:`Plan` as given, or the plan of a scenario (resolved once here)."""
+    if isinstance(scenario, Plan):
+        if model_exchange and not set(model_exchange) <= scenario.model_exchange:
+            raise ValueError("model_exchange: give it to build_plan (the plan fixes each instance's interface)")
+        return scenario
+    return build_plan(scenario, path_of=path_of, model_exchange=model_exchange)
+
+
+def build_fmus(plan, path_of=None, reuse: bool = False, model_exchange=frozenset()) -> dict[str, Fmu]:
+    """Instantiates and initializes every instance of the plan (or of a scenario: its plan is built),
+    parameters in initialization mode, then writes the fixed ``inputs``. Returns {instance name: Fmu}
+    in Gauss–Seidel order. With ``reuse`` the FMUs are unpacked once per process. Model Exchange
+    instances run under SciPy's solve_ivp (:class:`scfmu.fmu.Fmu`) with their plan's solver settings."""
+    plan = as_plan(plan, path_of, model_exchange)
+    fmus: dict[str, Fmu] = {}
+    try:
+        for u in plan.units:
+            kw = {}
+            if u.interface == "me":
+                kw = {"me_method": u.solver["method"], "me_rtol": u.solver["rtol"], "me_atol": u.solver["atol"],
+                      "me_max_step": u.solver["max_step"]}
+            fmus[u.name] = Fmu(u.model, name=u.name, start_time=plan.scenario.start_time, path=u.path,
+                               initialize=False, unpacked=unpacked(u.path) if reuse else None,
+                               interface=u.interface, **kw)
+        initialize_fmus(fmus, plan)
+    except Exception:
+        for f in fmus.values():
+            f.close()
+        raise
+    return fmus
+
+
+def initialize_fmus(fmus: dict[str, Fmu], plan) -> None:
+    """Initializes instantiated (or reset) FMUs: set-up, parameters in initialization mode, then the
+    fixed ``inputs``. Raises SimulationError when an FMU refuses to initialize."""
+    scenario: Scenario = plan.scenario if isinstance(plan, Plan) else plan
+    for c in scenario.components:
+        f = fmus[c.name]
+        f.enter_initialization_mode(scenario.start_time)
+        for k, v in c.params.items():
+            f.set(k, v)
+        try:
+            f.exit_initialization_mode()
+        except Exception as e:
+            msgs = "; ".join(m[2] for m in f.messages if m[0] >= 2)
+            what = "fmi2ExitInitializationMode" if f.fmi == 2 else "fmi3ExitInitializationMode"
+            raise SimulationError("fmu_error", f"{c.name} ({c.model}): {what} failed"
+                                  + (f": {msgs}" if msgs else (f": {e}" if f.interface == "me" else ""))) from None
+    for q, value in scenario.inputs.items():
+        inst, _, var = q.partition(".")
+        fmus[inst].set(var, value)
+
+
+def ports_of(fmus: dict[str, Fmu]) -> dict[str, tuple[list[str], list[str]]]:
+    return {name: (f.inputs(), f.outputs()) for name, f in fmus.items()}
