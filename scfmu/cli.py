@@ -104,7 +104,9 @@ def _paper(argv) -> int:
             print(f"  {name:12s} {help_}")
         return 0
     if argv[1] not in plugin.commands:
-        print(f"scfmu paper {plugin.key}: no command {argv[1]!r}; known: {', '.join(plugin.commands)}", file=sys.stderr)
+        from .scenario.values import did_you_mean
+        print(f"scfmu paper {plugin.key}: no command {argv[1]!r}{did_you_mean(argv[1], plugin.commands)}; known: "
+              f"{', '.join(plugin.commands)}", file=sys.stderr)
         return 2
     rc = resolve(plugin.commands[argv[1]][1])(argv[2:])
     return int(rc or 0)
@@ -116,8 +118,86 @@ LOCAL = {"scenarios": ("list the registered scenarios with descriptions", _scena
 ORDER = ("run", "scenarios", "campaign", "benchmark", "export", "report", "paper")
 
 
+# the optional extras (pyproject.toml) and the modules that tell whether each is installed
+EXTRAS = {"campaigns": ("pyarrow", "dask", "distributed"), "papers": ("pyswarms", "pygad"), "libcosim": ("libcosim",)}
+NEEDS = {"campaign": "campaigns", "benchmark": "campaigns", "report": "campaigns"}
+RESUME = {"run": "nothing was written; run the same command again to start over",
+          "campaign": "the workers were stopped and the runs finished so far are kept; run the same command "
+                      "again to resume",
+          "benchmark": "the workers were stopped; run the same command again to start over"}
+
+
+def _extra_of(module: str | None) -> str | None:
+    root = (module or "").split(".")[0]
+    for extra, mods in EXTRAS.items():
+        if root in mods or root == "libcosimpy" and extra == "libcosim":
+            return extra
+    return None
+
+
+def _missing_extra(command: str) -> str | None:
+    """The one line for a command whose extra is not installed (None when it is)."""
+    extra = NEEDS.get(command)
+    if extra is None:
+        return None
+    import importlib
+    for mod in EXTRAS[extra]:
+        try:
+            importlib.import_module(mod)
+        except ImportError:
+            return (f"scfmu {command} needs the {extra!r} extra ({mod} is not installed): "
+                    f"pip install 'scfmu[{extra}]'")
+    return None
+
+
+def _run_command(command: str, rest: list) -> int:
+    """Runs a subcommand; a user's mistake, a refused archive, an FMU's error, a missing extra or Ctrl-C
+    end in one line on stderr (exit 2, 2, 1, 2, 130), never in a traceback."""
+    from .fmu import ArchiveError
+    from .scenario.values import UsageError
+    from fmpy.fmi1 import FMICallException
+    try:
+        missing = _missing_extra(command)
+        if missing:
+            print(missing, file=sys.stderr)
+            return 2
+        if command in LOCAL:
+            return LOCAL[command][1](rest)
+        return int(resolve(COMMANDS[command][1])(rest) or 0)
+    except UsageError as e:
+        print(f"scfmu {command}: {e.message}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"\nscfmu {command}: interrupted (Ctrl-C); {RESUME.get(command, 'run the same command again')}",
+              file=sys.stderr)
+        return 130
+    except ArchiveError as e:
+        print(f"scfmu {command}: {e}", file=sys.stderr)
+        return 2
+    except FMICallException as e:
+        print(f"scfmu {command}: an FMU call failed: {e}", file=sys.stderr)
+        return 1
+    except ModuleNotFoundError as e:
+        extra = _extra_of(e.name)
+        if extra is None:
+            raise
+        print(f"scfmu {command} needs the {extra!r} extra ({e.name} is not installed): pip install 'scfmu[{extra}]'",
+              file=sys.stderr)
+        return 2
+    except BrokenPipeError:  # output piped into a program that stopped reading (`| head`)
+        import os
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 1
+
+
 def main(argv=None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
+    first = next((a for a in argv if not a.startswith("-")), None)
+    if first is not None and first not in ORDER and not (argv.index(first) > 0 and argv[argv.index(first) - 1] == "--fmus"):
+        from .scenario.values import did_you_mean
+        print(f"scfmu: unknown command {first!r}{did_you_mean(first, ORDER)} (commands: {', '.join(ORDER)}; "
+              f"`scfmu --help`)", file=sys.stderr)
+        return 2
     ap = argparse.ArgumentParser(prog="scfmu", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--fmus", metavar="DIR", help="folder of the FMUs to use")
     ap.add_argument("--version", action="store_true", help="print the version and exit")
@@ -139,9 +219,7 @@ def main(argv=None) -> int:
     if not a.command:
         ap.print_help()
         return 2
-    if a.command in LOCAL:
-        return LOCAL[a.command][1](rest)
-    return int(resolve(COMMANDS[a.command][1])(rest) or 0)
+    return _run_command(a.command, rest)
 
 
 if __name__ == "__main__":

@@ -20,7 +20,9 @@ from . import metrics
 from .engines import ENGINES, SimulationError, simulate
 from .results import write_csv
 from .scenario import options
+from .fmu import FmuError
 from .scenario.check import IncompatibleUnit, require
+from .scenario.values import UsageError, bounded_int, timing_problems
 from .scenario.ssp import file_stem
 
 ANGLES = ("roll", "pitch", "yaw")
@@ -75,20 +77,33 @@ def main(argv=None) -> int:
     ap.add_argument("--engine", default="native", choices=ENGINES, help="engine (all give bit-identical results)")
     ap.add_argument("--out", default=None, help="output folder (default out/<scenario>)")
     ap.add_argument("--no-plot", action="store_true")
+    ap.add_argument("--log-every", type=int, default=1, metavar="N",
+                    help="native engine: log every N-th communication step (for long runs; metrics on that grid)")
     args = ap.parse_args(argv)
     sc = options.build(args, notice=lambda t: print(t, file=sys.stderr))
+    bounded_int("--log-every", args.log_every, 1, 10 ** 9)
+    if args.log_every != 1 and args.engine != "native":
+        raise UsageError(f"--log-every {args.log_every}: allowed only with --engine native (the {args.engine} "
+                         f"engine logs every step)")
+    problems = timing_problems(sc.start_time, sc.stop_time, sc.step, log_every=args.log_every,
+                               log_hint=args.engine == "native")
+    if problems:
+        raise UsageError(problems[0])
     try:
         require(sc, warn=lambda t: print(f"warning: {t}", file=sys.stderr))
     except IncompatibleUnit as e:
-        print(f"scfmu run: {e}", file=sys.stderr)
+        print(f"scfmu run: {e.one_line()}", file=sys.stderr)
         return 2
     stem = file_stem(sc.name)
     out = Path(args.out or Path("out") / stem)
     out.mkdir(parents=True, exist_ok=True)
     try:
-        r = simulate(sc, args.engine)
+        r = simulate(sc, args.engine, **({"log_every": args.log_every} if args.log_every != 1 else {}))
     except SimulationError as e:
         print(f"scfmu run: the run failed ({e.status}): {e}", file=sys.stderr)
+        return 1
+    except FmuError as e:
+        print(f"scfmu run: the run failed: {e}", file=sys.stderr)
         return 1
     m = metrics.compute(sc.metrics, r)
     print(f"{sc.name}: {sc.description or ''}".rstrip(": "))

@@ -113,13 +113,14 @@ class Campaign:
         sc = self.scenario.to_dict()
         files = self.foreign_files()
         iso = self.isolated()
+        limits = fmu_access.archive_limits().to_dict()  # the client's archive limits hold on every worker
         out = []
         for i, ov in enumerate(self.overrides):
             for j, seed in enumerate(self.seeds):
                 out.append({"run": i * len(self.seeds) + j, "override_index": i, "overrides": dict(ov),
                             "seed": seed, "scenario": sc, "engine": self.engine, "timeseries": self.timeseries,
                             "ts_every": self.ts_every, "log_every": self.log_every, "fmu_files": files,
-                            "isolate": iso, "timeout": float(self.timeout)})
+                            "isolate": iso, "timeout": float(self.timeout), "archive_limits": limits})
         return out
 
     def describe(self) -> dict:
@@ -170,6 +171,8 @@ def run_one(spec: dict, fmu_dir: str | None = None, blobs: dict | None = None) -
     if os.environ.get("SCFMU_CRASH_TEST_RUN") == str(spec["run"]):  # test hook: a worker that dies mid-run
         os._exit(70)
     try:
+        if spec.get("archive_limits"):
+            fmu_access.set_archive_limits(spec["archive_limits"])
         spec = _materialize(spec, blobs)
     except Exception as e:
         return _failed_row(spec, "error", f"{type(e).__name__}: {e}"), None

@@ -104,6 +104,11 @@ def simulate(scenario, engine: str = "native", *, fmus: dict | None = None, over
     if seed is not None:
         scenario = scenario.with_seed(seed)
     engine = resolve_engine(engine)
+    from ..scenario.values import timing_problems  # bounded before any engine allocates its rows
+    problems = timing_problems(scenario.start_time, scenario.stop_time, scenario.step,
+                               log_every=kw.get("log_every", 1) if engine == "native" else 1)
+    if problems:
+        raise ValueError(problems[0])
     if engine == "reference":
         out = run_reference(scenario)
     elif engine == "lean":

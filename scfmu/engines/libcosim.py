@@ -37,8 +37,8 @@ def run_libcosim(scenario: Scenario) -> dict:
     ex = CosimExecution.from_step_size(step_size=step_ns)
     idx, mds = {}, {}
     for c in scenario.components:
+        mds[c.name] = {v.name: v for v in unpacked(fmu_path(c.model))[0].modelVariables}  # archive limits first
         idx[c.name] = ex.add_local_slave(CosimLocalSlave(fmu_path=str(fmu_path(c.model)), instance_name=c.name))
-        mds[c.name] = {v.name: v for v in unpacked(fmu_path(c.model))[0].modelVariables}
     for c in scenario.components:
         for k, v in c.params.items():
             var = mds[c.name][k]

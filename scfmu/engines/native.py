@@ -43,7 +43,7 @@ from pathlib import Path
 import numpy as np
 
 from .lean import SimulationError
-from ..fmu import Fmu, fmu_digest, fmu_path, unpacked
+from ..fmu import Fmu, fmu_digest, fmu_path, safe_extract, unpacked
 from ..scenario.model import Scenario
 from ..scenario.resolve import resolve
 
@@ -208,8 +208,7 @@ def build_container(scenario: Scenario, starts: dict | None = None) -> Path:
     work = Path(tempfile.mkdtemp(prefix="scfmu_container_"))
     try:
         for c in comps.values():  # nested FMUs unpacked under resources/<file stem>
-            with zipfile.ZipFile(c.filename) as z:
-                z.extractall(work / "resources" / Path(c.filename).stem)
+            safe_extract(c.filename, work / "resources" / Path(c.filename).stem)  # archive limits (scfmu.fmu)
         write_model_description(md, work / "modelDescription.xml")
         cfg = work / "resources" / "container.json"
         write_configuration(config, cfg)

@@ -13,16 +13,28 @@ import platform
 import sys
 import zipfile
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from fmpy import read_model_description
 
-from ..fmu import fmu_path
+from ..fmu import ArchiveError, fmu_path, inspect_archive
 from .model import Scenario
 from .resolve import resolve
+from .values import did_you_mean, value_problem
 
 
 class IncompatibleUnit(ValueError):
-    """A unit cannot take its place in the scenario; the message lists every reason."""
+    """A unit cannot take its place in the scenario; the message lists every reason (``errors``)."""
+
+    def __init__(self, message: str, errors: list | None = None):
+        super().__init__(message)
+        self.errors = list(errors or [])
+
+    def one_line(self) -> str:
+        """The message on one line when there is one reason (the command line's form), else as is."""
+        if len(self.errors) == 1:
+            return str(self).split("\n", 1)[0] + " " + self.errors[0]
+        return str(self)
 
 
 @dataclass
@@ -56,6 +68,11 @@ def check_unit(model: str, instantiate: bool = True) -> tuple[object | None, lis
     try:
         path = fmu_path(model)
     except FileNotFoundError as e:
+        return None, [str(e)]
+    try:
+        if zipfile.is_zipfile(path):  # (not a zip: reported below as an unreadable modelDescription.xml)
+            inspect_archive(path)  # archive limits before anything is inflated
+    except ArchiveError as e:
         return None, [str(e)]
     try:
         md = read_model_description(str(path), validate=False)
@@ -99,10 +116,15 @@ def check(scenario: Scenario, instantiate: bool = True) -> Report:
     sc = resolve_safely(scenario, rep)
     vars_of = {c.name: {v.name: v for v in mds[c.model].modelVariables} for c in sc.components}
     for c in sc.components:
-        for k in c.params:
+        params = [n for n, v in vars_of[c.name].items() if v.causality == "parameter"]
+        for k, val in c.params.items():
             v = vars_of[c.name].get(k)
             if v is None or v.causality != "parameter":
-                rep.errors.append(f"{c.name} ({c.model}): no parameter {k!r}")
+                rep.errors.append(f"{c.name} ({c.model}): no parameter {k!r}{did_you_mean(k, params)}")
+                continue
+            problem = value_problem(f"{c.name}.{k}", v, val)
+            if problem:
+                rep.errors.append(problem)
         for theirs in c.ports:
             if theirs not in vars_of[c.name]:
                 rep.errors.append(f"{c.name} ({c.model}): port map names {theirs!r}, which the unit does not have")
@@ -130,12 +152,77 @@ def check(scenario: Scenario, instantiate: bool = True) -> Report:
     for key, inst, var in sc.log_items():
         if inst in vars_of and var not in vars_of[inst]:
             rep.errors.append(f"logged signal {key!r}: {inst} has no variable {var!r}")
-    for q in sc.inputs:
+    for q, val in sc.inputs.items():
         inst, _, var = q.partition(".")
         v = vars_of.get(inst, {}).get(var)
         if v is None or v.causality != "input":
             rep.errors.append(f"fixed input {q}: {inst} has no input {var!r}")
+        else:
+            problem = value_problem(f"fixed input {q}", v, val)
+            if problem:
+                rep.errors.append(problem)
+    if not rep.errors and instantiate:
+        rep.errors += trial_initialization(sc)
     return rep
+
+
+def trial_initialization(sc: Scenario) -> list[str]:
+    """Each instance that is given parameters is instantiated and initialized alone with them (the calls
+    every engine makes); when it refuses them but initializes with its defaults, the unit's own log
+    message is the error (e.g. an exclusive bound the model description cannot declare)."""
+    from ..fmu import Fmu
+    errors = []
+    for c in sc.components:
+        if not c.params:
+            continue
+        path = fmu_path(c.model)
+        try:
+            Fmu(c.model, params=c.params, name=c.name, start_time=sc.start_time, path=path).close()
+            continue
+        except Exception as e:
+            refused = e
+        try:  # the same unit with its defaults: does it refuse the scenario's values, or everything?
+            Fmu(c.model, name=c.name, start_time=sc.start_time, path=path).close()
+        except Exception:
+            continue  # not caused by the values; the run reports it
+        msg = getattr(refused, "log", None)
+        errors.append(f"{c.name} ({Path(str(c.model)).name}) refuses the parameters it is given: "
+                      + (" | ".join(msg) if msg else str(refused)))
+    return errors
+
+
+def override_problems(scenario: Scenario, sets: list[dict], limit: int = 5) -> list[str]:
+    """The values of override sets (a campaign's list, grid or sample) checked against the declared
+    variables they set, without running anything; at most ``limit`` problems (the first ones)."""
+    from .resolve import declared
+    out = []
+    names = {c.name: c.model for c in scenario.components}
+    cache: dict = {}
+    for i, ov in enumerate(sets):
+        for key, val in ov.items():
+            q = key[len("input:"):] if key.startswith("input:") else key
+            inst, _, var = q.partition(".")
+            if inst not in names:
+                out.append(f"set {i}: {key}: no instance {inst!r}{did_you_mean(inst, names)}")
+                continue
+            if names[inst] not in cache:
+                try:
+                    cache[names[inst]] = declared(names[inst])
+                except Exception:
+                    cache[names[inst]] = None
+            vs = cache[names[inst]]
+            if vs is None:
+                continue
+            v = vs.get(scenario.native_name(inst, var), vs.get(var))
+            if v is None:
+                out.append(f"set {i}: {key}: {inst} has no variable {var!r}{did_you_mean(var, vs)}")
+            else:
+                problem = value_problem(key, v, val)
+                if problem:
+                    out.append(f"set {i}: {problem}")
+            if len(out) >= limit:
+                return out
+    return out
 
 
 def resolve_safely(scenario: Scenario, rep: Report) -> Scenario:
@@ -156,5 +243,5 @@ def require(scenario: Scenario, instantiate: bool = True, warn=None) -> Report:
         for w in rep.warnings:
             warn(w)
     if rep.errors:
-        raise IncompatibleUnit(f"scenario {scenario.name!r} cannot run:\n  " + "\n  ".join(rep.errors))
+        raise IncompatibleUnit(f"scenario {scenario.name!r} cannot run:\n  " + "\n  ".join(rep.errors), rep.errors)
     return rep
