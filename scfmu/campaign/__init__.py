@@ -435,9 +435,20 @@ def _client(scheduler: str | None, n_workers: int | None):
     from dask.distributed import Client, LocalCluster
     if scheduler:
         return Client(scheduler), None
-    cluster = LocalCluster(n_workers=n_workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
-                           dashboard_address=None, host="127.0.0.1",
-                           silence_logs=logging.CRITICAL)
+    # The worker processes start with SIGINT ignored (a disposition they inherit and keep): Ctrl-C in a
+    # terminal reaches the whole process group, and only this process should act on it, by closing the
+    # cluster (run()'s finally) instead of each worker dying with its own traceback.
+    import signal
+    import threading
+    main = threading.current_thread() is threading.main_thread()
+    old = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
+    try:
+        cluster = LocalCluster(n_workers=n_workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
+                               dashboard_address=None, host="127.0.0.1",
+                               silence_logs=logging.CRITICAL)
+    finally:
+        if main:
+            signal.signal(signal.SIGINT, old)
     return Client(cluster), cluster
 
 

@@ -130,6 +130,10 @@ def build(args, notice=print) -> Scenario:
     problems = timing_problems(sc.start_time, sc.stop_time, sc.step, log_every=None)
     if problems:
         raise UsageError(problems[0])
+    try:
+        sc.n_steps
+    except ValueError as e:
+        raise UsageError(str(e)) from None
     models = {}
     for inst, target in pairs(args.fmu, "--fmu").items():
         if "/" in target or target.endswith(".fmu"):
