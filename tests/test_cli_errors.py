@@ -315,6 +315,25 @@ def test_fmu_errors_carry_the_units_log_message():
     assert "PdController" in str(e.value) and "wn" in str(e.value)
 
 
+@pytest.mark.parametrize("engine", ["reference", "lean", "native", "compiled"])
+def test_no_engine_wraps_an_integer_or_hides_the_units_message(engine):
+    """The Python API too: an integer outside fmi2Integer is refused before any FMU call (it used to run as
+    error_law = 1), and an FMU's refusal carries the unit's message, on every engine."""
+    from fmpy.fmi1 import FMICallException
+    from scfmu.engines import SimulationError, simulate
+    if engine == "compiled":
+        from scfmu.engines.compiled import available
+        if not available():
+            pytest.skip("the compiled engine's library is not built")
+    sc = get("default", stop_time=1.0)
+    with pytest.raises(ValueError, match="error_law = 4294967297 is outside the Integer range"):
+        simulate(sc, engine, overrides={"controller.error_law": 2 ** 32 + 1})
+    with pytest.raises(FMICallException, match="value inf for wn is not finite"):
+        simulate(sc, engine, overrides={"controller.wn": math.inf})
+    with pytest.raises(SimulationError, match="parameter wn = -1 must be > 0"):
+        simulate(sc, engine, overrides={"controller.wn": -1.0})
+
+
 def test_a_failing_campaign_run_row_carries_the_units_message(tmp_path):
     from scfmu import campaign
     c = campaign.Campaign(get("default", stop_time=1.0), [{"controller.wn": -1.0}], isolate=False)
@@ -413,6 +432,17 @@ def test_ctrl_c_on_a_campaign_stops_the_workers_and_it_resumes(tmp_path):
     r = scfmu(*args, "--no-progress", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     assert "20 of 20 runs ok" in r.stdout
+    # the resumed rows are those of runs made on their own (first and last run, by the reference engine)
+    import pyarrow.parquet as pq
+    from scfmu import metrics
+    from scfmu.engines import simulate
+    rows = {row["run"]: row for row in pq.read_table(tmp_path / "c" / "results.parquet").to_pylist()}
+    assert sorted(rows) == list(range(20))
+    for run in (0, 19):
+        wn, seed = 0.5 + 0.1 * (run // 2), run % 2
+        sc = get("default", stop_time=10.0).with_overrides({"controller.wn": float(f"{wn:g}")}).with_seed(seed)
+        m = metrics.compute(sc.metrics, simulate(sc, "reference"))
+        assert rows[run]["eulerint_deg_s"] == m["eulerint_deg_s"], run
 
 
 def test_ctrl_c_on_the_benchmark(tmp_path):
