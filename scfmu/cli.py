@@ -38,11 +38,8 @@ def _scenarios(argv) -> int:
     a = ap.parse_args(argv)
     if a.show:
         from .scenario import files
-        try:
-            sc = REGISTRY.scenario(a.show)
-        except KeyError as e:
-            print(f"scfmu scenarios: {e.args[0]}", file=sys.stderr)
-            return 2
+        from .scenario.options import scenario_by_name
+        sc = scenario_by_name(a.show)  # an unknown name: one line with the closest known names (exit 2)
         print(files.dumps_json(sc) if a.json else files.dumps_toml(sc), end="")
         return 0
     rows = REGISTRY.scenario_names(a.pattern)
@@ -76,6 +73,12 @@ def _export(argv) -> int:
             return 2
         ns = argparse.Namespace(scenario=a.names[0], fmu=a.fmu, map=a.map, set=a.set, params=None, t_end=None, dt=None)
         items = [options.build(ns, notice=lambda t: print(t, file=sys.stderr))]
+        from .scenario.check import IncompatibleUnit, require
+        try:  # names, values against the declared types and bounds (no run)
+            require(items[0], instantiate=False, warn=lambda t: print(f"warning: {t}", file=sys.stderr))
+        except IncompatibleUnit as e:
+            print(f"scfmu export: {e.one_line()}", file=sys.stderr)
+            return 2
     try:
         export(a.kind, out, items)
     except (RuntimeError, KeyError, ValueError) as e:
@@ -187,6 +190,10 @@ def _run_command(command: str, rest: list) -> int:
     except BrokenPipeError:  # output piped into a program that stopped reading (`| head`)
         import os
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 1
+    except OSError as e:  # an output folder that cannot be written, a full disk, ...
+        where = f"{e.filename}: " if e.filename else ""
+        print(f"scfmu {command}: {where}{e.strerror or e}", file=sys.stderr)
         return 1
 
 
