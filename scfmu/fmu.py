@@ -45,7 +45,6 @@ from ctypes import POINTER, c_double
 
 import numpy as np
 from fmpy.fmi2 import FMU2Model, FMU2Slave, defaultCallbacks, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
-from scipy.integrate import solve_ivp
 
 _FMU_DIR_OVERRIDE: Path | None = None
 INT32 = (-(2 ** 31), 2 ** 31 - 1)  # the range of an FMI 2.0 Integer (fmi2Integer is a C int)
@@ -494,6 +493,7 @@ class Fmu:
         while t < t_end - eps:
             t_stop = t_end if self.next_event is None or self.next_event >= t_end - eps else self.next_event
             if self.nx:
+                from scipy.integrate import solve_ivp  # imported here: SciPy costs ~1 s at start-up
                 sol = solve_ivp(self._rhs, (t, t_stop), self._states(), method=self.me_method,
                                 rtol=self.me_rtol, atol=self.me_atol)
                 if not sol.success:
