@@ -355,12 +355,11 @@ class FmuError(FMICallException):
         self.model = fmu.model
         self.instance = getattr(fmu, "_instance_name", fmu.model)
         self.log = fmu.last_errors()
+        self.call = str(exc).rstrip(".")  # fmpy's text: "fmi2DoStep failed with status 3 (error)"
         self.args = (str(self),)
 
     def __str__(self) -> str:
-        head = f"{self.instance} ({Path(str(self.model)).name}): {self.function} failed"
-        label = {2: "discard", 3: "error", 4: "fatal"}.get(self.status)
-        head += f" with status {label}" if label else ""
+        head = f"{self.instance} ({Path(str(self.model)).name}): {self.call}"
         return head + (": " + " | ".join(self.log) if self.log else " (the unit logged no message)")
 
 
