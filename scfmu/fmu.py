@@ -206,6 +206,12 @@ def inspect_archive(path: str | Path, limits: ArchiveLimits | None = None) -> li
     if path.is_dir():
         raise ArchiveError(f"{path} is a directory, not an FMU file (give the .fmu archive)")
     try:
+        size = path.stat().st_size
+    except OSError as e:
+        raise ArchiveError(f"{path}: {e.strerror or e}") from None
+    if size > limits.max_bytes:  # before its directory (which could list millions of entries) is read
+        raise ArchiveError(f"{path}: {size} bytes; the limit is {limits.max_bytes} bytes (SCFMU_FMU_MAX_BYTES)")
+    try:
         with zipfile.ZipFile(path) as z:
             infos = z.infolist()
     except zipfile.BadZipFile as e:

@@ -115,6 +115,10 @@ def test_total_size_and_file_count_limits_from_the_environment(monkeypatch, priv
     monkeypatch.setenv("SCFMU_FMU_MAX_FILES", str(n - 1))
     with pytest.raises(ArchiveError, match=f"{n} entries; at most {n - 1}.*SCFMU_FMU_MAX_FILES"):
         safe_extract(pd)
+    monkeypatch.setenv("SCFMU_FMU_MAX_BYTES", str(pd.stat().st_size - 1))  # the archive itself is too large
+    with pytest.raises(ArchiveError, match=f"{pd.stat().st_size} bytes; the limit is"):
+        inspect_archive(pd)
+    monkeypatch.delenv("SCFMU_FMU_MAX_BYTES")
     monkeypatch.setenv("SCFMU_FMU_MAX_FILES", "many")
     with pytest.raises(ArchiveError, match="SCFMU_FMU_MAX_FILES = 'many': expected a positive integer"):
         safe_extract(pd)
