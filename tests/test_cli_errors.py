@@ -334,6 +334,31 @@ def test_no_engine_wraps_an_integer_or_hides_the_units_message(engine):
         simulate(sc, engine, overrides={"controller.wn": -1.0})
 
 
+def test_a_foreign_units_trial_initialization_runs_in_a_child(tmp_path, monkeypatch):
+    """A unit given as a file is tried in a forked child: its refusal is still reported with its own
+    message; a crash or a hang there costs a warning, not the process running the check."""
+    import shutil
+    import scfmu.scenario.check as chk
+    from scfmu.fmu import fmu_path
+    mine = tmp_path / "MyPd.fmu"
+    shutil.copyfile(fmu_path("PdController"), mine)
+    sc = get("default", stop_time=1.0).with_models({"controller": str(mine)})
+    rep = chk.check(sc.with_overrides({"controller.wn": -1.0}))
+    assert rep.errors == ["controller (MyPd.fmu) refuses the parameters it is given: fmi2ExitInitializationMode: "
+                          "parameter wn = -1 must be > 0"]
+    real = chk._trial  # (our own units are tried in this process: only the foreign one misbehaves)
+    monkeypatch.setattr(chk, "_trial", lambda c, t: os.kill(os.getpid(), signal.SIGSEGV) if c.name == "controller"
+                        else real(c, t))
+    rep = chk.check(sc.with_overrides({"controller.wn": 1.0}))
+    assert rep.ok and any("its trial initialization crashed (SIGSEGV)" in w for w in rep.warnings), rep
+    monkeypatch.setattr(chk, "_trial", lambda c, t: time.sleep(60) if c.name == "controller" else real(c, t))
+    monkeypatch.setattr(chk, "TRIAL_TIMEOUT", 1.0)
+    t0 = time.monotonic()
+    rep = chk.check(sc.with_overrides({"controller.wn": 1.0}))
+    assert rep.ok and any("did not end within 1 s" in w for w in rep.warnings), rep
+    assert time.monotonic() - t0 < 30
+
+
 def test_a_failing_campaign_run_row_carries_the_units_message(tmp_path):
     from scfmu import campaign
     c = campaign.Campaign(get("default", stop_time=1.0), [{"controller.wn": -1.0}], isolate=False)
