@@ -40,11 +40,8 @@ def _scenarios(argv) -> int:
     a = ap.parse_args(argv)
     if a.show:
         from .scenario import files
-        try:
-            sc = REGISTRY.scenario(a.show)
-        except KeyError as e:
-            print(f"scfmu scenarios: {e.args[0]}", file=sys.stderr)
-            return 2
+        from .scenario.options import scenario_by_name
+        sc = scenario_by_name(a.show)  # an unknown name: one line with the closest known names (exit 2)
         print(files.dumps_json(sc) if a.json else files.dumps_toml(sc), end="")
         return 0
     rows = REGISTRY.scenario_names(a.pattern)
@@ -81,6 +78,12 @@ def _export(argv) -> int:
                                 profile=a.profile)
         items = [options.build(ns, notice=lambda t: print(t, file=sys.stderr))]
         options.binding_report(items[0], "scfmu export", False, lambda t: print(t, file=sys.stderr))
+        from .scenario.check import IncompatibleUnit, require
+        try:  # names, values against the declared types and bounds (no run)
+            require(items[0], instantiate=False, warn=lambda t: print(f"warning: {t}", file=sys.stderr))
+        except IncompatibleUnit as e:
+            print(f"scfmu export: {e.one_line()}", file=sys.stderr)
+            return 2
     try:
         export(a.kind, out, items)
     except (RuntimeError, KeyError, ValueError) as e:
@@ -109,7 +112,9 @@ def _paper(argv) -> int:
             print(f"  {name:12s} {help_}")
         return 0
     if argv[1] not in plugin.commands:
-        print(f"scfmu paper {plugin.key}: no command {argv[1]!r}; known: {', '.join(plugin.commands)}", file=sys.stderr)
+        from .scenario.values import did_you_mean
+        print(f"scfmu paper {plugin.key}: no command {argv[1]!r}{did_you_mean(argv[1], plugin.commands)}; known: "
+              f"{', '.join(plugin.commands)}", file=sys.stderr)
         return 2
     rc = resolve(plugin.commands[argv[1]][1])(argv[2:])
     return int(rc or 0)
@@ -121,8 +126,90 @@ LOCAL = {"scenarios": ("list the registered scenarios with descriptions", _scena
 ORDER = ("run", "scenarios", "campaign", "benchmark", "export", "report", "paper", "check")
 
 
+# the optional extras (pyproject.toml) and the modules that tell whether each is installed
+EXTRAS = {"campaigns": ("pyarrow", "dask", "distributed"), "papers": ("pyswarms", "pygad"), "libcosim": ("libcosim",)}
+NEEDS = {"campaign": "campaigns", "benchmark": "campaigns", "report": "campaigns"}
+RESUME = {"run": "nothing was written; run the same command again to start over",
+          "campaign": "the workers were stopped and the runs finished so far are kept; run the same command "
+                      "again to resume",
+          "benchmark": "the workers were stopped; run the same command again to start over"}
+
+
+def _extra_of(module: str | None) -> str | None:
+    root = (module or "").split(".")[0]
+    for extra, mods in EXTRAS.items():
+        if root in mods or root == "libcosimpy" and extra == "libcosim":
+            return extra
+    return None
+
+
+def _missing_extra(command: str) -> str | None:
+    """The one line for a command whose extra is not installed (None when it is)."""
+    extra = NEEDS.get(command)
+    if extra is None:
+        return None
+    import importlib
+    for mod in EXTRAS[extra]:
+        try:
+            importlib.import_module(mod)
+        except ImportError:
+            return (f"scfmu {command} needs the {extra!r} extra ({mod} is not installed): "
+                    f"pip install 'scfmu[{extra}]'")
+    return None
+
+
+def _run_command(command: str, rest: list) -> int:
+    """Runs a subcommand; a user's mistake, a refused archive, an FMU's error, a missing extra or Ctrl-C
+    end in one line on stderr (exit 2, 2, 1, 2, 130), never in a traceback."""
+    from .fmu import ArchiveError
+    from .scenario.values import UsageError
+    from fmpy.fmi1 import FMICallException
+    try:
+        missing = _missing_extra(command)
+        if missing:
+            print(missing, file=sys.stderr)
+            return 2
+        if command in LOCAL:
+            return LOCAL[command][1](rest)
+        return int(resolve(COMMANDS[command][1])(rest) or 0)
+    except UsageError as e:
+        print(f"scfmu {command}: {e.message}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"\nscfmu {command}: interrupted (Ctrl-C); {RESUME.get(command, 'run the same command again')}",
+              file=sys.stderr)
+        return 130
+    except ArchiveError as e:
+        print(f"scfmu {command}: {e}", file=sys.stderr)
+        return 2
+    except FMICallException as e:
+        print(f"scfmu {command}: an FMU call failed: {e}", file=sys.stderr)
+        return 1
+    except ModuleNotFoundError as e:
+        extra = _extra_of(e.name)
+        if extra is None:
+            raise
+        print(f"scfmu {command} needs the {extra!r} extra ({e.name} is not installed): pip install 'scfmu[{extra}]'",
+              file=sys.stderr)
+        return 2
+    except BrokenPipeError:  # output piped into a program that stopped reading (`| head`)
+        import os
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 1
+    except OSError as e:  # an output folder that cannot be written, a full disk, ...
+        where = f"{e.filename}: " if e.filename else ""
+        print(f"scfmu {command}: {where}{e.strerror or e}", file=sys.stderr)
+        return 1
+
+
 def main(argv=None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
+    first = next((a for a in argv if not a.startswith("-")), None)
+    if first is not None and first not in ORDER and not (argv.index(first) > 0 and argv[argv.index(first) - 1] == "--fmus"):
+        from .scenario.values import did_you_mean
+        print(f"scfmu: unknown command {first!r}{did_you_mean(first, ORDER)} (commands: {', '.join(ORDER)}; "
+              f"`scfmu --help`)", file=sys.stderr)
+        return 2
     ap = argparse.ArgumentParser(prog="scfmu", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--fmus", metavar="DIR", help="folder of the FMUs to use")
     ap.add_argument("--version", action="store_true", help="print the version and exit")
@@ -144,9 +231,7 @@ def main(argv=None) -> int:
     if not a.command:
         ap.print_help()
         return 2
-    if a.command in LOCAL:
-        return LOCAL[a.command][1](rest)
-    return int(resolve(COMMANDS[a.command][1])(rest) or 0)
+    return _run_command(a.command, rest)
 
 
 if __name__ == "__main__":

@@ -22,7 +22,9 @@ from .fmu import is_path
 from .scenario.plan import PlanError, build_plan
 from .results import write_csv
 from .scenario import options
+from .fmu import FmuError
 from .scenario.check import IncompatibleUnit, require
+from .scenario.values import UsageError, bounded_int, timing_problems
 from .scenario.ssp import file_stem
 
 ANGLES = ("roll", "pitch", "yaw")
@@ -141,12 +143,22 @@ def main(argv=None) -> int:
     ap.add_argument("--out", default=None, help="output folder (default out/<scenario>[+<unit>...]: its own folder "
                                                 "per run; another run's folder gets a -2, -3, ... suffix)")
     ap.add_argument("--no-plot", action="store_true")
+    ap.add_argument("--log-every", type=int, default=1, metavar="N",
+                    help="native engine: log every N-th communication step (for long runs; metrics on that grid)")
     args = ap.parse_args(argv)
     sc = options.build(args, notice=lambda t: print(t, file=sys.stderr))
+    bounded_int("--log-every", args.log_every, 1, 10 ** 9)
+    if args.log_every != 1 and args.engine not in (None, "native"):
+        raise UsageError(f"--log-every {args.log_every}: allowed only with --engine native (the {args.engine} "
+                         f"engine logs every step)")
+    problems = timing_problems(sc.start_time, sc.stop_time, sc.step, log_every=args.log_every,
+                               log_hint=args.engine in (None, "native"))
+    if problems:
+        raise UsageError(problems[0])
     try:
         require(sc, warn=lambda t: print(f"warning: {t}", file=sys.stderr))
     except IncompatibleUnit as e:
-        print(f"scfmu run: {e}", file=sys.stderr)
+        print(f"scfmu run: {e.one_line()}", file=sys.stderr)
         return 2
     unbound = options.binding_report(sc, "scfmu run", args.strict, lambda t: print(t, file=sys.stderr))
     try:
@@ -159,6 +171,9 @@ def main(argv=None) -> int:
         if plan.model_exchange:  # fmpy's container (native) hosts Co-Simulation units only
             from .engines.compiled import available
             args.engine = "compiled" if available() else "lean"
+    if args.log_every != 1 and args.engine != "native":
+        raise UsageError(f"--log-every {args.log_every}: allowed only with --engine native (the {args.engine} "
+                         f"engine logs every step)")
     stem = file_stem(sc.name)
     ident = run_identity(sc, args.engine)
     out, notice = choose_folder(Path(args.out) if args.out else Path("out") / run_folder_name(sc), ident,
@@ -166,12 +181,15 @@ def main(argv=None) -> int:
     if notice:
         print(notice, file=sys.stderr)
     try:
-        r = simulate(plan, args.engine)
+        r = simulate(plan, args.engine, **({"log_every": args.log_every} if args.log_every != 1 else {}))
     except PlanError as e:
         print(f"scfmu run: {e}", file=sys.stderr)
         return 2
     except SimulationError as e:
         print(f"scfmu run: the run failed ({e.status}): {e}", file=sys.stderr)
+        return 1
+    except FmuError as e:
+        print(f"scfmu run: the run failed: {e}", file=sys.stderr)
         return 1
     out.mkdir(parents=True, exist_ok=True)
     m, mu = r.metrics, r.metric_units

@@ -115,13 +115,14 @@ class Campaign:
         sc = self.scenario.to_dict()
         files = self.foreign_files()
         iso = self.isolated()
+        limits = fmu_access.archive_limits().to_dict()  # the client's archive limits hold on every worker
         out = []
         for i, ov in enumerate(self.overrides):
             for j, seed in enumerate(self.seeds):
                 out.append({"run": i * len(self.seeds) + j, "override_index": i, "overrides": dict(ov),
                             "seed": seed, "scenario": sc, "engine": self.engine, "timeseries": self.timeseries,
                             "ts_every": self.ts_every, "log_every": self.log_every, "fmu_files": files,
-                            "isolate": iso, "timeout": float(self.timeout)})
+                            "isolate": iso, "timeout": float(self.timeout), "archive_limits": limits})
         return out
 
     def describe(self) -> dict:
@@ -172,6 +173,8 @@ def run_one(spec: dict, fmu_dir: str | None = None, blobs: dict | None = None) -
     if os.environ.get("SCFMU_CRASH_TEST_RUN") == str(spec["run"]):  # test hook: a worker that dies mid-run
         os._exit(70)
     try:
+        if spec.get("archive_limits"):
+            fmu_access.set_archive_limits(spec["archive_limits"])
         spec = _materialize(spec, blobs)
     except Exception as e:
         return _failed_row(spec, "error", f"{type(e).__name__}: {e}"), None
@@ -436,9 +439,20 @@ def _client(scheduler: str | None, n_workers: int | None):
     from dask.distributed import Client, LocalCluster
     if scheduler:
         return Client(scheduler), None
-    cluster = LocalCluster(n_workers=n_workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
-                           dashboard_address=None, host="127.0.0.1",
-                           silence_logs=logging.CRITICAL)
+    # The worker processes start with SIGINT ignored (a disposition they inherit and keep): Ctrl-C in a
+    # terminal reaches the whole process group, and only this process should act on it, by closing the
+    # cluster (run()'s finally) instead of each worker dying with its own traceback.
+    import signal
+    import threading
+    main = threading.current_thread() is threading.main_thread()
+    old = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
+    try:
+        cluster = LocalCluster(n_workers=n_workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
+                               dashboard_address=None, host="127.0.0.1",
+                               silence_logs=logging.CRITICAL)
+    finally:
+        if main:
+            signal.signal(signal.SIGINT, old)
     return Client(cluster), cluster
 
 

@@ -21,58 +21,132 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from pathlib import Path
 
 
 from .. import campaign
 from ..scenario import options
-from ..scenario.check import IncompatibleUnit, require
+from ..scenario.check import IncompatibleUnit, override_problems, require
 from ..scenario.options import value
+from ..scenario.values import UsageError, bounded_float, bounded_int, did_you_mean, timing_problems
 from . import plots as campaign_plots
+
+
+MAX_RUNS = 10_000_000  # runs of one campaign (parameter sets × seeds)
+SEED_RANGE = (0, 2 ** 31 - 1)  # a seed is given to Integer (fmi2Integer) seed parameters
+
+
+def _seed(text: str) -> int:
+    v = value(text)
+    if isinstance(v, bool) or not isinstance(v, int) or not SEED_RANGE[0] <= v <= SEED_RANGE[1]:
+        raise UsageError(f"--seeds: {text!r}: allowed: whole numbers in [{SEED_RANGE[0]}, {SEED_RANGE[1]}] "
+                         f"(0,1,2 or 0:10)")
+    return v
 
 
 def parse_seeds(text: str) -> list:
     if not text:
         return [None]
     if ":" in text:
-        a, b = text.split(":")
-        return list(range(int(a), int(b)))
-    return [int(x) for x in text.split(",")]
+        parts = text.split(":")
+        if len(parts) != 2:
+            raise UsageError(f"--seeds {text!r}: expected FIRST:END (END excluded) or a list 0,1,2")
+        a, b = _seed(parts[0]), _seed(parts[1])
+        if b <= a:
+            raise UsageError(f"--seeds {text!r}: END must be greater than FIRST")
+        bounded_int("--seeds: the number of seeds", b - a, 1, MAX_RUNS)
+        return list(range(a, b))
+    seeds = [_seed(x) for x in text.split(",")]
+    bounded_int("--seeds: the number of seeds", len(seeds), 1, MAX_RUNS)
+    return seeds
+
+
+DISTRIBUTIONS = ("uniform", "loguniform", "normal", "int", "choice")
 
 
 def parse_random(items: list[str]) -> dict:
     space = {}
     for it in items:
-        name, _, spec = it.partition("=")
+        name, sep, spec = it.partition("=")
         kind, _, rest = spec.partition(":")
+        if not sep or not name:
+            raise UsageError(f"--random {it!r}: expected INST.VAR=DIST:A:B")
+        if kind not in DISTRIBUTIONS:
+            raise UsageError(f"--random {it!r}: unknown distribution {kind!r}{did_you_mean(kind, DISTRIBUTIONS)}; "
+                             f"allowed: {', '.join(DISTRIBUTIONS)}")
         if kind == "choice":
-            space[name] = ("choice", [value(x) for x in rest.split(",")])
-        else:
-            lo, hi = rest.split(":")
-            space[name] = (kind, value(lo), value(hi))
+            vals = [value(x) for x in rest.split(",") if x]
+            if not vals:
+                raise UsageError(f"--random {it!r}: choice needs values: choice:a,b,c")
+            space[name] = ("choice", vals)
+            continue
+        parts = rest.split(":")
+        if len(parts) != 2:
+            raise UsageError(f"--random {it!r}: expected {kind}:A:B")
+        lo, hi = value(parts[0]), value(parts[1])
+        for x in (lo, hi):
+            if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
+                raise UsageError(f"--random {it!r}: {x!r} is not a finite number")
+        if kind == "int" and not (isinstance(lo, int) and isinstance(hi, int)):
+            raise UsageError(f"--random {it!r}: int:A:B needs whole numbers")
+        if kind == "normal" and not hi >= 0:
+            raise UsageError(f"--random {it!r}: the standard deviation {hi} must be ≥ 0")
+        if kind != "normal" and not lo <= hi:
+            raise UsageError(f"--random {it!r}: A = {lo} must not exceed B = {hi}")
+        if kind == "loguniform" and not lo > 0:
+            raise UsageError(f"--random {it!r}: loguniform needs 0 < A ≤ B")
+        space[name] = (kind, lo, hi)
     return space
 
 
 def build(args) -> campaign.Campaign:
     sc = options.build(args, notice=lambda t: print(t, file=sys.stderr))
+    bounded_int("--samples", args.samples, 1, MAX_RUNS)
+    bounded_int("--ts-every", args.ts_every, 1, 10 ** 9)
+    bounded_int("--log-every", args.log_every, 1, 10 ** 9)
+    if args.workers is not None:
+        bounded_int("--workers", args.workers, 1, 1024)
+    if args.chunk is not None:
+        bounded_int("--chunk", args.chunk, 1, 10 ** 6)
+    bounded_float("--timeout", args.timeout, 0.0, 10 ** 7)
+    problems = timing_problems(sc.start_time, sc.stop_time, sc.step, log_every=args.log_every)
+    if problems:
+        raise UsageError(problems[0])
     sets = [{}]
     if args.list:
-        sets = json.loads(Path(args.list).read_text())
+        try:
+            sets = json.loads(Path(args.list).read_text())
+        except OSError as e:
+            raise UsageError(f"--list {args.list}: {e.strerror or e}") from None
+        except ValueError as e:
+            raise UsageError(f"--list {args.list}: not valid JSON: {e}") from None
+        if not isinstance(sets, list) or not all(isinstance(x, dict) for x in sets) or not sets:
+            raise UsageError(f"--list {args.list}: expected a list of tables [{{\"inst.var\": value}}, ...]")
     if args.grid:
         axes = {}
         for it in args.grid:
-            k, _, v = it.partition("=")
-            axes[k] = [value(x) for x in v.split(",")]
+            k, sep, v = it.partition("=")
+            if not sep or not k or not v:
+                raise UsageError(f"--grid {it!r}: expected INST.VAR=V1,V2,...")
+            axes[k] = [value(x) for x in v.split(",") if x]
+        n = len(sets)
+        for vals in axes.values():
+            n *= len(vals)
+        bounded_int("--grid: the number of parameter sets", n, 1, MAX_RUNS)
         g = campaign.grid(axes)
         sets = [dict(a, **b) for a in sets for b in g]
+    seeds = parse_seeds(args.seeds)
     if args.random:
+        bounded_int("the number of runs", len(sets) * args.samples * len(seeds), 1, MAX_RUNS)
         r = campaign.random_sample(parse_random(args.random), args.samples, args.sample_seed)
         sets = [dict(a, **b) for a in sets for b in r]
+    bounded_int("the number of runs (parameter sets × seeds)", len(sets) * len(seeds), 1, MAX_RUNS)
     ts = None
     if args.timeseries is not None:
         ts = [x for x in args.timeseries.split(",") if x]
-    return campaign.Campaign(sc, sets, parse_seeds(args.seeds), engine=args.engine, timeseries=ts,
+    return campaign.Campaign(sc, sets, seeds, engine=args.engine, timeseries=ts,
                              ts_every=args.ts_every, log_every=args.log_every,
                              isolate=True if args.isolate else None, timeout=args.timeout)
 
@@ -112,14 +186,30 @@ def main(argv=None) -> int:
     try:
         require(c.scenario, warn=lambda t: print(f"warning: {t}", file=sys.stderr))
     except IncompatibleUnit as e:
-        print(f"scfmu campaign: {e}", file=sys.stderr)
+        print(f"scfmu campaign: {e.one_line()}", file=sys.stderr)
         return 2
     options.binding_report(c.scenario, "scfmu campaign", args.strict, lambda t: print(t, file=sys.stderr))
+    bad = override_problems(c.scenario, c.overrides)
+    if bad:
+        more = " (and more)" if len(bad) > 1 else ""
+        raise UsageError(f"{bad[0]}{more}")
     out = Path(args.out or Path("out") / "campaign" / c.scenario.name.replace("/", "_"))
     print(f"campaign {c.campaign_id()}: scenario {c.scenario.name}, {len(c.overrides)} parameter set(s) × "
           f"{len(c.seeds)} seed(s) = {len(c.overrides) * len(c.seeds)} runs, engine {c.engine} → {out}")
-    table = campaign.run(c, out, scheduler=args.scheduler, n_workers=args.workers, chunk=args.chunk,
-                         progress=not args.no_progress, overwrite=args.overwrite)
+    try:
+        table = campaign.run(c, out, scheduler=args.scheduler, n_workers=args.workers, chunk=args.chunk,
+                             progress=not args.no_progress, overwrite=args.overwrite)
+    except KeyboardInterrupt:  # campaign.run has stopped its workers (LocalCluster closed) and kept the rows
+        done = campaign.read_results(out)
+        n = 0 if done is None else done.num_rows
+        print(f"\nscfmu campaign: interrupted (Ctrl-C) after {n} of {len(c.overrides) * len(c.seeds)} runs; the "
+              f"workers were stopped and the rows are kept in {out}; run the same command again to resume",
+              file=sys.stderr)
+        return 130
+    except RuntimeError as e:
+        if "holds another campaign" in str(e) or "other FMU builds" in str(e):
+            raise UsageError(f"{e} (--overwrite replaces it)") from None
+        raise
     rows = table.to_pylist()
     ok = [r for r in rows if r["status"] == "ok"]
     counts: dict[str, int] = {}

@@ -154,6 +154,12 @@ def simulate(scenario, engine: str = "native", *, fmus: dict | None = None, over
     engine = resolve_engine(engine)
     if engine not in ENGINES:
         raise ValueError(f"engine {engine!r}: expected one of {ENGINES} or 'auto'")
+    from ..scenario.values import timing_problems  # bounded before any engine allocates its rows
+    sc = scenario.scenario if isinstance(scenario, Plan) else scenario
+    problems = timing_problems(sc.start_time, sc.stop_time, sc.step,
+                               log_every=kw.get("log_every", 1) if engine == "native" else 1)
+    if problems:
+        raise ValueError(problems[0])
     plan = scenario if isinstance(scenario, Plan) else build_plan(scenario, model_exchange=model_exchange)
     if engine == "reference":
         out = run_reference(plan)

@@ -42,7 +42,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..fmu import Fmu, fmu_digest, scalar_type, unpacked
+from ..fmu import Fmu, fmu_digest, safe_extract, scalar_type, unpacked
 from ..scenario.model import Scenario
 from ..scenario.plan import Plan, PlanError
 from .calls import SimulationError, raw_calls
@@ -199,8 +199,7 @@ def build_container(scenario, starts: dict | None = None) -> Path:
     work = Path(tempfile.mkdtemp(prefix="scfmu_container_"))
     try:
         for c in comps.values():  # nested FMUs unpacked under resources/<file stem>
-            with zipfile.ZipFile(c.filename) as z:
-                z.extractall(work / "resources" / Path(c.filename).stem)
+            safe_extract(c.filename, work / "resources" / Path(c.filename).stem)  # archive limits (scfmu.fmu)
         write_model_description(md, work / "modelDescription.xml")
         cfg = work / "resources" / "container.json"
         write_configuration(config, cfg)

@@ -15,17 +15,29 @@ import platform
 import sys
 import zipfile
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from fmpy import read_model_description
 
-from ..fmu import fmu_path
+from ..fmu import ArchiveError, fmu_path, inspect_archive
 from .model import Scenario
 from .plan import Unit, link_problem
 from .resolve import resolve
+from .values import did_you_mean, value_problem
 
 
 class IncompatibleUnit(ValueError):
-    """A unit cannot take its place in the scenario; the message lists every reason."""
+    """A unit cannot take its place in the scenario; the message lists every reason (``errors``)."""
+
+    def __init__(self, message: str, errors: list | None = None):
+        super().__init__(message)
+        self.errors = list(errors or [])
+
+    def one_line(self) -> str:
+        """The message on one line when there is one reason (the command line's form), else as is."""
+        if len(self.errors) == 1:
+            return str(self).split("\n", 1)[0] + " " + self.errors[0]
+        return str(self)
 
 
 @dataclass
@@ -69,6 +81,11 @@ def check_unit(model: str, instantiate: bool = True, interface: str = "") -> tup
     try:
         path = fmu_path(model)
     except FileNotFoundError as e:
+        return None, [str(e)]
+    try:
+        if zipfile.is_zipfile(path):  # (not a zip: reported below as an unreadable modelDescription.xml)
+            inspect_archive(path)  # archive limits before anything is inflated
+    except ArchiveError as e:
         return None, [str(e)]
     try:
         md = read_model_description(str(path), validate=False)
@@ -119,10 +136,15 @@ def check(scenario: Scenario, instantiate: bool = True) -> Report:
     sc = resolve_safely(scenario, rep)
     vars_of = {c.name: {v.name: v for v in mds[c.model].modelVariables} for c in sc.components}
     for c in sc.components:
-        for k in c.params:
+        params = [n for n, v in vars_of[c.name].items() if v.causality == "parameter"]
+        for k, val in c.params.items():
             v = vars_of[c.name].get(k)
             if v is None or v.causality != "parameter":
-                rep.errors.append(f"{c.name} ({c.model}): no parameter {k!r}")
+                rep.errors.append(f"{c.name} ({c.model}): no parameter {k!r}{did_you_mean(k, params)}")
+                continue
+            problem = value_problem(f"{c.name}.{k}", v, val)
+            if problem:
+                rep.errors.append(problem)
         for theirs in c.ports:
             if theirs not in vars_of[c.name]:
                 rep.errors.append(f"{c.name} ({c.model}): port map names {theirs!r}, which the unit does not have "
@@ -156,11 +178,17 @@ def check(scenario: Scenario, instantiate: bool = True) -> Report:
     for key, inst, var in sc.log_items():
         if inst in vars_of and var not in vars_of[inst]:
             rep.errors.append(f"logged signal {key!r}: {inst} has no variable {var!r}")
-    for q in sc.inputs:
+    for q, val in sc.inputs.items():
         inst, _, var = q.partition(".")
         v = vars_of.get(inst, {}).get(var)
         if v is None or v.causality != "input":
             rep.errors.append(f"fixed input {q}: {inst} has no input {var!r}")
+        else:
+            problem = value_problem(f"fixed input {q}", v, val)
+            if problem:
+                rep.errors.append(problem)
+    if not rep.errors and instantiate:
+        rep.errors += trial_initialization(sc, rep.warnings)
     return rep
 
 
@@ -234,8 +262,137 @@ def suggest_maps(sc: Scenario, vars_of: dict, mds: dict) -> list[str]:
         else:
             out.append(f"--map {inst}.{a}={b}")
     return out
+
+
 def _unit_of(c, md, variables) -> Unit:
     return Unit(c.name, c.model, None, md, int(str(md.fmiVersion)[0]), c.interface or "cs", {}, variables)
+
+
+TRIAL_TIMEOUT = 60.0  # [s] wall time of the trial initialization of a unit given as a file
+
+
+def _trial(c, start_time: float) -> str | None:
+    """The error of initializing component ``c`` alone with its parameters when it initializes with its
+    defaults (None when it takes them, or when it refuses its defaults too: not the values' fault)."""
+    from ..fmu import Fmu
+    path = fmu_path(c.model)
+    try:
+        Fmu(c.model, params=c.params, name=c.name, start_time=start_time, path=path).close()
+        return None
+    except Exception as e:
+        refused = e
+    try:  # the same unit with its defaults: does it refuse the scenario's values, or everything?
+        Fmu(c.model, name=c.name, start_time=start_time, path=path).close()
+    except Exception:
+        return None  # the run reports it
+    msg = getattr(refused, "log", None)
+    return (f"{c.name} ({Path(str(c.model)).name}) refuses the parameters it is given: "
+            + (" | ".join(msg) if msg else str(refused)))
+
+
+def _in_child(fn, timeout: float):
+    """``fn()`` in a forked child with a wall-time limit: ("ok", result), ("crash", signal name) or
+    ("timeout", None); a foreign unit that crashes or hangs cannot take this process with it."""
+    import os
+    import pickle
+    import select
+    import signal
+    import time
+    rfd, wfd = os.pipe()
+    pid = os.fork()
+    if pid == 0:
+        code = 0
+        try:
+            os.close(rfd)
+            with os.fdopen(wfd, "wb") as w:
+                w.write(pickle.dumps(fn()))
+        except BaseException:
+            code = 3
+        finally:
+            os._exit(code)
+    os.close(wfd)
+    chunks, deadline = [], time.monotonic() + timeout
+    with os.fdopen(rfd, "rb") as r:
+        while True:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                os.kill(pid, signal.SIGKILL)
+                os.waitpid(pid, 0)
+                return "timeout", None
+            ready, _, _ = select.select([r], [], [], min(left, 1.0))
+            if ready:
+                b = os.read(r.fileno(), 1 << 16)
+                if not b:
+                    break
+                chunks.append(b)
+    _, status = os.waitpid(pid, 0)
+    if os.WIFSIGNALED(status):
+        return "crash", signal.Signals(os.WTERMSIG(status)).name
+    try:
+        return "ok", pickle.loads(b"".join(chunks))
+    except Exception:
+        return "crash", f"exit code {os.WEXITSTATUS(status)}"
+
+
+def trial_initialization(sc: Scenario, warnings: list | None = None) -> list[str]:
+    """Each instance that is given parameters is instantiated and initialized alone with them (the calls
+    every engine makes); when it refuses them but initializes with its defaults, the unit's own log
+    message is the error (e.g. an exclusive bound the model description cannot declare). A unit given as
+    a file is tried in a child process (``TRIAL_TIMEOUT``): a crash or a hang there is a warning (the runs,
+    isolated, report it), not the end of this process."""
+    import os
+    from ..fmu import is_path
+    errors = []
+    for c in sc.components:
+        if not c.params:
+            continue
+        if is_path(c.model) and hasattr(os, "fork"):
+            kind, result = _in_child(lambda c=c: _trial(c, sc.start_time), TRIAL_TIMEOUT)
+            if kind != "ok":
+                if warnings is not None:
+                    warnings.append(f"{c.name} ({Path(str(c.model)).name}): its trial initialization "
+                                    + (f"did not end within {TRIAL_TIMEOUT:g} s" if kind == "timeout" else
+                                       f"crashed ({result})") + "; the runs will report it")
+                continue
+        else:
+            result = _trial(c, sc.start_time)
+        if result:
+            errors.append(result)
+    return errors
+
+
+def override_problems(scenario: Scenario, sets: list[dict], limit: int = 5) -> list[str]:
+    """The values of override sets (a campaign's list, grid or sample) checked against the declared
+    variables they set, without running anything; at most ``limit`` problems (the first ones)."""
+    from .resolve import declared
+    out = []
+    names = {c.name: c.model for c in scenario.components}
+    cache: dict = {}
+    for i, ov in enumerate(sets):
+        for key, val in ov.items():
+            q = key[len("input:"):] if key.startswith("input:") else key
+            inst, _, var = q.partition(".")
+            if inst not in names:
+                out.append(f"set {i}: {key}: no instance {inst!r}{did_you_mean(inst, names)}")
+                continue
+            if names[inst] not in cache:
+                try:
+                    cache[names[inst]] = declared(names[inst])
+                except Exception:
+                    cache[names[inst]] = None
+            vs = cache[names[inst]]
+            if vs is None:
+                continue
+            v = vs.get(scenario.native_name(inst, var), vs.get(var))
+            if v is None:
+                out.append(f"set {i}: {key}: {inst} has no variable {var!r}{did_you_mean(var, vs)}")
+            else:
+                problem = value_problem(key, v, val)
+                if problem:
+                    out.append(f"set {i}: {problem}")
+            if len(out) >= limit:
+                return out
+    return out
 
 
 def resolve_safely(scenario: Scenario, rep: Report) -> Scenario:
@@ -256,5 +413,5 @@ def require(scenario: Scenario, instantiate: bool = True, warn=None) -> Report:
         for w in rep.warnings:
             warn(w)
     if rep.errors:
-        raise IncompatibleUnit(f"scenario {scenario.name!r} cannot run:\n  " + "\n  ".join(rep.errors))
+        raise IncompatibleUnit(f"scenario {scenario.name!r} cannot run:\n  " + "\n  ".join(rep.errors), rep.errors)
     return rep

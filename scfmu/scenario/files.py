@@ -25,11 +25,13 @@ file's folder. ``scfmu scenarios --show NAME`` prints any registered scenario in
 from __future__ import annotations
 
 import json
+import math
 import tomllib
 from dataclasses import fields
 from pathlib import Path
 
 from .model import Component, Scenario
+from .values import timing_problems
 
 _FIELDS = {f.name for f in fields(Scenario)}
 _COMPONENT = {"name", "model", "params", "slot", "ports", "bind", "unused", "interface", "solver"}
@@ -75,15 +77,33 @@ def from_data(data: dict, where: str = "scenario", base: Path | None = None) -> 
         if c.get("interface", "") not in ("", "cs", "me"):
             raise ScenarioFileError(f"{w} ({c['name']}): interface = {c['interface']!r}; allowed: \"cs\" "
                                     f"(Co-Simulation), \"me\" (Model Exchange)")
-        model = c["model"]
-        if base is not None and (model.endswith(".fmu") or "/" in model) and not Path(model).is_absolute():
-            model = str((base / model).resolve())
+        model = _model(c["model"], f"{w} ({c['name']})", base)
+        for k in ("params", "slot"):
+            for name, v in c.get(k, {}).items():
+                if isinstance(v, bool) or isinstance(v, (int, str)):
+                    continue
+                if isinstance(v, float):
+                    if not math.isfinite(v):
+                        raise ScenarioFileError(f"{w} ({c['name']}): {k}.{name} = {v}: not finite; allowed: a "
+                                                f"finite number")
+                    continue
+                raise ScenarioFileError(f"{w} ({c['name']}): {k}.{name} = {v!r}: a {type(v).__name__}; allowed: "
+                                        f"a number, true/false or a text")
+        for theirs, ours in c.get("ports", {}).items():
+            if not isinstance(ours, str) or not ours:
+                raise ScenarioFileError(f"{w} ({c['name']}): ports.{theirs} = {ours!r}: allowed: a port name (text)")
         comps.append(Component(c["name"], model, dict(c.get("params", {})), dict(c.get("slot", {})),
                                dict(c.get("ports", {})), dict(c.get("bind", {})), list(c.get("unused", [])),
                                c.get("interface", ""), dict(c.get("solver", {}))))
     d = {k: v for k, v in data.items() if k != "components"}
     d.setdefault("name", where)
+    for k, v in d.get("inputs", {}).items():
+        if isinstance(v, float) and not math.isfinite(v) or not isinstance(v, (bool, int, float, str)):
+            raise ScenarioFileError(f"{where}: inputs.{k} = {v!r}: allowed: a finite number, true/false or a text")
     sc = Scenario(components=comps, **d)
+    problems = timing_problems(sc.start_time, sc.stop_time, sc.step, log_every=None)
+    if problems:
+        raise ScenarioFileError(f"{where}: {problems[0]}")
     try:
         sc.n_steps
     except ValueError as e:
@@ -97,6 +117,28 @@ def from_data(data: dict, where: str = "scenario", base: Path | None = None) -> 
     return sc
 
 
+def _model(model: str, where: str, base: Path | None) -> str:
+    """A component's model: a model name (letters, digits, '_', '-', '.'), or a path to an ``.fmu`` file,
+    taken relative to the scenario file's folder, that must exist as a file."""
+    if not (model.endswith(".fmu") or "/" in model or "\\" in model):
+        if not all(ch.isalnum() or ch in "_-." for ch in model) or model.startswith("."):
+            raise ScenarioFileError(f"{where}: model = {model!r}: allowed: a model name (letters, digits, '_') "
+                                    f"or a path to an .fmu file")
+        return model
+    p = Path(model).expanduser()
+    if base is not None and not p.is_absolute():
+        p = base / p
+    p = p.resolve()
+    if p.suffix.lower() != ".fmu":
+        raise ScenarioFileError(f"{where}: model = {model!r} (resolved to {p}): allowed: a path to an .fmu file")
+    if p.is_dir():
+        raise ScenarioFileError(f"{where}: model = {model!r} (resolved to {p}): a directory, not an FMU file")
+    if not p.is_file():
+        raise ScenarioFileError(f"{where}: model = {model!r}: no such file {p} (paths are taken relative to the "
+                                f"scenario file's folder)")
+    return str(p)
+
+
 def load(path: str | Path) -> Scenario:
     """Reads a scenario file (``.toml`` or ``.json``)."""
     path = Path(path)
@@ -104,10 +146,14 @@ def load(path: str | Path) -> Scenario:
         text = path.read_text()
     except OSError as e:
         raise ScenarioFileError(f"{path}: {e.strerror}") from None
+    except UnicodeDecodeError:
+        raise ScenarioFileError(f"{path}: not a text file (expected TOML or JSON in UTF-8)") from None
     try:
         data = tomllib.loads(text) if path.suffix.lower() == ".toml" else json.loads(text)
     except (tomllib.TOMLDecodeError, json.JSONDecodeError) as e:
         raise ScenarioFileError(f"{path}: not valid {path.suffix.lstrip('.').upper() or 'JSON'}: {e}") from None
+    if not isinstance(data, dict):
+        raise ScenarioFileError(f"{path}: expected a table of fields, not a {type(data).__name__}")
     data.setdefault("name", path.stem)
     return from_data(data, str(path), path.parent)
 

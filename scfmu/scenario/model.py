@@ -96,6 +96,10 @@ class Scenario:
 
     @property
     def n_steps(self) -> int:
+        from .values import timing_problems  # finite, positive, bounded (never an OverflowError/MemoryError)
+        problems = timing_problems(self.start_time, self.stop_time, self.step, log_every=None)
+        if problems:
+            raise ValueError(problems[0])
         n = int(round((self.stop_time - self.start_time) / self.step))
         if n <= 0 or abs(n * self.step - (self.stop_time - self.start_time)) > 1e-9 * max(1.0, abs(self.stop_time)):
             raise ValueError(f"stop_time - start_time = {self.stop_time - self.start_time} is not a positive "

@@ -17,12 +17,14 @@
 from __future__ import annotations
 
 import json
+import math
 import sys
 import tomllib
 from pathlib import Path
 
 from . import files, profile
 from .model import Scenario
+from .values import UsageError, did_you_mean, parse_cli, timing_problems
 from ..registry import REGISTRY
 
 
@@ -31,25 +33,46 @@ def get(name: str, **kw) -> Scenario:
 
 
 def value(text: str):
-    """A command-line value: int, float, true/false, or the string itself."""
-    for conv in (int, float):
-        try:
-            return conv(text)
-        except ValueError:
-            pass
-    if text.lower() in ("true", "false"):
-        return text.lower() == "true"
-    return text
+    """A command-line value: int, float, true/false, or the string itself (:func:`values.parse_cli`; the
+    pre-flight check then holds it to the declared type and bounds of what it sets)."""
+    return parse_cli(text)
 
 
 def pairs(items: list[str], what: str) -> dict:
     out = {}
     for it in items:
         k, sep, v = it.partition("=")
-        if not sep or not k or not v:
-            raise SystemExit(f"{what} {it!r}: expected NAME=VALUE")
+        if not sep or not k.strip() or not v.strip():
+            raise UsageError(f"{what} {it!r}: expected NAME=VALUE")
         out[k.strip()] = v.strip()
     return out
+
+
+def scenario_by_name(name: str, **kw) -> Scenario:
+    """A registered scenario; an unknown name is a :class:`UsageError` with the closest known names."""
+    try:
+        return get(name, **kw)
+    except KeyError as e:
+        known = [n for n, _ in REGISTRY.scenario_names("*")]
+        if name in known:
+            raise
+        if name.lower().endswith((".toml", ".json")):
+            raise UsageError(f"scenario file {name!r} not found") from None
+        raise UsageError(f"unknown scenario {name!r}{did_you_mean(name, known)} (`scfmu scenarios` lists them)") \
+            from None
+
+
+def fmu_file(option: str, text: str) -> str:
+    """The resolved path of an FMU file given on the command line; a :class:`UsageError` when it is a
+    directory, missing, or not an ``.fmu`` file."""
+    p = Path(text).expanduser()
+    if p.is_dir():
+        raise UsageError(f"{option}{text}: a directory, not an FMU file (give the .fmu archive)")
+    if not p.is_file():
+        raise UsageError(f"{option}{text}: no such file")
+    if p.suffix.lower() != ".fmu":
+        raise UsageError(f"{option}{text}: not an .fmu file (give the FMU archive)")
+    return str(p.resolve())
 
 
 def add_arguments(ap) -> None:
@@ -74,8 +97,13 @@ def load_params(path: str) -> dict:
     p = Path(path)
     try:
         data = tomllib.loads(p.read_text()) if p.suffix.lower() == ".toml" else json.loads(p.read_text())
-    except (OSError, ValueError) as e:
-        raise SystemExit(f"--params {path}: {e}") from None
+    except OSError as e:
+        raise UsageError(f"--params {path}: {e.strerror or e}") from None
+    except ValueError as e:
+        raise UsageError(f"--params {path}: not valid {'TOML' if p.suffix.lower() == '.toml' else 'JSON'}: "
+                         f"{str(e).splitlines()[0]}") from None
+    if not isinstance(data, dict):
+        raise UsageError(f"--params {path}: expected a table of INSTANCE.VAR = value")
     flat = {}
 
     def walk(prefix, d):
@@ -89,12 +117,13 @@ def load_params(path: str) -> dict:
 
 
 def build(args, notice=print) -> Scenario:
-    """The scenario the options describe; ``notice(text)`` gets the parameters a swap dropped."""
+    """The scenario the options describe; ``notice(text)`` gets the parameters a swap dropped. A user's
+    mistake raises :class:`~scfmu.scenario.values.UsageError` (one line; ``scfmu`` exits 2)."""
     if files.is_scenario_file(args.scenario):
         try:
             sc = files.load(args.scenario)
         except files.ScenarioFileError as e:
-            raise SystemExit(str(e)) from None
+            raise UsageError(str(e)) from None
         if args.t_end is not None:
             sc.stop_time = args.t_end
         if args.dt is not None:
@@ -105,23 +134,29 @@ def build(args, notice=print) -> Scenario:
             kw["stop_time"] = args.t_end
         if args.dt is not None:
             kw["step"] = args.dt
-        try:
-            sc = get(args.scenario, **kw)
-        except KeyError as e:
-            raise SystemExit(str(e.args[0] if e.args else e)) from None
+        sc = scenario_by_name(args.scenario, **kw)
+    for opt, v in (("--t-end", args.t_end), ("--dt", args.dt)):
+        if v is not None and not math.isfinite(v):
+            raise UsageError(f"{opt} {v}: not finite; allowed: a finite number of seconds")
+    problems = timing_problems(sc.start_time, sc.stop_time, sc.step, log_every=None)
+    if problems:
+        raise UsageError(problems[0])
+    try:
+        sc.n_steps
+    except ValueError as e:
+        raise UsageError(str(e)) from None
     models = {}
     for inst, target in pairs(args.fmu, "--fmu").items():
         if "/" in target or target.endswith(".fmu"):
-            p = Path(target).expanduser()
-            if not p.is_file():
-                raise SystemExit(f"--fmu {inst}={target}: no such file")
-            target = str(p.resolve())
+            target = fmu_file(f"--fmu {inst}=", target)
         models[inst] = target
-    try:
-        dropped = sc.dropped_params(models)
-        sc = sc.with_models(models)
-    except KeyError as e:
-        raise SystemExit(f"--fmu: {e.args[0]}") from None
+    instances = [c.name for c in sc.components]
+    for inst in models:
+        if inst not in instances:
+            raise UsageError(f"--fmu {inst}=...: scenario {sc.name!r} has no instance {inst!r}"
+                             f"{did_you_mean(inst, instances)} (it has {', '.join(instances)})")
+    dropped = sc.dropped_params(models)
+    sc = sc.with_models(models)
     for inst, names in dropped.items():
         notice(f"notice: {inst} is now {Path(models[inst]).name}; the parameters of its old model are not "
                f"passed on: {', '.join(names)} (set the new unit's own with --set {inst}.NAME=VALUE)")
@@ -143,14 +178,21 @@ def build(args, notice=print) -> Scenario:
     try:
         sc = sc.with_port_map(pairs(args.map, "--map"))
     except KeyError as e:
-        raise SystemExit(f"--map: {e.args[0]}") from None
+        raise UsageError(f"--map: {e.args[0]}") from None
     ov = load_params(args.params) if args.params else {}
     ov.update({k: value(v) for k, v in pairs(args.set, "--set").items()})
     if ov:
+        for key in ov:
+            inst = key.partition(".")[0] if not key.startswith("input:") else key[6:].partition(".")[0]
+            if "." not in key:
+                raise UsageError(f"--set {key}: expected INSTANCE.NAME=VALUE")
+            if inst not in instances:
+                raise UsageError(f"--set {key}: scenario {sc.name!r} has no instance {inst!r}"
+                                 f"{did_you_mean(inst, instances)} (it has {', '.join(instances)})")
         try:
             sc = sc.with_overrides(ov)
         except KeyError as e:
-            raise SystemExit(f"--set: {e.args[0]}") from None
+            raise UsageError(f"--set: {e.args[0]}") from None
     return sc
 
 

@@ -187,9 +187,8 @@ def read_ssp(path: str | Path, workdir: str | Path | None = None) -> tuple[Scena
     master settings from the annotation. Returns ``(scenario, fmu_files)`` where ``fmu_files[model]`` is
     the FMU unpacked from the archive into ``workdir`` (a new temporary directory by default); pass
     ``path_of=fmu_files.__getitem__`` to a master."""
-    workdir = Path(workdir or tempfile.mkdtemp(prefix="scfmu_ssp_"))
-    with zipfile.ZipFile(path) as z:
-        z.extractall(workdir)
+    from ..fmu import safe_extract  # the archive limits of FMUs hold for an SSP and the FMUs inside it
+    workdir = Path(safe_extract(path, workdir))
     root = ET.parse(workdir / "SystemStructure.ssd").getroot()
     system = root.find("ssd:System", NS)
     components, fixed, files = [], {}, {}
