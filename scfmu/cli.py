@@ -9,6 +9,7 @@ Subcommands (each has ``--help``):
   export ssp|loop [NAME]  SSP 1.0 files or loop FMUs (one container FMU per closed loop)
   report [--quick]        the reproduction report of every paper (HTML + Markdown)
   paper NNN COMMAND ...   a paper's own experiments (tuning, sweeps, cases): `scfmu paper` lists them
+  verify FMU [--importer] replay the reference results an FMU carries; largest deviation per output
 
 ``--fmus DIR`` (before the subcommand) takes the FMUs from DIR; otherwise ``SCFMU_FMU_DIR``, the FMUs
 shipped in the package, or a source checkout's ``fmus/``.
@@ -26,6 +27,7 @@ COMMANDS = {
     "campaign": ("many runs of a scenario on Dask (grids, random samples, seeds)", "scfmu.campaign.cli:main"),
     "report": ("the reproduction report of the papers (HTML + Markdown)", "scfmu.report.cli:main"),
     "benchmark": ("a controller (any FMU) beside the built-in ones on a family's scenarios", "scfmu.benchmark.cli:main"),
+    "verify": ("replay the reference results an FMU carries (fmi-ls-ref) in an importer", "scfmu.verify:main"),
 }
 
 
@@ -113,7 +115,7 @@ def _paper(argv) -> int:
 LOCAL = {"scenarios": ("list the registered scenarios with descriptions", _scenarios),
          "export": ("SSP 1.0 files or loop FMUs of scenarios", _export),
          "paper": ("a paper's own experiments: `scfmu paper` lists them", _paper)}
-ORDER = ("run", "scenarios", "campaign", "benchmark", "export", "report", "paper")
+ORDER = ("run", "scenarios", "campaign", "benchmark", "export", "report", "paper", "verify")
 
 
 def main(argv=None) -> int:
