@@ -176,7 +176,8 @@ renormalised at an event whenever | |q| - 1 | exceeds 1e-9.</p>",
         self.corrected && self.drift() > NORM_TOLERANCE
     }
     fn event_update(&mut self, _v: &Self::Vars, t: f64) -> Result<bool, String> {
-        if !self.corrected || self.drift() == 0.0 {
+        // within round-off of |q| = 1 nothing changes (idempotent: a repeated event pass reports no change)
+        if !self.corrected || self.drift() <= crate::math::attitude::NORM_ROUNDOFF {
             return Ok(false);
         }
         let n = self.copy.x.fixed_rows::<4>(0).norm();

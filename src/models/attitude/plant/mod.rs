@@ -36,6 +36,9 @@ struct Derived {
     wheel_torque_max: f64,
     wheel_momentum_max: f64,
     dipole_max: f64,
+    /// Model Exchange: drift of |q| (‖AᵀA − I‖) that asks for a projection event after a solver step
+    /// (`exchange::projection_threshold`).
+    projection_threshold: f64,
 }
 
 #[derive(Clone, Serialize, Deserialize)]
@@ -115,6 +118,7 @@ impl Model for AttitudePlant {
             wheel_torque_max: v.wheel_torque_coeff * v.wheel_max_current,
             wheel_momentum_max: v.wheel_inertia * v.wheel_max_speed,
             dipole_max: v.mtq_turns * v.mtq_coil_area * v.mtq_max_current,
+            projection_threshold: exchange::projection_threshold(exp),
         };
         let angles = (v.init_euler321_roll, v.init_euler321_pitch, v.init_euler321_yaw);
         let mut x = State::zeros();
