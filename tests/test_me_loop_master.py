@@ -25,7 +25,7 @@ from scfmu.engines import run_reference
 ALL_ME = ("command", "controller", "plant", "metrics")
 
 
-@pytest.mark.parametrize("tolerance,max_events", [(None, 1000), (1e-4, 20)])
+@pytest.mark.parametrize("tolerance,max_events", [(None, 1000), (1e-4, 5)])
 def test_all_me_loop_runs_with_settling_events(tolerance, max_events):
     sc = scenarios.get("default", stop_time=1.0)
     m = MeLoop(sc, tolerance=tolerance)
