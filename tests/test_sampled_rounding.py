@@ -233,3 +233,39 @@ def test_a_step_that_is_no_multiple_is_still_refused(unpacked, model):
     finally:
         u.close()
     assert any("is not an integer multiple of the sample time parameter step = 0.001 s" in m[2] for m in u.messages), u.messages
+
+
+def test_loop_fmu_with_a_sampled_controller_under_a_summed_clock():
+    """The loop FMU of paper 002 (fmpy's container around SingleAxisPlant and FopidController) passes the
+    master's steps on to the sampled controller: 20 000 steps of 1 ms summed (t += h, last step clipped to the
+    stop time) run without refusal and give the exact master's outputs bit for bit. (fmpy's container steps
+    its inner FMUs on its own grid, so loop FMUs built before the sample-grid change passed this too.)"""
+    path = ROOT / "fmus" / "loops" / "paper002_FOPID.fmu"
+    md = read_model_description(str(path))
+    d = extract(str(path))
+    outs = [v.valueReference for v in md.modelVariables if v.causality == "output" and v.type == "Real"]
+    n, h = 20_000, 1e-3  # the loop's default experiment, 20 s
+    stop, ms = masters(h, n)
+
+    def run(points, steps):
+        s = FMU2Slave(guid=md.guid, unzipDirectory=d, modelIdentifier=md.coSimulation.modelIdentifier, instanceName="loop")
+        s.instantiate()
+        s.setupExperiment(startTime=0.0, stopTime=stop)
+        s.enterInitializationMode()
+        s.exitInitializationMode()
+        rows = []
+        for t, hs in zip(points, steps):
+            s.doStep(t, hs)
+            rows.append(s.getReal(outs))
+        s.terminate()
+        s.freeInstance()
+        return np.array(rows)
+
+    try:
+        exact = run(*ms["exact"])
+        summed = run(*ms["summed"])
+    finally:
+        shutil.rmtree(d, ignore_errors=True)
+    assert ms["summed"][1][-1] != h  # the clipped last step
+    assert np.ptp(exact, axis=0).max() > 0
+    np.testing.assert_array_equal(summed[:n], exact)
