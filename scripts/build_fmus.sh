@@ -32,6 +32,7 @@ if [ -x .venv/bin/python ]; then
     .venv/bin/scfmu verify --write fmus/*.fmu fmus/fmi3/*.fmu
     .venv/bin/scfmu export ssp --out fmus/ssp
     .venv/bin/scfmu export loop --out fmus/loops
+    .venv/bin/scfmu verify --write --no-inputs fmus/loops/*.fmu
 else
     echo "build_fmus: no .venv (run scripts/setup.sh): fmus/ssp and fmus/loops not written" >&2
 fi

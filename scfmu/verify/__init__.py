@@ -85,6 +85,7 @@ class Experiment:
     rel_tol: float = REL_TOL
     abs_tol: float = ABS_TOL
     params: dict = None
+    inputs: bool = True  # whether the experiment gives the documented input signals (False: loop FMUs)
 
     def points(self) -> np.ndarray:
         n = int(round((self.stop - self.start) / self.step))
@@ -112,13 +113,13 @@ def _md(path: Path):
     return read_model_description(str(path))
 
 
-def reference_experiment(md) -> Experiment:
+def reference_experiment(md, inputs: bool = True) -> Experiment:
     de = md.defaultExperiment
     start = float(de.startTime or 0.0) if de else 0.0
     stop = float(de.stopTime) if de and de.stopTime is not None else 1.0
     base = float(de.stepSize) if de and de.stepSize else (stop - start) / 100
     m = max(1, math.ceil(round((stop - start) / base) / MAX_ROWS))
-    return Experiment(start, stop, base * m, params=dict(REF_PARAMS.get(md.coSimulation.modelIdentifier, {})))
+    return Experiment(start, stop, base * m, params=dict(REF_PARAMS.get(md.coSimulation.modelIdentifier, {})), inputs=inputs)
 
 
 def _real_type(md) -> str:
@@ -212,7 +213,7 @@ def fmusim_exe() -> str | None:
 def run_experiment(fmu: Path, exp: Experiment, importer: str = "fmpy") -> tuple[list[str], np.ndarray]:
     """(["time", outputs…], rows) of the reference experiment run in ``importer``."""
     md = _md(fmu)
-    ins, outs = input_names(md), output_names(md)
+    ins, outs = (input_names(md) if exp.inputs else []), output_names(md)
     if importer == "fmpy":
         data = _run_fmpy(fmu, md, exp, ins, outs)
     elif importer == "fmusim":
@@ -251,11 +252,15 @@ def _manifest(model: str, has_inputs: bool, has_params: bool = False) -> bytes:
 def _doc(model: str, exp: Experiment, ins: list[str]) -> str:
     text = (f"Reference results of {model} (FMI layered standard fmi-ls-ref, files in {REF_DIR}/).\n\n"
             f"Experiment: Co-Simulation from {exp.start!r} s to {exp.stop!r} s with a communication step of "
-            f"{exp.step!r} s, every parameter at its start value.\n")
+            f"{exp.step!r} s, every parameter at its start value"
+            + (f" except those in {model}_ref.ssv ({', '.join(f'{k} = {v!r}' for k, v in exp.params.items())})" if exp.params else "")
+            + ".\n")
     if ins:
         text += (f"Inputs ({model}_in.csv): given at every communication point and held over the step; quaternion "
                  "groups <p>_w.._z turn by 0.3 sin(0.2 t + 0.5 j) rad about (1, 2, 2)/3, every other input i is "
                  "0.1 sin((0.5 + 0.1 i) t + 0.3 i) + 0.01 i.\n")
+    elif not exp.inputs:
+        text += "Inputs: none given (the FMU runs as it is; a loop FMU runs its scenario).\n"
     text += (f"Results ({model}_ref.csv): the outputs at every communication point, row 0 after initialization, row k "
              "after doStep(t_(k-1), h). Made by the exporter with fmpy's simulate_fmu on x86-64 Linux.\n"
              f"A replay agrees when every output y satisfies max |y - y_ref| <= AbsTol + RelTol max |y_ref| "
@@ -264,12 +269,13 @@ def _doc(model: str, exp: Experiment, ins: list[str]) -> str:
     return text
 
 
-def reference_files(fmu: Path) -> dict[str, bytes]:
-    """The fmi-ls-ref files of ``fmu`` (archive path → bytes), from a run of its reference experiment in fmpy."""
+def reference_files(fmu: Path, inputs: bool = True) -> dict[str, bytes]:
+    """The fmi-ls-ref files of ``fmu`` (archive path → bytes), from a run of its reference experiment in fmpy
+    (``inputs=False``: no input is given, the FMU runs as it is, e.g. a loop FMU's scenario)."""
     md = _md(fmu)
     model = md.coSimulation.modelIdentifier
-    exp = reference_experiment(md)
-    ins = input_names(md)
+    exp = reference_experiment(md, inputs)
+    ins = input_names(md) if inputs else []
     names, data = run_experiment(fmu, exp, "fmpy")
     files = {f"{REF_DIR}/{model}_ref.csv": _csv_text(names, data).encode(),
              f"{REF_DIR}/{model}_ref.opt": exp.opt_text().encode(),
@@ -304,9 +310,9 @@ def inject(fmu: Path, files: dict[str, bytes]) -> None:
     tmp.replace(fmu)
 
 
-def write_references(fmus: list[Path], log=print) -> None:
+def write_references(fmus: list[Path], log=print, inputs: bool = True) -> None:
     for f in fmus:
-        files = reference_files(Path(f))
+        files = reference_files(Path(f), inputs)
         inject(Path(f), files)
         log(f"reference results: {f} ({len(files)} files)")
 
@@ -335,6 +341,7 @@ def read_references(fmu: Path) -> tuple[Experiment, list[str], np.ndarray]:
         if not res or not opt:
             raise VerifyError(f"{fmu}: the manifest names no result or no options file")
         exp = Experiment.parse(z.read(f"{REF_DIR}/{opt[0]}").decode())
+        exp.inputs = any(src.endswith("_in.csv") for src in rel)
         exp.params = {}
         for src in (s for s, r in rel.items() if r.get("role") == "parameter"):
             ps = ET.fromstring(z.read(f"{REF_DIR}/{src}"))
@@ -372,6 +379,8 @@ def main(argv=None) -> int:
     ap.add_argument("--importer", default="fmpy", help=f"one of {', '.join(IMPORTERS)} (default fmpy)")
     ap.add_argument("--write", action="store_true", help="(build step) run the reference experiment in fmpy and "
                     "write the reference files into each FMU")
+    ap.add_argument("--no-inputs", action="store_true", help="with --write: give no inputs (loop FMUs run their "
+                    "scenario as it is)")
     a = ap.parse_args(argv)
     if a.importer not in IMPORTERS:
         print(f"scfmu verify: --importer {a.importer!r}: expected one of {', '.join(IMPORTERS)}", file=sys.stderr)
@@ -385,7 +394,7 @@ def main(argv=None) -> int:
             return 2
         paths.append(p)
     if a.write:
-        write_references(paths)
+        write_references(paths, inputs=not a.no_inputs)
         return 0
     failed = False
     for p in paths:
