@@ -25,6 +25,7 @@ from scfmu import verify as V
 
 ROOT = Path(__file__).resolve().parents[1]
 FMUS = sorted((ROOT / "fmus").glob("*.fmu")) + sorted((ROOT / "fmus" / "fmi3").glob("*.fmu"))
+LOOPS = sorted((ROOT / "fmus" / "loops").glob("*.fmu"))
 IDS = [str(p.relative_to(ROOT / "fmus")) for p in FMUS]
 ROLE = re.compile(r"(document|requirement|specification|model|parameter|system|testcase|"
                   r"experiment(/(smoke-test|validation|uncertainty-analysis))?|result|method|rationale|report|request|"
@@ -46,10 +47,10 @@ def fmusim_rs():
 
 
 def test_every_fmu_is_shipped():
-    assert len(FMUS) >= 48, IDS
+    assert len(FMUS) >= 48 and len(LOOPS) >= 17, (IDS, LOOPS)
 
 
-@pytest.mark.parametrize("fmu", FMUS, ids=IDS)
+@pytest.mark.parametrize("fmu", FMUS + LOOPS, ids=IDS + [f"loops/{p.name}" for p in LOOPS])
 def test_manifest_follows_fmi_ls_ref(fmu):
     """The manifest's root, attributes and roles as the layered standard's schema defines them; every
     Related file is in the archive; the result has a column per output and a row per communication point."""
@@ -67,6 +68,7 @@ def test_manifest_follows_fmi_ls_ref(fmu):
             target = os.path.normpath(f"{V.REF_DIR}/{r.get('source')}")
             assert target in names, target
         md_outputs = V.output_names(V._md(fmu))
+        assert any(r.get("source").endswith("_in.csv") for r in related) == (fmu not in LOOPS and bool(V.input_names(V._md(fmu))))
     exp, head, data = V.read_references(fmu)
     assert head == ["time", *md_outputs]
     np.testing.assert_allclose(data[:, 0], exp.points(), rtol=0, atol=1e-9 * exp.stop)
@@ -80,6 +82,15 @@ def test_verifies_in_fmpy_and_in_fmi_rs(fmu, fmusim_rs, monkeypatch):
     for importer in ("fmpy", "fmusim"):
         devs = V.verify(fmu, importer)
         bad = [(d.name, d.max_dev, d.allowed) for d in devs if not d.ok]
+        assert not bad, (importer, bad)
+
+
+@pytest.mark.parametrize("fmu", LOOPS, ids=[p.name for p in LOOPS])
+def test_loop_fmus_verify_in_fmpy_and_in_fmi_rs(fmu, fmusim_rs, monkeypatch):
+    """A loop FMU's reference experiment is its scenario as it is (no inputs given)."""
+    monkeypatch.setenv("SCFMU_FMUSIM", fmusim_rs)
+    for importer in ("fmpy", "fmusim"):
+        bad = [(d.name, d.max_dev, d.allowed) for d in V.verify(fmu, importer) if not d.ok]
         assert not bad, (importer, bad)
 
 
