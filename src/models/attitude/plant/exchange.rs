@@ -33,7 +33,7 @@ pub use crate::math::attitude::NORM_ROUNDOFF as ROUNDOFF;
 
 /// The drift that asks for a projection event: max(NORM_TOLERANCE, the importer's relative tolerance).
 pub fn projection_threshold(exp: &crate::model::Experiment) -> f64 {
-    exp.tolerance.filter(|t| t.is_finite() && *t > 0.0).map_or(NORM_TOLERANCE, |t| t.min(1e-3).max(NORM_TOLERANCE))
+    crate::math::attitude::projection_threshold(exp.tolerance, NORM_TOLERANCE)
 }
 
 const fn s(name: &'static str, unit: &'static str, description: &'static str, on: &'static [&'static str]) -> StateDecl {
