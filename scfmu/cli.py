@@ -10,6 +10,7 @@ Subcommands (each has ``--help``):
   report [--quick]        the reproduction report of every paper (HTML + Markdown)
   paper NNN COMMAND ...   a paper's own experiments (tuning, sweeps, cases): `scfmu paper` lists them
   check FMU [--quick]     conformance and robustness gauntlet for any FMI 2.0/3.0 FMU (table, HTML, JSON)
+  verify FMU [--importer] replay the reference results an FMU carries; largest deviation per output
 
 ``--fmus DIR`` (before the subcommand) takes the FMUs from DIR; otherwise ``SCFMU_FMU_DIR``, the FMUs
 shipped in the package, or a source checkout's ``fmus/``.
@@ -28,6 +29,7 @@ COMMANDS = {
     "report": ("the reproduction report of the papers (HTML + Markdown)", "scfmu.report.cli:main"),
     "benchmark": ("a controller (any FMU) beside the built-in ones on a family's scenarios", "scfmu.benchmark.cli:main"),
     "check": ("conformance and robustness gauntlet for any FMI 2.0/3.0 FMU", "scfmu.check.cli:main"),
+    "verify": ("replay the reference results an FMU carries (fmi-ls-ref) in an importer", "scfmu.verify:main"),
 }
 
 
@@ -123,7 +125,7 @@ def _paper(argv) -> int:
 LOCAL = {"scenarios": ("list the registered scenarios with descriptions", _scenarios),
          "export": ("SSP 1.0 files or loop FMUs of scenarios", _export),
          "paper": ("a paper's own experiments: `scfmu paper` lists them", _paper)}
-ORDER = ("run", "scenarios", "campaign", "benchmark", "export", "report", "paper", "check")
+ORDER = ("run", "scenarios", "campaign", "benchmark", "export", "report", "paper", "check", "verify")
 
 
 # the optional extras (pyproject.toml) and the modules that tell whether each is installed

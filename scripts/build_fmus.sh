@@ -4,7 +4,8 @@
 # with fmu-package exactly as a user's model crate is packaged: modelDescription/<Model>.xml,
 # fmus/<Model>.fmu and the generated pages docs/models/*.md and docs/references.md. Then the
 # scenario files for other tools: fmus/ssp/<scenario>.ssp (SSP 1.0) and fmus/loops/<scenario>.fmu (one
-# container FMU per standard closed loop). The last two need the Python venv (scripts/setup.sh); without
+# container FMU per standard closed loop), after writing each FMU's reference results into it
+# (extra/org.fmi-standard.fmi-ls-ref/, `scfmu verify --write`). The last three need the Python venv (scripts/setup.sh); without
 # it they are skipped with a message. When the Windows cross toolchain is installed (scripts/setup.sh
 # installs it), every FMU also carries binaries/win64/<Model>.dll (scripts/build_win64.sh); without it
 # the FMUs carry linux64 only and this script says so. SCFMU_NO_WIN64=1 skips the Windows build.
@@ -27,8 +28,11 @@ if [ -n "${SCFMU_DARWIN64_LIB:-}" ]; then
 fi
 ./target/release/fmu-package "${package_args[@]}"
 if [ -x .venv/bin/python ]; then
+    # reference results inside every FMU (fmi-ls-ref; scfmu/verify): before the SSP and loop files copy them
+    .venv/bin/scfmu verify --write fmus/*.fmu fmus/fmi3/*.fmu
     .venv/bin/scfmu export ssp --out fmus/ssp
     .venv/bin/scfmu export loop --out fmus/loops
+    .venv/bin/scfmu verify --write --no-inputs fmus/loops/*.fmu
 else
     echo "build_fmus: no .venv (run scripts/setup.sh): fmus/ssp and fmus/loops not written" >&2
 fi

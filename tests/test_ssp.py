@@ -123,3 +123,71 @@ def _ports(sc):
         out[c.name] = ([v.name for v in md.modelVariables if v.causality == "input"],
                        [v.name for v in md.modelVariables if v.causality == "output"])
     return out
+
+
+def _ssd(name):
+    import zipfile
+    from xml.etree import ElementTree as ET
+    with zipfile.ZipFile(ssp_file(name)) as z:
+        return ET.fromstring(z.read("SystemStructure.ssd"))
+
+
+def test_every_name_inside_every_shipped_ssp_is_a_unique_identifier():
+    """OMSimulator refuses system and element names that are not identifiers (paper000_000-7L did):
+    the SystemStructureDescription, System, Element and ParameterSet names in every shipped file are
+    letters, digits and _ (not starting with a digit), unique within the file, and the descriptions'
+    names are unique across the shipped set."""
+    import re
+    import zipfile
+    from xml.etree import ElementTree as ET
+    rule = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
+    tops = []
+    for name in STANDARD:
+        root = _ssd(name)
+        system = root.find("ssd:System", ssp.NS)
+        elems = [e.get("name") for e in system.find("ssd:Elements", ssp.NS)]
+        with zipfile.ZipFile(ssp_file(name)) as z:
+            sets = [ET.fromstring(z.read(n)).get("name") for n in z.namelist() if n.endswith(".ssv")]
+        names = [root.get("name"), system.get("name"), *elems, *sets]
+        bad = [n for n in names if not rule.match(n or "")]
+        assert not bad, f"{name}: names that are not identifiers: {bad}"
+        assert len(set(elems)) == len(elems), f"{name}: duplicate element names {elems}"
+        tops.append(root.get("name"))
+    assert len(set(tops)) == len(tops), tops
+    assert "paper000_000_7L" in tops  # the file is still paper000_000-7L.ssp; the name inside is an identifier
+
+
+def test_identifier_rule_maps_and_refuses():
+    assert ssp.identifier("paper000/000-7L") == "paper000_000_7L"
+    assert ssp.identifier("3d model") == "_3d_model"
+    from scfmu.scenario.model import Component, Scenario
+    bad = Scenario(name="x", components=[Component("my-plant", "AttitudePlant", {})], stop_time=1.0, step=0.1)
+    with pytest.raises(ValueError, match="identifiers"):
+        ssp.write_ssp(bad, Path("/nonexistent/x.ssp"))
+
+
+@pytest.mark.parametrize("name", STANDARD)
+def test_step_is_where_omsimulator_and_libcosim_look_for_it(name):
+    root = _ssd(name)
+    sc = resolve(scenarios.get(name))
+    oms = root.find("ssd:System/ssd:Annotations/ssc:Annotation[@type='org.openmodelica']", ssp.NS)
+    assert float(oms.find(".//oms:FixedStepMaster", ssp.NS).get("stepSize")) == sc.step
+    osp = root.find("ssd:DefaultExperiment/ssd:Annotations/ssc:Annotation[@type='com.opensimulationplatform']", ssp.NS)
+    assert float(osp.find("osp:Algorithm/osp:FixedStepAlgorithm", ssp.NS).get("baseStepSize")) == sc.step
+
+
+@pytest.mark.parametrize("name", STANDARD)
+def test_every_shipped_ssp_imports_in_libcosim_as_shipped(name):
+    """libcosim's SSP loader opens every shipped file with no step passed by hand (it takes the step from
+    the com.opensimulationplatform annotation) and runs one step of it; without the annotation it refuses."""
+    pytest.importorskip("libcosimpy")
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+    log_output_level(CosimLogLevel.ERROR)
+    sc = resolve(scenarios.get(name))
+    ex = CosimExecution.from_ssp_file(str(ssp_file(name)))
+    assert ex is not None
+    assert ex.num_slaves() == len(sc.components)
+    assert ex.step()
+    st = ex.status()
+    assert st.current_time == int(round(sc.step * 1e9))  # one step of the annotated size, in ns

@@ -11,7 +11,7 @@ from pathlib import Path
 
 from ..registry import REGISTRY
 from ..scenario import get
-from ..scenario.ssp import file_stem, validate_ssp, write_ssp
+from ..scenario.ssp import file_stem, identifier, validate_ssp, write_ssp
 from .loops import write_loop_fmu
 
 KINDS = ("ssp", "loop")
@@ -24,10 +24,15 @@ def export(kind: str, out: str | Path, names=None, log=print) -> list[Path]:
         raise ValueError(f"export kind {kind!r}: expected one of {KINDS}")
     out = Path(out)
     written = []
+    ssd_names = {}
     for item in (names or REGISTRY.exported_scenarios()):
         sc = get(item) if isinstance(item, str) else item
         stem = file_stem(item if isinstance(item, str) else sc.name)  # the name asked for (paper001/a, not .../dist0)
         if kind == "ssp":
+            # the system names inside the files are identifiers and must stay unique across the set
+            other = ssd_names.setdefault(identifier(file_stem(sc.name)), stem)
+            if other != stem:
+                raise ValueError(f"scenarios {other} and {stem} get the same SSP system name {identifier(file_stem(sc.name))}")
             p = write_ssp(sc, out / f"{stem}.ssp")
             problems = validate_ssp(p)
             what = "not valid SSP 1.0"

@@ -3,11 +3,15 @@
 One scenario declaration is the only source of the wiring: :func:`write_ssp` resolves
 it with :meth:`Scenario.wiring` (the same call the masters use) and writes
 
-* ``SystemStructure.ssd``: one ``ssd:Component`` per instance (``source="resources/<Model>.fmu"``) with a
+* ``SystemStructure.ssd`` (named by the scenario's name made an identifier, :func:`identifier`; the
+  instance names must be identifiers already): one ``ssd:Component`` per instance (``source="resources/<Model>.fmu"``) with a
   connector for every input and output of its FMU, one ``ssd:Connection`` per link, a
   ``ssd:DefaultExperiment`` (start and stop time) and, as an ``ssc:Annotation`` of type
   ``com.github.spacecraft-fmus.scfmu``, the master settings that SSP 1.0 has no element for
   (communication step, Gauss–Seidel order = element order, logged signals, metrics name, seed parameters);
+  the communication step also where OpenModelica/OMSimulator (``org.openmodelica`` system annotation,
+  ``oms:FixedStepMaster stepSize``) and libcosim (``com.opensimulationplatform`` DefaultExperiment
+  annotation, ``osp:FixedStepAlgorithm baseStepSize``) look for it, so both import the file as shipped;
 * ``resources/<instance>.ssv``: the instance's parameter values (SSP 1.0 parameter values, typed after the
   FMU's modelDescription) and the constant values of its open inputs that the scenario fixes (disturbances),
   bound to the component by an ``ssd:ParameterBinding``;
@@ -25,6 +29,7 @@ Standard files: ``scfmu export ssp`` (called by ``scripts/build_fmus.sh``) write
 from __future__ import annotations
 
 import json
+import re
 import tempfile
 import zipfile
 from pathlib import Path
@@ -45,12 +50,31 @@ SCFMU_NS = "https://github.com/spacecraft-fmus/scfmu/ssp-annotation"
 # system's type as "none" and refuses the file): a fixed-step master with the scenario's step
 OMS_TYPE = "org.openmodelica"
 OMS_NS = "https://raw.githubusercontent.com/OpenModelica/OMSimulator/master/schema/oms.xsd"
-NS = {"ssd": SSD_NS, "ssc": SSC_NS, "ssv": SSV_NS, "scfmu": SCFMU_NS, "oms": OMS_NS}
+# libcosim (Open Simulation Platform) reads the step of its fixed-step algorithm from its own annotation
+# of the DefaultExperiment, matched by literal prefixed tag names (a Boost property tree, no namespace
+# processing): <ssc:Annotation type="com.opensimulationplatform"><osp:Algorithm><osp:FixedStepAlgorithm
+# baseStepSize="…"/></osp:Algorithm></ssc:Annotation>, with the prefix osp bound to OSP_NS
+OSP_TYPE = "com.opensimulationplatform"
+OSP_NS = "http://opensimulationplatform.com/SSP/OSPAnnotations"
+NS = {"ssd": SSD_NS, "ssc": SSC_NS, "ssv": SSV_NS, "scfmu": SCFMU_NS, "oms": OMS_NS, "osp": OSP_NS}
 for _p, _u in NS.items():
     ET.register_namespace(_p, _u)
 
+IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
+
+
 def file_stem(scenario_name: str) -> str:
     return scenario_name.replace("/", "_")
+
+
+def identifier(name: str) -> str:
+    """``name`` as an identifier every SSP importer accepts (letters, digits and ``_``, not starting with
+    a digit; OMSimulator refuses any other character in a system or element name): every other character
+    becomes ``_`` (``paper000/000-7L`` → ``paper000_000_7L``), a leading digit gets a ``_`` before it."""
+    out = re.sub(r"[^A-Za-z0-9_]", "_", name)
+    if not out or out[0].isdigit():
+        out = "_" + out
+    return out
 
 
 def _q(ns: str, tag: str) -> str:
@@ -96,6 +120,10 @@ def write_ssp(scenario: Scenario, path: str | Path, path_of=None) -> Path:
     if path_of is None:
         scenario = resolve(scenario)
     path = Path(path)
+    bad = [c.name for c in scenario.components if not IDENTIFIER.match(c.name)]
+    if bad or len({c.name for c in scenario.components}) != len(scenario.components):
+        raise ValueError(f"scenario {scenario.name}: instance names must be unique identifiers (letters, digits, _) "
+                         f"for SSP importers; got {[c.name for c in scenario.components]}")
     path_of = path_of or fmu_path
     mds = {c.model: read_model_description(str(path_of(c.model))) for c in scenario.components}
     fmi3 = [c.name for c in scenario.components if mds[c.model].fmiVersion.startswith("3")]
@@ -115,7 +143,7 @@ def write_ssp(scenario: Scenario, path: str | Path, path_of=None) -> Path:
         fixed.setdefault(inst, []).append((var, value))
 
     root = ET.Element(_q("ssd", "SystemStructureDescription"),
-                      {"version": "1.0", "name": file_stem(scenario.name), "generationTool": "scfmu.ssp",
+                      {"version": "1.0", "name": identifier(file_stem(scenario.name)), "generationTool": "scfmu.ssp",
                        "description": scenario.description or scenario.name})
     system = ET.SubElement(root, _q("ssd", "System"), {"name": "loop"})
     elements = ET.SubElement(system, _q("ssd", "Elements"))
@@ -153,6 +181,8 @@ def write_ssp(scenario: Scenario, path: str | Path, path_of=None) -> Path:
     exp = ET.SubElement(root, _q("ssd", "DefaultExperiment"),
                         {"startTime": repr(float(scenario.start_time)), "stopTime": repr(float(scenario.stop_time))})
     anns = ET.SubElement(exp, _q("ssd", "Annotations"))
+    osp = ET.SubElement(ET.SubElement(anns, _q("ssc", "Annotation"), {"type": OSP_TYPE}), _q("osp", "Algorithm"))
+    ET.SubElement(osp, _q("osp", "FixedStepAlgorithm"), {"baseStepSize": repr(float(scenario.step))})
     ann = ET.SubElement(anns, _q("ssc", "Annotation"), {"type": ANNOTATION_TYPE})
     master = ET.SubElement(ann, _q("scfmu", "Master"),
                            {"scheme": "fixed-step Gauss-Seidel in element order", "stepSize": repr(float(scenario.step))})

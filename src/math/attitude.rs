@@ -5,6 +5,19 @@ use nalgebra::{Matrix3, Quaternion, Vector3};
 use std::f64::consts::PI;
 
 /// Cross-product matrix [a×], so that [a×] b = a × b.
+
+/// Deviation of |q| from 1 (or of ‖AᵀA − I‖ from 0) that is only the round-off of a normalisation
+/// (8 ulp of 1): a projection event leaves such a state alone, so repeating it changes nothing.
+pub const NORM_ROUNDOFF: f64 = 8.0 * f64::EPSILON;
+
+/// Model Exchange: the drift of |q| (‖AᵀA − I‖) after a solver step that asks for a projection event:
+/// the importer's relative tolerance (fmi2SetupExperiment, capped at 1e-3) when it is looser than
+/// `floor`, else `floor`. A threshold tighter than the solver's own accuracy asks for an event after
+/// nearly every step.
+pub fn projection_threshold(tolerance: Option<f64>, floor: f64) -> f64 {
+    tolerance.filter(|t| t.is_finite() && *t > 0.0).map_or(floor, |t| t.min(1e-3).max(floor))
+}
+
 pub fn skew(a: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::new(0.0, -a.z, a.y, a.z, 0.0, -a.x, -a.y, a.x, 0.0)
 }

@@ -1,6 +1,7 @@
 //! Shared math used by the models: attitude representations and conversions, integrators, the
 //! Riccati equation (LQR), pole placement, fuzzy inference, relative orbital motion, predictive-control
-//! gains, counter-based random numbers, the orbit environment, Grünwald–Letnikov fractional calculus
+//! gains, counter-based random numbers, the sample grid of the sampled units (a master's rounded
+//! time taken as the grid instant), the orbit environment, Grünwald–Letnikov fractional calculus
 //! with the PID / PI^λD^μ laws, and interval type-2 fuzzy inference (Karnik–Mendel type reduction).
 //! Each module carries its own unit tests against closed-form results.
 
@@ -14,6 +15,7 @@ pub mod predictive_control;
 pub mod random;
 pub mod relative_orbit;
 pub mod riccati;
+pub mod sample_grid;
 pub mod spline;
 pub mod type2_fuzzy;
 

@@ -64,6 +64,8 @@ pub struct ReferenceCorrector {
     splines: [NotAKnotSpline; 3],
     t_end: f64,
     copy: OpenLoopCopy,
+    /// Model Exchange: the drift of the copy's |q| that asks for a projection event.
+    projection_threshold: f64,
 }
 
 impl ReferenceCorrector {
@@ -110,11 +112,12 @@ both modes (e.g. to drive the plant open loop).</p>\n\
 <p>Model Exchange: the copy's state (q, w, e, e') is published as the continuous states state_q_*, state_w_*, \
 state_e_*, state_e_dot_* (constant in mode 0); u_ol(t) is evaluated at every instant instead of being held over a \
 communication step; the spline knots are time events (u_ol drops to 0 after the last); the copy's quaternion is \
-renormalised at an event whenever | |q| - 1 | exceeds 1e-9.</p>",
+renormalised at an event whenever | |q| - 1 | exceeds the importer's tolerance (fmi2SetupExperiment, at most 1e-3) \
+or 1e-9 without one; within 8 ulp of 1 the event changes nothing (a repeated event pass settles).</p>",
         ..ModelInfo::DEFAULT
     };
 
-    fn initialize(v: &mut ReferenceCorrectorVars, _exp: &Experiment) -> Result<Self, String> {
+    fn initialize(v: &mut ReferenceCorrectorVars, exp: &Experiment) -> Result<Self, String> {
         let t_end = v.spline_t_end;
         let times: Vec<f64> = (0..N_NODES).map(|k| t_end * k as f64 / (N_NODES - 1) as f64).collect();
         let n = nodes(v);
@@ -124,7 +127,8 @@ renormalised at an event whenever | |q| - 1 | exceeds 1e-9.</p>",
         let limit = v.u_max.component_mul(&v.effectiveness);
         let gains = Gains { k_q: v.k_q, k_qdot: v.k_qdot };
         let copy = OpenLoopCopy::new(&v.inertia, &limit, gains, v.max_internal_step, &q0, &v.init_w, &v.init_ref_error, &v.init_ref_error_rate)?;
-        Ok(ReferenceCorrector { corrected: v.mode == 1, splines, t_end, copy })
+        let projection_threshold = crate::math::attitude::projection_threshold(exp.tolerance, NORM_TOLERANCE);
+        Ok(ReferenceCorrector { corrected: v.mode == 1, splines, t_end, copy, projection_threshold })
     }
 
     fn outputs(&self, v: &mut ReferenceCorrectorVars, t: f64) -> ModelResult {
@@ -173,10 +177,11 @@ renormalised at an event whenever | |q| - 1 | exceeds 1e-9.</p>",
         (1..N_NODES).map(|k| self.t_end * k as f64 / (N_NODES - 1) as f64).find(|tk| *tk > t)
     }
     fn completed_integrator_step(&mut self, _v: &Self::Vars, _t: f64) -> bool {
-        self.corrected && self.drift() > NORM_TOLERANCE
+        self.corrected && self.drift() > self.projection_threshold
     }
     fn event_update(&mut self, _v: &Self::Vars, t: f64) -> Result<bool, String> {
-        if !self.corrected || self.drift() == 0.0 {
+        // within round-off of |q| = 1 nothing changes (idempotent: a repeated event pass reports no change)
+        if !self.corrected || self.drift() <= crate::math::attitude::NORM_ROUNDOFF {
             return Ok(false);
         }
         let n = self.copy.x.fixed_rows::<4>(0).norm();

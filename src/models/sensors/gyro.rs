@@ -5,9 +5,9 @@
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
-use super::shared::{last_sample_before, rotation, MAX_SAMPLES_PER_CALL};
+use super::shared::{sample_index, last_sample_before, rotation, MAX_SAMPLES_PER_CALL};
 use crate::declare_variables;
-use crate::math::random::{hold_index, normal};
+use crate::math::random::normal;
 use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult};
 
 /// √(2 ln 2 / π): the Allan deviation of flicker rate noise of coefficient B is this × B ([IEEE-952]).
@@ -106,7 +106,7 @@ impl Model for Gyro {
         name: "Gyro",
         description: "Three-axis rate gyro: scale factor, misalignment, constant bias, bias instability, rate and angle random walk, sampled at its own rate, seeded",
         source: "error model of [Markley-Crassidis-2014] Sec. 4.7.1 (angle and rate random walk) and [IEEE-952] Annex C (Allan variance: N, B, K); bias instability realised as a Gauss-Markov bias (project choice)",
-        equations_html: "<pre>samples at t_k = k T (k = 0, 1, ...), output held until the next sample:\n\
+        equations_html: concat!("<pre>samples at t_k = k T (k = 0, 1, ...), output held until the next sample:\n\
 w_meas,k = (I + diag(s)) R(theta)^T w(t_k) + b_0 + b_GM,k + b_RW,k + (N/sqrt(T)) n_k\n\
 b_GM,0 = sigma_b n'_0,   b_GM,k = phi b_GM,k-1 + sigma_b sqrt(1 - phi^2) n'_k,   phi = exp(-T/tau_c)\n\
 b_RW,0 = 0,             b_RW,k = b_RW,k-1 + K sqrt(T) n''_k\n\
@@ -118,14 +118,14 @@ K sqrt(tau/3) (slope +1/2)</pre>\n\
 <p>Parameters are given as power spectral densities (N^2, K^2) because FMI units have integer exponents. \
 R(theta) is the rotation matrix of the misalignment rotation vector. A sample strictly inside a communication \
 step sees the input held at the step's start. The draws depend only on (seed, k, channel), so the output does \
-not depend on the communication step, and an FMU state restores the bias states exactly.</p>",
+not depend on the communication step, and an FMU state restores the bias states exactly.</p>", crate::sample_grid_note!()),
         feedthrough: Feedthrough::AllInputs,
         ..ModelInfo::DEFAULT
     };
 
     fn initialize(v: &mut GyroVars, exp: &Experiment) -> Result<Self, String> {
         let t = v.sample_period;
-        let k0 = hold_index(exp.start_time, t);
+        let k0 = sample_index(exp.start_time, t);
         let phi = (-t / v.bias_corr_time).exp();
         v.gm_std = v.bias_instability * (FLICKER_FLOOR / GM_ADEV_PEAK);
         v.rate_noise_std = v.arw_psd.map(|p| (p / t).sqrt());
@@ -146,7 +146,7 @@ not depend on the communication step, and an FMU state restores the bias states 
     }
 
     fn outputs(&self, v: &mut GyroVars, t: f64) -> ModelResult {
-        let k = hold_index(t, self.d.period);
+        let k = sample_index(t, self.d.period);
         let s = if k > self.s.k { self.propagate(&self.s, k, &v.w)? } else { self.s.clone() };
         if s.k < self.d.k0 {
             return Err(format!("the gyro has no sample before the start time (t = {t})"));

@@ -4,11 +4,11 @@
 use nalgebra::{Quaternion, Vector3};
 use serde::{Deserialize, Serialize};
 
-use super::shared::{check_unit, max_queue, DelayLine, OrbitParams, TrueAttitude};
+use super::shared::{sample_index, check_unit, max_queue, DelayLine, OrbitParams, TrueAttitude};
 use crate::declare_variables;
 use crate::math::attitude::attitude_matrix;
 use crate::math::environment::CircularOrbit;
-use crate::math::random::{hold_index, normal};
+use crate::math::random::normal;
 use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult};
 
 declare_variables! {
@@ -55,16 +55,16 @@ impl Model for Magnetometer {
         name: "Magnetometer",
         description: "Three-axis magnetometer: the plant's dipole field in body axes with bias and white noise, sampled at its own rate, seeded",
         source: "magnetometer model of [Markley-Crassidis-2014] Sec. 4.5 (field + bias + white noise); the non-tilted dipole of the plant's orbit environment ([T2FSMC-LEO] set-up, project choice)",
-        equations_html: "<pre>samples at t_k = k T, held until the next sample:\n\
+        equations_html: concat!("<pre>samples at t_k = k T, held until the next sample:\n\
 b_meas,k = A(q(t_k)) B_R(t_k) + b + sigma (.) n_k,   n_k,i = N(seed, k, i) of math::random\n\
 B_R(t)   = (M_E / r^3) [z - 3 (z . r_hat) r_hat],   r_hat(t) = [cos u, sin u cos i, sin u sin i],  u = u_0 + n t\n\
-(the plant's field: same orbit parameters and value references 160-164)</pre>",
+(the plant's field: same orbit parameters and value references 160-164)</pre>", crate::sample_grid_note!()),
         feedthrough: Feedthrough::AllInputs,
         ..ModelInfo::DEFAULT
     };
 
     fn initialize(v: &mut MagnetometerVars, exp: &Experiment) -> Result<Self, String> {
-        let k0 = hold_index(exp.start_time, v.sample_period);
+        let k0 = sample_index(exp.start_time, v.sample_period);
         let d = Derived { period: v.sample_period, k0, seed: v.seed as i64, orbit: v.orbit.orbit(), noise: v.noise, bias: v.bias };
         Ok(Magnetometer { d, line: DelayLine::new([0.0; 3], k0) })
     }

@@ -4,9 +4,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::shared::{max_queue, DelayLine};
+use super::shared::{sample_index, max_queue, DelayLine};
 use crate::declare_variables;
-use crate::math::random::hold_index;
 use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult};
 
 /// Number of channels.
@@ -56,12 +55,12 @@ impl Model for SampleHold {
         name: "SampleHold",
         description: "Zero-order hold of 8 signals at a flight-computer period with a computation delay (whole samples or a fraction)",
         source: "sampled-data timing of a flight computer ([Franklin-Powell-Workman-1998] Ch. 4: zero-order hold, computation delay); project choice",
-        equations_html: "<pre>samples at t_k = k T (k = 0, 1, ...):  y(t) = u(t_k)  for  t_k + d <= t < t_k+1 + d\n\
+        equations_html: concat!("<pre>samples at t_k = k T (k = 0, 1, ...):  y(t) = u(t_k)  for  t_k + d <= t < t_k+1 + d\n\
 i.e. y(t) = u(floor((t - d)/T) T), and y = initial_output for t < d\n\
 d = m T (whole samples) or any fraction; delay_samples = d / T</pre>\n\
 <p>Placed after a controller whose inputs are the sensors' outputs, it turns the controller into a sampled one \
 whose command computed at t_k is applied from t_k + d. A sample strictly inside a communication step sees the \
-input held at the step's start; with T and d multiples of the communication step the staircase is exact.</p>",
+input held at the step's start; with T and d multiples of the communication step the staircase is exact.</p>", crate::sample_grid_note!()),
         feedthrough: Feedthrough::AllInputs,
         ..ModelInfo::DEFAULT
     };
@@ -71,7 +70,7 @@ input held at the step's start; with T and d multiples of the communication step
             return Err(format!("parameters delay = {} and sample_period = {}: the delay is more than 1e6 sample periods", v.delay, v.sample_period));
         }
         v.delay_samples = v.delay / v.sample_period;
-        let k0 = hold_index(exp.start_time, v.sample_period);
+        let k0 = sample_index(exp.start_time, v.sample_period);
         Ok(SampleHold { period: v.sample_period, delay: v.delay, k0, line: DelayLine::new([v.initial_output; CHANNELS], k0) })
     }
 

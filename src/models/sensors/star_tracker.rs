@@ -4,11 +4,11 @@
 use nalgebra::{Matrix3, Quaternion, Vector3};
 use serde::{Deserialize, Serialize};
 
-use super::shared::{check_unit, max_queue, quat_of_rotation, rotation, DelayLine, SunParams, TrueAttitude};
+use super::shared::{sample_index, check_unit, max_queue, quat_of_rotation, rotation, DelayLine, SunParams, TrueAttitude};
 use crate::declare_variables;
 use crate::math::attitude::attitude_matrix;
 use crate::math::environment::sun_ref;
-use crate::math::random::{hold_index, normal};
+use crate::math::random::normal;
 use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult};
 
 declare_variables! {
@@ -77,7 +77,7 @@ impl Model for StarTracker {
         name: "StarTracker",
         description: "Star tracker: attitude quaternion with cross- and about-boresight noise, update rate, latency and sun-exclusion availability flag, seeded",
         source: "measurement model of [Markley-Crassidis-2014] Sec. 5.4 (error rotation with a larger about-boresight error); sun exclusion cone and the sun on the ecliptic: project choice",
-        equations_html: "<pre>samples at t_k = k T, delivered at t_k + d (latency), held until the next delivery:\n\
+        equations_html: concat!("<pre>samples at t_k = k T, delivered at t_k + d (latency), held until the next delivery:\n\
 dtheta_S = (sigma_c n_k,0, sigma_c n_k,1, sigma_a n_k,2)          sensor axes (z = boresight)\n\
 q_meas,k = q(t_k) (x) exp(R(mount) dtheta_S / 2)                 error rotation in body axes\n\
 valid_k  = angle(boresight, sun) >= sun_exclusion,  boresight_B = R(mount) e_z,\n\
@@ -87,7 +87,7 @@ output at t: sample k_d = floor((t - d)/T); if k_d < 0 or sample k_d is not vali
 n_k,i: standard normal numbers N(seed, k, i) of math::random</pre>\n\
 <p>The error statistics per sensor axis are those declared (sigma_c, sigma_c, sigma_a); the error is the \
 rotation from the true to the measured body frame. A sample strictly inside a communication step sees the \
-attitude held at the step's start.</p>",
+attitude held at the step's start.</p>", crate::sample_grid_note!()),
         feedthrough: Feedthrough::AllInputs,
         ..ModelInfo::DEFAULT
     };
@@ -96,7 +96,7 @@ attitude held at the step's start.</p>",
         if v.latency / v.sample_period > 1e6 {
             return Err(format!("parameters latency = {} and sample_period = {}: the latency is more than 1e6 sample periods", v.latency, v.sample_period));
         }
-        let k0 = hold_index(exp.start_time, v.sample_period);
+        let k0 = sample_index(exp.start_time, v.sample_period);
         let d = Derived {
             period: v.sample_period,
             latency: v.latency,

@@ -4,11 +4,11 @@
 use nalgebra::{Matrix3, Quaternion, Vector3};
 use serde::{Deserialize, Serialize};
 
-use super::shared::{check_unit, rotation, DelayLine, OrbitParams, SunParams, TrueAttitude};
+use super::shared::{sample_index, check_unit, rotation, DelayLine, OrbitParams, SunParams, TrueAttitude};
 use crate::declare_variables;
 use crate::math::attitude::attitude_matrix;
 use crate::math::environment::{in_eclipse, sun_ref, CircularOrbit};
-use crate::math::random::{hold_index, normal};
+use crate::math::random::normal;
 use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult, SWITCH};
 
 declare_variables! {
@@ -76,7 +76,7 @@ impl Model for SunSensor {
         name: "SunSensor",
         description: "Sun sensor: body-frame sun direction with angular noise and bias, field of view and Earth shadow, sampled at its own rate, seeded",
         source: "sun-sensor measurement model of [Markley-Crassidis-2014] Sec. 4.4 (unit-vector measurement with small-angle noise); sun on the ecliptic and cylindrical shadow: project choice",
-        equations_html: "<pre>samples at t_k = k T, held until the next sample:\n\
+        equations_html: concat!("<pre>samples at t_k = k T, held until the next sample:\n\
 s_R(t)   = [cos l, sin l cos eps, sin l sin eps],  l = l_0 + n_sun t,  eps = 23.439 deg,  n_sun = 2 pi / 365.256 d\n\
 s_B      = A(q(t_k)) s_R(t_k)\n\
 s_meas,k = R(b + sigma n_k) s_B,   n_k,i = N(seed, k, i) of math::random, R(.) the rotation of a rotation vector\n\
@@ -85,13 +85,13 @@ valid_k  = s_B . boresight_B >= cos(fov)  and not in shadow (eclipse = 1): r_hat
 while not valid: the last valid sample, valid = 0 (before any: (0, 0, 1))</pre>\n\
 <p>The angular error about each axis perpendicular to the sun line has standard deviation sigma (the component \
 of the noise along the sun line does not move the direction), so the angle between measured and true direction \
-is Rayleigh-distributed with mean square 2 sigma^2.</p>",
+is Rayleigh-distributed with mean square 2 sigma^2.</p>", crate::sample_grid_note!()),
         feedthrough: Feedthrough::AllInputs,
         ..ModelInfo::DEFAULT
     };
 
     fn initialize(v: &mut SunSensorVars, exp: &Experiment) -> Result<Self, String> {
-        let k0 = hold_index(exp.start_time, v.sample_period);
+        let k0 = sample_index(exp.start_time, v.sample_period);
         let d = Derived {
             period: v.sample_period,
             k0,

@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::shared::{law_params, sampled_output, sampled_step};
+use super::shared::{law_params, sampled_output, sampled_step, SampleCounter};
 use crate::declare_variables;
 use super::shared::laws::FopidLaw;
 use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult, SWITCH};
@@ -20,7 +20,7 @@ declare_variables! {
         102 => kd: Real = 8.0, Parameter, "", "Derivative gain K_D (per rad s^-mu; project default)";
         103 => lambda: Real = 1.0, Parameter, "", "Integral order lambda", Range(0.0, 2.0);
         104 => mu: Real = 1.0, Parameter, "", "Derivative order mu", Range(0.0, 2.0);
-        105 => step: Real = 0.001, Parameter, "s", "Sample time h; every communication step must be an integer multiple of it", Positive;
+        105 => step: Real = 0.001, Parameter, "s", "Sample time h; every communication step must be an integer multiple of it (to 1e-10 of the time, at most 1e-3 h)", Positive;
         120 => gl_memory: Integer = 0, Parameter, "", "Grunwald-Letnikov memory in samples (0 = full memory; L > 0 keeps the last L samples)", Range(0.0, 1e7);
         121 => history_before_start: Integer = 0, Parameter, "", "0: e_k = 0 for k < 0 (derivative kick at t = 0); 1: the derivative sees e_k = e_0 for k < 0", Choice(SWITCH);
     }
@@ -30,6 +30,8 @@ declare_variables! {
 #[derive(Clone, Serialize, Deserialize)]
 pub struct FopidController {
     law: FopidLaw,
+    /// The sample grid t_start + n h (n = samples in the history).
+    clock: SampleCounter,
 }
 
 impl Model for FopidController {
@@ -44,8 +46,12 @@ u_n = K_P e_n + K_I D^(-lambda) e_n + K_D D^(mu) e_n\n\
 D^alpha e(t_n) = h^(-alpha) sum_{j=0}^{min(n, L-1)} w_j e_(n-j),  w_0 = 1,  w_j = (1 - (alpha + 1)/j) w_(j-1)\n\
 alpha = -lambda (integral), alpha = mu (derivative); e_k = 0 for k &lt; 0; L = gl_memory (0 = full memory)</pre>\n\
 <p>The error of t_n is appended to the history in doStep(t_n, h); the output read at t_n uses the inputs just set, so \
-u depends directly on theta and theta_ref. A communication step must be an integer multiple k of the parameter step (h): the inputs are \
-held over it and the law takes k samples of the same error; any other step is an error. With history_before_start = 1 the derivative term sees a constant past e_k = e_0 (no derivative \
+u depends directly on theta and theta_ref. A communication step must be an integer multiple k of the parameter step (h) starting at the next sample instant \
+t_start + n h (n = samples taken: the schedule is an integer counter, never a sum of times); the inputs are \
+held over it and the law takes k samples of the same error; any other step is an error. A master's rounding is \
+tolerated: a step or communication point within 1e-10 of the time (at most 1e-3 h) of a multiple or instant is \
+taken as it, which covers masters that sum t += h (1e5 steps drift by about 2e-12 of the time) and clip the \
+last step to the stop time; a step of rounding size (k = 0) takes no sample. With history_before_start = 1 the derivative term sees a constant past e_k = e_0 (no derivative \
 kick at t = 0); the integral always starts at t = 0. lambda = mu = 1 is the integer PID (PidController). \
 The sums are evaluated exactly (to round-off) in O(log^2 n) amortised time per step: the 64 newest samples \
 directly, older ones in FFT blocks. The FMU state holds the whole history.</p>",
@@ -55,9 +61,9 @@ directly, older ones in FFT blocks. The FMU state holds the whole history.</p>",
         variable_step: false, // a constant step, any integer multiple of `step`
     };
 
-    fn initialize(v: &mut FopidControllerVars, _exp: &Experiment) -> Result<Self, String> {
+    fn initialize(v: &mut FopidControllerVars, exp: &Experiment) -> Result<Self, String> {
         let p = law_params(v.kp, v.ki, v.kd, v.lambda, v.mu, v.step, v.gl_memory, v.history_before_start);
-        Ok(FopidController { law: FopidLaw::new(p)? })
+        Ok(FopidController { law: FopidLaw::new(p)?, clock: SampleCounter { start: exp.start_time, period: v.step } })
     }
 
     fn outputs(&self, v: &mut FopidControllerVars, _t: f64) -> ModelResult {
@@ -65,8 +71,8 @@ directly, older ones in FFT blocks. The FMU state holds the whole history.</p>",
         Ok(())
     }
 
-    fn step(&mut self, v: &FopidControllerVars, _t: f64, h: f64) -> ModelResult {
-        sampled_step(&mut self.law, h, v.step, v.theta_ref, v.theta)
+    fn step(&mut self, v: &FopidControllerVars, t: f64, h: f64) -> ModelResult {
+        sampled_step(&mut self.law, &self.clock, t, h, v.theta_ref, v.theta)
     }
 }
 

@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::shared::{law_params, sampled_output, sampled_step};
+use super::shared::{law_params, sampled_output, sampled_step, SampleCounter};
 use crate::declare_variables;
 use super::shared::laws::PidLaw;
 use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult, SWITCH};
@@ -18,7 +18,7 @@ declare_variables! {
         100 => kp: Real = 2.0, Parameter, "", "Proportional gain K_P (per rad; project default)";
         101 => ki: Real = 0.1, Parameter, "1/s", "Integral gain K_I (per rad s; project default)";
         102 => kd: Real = 8.0, Parameter, "s", "Derivative gain K_D (s per rad; project default)";
-        105 => step: Real = 0.001, Parameter, "s", "Sample time h; every communication step must be an integer multiple of it", Positive;
+        105 => step: Real = 0.001, Parameter, "s", "Sample time h; every communication step must be an integer multiple of it (to 1e-10 of the time, at most 1e-3 h)", Positive;
         120 => gl_memory: Integer = 0, Parameter, "", "Memory in samples (0 = full; L > 0: the integral sums the last L samples)", Range(0.0, 1e7);
         121 => history_before_start: Integer = 0, Parameter, "", "0: e_(-1) = 0 (derivative kick at t = 0); 1: e_(-1) = e_0", Choice(SWITCH);
     }
@@ -28,6 +28,8 @@ declare_variables! {
 #[derive(Clone, Serialize, Deserialize)]
 pub struct PidController {
     law: PidLaw,
+    /// The sample grid t_start + n h (n = samples in the history).
+    clock: SampleCounter,
 }
 
 impl Model for PidController {
@@ -41,8 +43,12 @@ impl Model for PidController {
 u_n = K_P e_n + K_I h sum_{j=0}^{min(n, L-1)} e_(n-j) + K_D (e_n - e_(n-1)) / h\n\
 e_k = 0 for k &lt; 0; L = gl_memory (0 = full memory)</pre>\n\
 <p>The error of t_n is appended to the history in doStep(t_n, h); the output read at t_n uses the inputs just set, so \
-u depends directly on theta and theta_ref. A communication step must be an integer multiple k of the parameter step (h): the inputs are \
-held over it and the law takes k samples of the same error; any other step is an error. With history_before_start = 1 the derivative uses e_(-1) = e_0 (no derivative kick at t = 0); \
+u depends directly on theta and theta_ref. A communication step must be an integer multiple k of the parameter step (h) starting at the next sample instant \
+t_start + n h (n = samples taken: the schedule is an integer counter, never a sum of times); the inputs are \
+held over it and the law takes k samples of the same error; any other step is an error. A master's rounding is \
+tolerated: a step or communication point within 1e-10 of the time (at most 1e-3 h) of a multiple or instant is \
+taken as it, which covers masters that sum t += h (1e5 steps drift by about 2e-12 of the time) and clip the \
+last step to the stop time; a step of rounding size (k = 0) takes no sample. With history_before_start = 1 the derivative uses e_(-1) = e_0 (no derivative kick at t = 0); \
 the integral always starts at t = 0. The same law as FopidController with lambda = mu = 1, written with a running \
 sum (O(1) per step). The FMU state holds the whole history.</p>",
         feedthrough: Feedthrough::AllInputs,
@@ -51,9 +57,9 @@ sum (O(1) per step). The FMU state holds the whole history.</p>",
         variable_step: false, // a constant step, any integer multiple of `step`
     };
 
-    fn initialize(v: &mut PidControllerVars, _exp: &Experiment) -> Result<Self, String> {
+    fn initialize(v: &mut PidControllerVars, exp: &Experiment) -> Result<Self, String> {
         let p = law_params(v.kp, v.ki, v.kd, 1.0, 1.0, v.step, v.gl_memory, v.history_before_start);
-        Ok(PidController { law: PidLaw::new(p)? })
+        Ok(PidController { law: PidLaw::new(p)?, clock: SampleCounter { start: exp.start_time, period: v.step } })
     }
 
     fn outputs(&self, v: &mut PidControllerVars, _t: f64) -> ModelResult {
@@ -61,8 +67,8 @@ sum (O(1) per step). The FMU state holds the whole history.</p>",
         Ok(())
     }
 
-    fn step(&mut self, v: &PidControllerVars, _t: f64, h: f64) -> ModelResult {
-        sampled_step(&mut self.law, h, v.step, v.theta_ref, v.theta)
+    fn step(&mut self, v: &PidControllerVars, t: f64, h: f64) -> ModelResult {
+        sampled_step(&mut self.law, &self.clock, t, h, v.theta_ref, v.theta)
     }
 }
 

@@ -4,7 +4,13 @@
 //! - Quaternion (kinematics 0 and 4): the solver integrates q̇ = ½ q ⊗ ω freely, which keeps |q| = 1 only
 //!   up to its tolerance. After an accepted step whose |q| is off by more than [`NORM_TOLERANCE`] the
 //!   plant asks for an event (`fmi2CompletedIntegratorStep` → enterEventMode) and renormalises q in
-//!   the event update (valuesOfContinuousStatesChanged); every time event renormalises too.
+//!   the event update (valuesOfContinuousStatesChanged); every time event renormalises too. The
+//!   threshold is the larger of [`NORM_TOLERANCE`] and the relative tolerance the importer gave in
+//!   fmi2SetupExperiment (a solver at rtol 1e-4 drifts about that much per step: a 1e-9 threshold then
+//!   asked for an event after every step, and a master that restarts its solver at each event, such as
+//!   CVODE in OMSimulator, no longer advanced). The projection is idempotent: within [`ROUNDOFF`] of the
+//!   invariant it changes nothing and reports no change, so a master that repeats the event iteration
+//!   while values change (or outputs move) settles after one pass.
 //! - DCM (kinematics 1) with `dcm_orthonormalize = 1`: the same with ‖AᵀA − I‖ and the nearest
 //!   rotation matrix. The sign-continuous output quaternion follows every accepted step.
 //! - Euler angles (kinematics 2): the right-hand side refuses the singularity roll = ±90°.
@@ -18,8 +24,17 @@ use crate::math::attitude::orthonormalize;
 use crate::math::random::hold_index;
 use crate::model::StateDecl;
 
-/// Largest drift of |q| (or of ‖AᵀA − I‖) accepted between events.
+/// Largest drift of |q| (or of ‖AᵀA − I‖) accepted between events (when the importer gives no looser
+/// tolerance).
 pub const NORM_TOLERANCE: f64 = 1e-9;
+
+/// Drift that is only the round-off of a normalisation: the event update leaves it alone.
+pub use crate::math::attitude::NORM_ROUNDOFF as ROUNDOFF;
+
+/// The drift that asks for a projection event: max(NORM_TOLERANCE, the importer's relative tolerance).
+pub fn projection_threshold(exp: &crate::model::Experiment) -> f64 {
+    crate::math::attitude::projection_threshold(exp.tolerance, NORM_TOLERANCE)
+}
 
 const fn s(name: &'static str, unit: &'static str, description: &'static str, on: &'static [&'static str]) -> StateDecl {
     StateDecl::new(name, unit, description).depends_on(on)
@@ -96,11 +111,14 @@ impl AttitudePlant {
             let mut x = self.x;
             let _ = post_step(Kinematics::Dcm, false, &mut self.q_dcm, &mut x, 0.0);
         }
-        self.drift(v) > NORM_TOLERANCE
+        self.drift(v) > self.d.projection_threshold
     }
 
     /// Event update: renormalise q (re-orthonormalise A); whether the state changed.
     pub(super) fn project(&mut self, v: &AttitudePlantVars, t: f64) -> Result<bool, String> {
+        if self.drift(v) <= ROUNDOFF {
+            return Ok(false); // already on the invariant: a repeated event pass changes nothing
+        }
         let before = self.x;
         match self.kin {
             Kinematics::Quaternion | Kinematics::QuaternionLinearDynamics => post_step(self.kin, false, &mut self.q_dcm, &mut self.x, t)?,

@@ -39,6 +39,9 @@ struct Derived {
     dipole_max: f64,
     /// Actuator-to-body map M = R(δ) diag(k) (misalignment δ, scale factor k).
     actuator_map: Matrix3<f64>,
+    /// Model Exchange: drift of |q| (‖AᵀA − I‖) that asks for a projection event after a solver step
+    /// (`exchange::projection_threshold`).
+    projection_threshold: f64,
 }
 
 #[derive(Clone, Serialize, Deserialize)]
@@ -120,6 +123,7 @@ impl Model for AttitudePlant {
             wheel_momentum_max: v.wheel_inertia * v.wheel_max_speed,
             dipole_max: v.mtq_turns * v.mtq_coil_area * v.mtq_max_current,
             actuator_map: nalgebra::Rotation3::new(v.actuator_misalignment).into_inner() * Matrix3::from_diagonal(&v.actuator_scale),
+            projection_threshold: exchange::projection_threshold(exp),
         };
         let angles = (v.init_euler321_roll, v.init_euler321_pitch, v.init_euler321_yaw);
         let mut x = State::zeros();

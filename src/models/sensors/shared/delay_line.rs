@@ -3,8 +3,9 @@
 //! Samples are taken at t_k = k T (k = 0, 1, …), each from the inputs the unit holds at t_k (inputs are
 //! held over a communication step, so a sample strictly inside a step sees the inputs of the step's
 //! start). Sample k is delivered at t_k + d (d = delay or latency ≥ 0): the output at t is the sample of
-//! index k_d(t) = ⌊(t − d)/T⌋ (`math::random::hold_index`: within 1e-9 T below a boundary counts as on
-//! it), i.e. a zero-order hold of the samples shifted by d. Before the first delivery (t < d) and while
+//! index k_d(t) = ⌊(t − d)/T⌋ (`math::sample_grid::index_at`: a time within the grid tolerance — 1e-10
+//! of the time, at most 1e-3 T — of an instant k T counts as on it, so a master's summed or clipped time
+//! gives the same samples as exact multiples), i.e. a zero-order hold of the samples shifted by d. Before the first delivery (t < d) and while
 //! the delivered sample is not usable (a sensor's availability flag), the output is the last usable
 //! delivered sample (`held`, initially the unit's initial output).
 //!
@@ -15,16 +16,27 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::math::random::hold_index;
+use crate::math::sample_grid;
 use crate::model::ModelResult;
 
 /// At most this many samples per doStep (bounded work: a longer step is refused before any work).
 pub const MAX_SAMPLES_PER_CALL: i64 = 1_000_000;
 
-/// Index of the last sample instant k T strictly before `t_end` (−1 if none): samples latched by a
-/// step that ends at t_end.
+/// Index of the last sample instant k T strictly before `t_end` (−1 if none; an instant within the grid
+/// tolerance of t_end is at t_end): samples latched by a step that ends at t_end.
 pub fn last_sample_before(t_end: f64, period: f64) -> i64 {
-    (t_end / period - 1e-9).ceil() as i64 - 1
+    sample_grid::last_before(t_end, period, t_end)
+}
+
+/// Index k of the sample interval [k T, (k+1) T) holding t (on the grid to its tolerance).
+pub fn sample_index(t: f64, period: f64) -> i64 {
+    sample_grid::index_at(t, period, t)
+}
+
+/// Index of the sample delivered at t with delay d: the interval of t − d, on the grid to the
+/// tolerance of the times t and d the difference is made of.
+pub fn delivered_index(t: f64, delay: f64, period: f64) -> i64 {
+    sample_grid::index_at(t - delay, period, t.abs() + delay.abs())
 }
 
 /// Latched samples of type `T` awaiting delivery, and the last delivered usable one.
@@ -47,7 +59,7 @@ impl<T: Clone> DelayLine<T> {
     /// The output at t: (sample, usable). `fresh(k)` computes sample k from the current inputs (used
     /// when sample k is due now and not latched yet).
     pub fn at(&self, t: f64, period: f64, delay: f64, fresh: impl FnOnce(i64) -> T, usable: impl Fn(&T) -> bool) -> (T, bool) {
-        let kd = hold_index(t - delay, period);
+        let kd = delivered_index(t, delay, period);
         if kd < 0 {
             return (self.held.clone(), false);
         }
@@ -73,7 +85,7 @@ impl<T: Clone> DelayLine<T> {
             return Err(format!("a step to t = {} takes {} samples of period {period} s (at most {MAX_SAMPLES_PER_CALL} per step)",
                                t + h, k_end - first + 1));
         }
-        let kd = hold_index(t + h - delay, period);
+        let kd = delivered_index(t + h, delay, period);
         // drop what is superseded at t + h: entries below kd (the last usable of them becomes `held`),
         // then latch the new samples (those already superseded only update `held`)
         let n_old = self.queue.iter().take_while(|(k, _)| *k < kd).count();

@@ -6,7 +6,7 @@
 pub mod delay_line;
 pub mod ports;
 
-pub use delay_line::{last_sample_before, max_queue, DelayLine, MAX_SAMPLES_PER_CALL};
+pub use delay_line::{delivered_index, last_sample_before, max_queue, sample_index, DelayLine, MAX_SAMPLES_PER_CALL};
 pub use ports::{OrbitParams, SunParams, TrueAttitude};
 
 use nalgebra::{Matrix3, Quaternion, Rotation3, Vector3};

@@ -5,6 +5,8 @@ pub mod laws;
 
 use laws::{FopidLaw, FopidParams, PidLaw};
 
+pub use crate::math::sample_grid::SampleCounter;
+
 /// Law parameters from the declared variables (the bounds were checked by the FMI layer).
 #[allow(clippy::too_many_arguments)]
 pub fn law_params(kp: f64, ki: f64, kd: f64, lambda: f64, mu: f64, step: f64, gl_memory: i32, history_before_start: i32) -> FopidParams {
@@ -13,19 +15,16 @@ pub fn law_params(kp: f64, ki: f64, kd: f64, lambda: f64, mu: f64, step: f64, gl
 
 /// Most samples one communication step may take (as the plants' internal steps): bounds the work
 /// and the history growth of one fmi2DoStep.
-pub const MAX_SAMPLES_PER_STEP: usize = 1_000_000;
+pub const MAX_SAMPLES_PER_STEP: u64 = 1_000_000;
 
-/// The GL history is sampled at `step`: a communication step must be an integer multiple k >= 1 of
-/// it (to 1e-9 relative), and then takes k samples; any other step is an error.
-pub fn samples_in_step(h: f64, step: f64) -> Result<usize, String> {
-    let k = (h / step).round();
-    if !(k >= 1.0 && (h - k * step).abs() <= 1e-9 * h) {
-        return Err(format!(
-            "communication step {h} s is not an integer multiple of the sample time parameter step = {step} s (the error history is sampled at step)"
-        ));
-    }
-    if k > MAX_SAMPLES_PER_STEP as f64 {
-        return Err(format!("communication step {h} s would take {k} samples of step = {step} s (at most {MAX_SAMPLES_PER_STEP} per doStep)"));
+/// The GL history is sampled at `step` on an integer sample counter (`math::sample_grid`): a
+/// communication step must be a whole multiple k >= 0 of it and start at the counter's instant
+/// start + n step (both to the grid tolerance, which absorbs a master's summed or clipped time), and
+/// then takes k samples; any other step is an error.
+pub fn samples_in_step(clock: &SampleCounter, n: usize, t: f64, h: f64) -> Result<usize, String> {
+    let k = clock.step(n as u64, t, h, "the error history is sampled at step")?;
+    if k > MAX_SAMPLES_PER_STEP {
+        return Err(format!("communication step {h} s would take {k} samples of step = {} s (at most {MAX_SAMPLES_PER_STEP} per doStep)", clock.period));
     }
     Ok(k as usize)
 }
@@ -35,6 +34,8 @@ pub fn samples_in_step(h: f64, step: f64) -> Result<usize, String> {
 pub trait SampledLaw {
     fn output(&self, e: f64) -> f64;
     fn push(&mut self, e: f64);
+    /// Samples taken so far (the sample counter).
+    fn samples(&self) -> usize;
 }
 
 impl SampledLaw for PidLaw {
@@ -44,6 +45,9 @@ impl SampledLaw for PidLaw {
     fn push(&mut self, e: f64) {
         PidLaw::push(self, e)
     }
+    fn samples(&self) -> usize {
+        self.len()
+    }
 }
 
 impl SampledLaw for FopidLaw {
@@ -52,6 +56,9 @@ impl SampledLaw for FopidLaw {
     }
     fn push(&mut self, e: f64) {
         FopidLaw::push(self, e)
+    }
+    fn samples(&self) -> usize {
+        self.len()
     }
 }
 
@@ -65,10 +72,10 @@ pub fn sampled_output(law: &impl SampledLaw, theta_ref: f64, theta: f64) -> Resu
     Ok((u, e))
 }
 
-/// One communication step of k samples (see [`samples_in_step`]): the inputs are held over the step,
-/// so the error of t_n joins the history k times (the law is sampled at t_n, t_n + step, …).
-pub fn sampled_step(law: &mut impl SampledLaw, h: f64, step: f64, theta_ref: f64, theta: f64) -> Result<(), String> {
-    let k = samples_in_step(h, step)?;
+/// One communication step doStep(t, h) of k samples (see [`samples_in_step`]): the inputs are held
+/// over the step, so the error of t_n joins the history k times (the law is sampled at t_n, t_n + step, …).
+pub fn sampled_step(law: &mut impl SampledLaw, clock: &SampleCounter, t: f64, h: f64, theta_ref: f64, theta: f64) -> Result<(), String> {
+    let k = samples_in_step(clock, law.samples(), t, h)?;
     let e = theta_ref - theta;
     for _ in 0..k {
         law.push(e);
