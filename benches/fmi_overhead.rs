@@ -11,7 +11,7 @@ use std::hint::black_box;
 use std::time::Instant;
 
 use common::TestFmu;
-use spacecraft_fmus::fmi::abi::{fmi2DoStep, fmi2GetReal, fmi2SetReal};
+use spacecraft_fmus::fmi::fmi2::{fmi2DoStep, fmi2GetReal, fmi2SetReal};
 use spacecraft_fmus::model::{Experiment, Fmu};
 use spacecraft_fmus::models::attitude::control::PdController;
 use spacecraft_fmus::models::attitude::AttitudePlant;

@@ -10,8 +10,7 @@ use std::hint::black_box;
 use std::time::Instant;
 
 use spacecraft_fmus::model::guid::guid;
-use spacecraft_fmus::fmi::abi::*;
-use spacecraft_fmus::fmi::CallbackFunctions;
+use spacecraft_fmus::fmi::fmi2::*;
 use spacecraft_fmus::model::{Experiment, Fmu, SlotMut, Variables};
 use spacecraft_fmus::models::attitude::plant::AttitudePlantVars;
 use spacecraft_fmus::models::attitude::AttitudePlant;

@@ -315,16 +315,12 @@ pub fn read_catalogue(bytes: &[u8]) -> Result<Catalogue, String> {
 ///
 /// One library may hold several models: each FMU carries the same binary under its own name
 /// (`binaries/<platform>/<Model>.<ext>`), and `fmi2Instantiate` picks the model by that file name and
-/// checks the GUID (`fmi3InstantiateCoSimulation`: the instantiationToken, the same GUID). Every function goes through the layer in `spacecraft_fmus::fmi::abi` (state machine,
+/// checks the GUID (`fmi3InstantiateCoSimulation`: the instantiationToken, the same GUID). Every function goes through the layer in `spacecraft_fmus::fmi` (`fmi2`, `fmi3`: state machine,
 /// status and logging, panics caught, validated FMU states).
 #[macro_export]
 macro_rules! export_fmus {
     (list: $list:expr) => {
         const _: () = {
-            use ::std::ffi::{c_char, c_int, c_void};
-            use $crate::fmi::abi as abi;
-            use $crate::fmi::CallbackFunctions;
-            type Component = *mut c_void;
             static MODELS: &[$crate::model::ModelEntry] = $list;
 
             /// The declarations of this library's models, for the packaging tool: `*size` bytes at the
@@ -351,66 +347,7 @@ macro_rules! export_fmus {
                 }
             }
 
-            #[no_mangle] pub extern "C" fn fmi2GetTypesPlatform() -> *const c_char { abi::fmi2GetTypesPlatform() }
-            #[no_mangle] pub extern "C" fn fmi2GetVersion() -> *const c_char { abi::fmi2GetVersion() }
-            #[no_mangle] pub extern "C" fn fmi2Instantiate(name: *const c_char, fmu_type: c_int, guid: *const c_char, resources: *const c_char,
-                functions: *const CallbackFunctions, visible: c_int, logging_on: c_int) -> Component {
-                abi::fmi2Instantiate(MODELS, name, fmu_type, guid, resources, functions, visible, logging_on)
-            }
-            #[no_mangle] pub extern "C" fn fmi2FreeInstance(c: Component) { abi::fmi2FreeInstance(c) }
-            #[no_mangle] pub extern "C" fn fmi2SetDebugLogging(c: Component, on: c_int, n: usize, cats: *const *const c_char) -> c_int { abi::fmi2SetDebugLogging(c, on, n, cats) }
-            #[no_mangle] pub extern "C" fn fmi2SetupExperiment(c: Component, tol_defined: c_int, tol: f64, start: f64, stop_defined: c_int, stop: f64) -> c_int {
-                abi::fmi2SetupExperiment(c, tol_defined, tol, start, stop_defined, stop)
-            }
-            #[no_mangle] pub extern "C" fn fmi2EnterInitializationMode(c: Component) -> c_int { abi::fmi2EnterInitializationMode(c) }
-            #[no_mangle] pub extern "C" fn fmi2ExitInitializationMode(c: Component) -> c_int { abi::fmi2ExitInitializationMode(c) }
-            #[no_mangle] pub extern "C" fn fmi2Terminate(c: Component) -> c_int { abi::fmi2Terminate(c) }
-            #[no_mangle] pub extern "C" fn fmi2Reset(c: Component) -> c_int { abi::fmi2Reset(c) }
-            #[no_mangle] pub extern "C" fn fmi2GetReal(c: Component, vr: *const u32, n: usize, v: *mut f64) -> c_int { abi::fmi2GetReal(c, vr, n, v) }
-            #[no_mangle] pub extern "C" fn fmi2GetInteger(c: Component, vr: *const u32, n: usize, v: *mut c_int) -> c_int { abi::fmi2GetInteger(c, vr, n, v) }
-            #[no_mangle] pub extern "C" fn fmi2GetBoolean(c: Component, vr: *const u32, n: usize, v: *mut c_int) -> c_int { abi::fmi2GetBoolean(c, vr, n, v) }
-            #[no_mangle] pub extern "C" fn fmi2GetString(c: Component, vr: *const u32, n: usize, v: *mut *const c_char) -> c_int { abi::fmi2GetString(c, vr, n, v) }
-            #[no_mangle] pub extern "C" fn fmi2SetReal(c: Component, vr: *const u32, n: usize, v: *const f64) -> c_int { abi::fmi2SetReal(c, vr, n, v) }
-            #[no_mangle] pub extern "C" fn fmi2SetInteger(c: Component, vr: *const u32, n: usize, v: *const c_int) -> c_int { abi::fmi2SetInteger(c, vr, n, v) }
-            #[no_mangle] pub extern "C" fn fmi2SetBoolean(c: Component, vr: *const u32, n: usize, v: *const c_int) -> c_int { abi::fmi2SetBoolean(c, vr, n, v) }
-            #[no_mangle] pub extern "C" fn fmi2SetString(c: Component, vr: *const u32, n: usize, v: *const *const c_char) -> c_int { abi::fmi2SetString(c, vr, n, v) }
-            #[no_mangle] pub extern "C" fn fmi2GetFMUstate(c: Component, s: *mut *mut c_void) -> c_int { abi::fmi2GetFMUstate(c, s) }
-            #[no_mangle] pub extern "C" fn fmi2SetFMUstate(c: Component, s: *mut c_void) -> c_int { abi::fmi2SetFMUstate(c, s) }
-            #[no_mangle] pub extern "C" fn fmi2FreeFMUstate(c: Component, s: *mut *mut c_void) -> c_int { abi::fmi2FreeFMUstate(c, s) }
-            #[no_mangle] pub extern "C" fn fmi2SerializedFMUstateSize(c: Component, s: *mut c_void, size: *mut usize) -> c_int { abi::fmi2SerializedFMUstateSize(c, s, size) }
-            #[no_mangle] pub extern "C" fn fmi2SerializeFMUstate(c: Component, s: *mut c_void, buf: *mut c_char, size: usize) -> c_int { abi::fmi2SerializeFMUstate(c, s, buf, size) }
-            #[no_mangle] pub extern "C" fn fmi2DeSerializeFMUstate(c: Component, buf: *const c_char, size: usize, s: *mut *mut c_void) -> c_int { abi::fmi2DeSerializeFMUstate(c, buf, size, s) }
-            #[no_mangle] pub extern "C" fn fmi2GetDirectionalDerivative(c: Component, vu: *const u32, nu: usize, vk: *const u32, nk: usize, dk: *const f64, du: *mut f64) -> c_int {
-                abi::fmi2GetDirectionalDerivative(c, vu, nu, vk, nk, dk, du)
-            }
-            #[no_mangle] pub extern "C" fn fmi2SetRealInputDerivatives(c: Component, vr: *const u32, n: usize, order: *const c_int, v: *const f64) -> c_int {
-                abi::fmi2SetRealInputDerivatives(c, vr, n, order, v)
-            }
-            #[no_mangle] pub extern "C" fn fmi2GetRealOutputDerivatives(c: Component, vr: *const u32, n: usize, order: *const c_int, v: *mut f64) -> c_int {
-                abi::fmi2GetRealOutputDerivatives(c, vr, n, order, v)
-            }
-            #[no_mangle] pub extern "C" fn fmi2DoStep(c: Component, t: f64, h: f64, no_prior: c_int) -> c_int { abi::fmi2DoStep(c, t, h, no_prior) }
-            #[no_mangle] pub extern "C" fn fmi2CancelStep(c: Component) -> c_int { abi::fmi2CancelStep(c) }
-            #[no_mangle] pub extern "C" fn fmi2GetStatus(c: Component, k: c_int, v: *mut c_int) -> c_int { abi::fmi2GetStatus(c, k, v) }
-            #[no_mangle] pub extern "C" fn fmi2GetRealStatus(c: Component, k: c_int, v: *mut f64) -> c_int { abi::fmi2GetRealStatus(c, k, v) }
-            #[no_mangle] pub extern "C" fn fmi2GetIntegerStatus(c: Component, k: c_int, v: *mut c_int) -> c_int { abi::fmi2GetIntegerStatus(c, k, v) }
-            #[no_mangle] pub extern "C" fn fmi2GetBooleanStatus(c: Component, k: c_int, v: *mut c_int) -> c_int { abi::fmi2GetBooleanStatus(c, k, v) }
-            #[no_mangle] pub extern "C" fn fmi2EnterEventMode(c: Component) -> c_int { abi::fmi2EnterEventMode(c) }
-            #[no_mangle] pub extern "C" fn fmi2NewDiscreteStates(c: Component, info: *mut abi::EventInfo2) -> c_int { abi::fmi2NewDiscreteStates(c, info) }
-            #[no_mangle] pub extern "C" fn fmi2EnterContinuousTimeMode(c: Component) -> c_int { abi::fmi2EnterContinuousTimeMode(c) }
-            #[no_mangle] pub extern "C" fn fmi2CompletedIntegratorStep(c: Component, no_prior: c_int, enter: *mut c_int, term: *mut c_int) -> c_int {
-                abi::fmi2CompletedIntegratorStep(c, no_prior, enter, term)
-            }
-            #[no_mangle] pub extern "C" fn fmi2SetTime(c: Component, t: f64) -> c_int { abi::fmi2SetTime(c, t) }
-            #[no_mangle] pub extern "C" fn fmi2SetContinuousStates(c: Component, x: *const f64, n: usize) -> c_int { abi::fmi2SetContinuousStates(c, x, n) }
-            #[no_mangle] pub extern "C" fn fmi2GetDerivatives(c: Component, dx: *mut f64, n: usize) -> c_int { abi::fmi2GetDerivatives(c, dx, n) }
-            #[no_mangle] pub extern "C" fn fmi2GetEventIndicators(c: Component, z: *mut f64, n: usize) -> c_int { abi::fmi2GetEventIndicators(c, z, n) }
-            #[no_mangle] pub extern "C" fn fmi2GetContinuousStates(c: Component, x: *mut f64, n: usize) -> c_int { abi::fmi2GetContinuousStates(c, x, n) }
-            #[no_mangle] pub extern "C" fn fmi2GetNominalsOfContinuousStates(c: Component, x: *mut f64, n: usize) -> c_int {
-                abi::fmi2GetNominalsOfContinuousStates(c, x, n)
-            }
-            #[no_mangle] pub extern "C" fn fmi2GetStringStatus(c: Component, k: c_int, v: *mut *const c_char) -> c_int { abi::fmi2GetStringStatus(c, k, v) }
-            // FMI 3.0 Co-Simulation: the same instances and models (src/export3.rs)
+            $crate::__export_fmi2!(MODELS);
             $crate::__export_fmi3!(MODELS);
         };
     };

@@ -1,11 +1,11 @@
-//! Spacecraft guidance and control units as FMI 2.0 Co-Simulation FMUs, and the runtime that exports
-//! them — ours and anyone's.
+//! Spacecraft guidance and control units as FMI 2.0 and FMI 3.0 FMUs (Co-Simulation, and Model
+//! Exchange where the equations are continuous), and the runtime that exports them — ours and anyone's.
 //!
 //! - `export`: the public export API in one place — the model contract, the declaration macros,
 //!   [`export_fmus!`] (which generates a shared library's FMI entry points) and the catalogue the
 //!   packaging tool reads back. Start there (docs/export.md walks through a model of your own).
-//! - `fmi`: the FMI 2.0 and 3.0 CS C functions, state machine, logging and FMU state, written once; exported by
-//!   `export_fmus!` in the crate that builds the shared library, never by this one (an rlib).
+//! - `fmi`: the FMI 2.0 and 3.0 C functions (Co-Simulation and Model Exchange), state machine, logging and
+//!   FMU state, written once, one folder per version over one C boundary; exported by `export_fmus!` in the crate that builds the shared library, never by this one (an rlib).
 //! - `model`: what a model is (declared variables + init/outputs/step), the declaration macro, GUIDs.
 //! - `models`: the project's FMUs, one folder per family; `registry` lists them.
 //! - `math`: shared math (attitude conventions, integrators, ...), unit-tested on its own.
@@ -17,7 +17,6 @@
 //! the only code that links an XML writer and `zip`).
 
 pub mod export;
-mod export3;
 pub mod fmi;
 pub mod math;
 pub mod model;

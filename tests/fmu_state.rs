@@ -6,7 +6,7 @@ mod common;
 use std::ffi::c_void;
 
 use common::*;
-use spacecraft_fmus::fmi::abi::*;
+use spacecraft_fmus::fmi::fmi2::*;
 
 const OUTPUTS: &[&str] = &["q_w", "q_x", "q_y", "q_z", "w_x", "w_y", "w_z", "h_total_ref_x"];
 

@@ -11,7 +11,7 @@ mod common;
 use std::ffi::{c_int, c_void};
 
 use common::*;
-use spacecraft_fmus::fmi::abi::*;
+use spacecraft_fmus::fmi::fmi2::*;
 use spacecraft_fmus::model::{Causality, VarKind};
 use spacecraft_fmus::registry;
 

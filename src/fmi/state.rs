@@ -15,7 +15,8 @@ use std::sync::{Mutex, MutexGuard};
 use serde::{Deserialize, Serialize};
 
 use super::instance::{CallResult, Fail, Instance, Run};
-use super::{BuildAddrHasher, FsmState};
+use super::live::BuildAddrHasher;
+use super::types::FsmState;
 use crate::model::DynModel;
 
 const MAGIC: &[u8; 8] = b"SCFMUST\0";

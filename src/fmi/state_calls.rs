@@ -1,5 +1,5 @@
-//! The bodies of the FMU-state C functions, shared by FMI 2.0 (`abi_more.rs`) and FMI 3.0
-//! (`fmi3_more.rs`): each C function checks its pointers, then calls one of these inside its own
+//! The bodies of the FMU-state C functions, shared by FMI 2.0 (`fmi2/state.rs`) and FMI 3.0
+//! (`fmi3/state.rs`): each C function checks its pointers, then calls one of these inside its own
 //! `call`/`call3` (state machine, panic guard, logging).
 
 use std::ffi::c_void;

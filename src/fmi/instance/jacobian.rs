@@ -4,8 +4,7 @@
 //! state derivatives as unknowns and the continuous states as knowns (the Jacobian ∂ẋ/∂x an implicit
 //! solver asks for; FMI 2.0 section 3.2.2, FMI 3.0 section 2.2.11).
 
-use super::instance::{CallResult, Fail, Instance};
-use super::instance_me::LayerVar;
+use super::{CallResult, Fail, Instance, LayerVar};
 use crate::model::{Causality, SlotMut, Value, VarKind};
 
 /// A known: an input (declaration index) or a continuous state.

@@ -1,15 +1,18 @@
 //! One FMU instance: state machine, logging, value access with the causality/variability rules,
-//! initialization and stepping. Called only from `abi`, after null/state checks.
+//! initialization and stepping. Called only from the FMI 2.0 and 3.0 functions
+//! (`fmi2/`, `fmi3/`), after their null and state checks; `me.rs` adds the Model Exchange methods and
+//! `jacobian.rs` the directional derivatives.
 
 use std::collections::HashSet;
-use std::ffi::{c_char, c_int, c_void, CString};
+use std::ffi::{c_int, c_void, CString};
 
 use serde::{Deserialize, Serialize};
 
-use super::{FsmState, LoggerFn, Status, LOG_CATEGORIES};
+mod jacobian;
+pub mod me;
 
-/// `fmi3LogMessageCallback`: not variadic, the message is plain text (not a printf format).
-pub type Log3Fn = unsafe extern "C" fn(env: *mut c_void, status: c_int, category: *const c_char, message: *const c_char);
+use crate::fmi::types::{FsmState, Log3Fn, LoggerFn, Status, LOG_CATEGORIES};
+use crate::model::{DERIVATIVE_VR_BASE, STATE_VR_BASE};
 
 /// The master's logger: FMI 2.0 (`fmi2CallbackLogger`) or FMI 3.0 (`fmi3LogMessageCallback`).
 #[derive(Clone, Copy)]
@@ -279,11 +282,11 @@ impl Instance {
         for (i, vr) in vrs.iter().enumerate() {
             if kind == VarKind::Real {
                 if let Some(var) = self.layer_var(*vr) {
-                    let (super::instance_me::LayerVar::State(k) | super::instance_me::LayerVar::Derivative(k)) = var;
+                    let (LayerVar::State(k) | LayerVar::Derivative(k)) = var;
                     let name = self.entry.state_decls()[k].name;
                     return Err(Fail::error(match var {
-                        super::instance_me::LayerVar::State(_) => format!("{name} is a continuous state: set it with fmi2SetContinuousStates (Model Exchange)"),
-                        super::instance_me::LayerVar::Derivative(_) => format!("der({name}) is a state derivative and cannot be set"),
+                        LayerVar::State(_) => format!("{name} is a continuous state: set it with fmi2SetContinuousStates (Model Exchange)"),
+                        LayerVar::Derivative(_) => format!("der({name}) is a state derivative and cannot be set"),
                     }));
                 }
             }
@@ -428,5 +431,27 @@ impl Instance {
     pub fn reset(&mut self) {
         self.model = (self.entry.create)();
         self.run = Run::INSTANTIATED;
+    }
+}
+
+/// A variable the layer publishes for a Model Exchange model.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LayerVar {
+    State(usize),
+    Derivative(usize),
+}
+
+/// The Model Exchange variables the layer adds to a model's own (continuous states and their
+/// derivatives, at reserved value references): here, because value access (above) refuses to set them.
+impl Instance {
+    pub fn n_states(&self) -> usize {
+        self.entry.state_decls().len()
+    }
+
+    /// The continuous state or derivative behind a value reference, if it is one.
+    pub fn layer_var(&self, vr: u32) -> Option<LayerVar> {
+        let n = self.n_states();
+        let k = |base: u32| vr.checked_sub(base).map(|k| k as usize).filter(|k| *k < n);
+        k(STATE_VR_BASE).map(LayerVar::State).or_else(|| k(DERIVATIVE_VR_BASE).map(LayerVar::Derivative))
     }
 }

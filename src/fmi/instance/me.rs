@@ -2,9 +2,8 @@
 //! event iteration and the mode switches. The importer's solver integrates; the model gives ẋ, its
 //! time events and, where it keeps an invariant (a unit quaternion), a projection at events.
 
-use super::instance::{CallResult, Fail, Instance};
-use super::FsmState;
-use crate::model::{DERIVATIVE_VR_BASE, STATE_VR_BASE};
+use super::{CallResult, Fail, Instance, LayerVar};
+use crate::fmi::types::FsmState;
 
 /// What `fmi2NewDiscreteStates` reports (the fields of `fmi2EventInfo`).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -16,25 +15,7 @@ pub struct EventInfo {
     pub next_event_time: Option<f64>,
 }
 
-/// A variable the layer publishes for a Model Exchange model.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum LayerVar {
-    State(usize),
-    Derivative(usize),
-}
-
 impl Instance {
-    pub fn n_states(&self) -> usize {
-        self.entry.state_decls().len()
-    }
-
-    /// The continuous state or derivative behind a value reference, if it is one.
-    pub fn layer_var(&self, vr: u32) -> Option<LayerVar> {
-        let n = self.n_states();
-        let k = |base: u32| vr.checked_sub(base).map(|k| k as usize).filter(|k| *k < n);
-        k(STATE_VR_BASE).map(LayerVar::State).or_else(|| k(DERIVATIVE_VR_BASE).map(LayerVar::Derivative))
-    }
-
     /// Value of a state or derivative variable (derivatives at the current time and inputs).
     pub fn layer_value(&mut self, var: LayerVar) -> CallResult<f64> {
         let mut buf = vec![0.0; self.n_states()];

@@ -5,9 +5,8 @@
 use std::ffi::{c_char, c_int, c_void, CStr, CString};
 use std::sync::Mutex;
 
-use super::fmi3::*;
-use super::fmi3_more::*;
-use super::{FsmState, Status};
+use super::*;
+use crate::fmi::types::{FsmState, Status};
 use crate::export::*;
 
 declare_variables! {

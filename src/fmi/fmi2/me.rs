@@ -1,12 +1,13 @@
 //! The FMI 2.0 Model Exchange C functions (chapter 3), on the same instances, checks and logging as
-//! the Co-Simulation ones (`abi.rs`). Each one refuses a Co-Simulation instance with a message.
+//! the Co-Simulation ones (`common.rs`). Each one refuses a Co-Simulation instance with a message.
 #![allow(non_snake_case, clippy::missing_safety_doc, clippy::not_unsafe_ptr_arg_deref)]
 
 use std::ffi::c_int;
 
-use super::abi::{call, out_ptr, slice, slice_mut, Component};
-use super::instance::{CallResult, Fail, Instance};
-use super::{mask, FsmState};
+use super::common::{call, mask, Component};
+use crate::fmi::boundary::{out_ptr, slice, slice_mut};
+use crate::fmi::instance::{CallResult, Fail, Instance};
+use crate::fmi::types::FsmState;
 
 /// `fmi2GetDerivatives` (FMI 2.0 ME state table): event, continuous-time, terminated and error state,
 /// not initialization mode (the Reference FMUs use the same masks).

@@ -1,0 +1,20 @@
+//! FMI 3.0: one room over the shared C boundary, the same instances as FMI 2.0. `common` holds what
+//! every FMI 3.0 function shares (state tables, `call3`, `time`, life cycle); `values` get/set for both
+//! interfaces; `cs` Co-Simulation, `me` Model Exchange (and the functions both interfaces export with
+//! ME rules); `state` FMU states, directional derivatives and variable dependencies; `unsupported` the
+//! functions of features these FMUs do not declare; `export` the `#[no_mangle]` wrappers. The files
+//! import `common`, the boundary and the instance, never each other, and nothing here imports FMI 2.0.
+
+pub mod common;
+pub mod cs;
+mod export;
+pub mod me;
+pub mod state;
+#[cfg(test)]
+mod tests;
+pub mod unsupported;
+pub mod values;
+
+/// Every FMI 3.0 function in one path (`spacecraft_fmus::fmi::fmi3::*`), for Rust code that drives the
+/// layer directly.
+pub use self::{common::*, cs::*, me::*, state::*, unsupported::*, values::*};

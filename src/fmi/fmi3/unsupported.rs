@@ -1,0 +1,130 @@
+//! Every FMI 3.0 function of a feature these FMUs do not declare (adjoint derivatives, Configuration
+//! Mode, variable types other than Float64/Int32/Boolean, clocks, Scheduled Execution). They exist
+//! because the standard's importers (fmpy, FMI Library) resolve every `fmi3*` symbol when they load a
+//! binary; each one refuses with `fmi3Error` and a logged reason, as the standard prescribes for a call
+//! the model description does not allow.
+#![allow(non_snake_case, clippy::missing_safety_doc, clippy::not_unsafe_ptr_arg_deref, clippy::too_many_arguments)]
+
+use std::ffi::{c_char, c_int, c_void};
+
+use super::common::{call3, log_without_instance3, mask3, refuse, Instance3};
+use crate::fmi::boundary::slice;
+use crate::fmi::instance::Fail;
+use crate::fmi::types::Log3Fn;
+
+pub extern "C" fn fmi3GetAdjointDerivative(c: Instance3, _u: *const u32, _nu: usize, _k: *const u32, _nk: usize, _s: *const f64, _ns: usize, _out: *mut f64, _no: usize) -> c_int {
+    refuse(c, "fmi3GetAdjointDerivative", mask3::DIRECTIONAL_DERIVATIVE, "providesAdjointDerivatives = false")
+}
+
+pub extern "C" fn fmi3EnterConfigurationMode(c: Instance3) -> c_int {
+    refuse(c, "fmi3EnterConfigurationMode", mask3::ANY, "this FMU has no structural parameters")
+}
+
+pub extern "C" fn fmi3ExitConfigurationMode(c: Instance3) -> c_int {
+    refuse(c, "fmi3ExitConfigurationMode", mask3::ANY, "this FMU has no structural parameters (Configuration Mode is never entered)")
+}
+
+/// Variables of a type this FMU does not have: a call with values is refused (naming the first value
+/// reference); an empty call does nothing.
+fn no_such_type(c: Instance3, func: &str, allowed: u16, ty: &str, vr: *const u32, n: usize) -> c_int {
+    call3(c, func, allowed, |_| {
+        let vrs = unsafe { slice(vr, n, "valueReferences[]")? };
+        match vrs.first() {
+            None => Ok(()),
+            Some(v) => Err(Fail::error(format!("unknown {ty} value reference {v}: this FMU has no variables of type {ty}"))),
+        }
+    })
+}
+
+macro_rules! other_types {
+    ($($get:ident, $set:ident, $t:ty, $name:literal;)*) => {$(
+        pub extern "C" fn $get(c: Instance3, vr: *const u32, n: usize, _v: *mut $t, _nv: usize) -> c_int {
+            no_such_type(c, stringify!($get), mask3::GET, $name, vr, n)
+        }
+        pub extern "C" fn $set(c: Instance3, vr: *const u32, n: usize, _v: *const $t, _nv: usize) -> c_int {
+            no_such_type(c, stringify!($set), mask3::SET, $name, vr, n)
+        }
+    )*};
+}
+
+other_types! {
+    fmi3GetFloat32, fmi3SetFloat32, f32, "Float32";
+    fmi3GetInt8, fmi3SetInt8, i8, "Int8";
+    fmi3GetUInt8, fmi3SetUInt8, u8, "UInt8";
+    fmi3GetInt16, fmi3SetInt16, i16, "Int16";
+    fmi3GetUInt16, fmi3SetUInt16, u16, "UInt16";
+    fmi3GetUInt32, fmi3SetUInt32, u32, "UInt32";
+    fmi3GetInt64, fmi3SetInt64, i64, "Int64";
+    fmi3GetUInt64, fmi3SetUInt64, u64, "UInt64";
+    fmi3GetString, fmi3SetString, *const c_char, "String";
+}
+
+pub extern "C" fn fmi3GetBinary(c: Instance3, vr: *const u32, n: usize, _sizes: *mut usize, _v: *mut *const u8, _nv: usize) -> c_int {
+    no_such_type(c, "fmi3GetBinary", mask3::GET, "Binary", vr, n)
+}
+
+pub extern "C" fn fmi3SetBinary(c: Instance3, vr: *const u32, n: usize, _sizes: *const usize, _v: *const *const u8, _nv: usize) -> c_int {
+    no_such_type(c, "fmi3SetBinary", mask3::SET, "Binary", vr, n)
+}
+
+pub extern "C" fn fmi3GetClock(c: Instance3, vr: *const u32, n: usize, _v: *mut u8) -> c_int {
+    no_such_type(c, "fmi3GetClock", mask3::ANY, "Clock", vr, n)
+}
+
+pub extern "C" fn fmi3SetClock(c: Instance3, vr: *const u32, n: usize, _v: *const u8) -> c_int {
+    no_such_type(c, "fmi3SetClock", mask3::ANY, "Clock", vr, n)
+}
+
+pub extern "C" fn fmi3GetIntervalDecimal(c: Instance3, vr: *const u32, n: usize, _i: *mut f64, _q: *mut c_int) -> c_int {
+    no_such_type(c, "fmi3GetIntervalDecimal", mask3::ANY, "Clock", vr, n)
+}
+
+pub extern "C" fn fmi3GetIntervalFraction(c: Instance3, vr: *const u32, n: usize, _counters: *mut u64, _r: *mut u64, _q: *mut c_int) -> c_int {
+    no_such_type(c, "fmi3GetIntervalFraction", mask3::ANY, "Clock", vr, n)
+}
+
+pub extern "C" fn fmi3GetShiftDecimal(c: Instance3, vr: *const u32, n: usize, _s: *mut f64) -> c_int {
+    no_such_type(c, "fmi3GetShiftDecimal", mask3::ANY, "Clock", vr, n)
+}
+
+pub extern "C" fn fmi3GetShiftFraction(c: Instance3, vr: *const u32, n: usize, _counters: *mut u64, _r: *mut u64) -> c_int {
+    no_such_type(c, "fmi3GetShiftFraction", mask3::ANY, "Clock", vr, n)
+}
+
+pub extern "C" fn fmi3SetIntervalDecimal(c: Instance3, vr: *const u32, n: usize, _i: *const f64) -> c_int {
+    no_such_type(c, "fmi3SetIntervalDecimal", mask3::ANY, "Clock", vr, n)
+}
+
+pub extern "C" fn fmi3SetIntervalFraction(c: Instance3, vr: *const u32, n: usize, _counters: *const u64, _r: *const u64) -> c_int {
+    no_such_type(c, "fmi3SetIntervalFraction", mask3::ANY, "Clock", vr, n)
+}
+
+pub extern "C" fn fmi3SetShiftDecimal(c: Instance3, vr: *const u32, n: usize, _s: *const f64) -> c_int {
+    no_such_type(c, "fmi3SetShiftDecimal", mask3::ANY, "Clock", vr, n)
+}
+
+pub extern "C" fn fmi3SetShiftFraction(c: Instance3, vr: *const u32, n: usize, _counters: *const u64, _r: *const u64) -> c_int {
+    no_such_type(c, "fmi3SetShiftFraction", mask3::ANY, "Clock", vr, n)
+}
+
+// ----- Scheduled Execution ---------------------------------------------------------------------------
+
+pub extern "C" fn fmi3InstantiateScheduledExecution(
+    _name: *const c_char,
+    _token: *const c_char,
+    _resources: *const c_char,
+    _visible: u8,
+    _logging_on: u8,
+    env: *mut c_void,
+    log_message: Option<Log3Fn>,
+    _clock_update: *const c_void,
+    _lock: *const c_void,
+    _unlock: *const c_void,
+) -> Instance3 {
+    log_without_instance3(log_message, env, "fmi3InstantiateScheduledExecution", "this FMU provides no Scheduled Execution (no <ScheduledExecution> element)");
+    std::ptr::null_mut()
+}
+
+pub extern "C" fn fmi3ActivateModelPartition(c: Instance3, _clock: u32, _t: f64) -> c_int {
+    refuse(c, "fmi3ActivateModelPartition", mask3::ANY, "Scheduled Execution function; this FMU provides Co-Simulation only")
+}
