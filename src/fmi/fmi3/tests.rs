@@ -103,15 +103,15 @@ fn an_error_terminates_and_reset_recovers() {
     let c = new(&log);
     assert_eq!(fmi3SetBoolean(c, [0u32].as_ptr(), 1, [1u8].as_ptr(), 1), ERROR);
     assert!(last(&log).contains("fmi3SetBoolean") && last(&log).contains("value reference 0 is u"), "{}", last(&log));
-    let inst = super::abi::instance_of(c, true).unwrap();
+    let inst = crate::fmi::boundary::instance_of(c, true).unwrap();
     assert_eq!(inst.run.fsm, FsmState::Terminated);
     assert_eq!(fmi3EnterInitializationMode(c, 0, 0.0, 0.0, 0, 0.0), ERROR);
     assert!(last(&log).contains("not allowed in state Terminated"), "{}", last(&log));
     assert_eq!(fmi3Reset(c), OK);
-    assert_eq!(super::abi::instance_of(c, true).unwrap().run.fsm, FsmState::Instantiated);
+    assert_eq!(crate::fmi::boundary::instance_of(c, true).unwrap().run.fsm, FsmState::Instantiated);
     // an FMI 2.0 function does not know an FMI 3.0 instance, and the other way round
-    assert_eq!(super::abi::fmi2EnterInitializationMode(c), ERROR);
-    assert!(super::abi::instance_of(c, false).is_none());
+    assert_eq!(crate::fmi::fmi2::fmi2EnterInitializationMode(c), ERROR);
+    assert!(crate::fmi::boundary::instance_of(c, false).is_none());
     fmi3FreeInstance(c);
 }
 
