@@ -151,3 +151,18 @@ def test_builtin_tuning_reaches_the_run_on_its_own_scenario(tmp_path):
         ise = metrics.compute(sc.metrics, simulate(sc, "native"))["ise"]
         assert math.isclose(rows[b.label], ise, rel_tol=1e-9), (b.label, rows[b.label], ise)
     assert len({round(v, 6) for v in rows.values()}) == 4, rows
+
+
+def test_time_in_saturation_above_the_threshold_is_a_warning_at_the_top():
+    """A pair whose actuators sit at their limit for more than SATURATION_WARNING % of the run is named in the
+    warnings block; one below it is not (the threshold is a project choice, stated on the page)."""
+    from types import SimpleNamespace as NS
+
+    from scfmu.benchmark import WARNINGS, engineering
+    limit = engineering.SATURATION_WARNING
+    hot = NS(case="003-N", controller="SMC", means={"sat_frac": limit + 1.0})
+    cool = NS(case="003-N", controller="PD", means={"sat_frac": limit - 1.0})
+    unknown = NS(case="003-N", controller="LQR", means={})
+    assert engineering.saturation_warnings in WARNINGS
+    out = engineering.saturation_warnings([], [hot, cool, unknown], {})
+    assert len(out) == 1 and out[0].startswith("003-N / SMC: actuators at their limit 26 % of the run"), out

@@ -567,3 +567,6 @@ def write_page(out: Path, family: str, cases, entries: list[Entry], unit_label, 
     (out / "benchmark.md").write_text("\n".join(md) + "\n", encoding="utf-8")
     (out / "index.html").write_text(f"<!doctype html><html><head><meta charset='utf-8'><title>{html.escape(title)}"
                                     "</title></head><body>" + "\n".join(h) + "</body></html>\n", encoding="utf-8")
+
+
+add_warning(engineering.saturation_warnings)  # time in actuator saturation (scfmu.benchmark.engineering)

@@ -100,6 +100,21 @@ def eval_text(sc) -> str:
             f"RPE/PDE/jitter window {EVAL_FRACTION * T / WINDOWS:g} s")
 
 
+SATURATION_WARNING = 25.0  # [%] of the run at an actuator limit that the page's warnings name (project choice)
+
+
+def saturation_warnings(cases, entries, ctx) -> list[str]:
+    """Warnings-block lines for the pairs whose actuators sit at their limit for more than
+    :data:`SATURATION_WARNING` per cent of the run (mean over the runs)."""
+    out = []
+    for e in entries:
+        v = e.means.get("sat_frac", math.nan)
+        if math.isfinite(v) and v > SATURATION_WARNING:
+            out.append(f"{e.case} / {e.controller}: actuators at their limit {v:.0f} % of the run "
+                       f"(warned above {SATURATION_WARNING:g} %)")
+    return out
+
+
 def entry_metrics(e, sc, folder, good_rows) -> None:
     """Means over the runs that succeeded of the saturation fraction and pointing errors (into ``e.means``)."""
     if not applies(sc) or not good_rows:
