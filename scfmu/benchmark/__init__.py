@@ -228,6 +228,7 @@ def run(unit: str | None, family: str, out: str | Path, label: str | None = None
     if own:
         client, cluster = campaign._client(None, workers)
     entries: list[Entry] = []
+    jobs: list = []  # (entry, case, scenario, campaign, folder) of the pairs that run
     pairs: dict = {}  # (case, controller) -> scenario, for the Monte Carlo and the margins
     t0 = time.time()
     studies = None
@@ -271,26 +272,13 @@ def run(unit: str | None, family: str, out: str | Path, label: str | None = None
                 ts = list(dict.fromkeys([k for k in keys if k in sc.log] + (ts_keys or [])))
                 c = campaign.Campaign(sc, sets, seeds, timeseries=ts or None, ts_every=every)
                 folder = out / "runs" / _slug(case.label) / _slug(name)  # one folder per case (two cases may share a scenario)
-                table = campaign.run(c, folder, client=client, progress=False, overwrite=True)
-                rows = sorted(table.to_pylist(), key=lambda r: r["run"])
-                e.runs = len(rows)
-                good = [r for r in rows if r["status"] == "ok"]
-                e.rows = good
-                e.ok = len(good)
-                e.settled = sum(1 for r in good if math.isfinite(r.get("settling_s", math.nan)))
-                e.failures = [f"run {r['run']}: {r['status']}: {r['message'][:160]}" for r in rows if r["status"] != "ok"]
-                for k in dict.fromkeys([k for k, _ in COLUMNS] + [case.primary]):
-                    v = np.array([r.get(k, math.nan) for r in good], dtype=float)
-                    e.means[k] = float(np.mean(v)) if v.size and np.all(np.isfinite(v)) else math.nan
-                engineering.entry_metrics(e, sc, folder, good)
-                if c.timeseries and good:
-                    try:
-                        e.series = campaign.read_timeseries(folder, good[0]["run"])
-                    except OSError:
-                        e.series = None
-                _check_error_growth(e)
-                log(f"  {case.label} / {name}: {e.ok}/{e.runs} ok, {case.primary} = {e.means.get(case.primary, math.nan):.6g}"
-                    + (f"; {e.config}" if e.envelope == "retuned" else ""))
+                jobs.append((e, case, sc, c, folder))
+        # the pairs' campaigns run side by side (threads sharing the Dask client), so that single-run pairs keep
+        # every worker busy; each pair's rows and series are its own, so the results do not depend on the order
+        from concurrent.futures import ThreadPoolExecutor
+        with ThreadPoolExecutor(max_workers=max(2, 2 * (workers or 1))) as pool:
+            for job in [pool.submit(_run_pair, client, log, *j) for j in jobs]:
+                job.result()
         if family == "attitude":  # robustness Monte Carlo and stability margins (scfmu.benchmark.engineering)
             studies = engineering.studies(cases, pairs, entries, out, client, quick, log)
     finally:
@@ -302,6 +290,30 @@ def run(unit: str | None, family: str, out: str | Path, label: str | None = None
     if family == "attitude":
         engineering.append_to_page(out, cases, entries, ranks(cases, entries), unit_label, studies)
     return entries
+
+
+def _run_pair(client, log, e: Entry, case, sc, c, folder: Path) -> None:
+    """Runs one (scenario, controller) pair's campaign and fills its entry (means, series, flags)."""
+    table = campaign.run(c, folder, client=client, progress=False, overwrite=True)
+    rows = sorted(table.to_pylist(), key=lambda r: r["run"])
+    e.runs = len(rows)
+    good = [r for r in rows if r["status"] == "ok"]
+    e.rows = good
+    e.ok = len(good)
+    e.settled = sum(1 for r in good if math.isfinite(r.get("settling_s", math.nan)))
+    e.failures = [f"run {r['run']}: {r['status']}: {r['message'][:160]}" for r in rows if r["status"] != "ok"]
+    for k in dict.fromkeys([k for k, _ in COLUMNS] + [case.primary]):
+        v = np.array([r.get(k, math.nan) for r in good], dtype=float)
+        e.means[k] = float(np.mean(v)) if v.size and np.all(np.isfinite(v)) else math.nan
+    engineering.entry_metrics(e, sc, folder, good)
+    if c.timeseries and good:
+        try:
+            e.series = campaign.read_timeseries(folder, good[0]["run"])
+        except OSError:
+            e.series = None
+    _check_error_growth(e)
+    log(f"  {case.label} / {e.controller}: {e.ok}/{e.runs} ok, {case.primary} = {e.means.get(case.primary, math.nan):.6g}"
+        + (f"; {e.config}" if e.envelope == "retuned" else ""))
 
 
 def _slug(text: str) -> str:
