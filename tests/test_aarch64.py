@@ -96,54 +96,57 @@ def test_every_fmu_carries_one_aarch64_build_in_both_fmi_versions(fmus_with_aarc
 
 @pytest.fixture(scope="module")
 def work(tmp_path_factory, fmus_with_aarch64):
-    """A folder with the x86-64 and aarch64 builds of the masters and of the FMUs' binaries:
-    <Model>.so / <Model>.arm.so (FMI 2.0), <Model>.3.so / <Model>.3.arm.so (FMI 3.0), and the GUIDs."""
+    """A folder with the x86-64 and aarch64 builds of the masters (<name>, <name>.arm) and the FMUs' binaries
+    under their own file names (the library finds its model by its file name): x86/<Model>.so and
+    arm/<Model>.so (FMI 2.0), x86_3/AttitudePlant.so and arm_3/AttitudePlant.so (FMI 3.0); and the GUIDs."""
     d = tmp_path_factory.mktemp("aarch64")
     for src, name, extra in ((LOADER, "fmi_loop", ["-ldl"]), (HOSTILE2, "fmi_hostile", ["-pthread", "-ldl", "-lm"]),
                              (HOSTILE3, "fmi3_hostile", ["-ldl", "-lm"])):
         for cc, suffix in (("gcc", ""), (CROSS_GCC, ".arm")):
             subprocess.run([cc, "-O1", "-Wall", "-Werror", "-o", str(d / (name + suffix)), str(src), *extra], check=True)
         assert elf_machine((d / f"{name}.arm").read_bytes())[1] == EM_AARCH64
+    for sub in ("x86", "arm", "x86_3", "arm_3"):
+        (d / sub).mkdir()
     info = {}
     for model in ("AttitudePlant", "PdController", *NONLINEAR_CONTROLLERS):
         with zipfile.ZipFile(FMUS / f"{model}.fmu") as z:
-            (d / f"{model}.so").write_bytes(z.read(f"binaries/linux64/{model}.so"))
-            (d / f"{model}.arm.so").write_bytes(z.read(f"binaries/aarch64-linux/{model}.so"))
+            (d / "x86" / f"{model}.so").write_bytes(z.read(f"binaries/linux64/{model}.so"))
+            (d / "arm" / f"{model}.so").write_bytes(z.read(f"binaries/aarch64-linux/{model}.so"))
             root = ET.fromstring(z.read("modelDescription.xml"))
         info[model] = (root.get("guid"), {v.get("name"): int(v.get("valueReference"))
                                           for v in root.iter("ScalarVariable")})
     with zipfile.ZipFile(FMUS / "fmi3" / "AttitudePlant.fmu") as z:
-        (d / "AttitudePlant.3.so").write_bytes(z.read("binaries/x86_64-linux/AttitudePlant.so"))
-        (d / "AttitudePlant.3.arm.so").write_bytes(z.read("binaries/aarch64-linux/AttitudePlant.so"))
+        (d / "x86_3" / "AttitudePlant.so").write_bytes(z.read("binaries/x86_64-linux/AttitudePlant.so"))
+        (d / "arm_3" / "AttitudePlant.so").write_bytes(z.read("binaries/aarch64-linux/AttitudePlant.so"))
         info["token3"] = re.search(r'instantiationToken="([^"]+)"', z.read("modelDescription.xml").decode()).group(1)
     return d, info
 
 
-def run_native(d: Path, prog: str, *args: str, timeout: float = 300) -> subprocess.CompletedProcess:
-    return subprocess.run([str(d / prog), *args], cwd=d, capture_output=True, text=True, timeout=timeout)
+def run_native(d: Path, sub: str, prog: str, *args: str, timeout: float = 300) -> subprocess.CompletedProcess:
+    return subprocess.run([str(d / prog), *args], cwd=d / sub, capture_output=True, text=True, timeout=timeout)
 
 
-def run_arm(d: Path, prog: str, *args: str, timeout: float = 900) -> subprocess.CompletedProcess:
+def run_arm(d: Path, sub: str, prog: str, *args: str, timeout: float = 900) -> subprocess.CompletedProcess:
     # -L: the aarch64 dynamic loader and C library (libc6-arm64-cross) for the emulated process
-    return subprocess.run([QEMU, "-L", str(SYSROOT), str(d / f"{prog}.arm"), *args], cwd=d, capture_output=True,
-                          text=True, timeout=timeout)
+    return subprocess.run([QEMU, "-L", str(SYSROOT), str(d / f"{prog}.arm"), *args], cwd=d / sub,
+                          capture_output=True, text=True, timeout=timeout)
 
 
 def test_the_arm_master_really_runs_emulated(work):
     """The aarch64 master cannot run natively here (so the comparisons below are not x86-64 against
-    itself), and under qemu it reports an aarch64 FMU binary refusing a wrong GUID by name."""
+    itself); under qemu the aarch64 library finds its own file name (it refuses another model's GUID,
+    naming AttitudePlant), and the x86-64 library does not load into the emulated process."""
     d, info = work
     with pytest.raises(OSError):
-        subprocess.run([str(d / "fmi_loop.arm"), "instantiate", "./AttitudePlant.arm.so", "x"], cwd=d,
+        subprocess.run([str(d / "fmi_loop.arm"), "instantiate", "./AttitudePlant.so", "x"], cwd=d / "arm",
                        capture_output=True, timeout=30)
-    p = run_arm(d, "fmi_loop", "instantiate", "./AttitudePlant.arm.so", info["PdController"][0])
+    p = run_arm(d, "arm", "fmi_loop", "instantiate", "./AttitudePlant.so", info["PdController"][0])
     assert p.stdout.split() == ["null"], p.stdout + p.stderr
     assert "does not match AttitudePlant's GUID" in p.stderr, p.stderr
-    p = run_arm(d, "fmi_loop", "instantiate", "./AttitudePlant.arm.so", info["AttitudePlant"][0])
+    p = run_arm(d, "arm", "fmi_loop", "instantiate", "./AttitudePlant.so", info["AttitudePlant"][0])
     assert p.stdout.split() == ["instance"], p.stdout + p.stderr
-    # the x86-64 library does not load into the emulated aarch64 process
-    p = run_arm(d, "fmi_loop", "instantiate", "./AttitudePlant.so", info["AttitudePlant"][0])
-    assert p.returncode != 0 and "FAIL" in p.stdout + p.stderr
+    p = run_arm(d, "x86", "fmi_loop", "instantiate", "./AttitudePlant.so", info["AttitudePlant"][0])
+    assert p.returncode != 0 and "FAIL" in p.stdout + p.stderr, p.stdout + p.stderr
 
 
 def exported(nm: str, lib: Path) -> set[str]:
@@ -158,20 +161,20 @@ def needed(lib: Path) -> set[str]:
 
 def test_aarch64_build_exports_the_same_fmi_functions_and_needs_only_the_c_library(work):
     d, _ = work
-    arm, x86 = exported(CROSS_NM, d / "AttitudePlant.arm.so"), exported("nm", d / "AttitudePlant.so")
+    arm, x86 = exported(CROSS_NM, d / "arm" / "AttitudePlant.so"), exported("nm", d / "x86" / "AttitudePlant.so")
     assert arm == x86 and len({s for s in arm if s.startswith("fmi2")}) == 44
     assert len({s for s in arm if s.startswith("fmi3")}) == 75
-    deps = needed(d / "AttitudePlant.arm.so")
+    deps = needed(d / "arm" / "AttitudePlant.so")
     assert deps and deps <= SYSTEM_SONAMES, deps
     assert "libc.so.6" in deps
 
 
 def run_loops(work, controller: str, steps: int = 1000, dt: float = 0.05):
     d, info = work
-    native = run_native(d, "fmi_loop", *loop_args(info, "so", steps, dt, controller))
+    args = loop_args(info, "so", steps, dt, controller)
+    native = run_native(d, "x86", "fmi_loop", *args)
     assert native.returncode == 0, native.stdout[-2000:] + native.stderr[-2000:]
-    arm_args = [a.replace(".so", ".arm.so") if a.endswith(".so") else a for a in loop_args(info, "so", steps, dt, controller)]
-    arm = run_arm(d, "fmi_loop", *arm_args)
+    arm = run_arm(d, "arm", "fmi_loop", *args)
     assert arm.returncode == 0, arm.stdout[-2000:] + arm.stderr[-2000:]
     head_x86, rows_x86 = parse_loop(native.stdout)
     head_arm, rows_arm = parse_loop(arm.stdout)
@@ -219,8 +222,8 @@ HOSTILE_FMI3 = [("abuse",), ("me",), ("mixed",)]
 def test_hostile_fmi2_master_reports_the_same_on_aarch64(work, args):
     d, info = work
     guid = info["AttitudePlant"][0]
-    native = run_native(d, "fmi_hostile", "./AttitudePlant.so", guid, *args)
-    arm = run_arm(d, "fmi_hostile", "./AttitudePlant.arm.so", guid, *args)
+    native = run_native(d, "x86", "fmi_hostile", "./AttitudePlant.so", guid, *args)
+    arm = run_arm(d, "arm", "fmi_hostile", "./AttitudePlant.so", guid, *args)
     assert native.returncode == 0 and native.stdout.startswith("ok"), native.stdout + native.stderr[-2000:]
     assert arm.returncode == 0 and arm.stdout.startswith("ok"), arm.stdout + arm.stderr[-2000:]
     assert arm.stdout == native.stdout
@@ -229,8 +232,8 @@ def test_hostile_fmi2_master_reports_the_same_on_aarch64(work, args):
 @pytest.mark.parametrize("args", HOSTILE_FMI3, ids=lambda a: " ".join(a))
 def test_hostile_fmi3_master_reports_the_same_on_aarch64(work, args):
     d, info = work
-    native = run_native(d, "fmi3_hostile", "./AttitudePlant.3.so", info["token3"], *args)
-    arm = run_arm(d, "fmi3_hostile", "./AttitudePlant.3.arm.so", info["token3"], *args)
+    native = run_native(d, "x86_3", "fmi3_hostile", "./AttitudePlant.so", info["token3"], *args)
+    arm = run_arm(d, "arm_3", "fmi3_hostile", "./AttitudePlant.so", info["token3"], *args)
     assert native.returncode == 0 and native.stdout.startswith("ok"), native.stdout + native.stderr[-2000:]
     assert arm.returncode == 0 and arm.stdout.startswith("ok"), arm.stdout + arm.stderr[-2000:]
     assert arm.stdout == native.stdout
