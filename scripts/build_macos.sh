@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
-# Cross-builds the workspace's two shared libraries for macOS on Linux, for both Mac CPUs: Intel
-# (x86_64-apple-darwin, macOS 10.12 or later) and Apple silicon (aarch64-apple-darwin, macOS 11 or later):
-#   target/macos/<triple>/release/libspacecraft_fmus_cdylib.dylib   the FMUs' binary
-#   target/macos/<triple>/release/libscfmu_native_loop.dylib        the compiled engine's loop (macOS wheels)
+# Cross-builds the FMUs' shared library for macOS on Linux, for both Mac CPUs: Intel (x86_64-apple-darwin,
+# macOS 10.12 or later) and Apple silicon (aarch64-apple-darwin, macOS 11 or later):
+#   target/macos/<triple>/release/libspacecraft_fmus_cdylib.dylib
+# The compiled engine's loop library (scfmu/engines/native_loop) is not built for macOS: a second cargo run
+# with its own install name compiles std again (cargo hashes std differently per run), which doubles an
+# already long build; the macOS wheels therefore carry no compiled loop and campaigns there use the
+# "native" engine.
 # Prints one line per CPU, `x86_64-darwin=PATH` and `aarch64-darwin=PATH` (fmu-package --add-lib specs).
 #
 # No macOS SDK and no Apple tool: Debian's Rust (rustc-web, cargo-web) compiles the standard library for
@@ -49,26 +52,34 @@ fi
 
 zig_version=$("$PY" -m ziglang version)
 rust_version=$("$RUSTC_DEB" --version)
-# cargo-zigbuild runs `cargo` from PATH: Debian's, with the compiler whose std sources we build from.
-shim=$(mktemp -d)
+# cargo-zigbuild runs `cargo` and `zig` from PATH: Debian's cargo (with the compiler whose std sources we
+# build from) and the pinned ziglang of .venv. They sit in a fixed folder of the cache, with a copy of
+# cargo-zigbuild itself: the linker wrapper it writes names these paths, and cargo rebuilds everything
+# when the linker's path changes, so the paths must not depend on the clone or on a temporary folder.
+tools=$(cross_cache_dir macos-tools "$rust_version-zig-$zig_version")
+ln -sfn "$CARGO_DEB" "$tools/cargo"
+printf '#!/bin/sh\nexec "%s" -m ziglang "$@"\n' "$PWD/$PY" >"$tools/zig.tmp.$$" && chmod +x "$tools/zig.tmp.$$" && mv -f "$tools/zig.tmp.$$" "$tools/zig"
+cmp -s "$ZIGBUILD" "$tools/cargo-zigbuild" || { cp "$ZIGBUILD" "$tools/cargo-zigbuild.tmp.$$" && mv -f "$tools/cargo-zigbuild.tmp.$$" "$tools/cargo-zigbuild"; }
 json=$(mktemp)
-trap 'rm -rf "$shim" "$json"' EXIT
-ln -s "$CARGO_DEB" "$shim/cargo"
-# ... and `zig` from PATH: the pinned ziglang of .venv
-printf '#!/bin/sh\nexec %s -m ziglang "$@"\n' "$PWD/$PY" >"$shim/zig"
-chmod +x "$shim/zig"
+trap 'rm -f "$json"' EXIT
 
 start_all=$(date +%s)
 for pair in x86_64-darwin:x86_64-apple-darwin aarch64-darwin:aarch64-apple-darwin; do
     key=${pair%%:*} triple=${pair#*:}
     cache=$(cross_cache_dir "$triple" "$rust_version-zig-$zig_version")
     start=$(date +%s)
-    PATH="$shim:$PATH" CARGO="$CARGO_DEB" RUSTC="$RUSTC_DEB" RUSTDOC=/usr/bin/rustdoc RUSTC_BOOTSTRAP=1 \
-    CARGO_ZIGBUILD_CACHE_DIR="$cache/zigbuild" \
-    CARGO_PROFILE_RELEASE_STRIP=false \
-        "$ZIGBUILD" zigbuild --release --locked --lib -p spacecraft_fmus_cdylib -p scfmu_native_loop \
-        -Z build-std=std,panic_unwind --target "$triple" --target-dir "$cache" \
-        --message-format=json-render-diagnostics >"$json"
+    # the oldest macOS of each CPU that Rust supports (its targets' defaults), passed to Zig's linker
+    # (else it stamps its newest macOS into the library and older ones refuse to load it); `cargo rustc`
+    # to give the library the install name @rpath/<file> (not the build folder)
+    case "$triple" in x86_64-*) min=10.12 ;; *) min=11.0 ;; esac
+    : >"$json"
+    for pkg in spacecraft_fmus_cdylib; do
+        PATH="$tools:$PATH" CARGO="$CARGO_DEB" RUSTC="$RUSTC_DEB" RUSTDOC=/usr/bin/rustdoc RUSTC_BOOTSTRAP=1 \
+        MACOSX_DEPLOYMENT_TARGET=$min CARGO_ZIGBUILD_CACHE_DIR="$cache/zigbuild" CARGO_PROFILE_RELEASE_STRIP=false \
+            "$tools/cargo-zigbuild" rustc --release --locked --lib -p "$pkg" \
+            -Z build-std=std,panic_unwind --target "$triple" --target-dir "$cache" \
+            --message-format=json-render-diagnostics -- -C "link-arg=-Wl,-install_name,@rpath/lib$pkg.dylib" >>"$json"
+    done
     out=target/macos/$triple/release
     cross_products "$json" "$out" >/dev/null
     lib=$out/libspacecraft_fmus_cdylib.dylib
