@@ -67,8 +67,8 @@ loop_lib() {
         linux-x86_64) echo "linux64 target/release/libscfmu_native_loop.so" ;;
         linux-aarch64) echo "linux64 target/aarch64/aarch64-unknown-linux-gnu/release/libscfmu_native_loop.so" ;;
         win-amd64) echo "win64 target/win64/x86_64-win7-windows-gnu/release/scfmu_native_loop.dll" ;;
-        macos-x86_64) echo "darwin64 target/macos/x86_64-apple-darwin/release/libscfmu_native_loop.dylib" ;;
-        macos-arm64) echo "darwin64 target/macos/aarch64-apple-darwin/release/libscfmu_native_loop.dylib" ;;
+        # not built for macOS (scripts/build_macos.sh says why): the macOS wheels use the "native" engine
+        macos-*) echo "darwin64 -" ;;
     esac
 }
 mkdir -p "$out"
@@ -79,7 +79,7 @@ for plat in "${platforms[@]}"; do
     cp pyproject.toml README.md "$stage/"
     tar --exclude='__pycache__' --exclude='*/tests' -cf - scfmu | tar -xf - -C "$stage"
     read -r folder lib <<<"$(loop_lib "$plat")"
-    if [ -f "$lib" ]; then
+    if [ "$lib" != - ] && [ -f "$lib" ]; then
         mkdir -p "$stage/scfmu/engines/native_loop/bin/$folder"
         cp "$lib" "$stage/scfmu/engines/native_loop/bin/$folder/"
     else
