@@ -8,6 +8,10 @@
 # sources in /usr/lib/rustlib/src) to build std for the target itself
 # (-Z build-std, allowed on a stable compiler by RUSTC_BOOTSTRAP=1) and the MinGW-w64 linker
 # (gcc-mingw-w64-x86-64). scripts/setup.sh installs these packages. Why the win7 target: docs/tools.md.
+# The cargo target folder (std compiled for the target included) lives in the cross-build cache
+# (scripts/cross_cache.sh, under ~/.cache by default), shared by every clone and by users' crates: std
+# is compiled once per machine and compiler version, not at every clean build; the DLLs are copied out
+# into target/win64 (or the crate's target folder).
 #
 #   scripts/build_win64.sh                         build; prints the FMUs' DLL path on the last line
 #   scripts/build_win64.sh --manifest-path PATH    build that package; prints its release folder on the last line
@@ -18,6 +22,7 @@ if [ "${1:-}" = "--manifest-path" ]; then
     manifest=$(realpath "${2:?--manifest-path needs a path}")
 fi
 cd "$(dirname "$0")/.."
+. scripts/cross_cache.sh
 
 TARGET=x86_64-win7-windows-gnu
 RUSTC_DEB=/usr/bin/rustc
@@ -43,22 +48,31 @@ if [ "${1:-}" = "--check" ]; then
 fi
 
 # The Debian compiler is used for everything of this build (RUSTC), never the rustup one: std is
-# compiled from the sources that match it exactly. Separate target dir: the Linux build is untouched.
+# compiled from the sources that match it exactly. Its own target dir (in the cache): the Linux build
+# is untouched.
+cache=$(cross_cache_dir "$TARGET" "$("$RUSTC_DEB" --version)")
+json=$(mktemp)
+trap 'rm -f "$json"' EXIT
+build() {
+    RUSTC_BOOTSTRAP=1 RUSTC="$RUSTC_DEB" RUSTDOC=/usr/bin/rustdoc \
+    CARGO_TARGET_X86_64_WIN7_WINDOWS_GNU_LINKER="$LINKER" \
+        "$CARGO_DEB" build --release --lib -Z build-std=std,panic_unwind --target "$TARGET" --target-dir "$cache" \
+        --message-format=json-render-diagnostics "$@" >"$json"
+}
+start=$(date +%s)
 if [ -n "$manifest" ]; then
     # the package's own target folder (its workspace's), win64 below it
     target_dir=$("$CARGO_DEB" metadata --no-deps --format-version 1 --manifest-path "$manifest" |
         python3 -c 'import json, sys; print(json.load(sys.stdin)["target_directory"])')/win64
-    RUSTC_BOOTSTRAP=1 RUSTC="$RUSTC_DEB" RUSTDOC=/usr/bin/rustdoc \
-    CARGO_TARGET_X86_64_WIN7_WINDOWS_GNU_LINKER="$LINKER" \
-        "$CARGO_DEB" build --release --lib -Z build-std=std,panic_unwind \
-        --manifest-path "$manifest" --target "$TARGET" --target-dir "$target_dir" >&2
+    build --manifest-path "$manifest"
+    cross_products "$json" "$target_dir/$TARGET/release" >/dev/null
+    echo "build_win64: built in $(( $(date +%s) - start )) s (cargo target folder: $cache)" >&2
     echo "$target_dir/$TARGET/release"
     exit 0
 fi
-RUSTC_BOOTSTRAP=1 RUSTC="$RUSTC_DEB" RUSTDOC=/usr/bin/rustdoc \
-CARGO_TARGET_X86_64_WIN7_WINDOWS_GNU_LINKER="$LINKER" \
-    "$CARGO_DEB" build --release --locked --lib -p spacecraft_fmus_cdylib -p scfmu_native_loop -Z build-std=std,panic_unwind \
-    --target "$TARGET" --target-dir target/win64 >&2
+build --locked -p spacecraft_fmus_cdylib -p scfmu_native_loop
+cross_products "$json" "target/win64/$TARGET/release" >/dev/null
 dll=target/win64/$TARGET/release/spacecraft_fmus_cdylib.dll
 [ -f "$dll" ] || { echo "build_win64: $dll was not produced" >&2; exit 1; }
+echo "build_win64: built in $(( $(date +%s) - start )) s (cargo target folder: $cache)" >&2
 echo "$dll"

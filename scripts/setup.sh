@@ -49,6 +49,31 @@ if [ ${#win_missing[@]} -gt 0 ]; then
         echo "setup: for Windows binaries in the FMUs install ${win_missing[*]} (Debian 12)" >&2
     fi
 fi
+# Linux aarch64 binaries (scripts/build_aarch64.sh) and their emulated run (tests/test_aarch64.py): the
+# cross linker and C library, qemu's user-mode emulator, and Debian's prebuilt aarch64 std for the same
+# Rust 1.96 (libstd-rust-web-dev:arm64, from Debian's arm64 architecture, added to dpkg for it). Best
+# effort like the Windows tools; without them the FMUs carry no aarch64-linux binaries and
+# scripts/build_fmus.sh says so. macOS binaries need no system package (Zig and cargo-zigbuild come from
+# requirements.txt).
+arm_missing=()
+if command -v dpkg-query >/dev/null 2>&1; then
+    for p in gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user libstd-rust-web-dev:arm64; do
+        dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "ok installed" || arm_missing+=("$p")
+    done
+fi
+if [ ${#arm_missing[@]} -gt 0 ]; then
+    if can_apt; then
+        echo "setup: installing the aarch64 cross toolchain and qemu-user: ${arm_missing[*]}"
+        if ! dpkg --print-foreign-architectures | grep -qx arm64; then
+            dpkg --add-architecture arm64
+            apt_updated=0
+        fi
+        apt_install --no-install-recommends "${arm_missing[@]}" ||
+            echo "setup: could not install ${arm_missing[*]}: FMUs will carry no aarch64-linux binaries" >&2
+    else
+        echo "setup: for aarch64 Linux binaries install ${arm_missing[*]} (Debian 12, arm64 architecture added)" >&2
+    fi
+fi
 PY=${PYTHON:-python3}
 if ! command -v "$PY" >/dev/null 2>&1; then
     echo "setup: $PY not found (Python >= 3.11 needed)." >&2

@@ -1,29 +1,81 @@
-"""The wheel: scripts/build_wheel.sh packages the built FMUs into a wheel; installed with pip into a fresh
-virtual environment, in a folder outside the repository, with no Rust toolchain on PATH, `scfmu run default`
-prints the run 000-6 metrics (EULERINT 156.4 deg·s) and writes the CSV and PNG from the FMUs inside the
-wheel. Dependencies come from the pip cache or the package index, as for a user."""
+"""The wheels: scripts/build_wheel.sh --platform all packages the built FMUs into one wheel per platform whose
+binaries they carry (manylinux x86_64 and aarch64, win_amd64, macOS x86_64 and arm64), each tagged for its
+platform and carrying only that platform's binaries; the Linux x86-64 one, installed with pip into a fresh
+virtual environment, in a folder outside the repository, with no Rust toolchain on PATH, runs `scfmu run
+default` (the run 000-6 metrics, EULERINT 156.4 deg·s, the CSV and PNG) from the FMUs inside the wheel.
+Dependencies come from the pip cache or the package index, as for a user."""
 
 import os
 import re
 import shutil
+import struct
 import subprocess
 import venv
+import zipfile
 from pathlib import Path
 
 import pytest
+from packaging.tags import sys_tags
+from packaging.utils import parse_wheel_filename
 
 ROOT = Path(__file__).resolve().parents[1]
+# platform -> (FMI 2.0 folder in the wheel, FMI 3.0 tuple, binary check, compiled loop library (None: not built
+# for macOS, scripts/build_macos.sh), tag pattern)
+ELF_X86_64, ELF_AARCH64 = ("ELF", 62), ("ELF", 183)
+MACHO_X86_64, MACHO_ARM64 = ("Mach-O", 0x01000007), ("Mach-O", 0x0100000C)
+PLATFORMS = {
+    "linux-x86_64": ("linux64", "x86_64-linux", ELF_X86_64, "linux64/libscfmu_native_loop.so", r"manylinux_2_(\d+)_x86_64"),
+    "linux-aarch64": ("linux64", "aarch64-linux", ELF_AARCH64, "linux64/libscfmu_native_loop.so", r"manylinux_2_(\d+)_aarch64"),
+    "win-amd64": ("win64", "x86_64-windows", ("PE", 0x8664), "win64/scfmu_native_loop.dll", r"win_amd64"),
+    "macos-x86_64": ("darwin64", "x86_64-darwin", MACHO_X86_64, None, r"macosx_10_12_x86_64"),
+    "macos-arm64": ("darwin64", "aarch64-darwin", MACHO_ARM64, None, r"macosx_11_0_arm64"),
+}
+# the FMI 2.0 folders of fmus/<Model>.fmu that make each platform's wheel
+SOURCE_FOLDER = {"linux-x86_64": "linux64", "linux-aarch64": "aarch64-linux", "win-amd64": "win64",
+                 "macos-x86_64": "darwin64", "macos-arm64": "darwin64"}
+
+
+def binary_kind(data: bytes) -> tuple[str, int]:
+    """(format, machine) read from the file's own header: ELF e_machine, PE machine, thin Mach-O cputype."""
+    if data[:4] == b"\x7fELF":
+        return "ELF", struct.unpack_from("<H", data, 18)[0]
+    if data[:2] == b"MZ":
+        pe = struct.unpack_from("<I", data, 0x3C)[0]
+        assert data[pe:pe + 4] == b"PE\0\0"
+        return "PE", struct.unpack_from("<H", data, pe + 4)[0]
+    if data[:4] == b"\xcf\xfa\xed\xfe":
+        return "Mach-O", struct.unpack_from("<I", data, 4)[0]
+    return "unknown", 0
+
+
+def expected_platforms() -> list[str]:
+    names = zipfile.ZipFile(ROOT / "fmus" / "AttitudePlant.fmu").namelist()
+    have = {n.split("/")[1] for n in names if n.startswith("binaries/")}
+    return [p for p in PLATFORMS if SOURCE_FOLDER[p] in have]
 
 
 @pytest.fixture(scope="module")
-def installed(tmp_path_factory):
+def wheels(tmp_path_factory) -> dict[str, Path]:
+    """{platform: wheel} from one run of scripts/build_wheel.sh --platform all --no-fmu-build."""
     if not list((ROOT / "fmus").glob("*.fmu")):
         pytest.fail("no FMUs in fmus/ (scripts/build_fmus.sh)")
-    d = tmp_path_factory.mktemp("wheel")
-    r = subprocess.run([str(ROOT / "scripts" / "build_wheel.sh"), "--no-fmu-build", "--out", str(d / "dist")],
-                       capture_output=True, text=True, timeout=900)
+    d = tmp_path_factory.mktemp("wheels")
+    r = subprocess.run([str(ROOT / "scripts" / "build_wheel.sh"), "--no-fmu-build", "--platform", "all",
+                        "--out", str(d / "dist")], capture_output=True, text=True, timeout=1800)
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
-    wheel = Path(r.stdout.strip().splitlines()[-1])
+    written = re.findall(r"^build_wheel: wrote (\S+) .* for (\S+)\)$", r.stdout, re.M)
+    out = {plat: Path(path) for path, plat in written}
+    assert sorted(out) == sorted(expected_platforms()), r.stdout
+    assert Path(r.stdout.strip().splitlines()[-1]) in out.values()
+    if os.environ.get("CI") == "true":  # scripts/setup.sh installs every cross toolchain there
+        assert sorted(out) == sorted(PLATFORMS), "CI builds every platform's binaries"
+    return out
+
+
+@pytest.fixture(scope="module")
+def installed(tmp_path_factory, wheels):
+    d = tmp_path_factory.mktemp("wheel")
+    wheel = wheels["linux-x86_64"]
     assert wheel.is_file() and wheel.suffix == ".whl"
     env_dir = d / "venv"
     venv.EnvBuilder(with_pip=True, clear=True).create(env_dir)
@@ -55,6 +107,64 @@ def test_wheel_carries_every_fmu_and_the_data(installed):
     assert not [n for n in names if "/tests/" in n], "the package's tests are not shipped"
     # the compiled engine's loop library (cargo build --release), for this platform
     assert "scfmu/engines/native_loop/bin/linux64/libscfmu_native_loop.so" in names
+    # the FMI 3.0 twins too
+    assert {Path(n).name for n in names if n.startswith("scfmu/fmus/fmi3/")} == {p.name for p in (ROOT / "fmus").glob("*.fmu")}
+
+
+def glibc_versions(lib: Path, objdump: str) -> set[tuple[int, int]]:
+    """The glibc symbol versions an ELF file needs, as objdump lists its dynamic symbols."""
+    out = subprocess.run([objdump, "-T", str(lib)], capture_output=True, text=True, check=True).stdout
+    return {(int(a), int(b)) for a, b in re.findall(r"\(GLIBC_(\d+)\.(\d+)\)", out)}
+
+
+@pytest.mark.parametrize("plat", list(PLATFORMS))
+def test_platform_wheel_is_tagged_and_carries_only_its_platform_binaries(wheels, plat, tmp_path):
+    if plat not in wheels:
+        pytest.skip(f"the FMUs carry no {SOURCE_FOLDER[plat]} binaries (cross toolchain not installed)")
+    wheel = wheels[plat]
+    folder, tuple3, kind, loop, tag_re = PLATFORMS[plat]
+    _, _, _, tags = parse_wheel_filename(wheel.name)
+    assert len(tags) == 1
+    tag = next(iter(tags))
+    assert (tag.interpreter, tag.abi) == ("py3", "none")
+    m = re.fullmatch(tag_re, tag.platform)
+    assert m, tag.platform
+    z = zipfile.ZipFile(wheel)
+    meta = z.read(next(n for n in z.namelist() if n.endswith(".dist-info/WHEEL"))).decode()
+    assert f"Tag: py3-none-{tag.platform}" in meta
+    # pip on this machine (Linux x86-64) takes the x86-64 Linux wheel and no other
+    here = {str(t) for t in sys_tags()}
+    assert (f"py3-none-{tag.platform}" in here) == (plat == "linux-x86_64")
+    fmus = [n for n in z.namelist() if n.startswith("scfmu/fmus/") and n.endswith(".fmu")]
+    assert len(fmus) == 2 * len(list((ROOT / "fmus").glob("*.fmu")))
+    shipped = []
+    for n in fmus:
+        model = Path(n).stem
+        inner = zipfile.ZipFile(z.open(n))
+        bins = [b for b in inner.namelist() if b.startswith("binaries/")]
+        want = f"binaries/{tuple3 if '/fmi3/' in n else folder}/{model}"
+        assert len(bins) == 1 and bins[0].startswith(want + "."), (n, bins)
+        data = inner.read(bins[0])
+        assert binary_kind(data) == kind, (n, binary_kind(data))
+        assert "modelDescription.xml" in inner.namelist()
+        shipped.append(data)
+    loops = [n for n in z.namelist() if n.startswith("scfmu/engines/native_loop/bin/")]
+    assert loops == ([f"scfmu/engines/native_loop/bin/{loop}"] if loop else []), loops
+    shipped += [z.read(n) for n in loops]
+    for data in shipped[-len(loops):] if loops else []:
+        assert binary_kind(data) == kind
+    assert not [n for n in z.namelist() if n.endswith((".ssp",)) or "/loops/" in n], "no SSP or loop files"
+    if plat.startswith("linux"):
+        # manylinux_2_N: N is the newest glibc symbol version any shipped binary needs (PEP 600)
+        objdump = "objdump" if plat == "linux-x86_64" else "aarch64-linux-gnu-objdump"
+        if shutil.which(objdump) is None:
+            pytest.skip(f"{objdump} not installed")
+        newest = set()
+        for i, data in enumerate(set(shipped)):
+            f = tmp_path / f"lib{i}.so"
+            f.write_bytes(data)
+            newest |= glibc_versions(f, objdump)
+        assert max(newest) == (2, int(m.group(1))), (sorted(newest)[-3:], tag.platform)
 
 
 def test_installed_wheel_uses_its_compiled_loop(installed, tmp_path):

@@ -14,6 +14,7 @@ pub mod description;
 pub mod description3;
 pub mod docs;
 mod load;
+pub mod platforms;
 pub mod references;
 pub mod structure;
 
@@ -100,14 +101,9 @@ pub const LIB_EXT: &str = if cfg!(target_os = "windows") {
     "so"
 };
 
-/// Shared-library extension of an FMI 2.0 platform folder (`None` for a folder we do not build).
+/// Shared-library extension of a platform key (`None` for one we do not build); keys: [`platforms`].
 pub fn platform_lib_ext(platform: &str) -> Option<&'static str> {
-    match platform {
-        "linux64" => Some("so"),
-        "win64" => Some("dll"),
-        "darwin64" => Some("dylib"),
-        _ => None,
-    }
+    platforms::lib_ext(platform)
 }
 
 /// A model-description writer: FMI 2.0 ([`model_description`]) or FMI 3.0 ([`model_description3`]).
@@ -152,25 +148,16 @@ pub fn stale_model_descriptions3(units: &[Unit], dir: &Path) -> Vec<String> {
     stale_rendered(units, dir, model_description3, "fmi3/")
 }
 
-/// FMI 3.0 platform tuple of a binary stored under an FMI 2.0 platform folder. A `darwin64` build is
-/// told apart by its Mach-O CPU type (x86_64 or arm64).
+/// FMI 3.0 platform tuple of a build ([`platforms::tuple`]). A `darwin64` build is told apart by its
+/// Mach-O CPU type (x86_64 or arm64).
 pub fn platform_tuple(b: &Binary) -> Option<&'static str> {
-    match b.platform {
-        "linux64" => Some("x86_64-linux"),
-        "win64" => Some("x86_64-windows"),
-        "darwin64" => match b.bytes.get(4..8) {
-            Some([0x07, 0, 0, 0x01]) => Some("x86_64-darwin"),
-            Some([0x0c, 0, 0, 0x01]) => Some("aarch64-darwin"),
-            _ => None,
-        },
-        _ => None,
-    }
+    platforms::tuple(b.platform, b.bytes)
 }
 
 /// One platform's build of the cdylib, to be stored as `binaries/<platform>/<Model>.<ext>`.
 #[derive(Clone, Copy, Debug)]
 pub struct Binary<'a> {
-    /// FMI 2.0 platform folder: `linux64`, `win64`, `darwin64`.
+    /// Platform key ([`platforms`]): `linux64`, `win64`, `aarch64-linux`, `x86_64-darwin`, `aarch64-darwin`, `darwin64`.
     pub platform: &'a str,
     /// Shared-library extension on that platform: `so`, `dll`, `dylib`.
     pub ext: &'a str,
@@ -185,10 +172,13 @@ impl<'a> Binary<'a> {
 }
 
 /// Writes one `.fmu` archive (deterministic: fixed timestamps, fixed order) holding the model
-/// description, one binary per entry of `binaries` (in the given order) and the documentation.
+/// description, one binary per entry of `binaries` (in the given order; the macOS builds joined into
+/// one universal `darwin64` file, [`platforms::fmi2_binaries`]) and the documentation.
 pub fn write_fmu(unit: &Unit, binaries: &[Binary], out_dir: &Path) -> std::io::Result<std::path::PathBuf> {
     let name = unit.entry.info.name;
-    let files = binaries.iter().map(|b| Ok((format!("binaries/{}/{name}.{}", b.platform, b.ext), b.bytes))).collect::<std::io::Result<Vec<_>>>()?;
+    let builds: Vec<(&str, &[u8])> = binaries.iter().map(|b| (b.platform, b.bytes)).collect();
+    let folders = platforms::fmi2_binaries(&builds).map_err(std::io::Error::other)?;
+    let files: Vec<(String, &[u8])> = folders.iter().map(|(dir, ext, bytes)| (format!("binaries/{dir}/{name}.{ext}"), bytes.as_ref())).collect();
     write_archive(unit, &model_description(&unit.entry, unit.guid, unit.package), &files, out_dir)
 }
 

@@ -13,7 +13,8 @@
 //!   `modelDescription/`, always).
 //! - `--win64`: add `binaries/win64/<Model>.dll` from `scripts/build_win64.sh`: `auto` (default) when
 //!   the cross toolchain is installed, `yes` requires it, `no` skips it (also `SCFMU_NO_WIN64=1`).
-//! - `--add-lib PLATFORM=PATH`: store another platform's build of the same crate (linux64, win64, darwin64).
+//! - `--add-lib PLATFORM=PATH`: store another platform's build of the same crate (linux64, win64,
+//!   aarch64-linux, x86_64-darwin, aarch64-darwin, darwin64; folders: src/package/src/platforms.rs).
 //! - `--check`: write nothing; exit 1 if the XML folder (and, for the project, the generated pages under
 //!   docs/) differ from what the declarations generate.
 //!
@@ -59,7 +60,7 @@ fn parse() -> Result<Args, String> {
                 let spec = value("--add-lib")?;
                 match spec.split_once('=') {
                     Some((platform, path)) if platform_lib_ext(platform).is_some() && !path.is_empty() => a.extra.push((platform.into(), PathBuf::from(path))),
-                    _ => return Err(format!("--add-lib wants PLATFORM=PATH with PLATFORM linux64, win64 or darwin64, got {spec:?}")),
+                    _ => return Err(format!("--add-lib wants PLATFORM=PATH with PLATFORM {}, got {spec:?}", spacecraft_fmus_package::platforms::KEYS)),
                 }
             }
             "--locked" => a.locked = true,
