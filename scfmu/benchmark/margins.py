@@ -92,16 +92,15 @@ class _Driver:
         self.vr = [vr[p] for p in ports]
         # where the master's buffer holds each plant input: the "set" op of the plant
         self.read_at = []
-        for (kind, inst, vrs, b, off), op in zip(self.m.plan_ops, self.m._ops):
-            if kind == "set" and inst == plant:
+        for (kind, typ, inst, vrs, _b, _off), op in zip(self.m.plan_ops, self.m._ops):
+            if kind == "set" and typ == "Real" and inst == plant:  # op = (fn, vr array, n, buffer address)
                 for p, v in zip(ports, self.vr):
                     if v not in vrs:
                         raise KeyError(f"{plant}.{p} is not fed by another unit: no loop to break")
-                    self.read_at.append(op[4] + 8 * vrs.index(v))
+                    self.read_at.append(op[3] + ctypes.sizeof(c_double) * vrs.index(v))
         if len(self.read_at) != len(ports):
             raise KeyError(f"{plant}: torque inputs not connected")
-        self._set = self.m._set[plant]
-        self._comp = self.m._comp[plant]
+        self._set = self.m.calls[plant].set["Real"]  # (vr array address, n, values address) -> status
         self._one_vr = (c_uint * 1)()
         self._one_val = (c_double * 1)()
         self.k = 0
@@ -125,16 +124,16 @@ class _Driver:
         for j in range(n):
             t = sc.start_time + self.k * sc.step
             st = 0
-            for fn, comp, vrs, m, buf in ops:
-                st |= fn(comp, vrs, m, buf)
+            for fn, vrs, m, buf in ops:
+                st |= fn(vrs, m, buf)
             for i in range(len(self.read_at)):
                 out[j, i] = self.value(i)
             if axis >= 0 and pulse is not None and j < len(pulse) and pulse[j] != 0.0:
                 self._one_vr[0] = self.vr[axis]
                 self._one_val[0] = out[j, axis] + pulse[j]
-                st |= self._set(self._comp, ctypes.addressof(self._one_vr), 1, ctypes.addressof(self._one_val))
-            for fn, comp in steps:
-                st |= fn(comp, t, sc.step, 1)
+                st |= self._set(ctypes.addressof(self._one_vr), 1, ctypes.addressof(self._one_val))
+            for fn in steps:
+                st |= fn(t, sc.step)
             if st > 1:
                 self.m._fail(t)
             self.k += 1
