@@ -263,4 +263,8 @@ def test_benchmark_ranks_a_unit_beside_the_builtins(tmp_path, my_pd):
     assert mine[k] == pd[k] and abs(float(mine[k]) - 156.408) < 1e-3
     assert mine["pass"] == "True" and mine["rank"] == pd["rank"]  # the same law: the same rank
     md = (tmp_path / "benchmark.md").read_text()
-    assert "**MyPd**" in md and "rank" in md and len(list((tmp_path / "figures").glob("*.png"))) == 2
+    figures = sorted(p.name for p in (tmp_path / "figures").glob("*.png"))
+    responses = [f for f in figures if not f.startswith(("bode_", "effort_"))]  # one response figure per scenario
+    assert "**MyPd**" in md and "rank" in md and len(responses) == 2, figures
+    # the large slew also gets its effort-vs-performance scatter and the Bode plots of its loops (margins)
+    assert any(f.startswith("bode_large_slew") for f in figures) and any(f.startswith("effort_large") for f in figures)
