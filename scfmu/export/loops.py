@@ -47,9 +47,19 @@ def _platform_of(name: str, prefix: str) -> str | None:
     return parts[1] if len(parts) >= 3 and parts[0] == "binaries" else None
 
 
+# FMI 2.0 platform folders and the FMI 3.0 platform tuple of the same binaries (the loop FMU is FMI 2.0; units
+# nested in it may be FMI 3.0, whose folders are tuples)
+_PLATFORM_KEY = {"linux64": "x86_64-linux", "win64": "x86_64-windows", "darwin64": "x86_64-darwin"}
+
+
+def _same_platform(a: str | None, b: str) -> bool:
+    return a is not None and _PLATFORM_KEY.get(a, a) == _PLATFORM_KEY.get(b, b)
+
+
 def strip_unshared_platforms(fmu: str | Path) -> list[str]:
     """Rewrites the container FMU ``fmu`` so that it keeps a platform's binaries only where the container
-    binary and every nested FMU (``resources/<name>/modelDescription.xml``) carry that platform; removes
+    binary and every nested FMU (``resources/<name>/modelDescription.xml``) carry that platform (an FMI 2.0
+    folder such as ``linux64`` and the FMI 3.0 tuple ``x86_64-linux`` name the same platform); removes
     the other platform folders at the top and inside the nested FMUs. Returns the platforms kept (sorted).
     Entry order, contents and compression of what is kept are unchanged."""
     fmu = Path(fmu)
@@ -59,11 +69,12 @@ def strip_unshared_platforms(fmu: str | Path) -> list[str]:
         nested = [n[: -len("modelDescription.xml")] for n in names
                   if n.startswith("resources/") and n.endswith("/modelDescription.xml") and n.count("/") == 2]
         top = {p for n in names if (p := _platform_of(n, ""))}
-        keep = {p for p in top if all(any(_platform_of(n, pre) == p for n in names) for pre in nested)}
+        keep = {p for p in top if all(any(_same_platform(_platform_of(n, pre), p) for n in names) for pre in nested)}
+        keys = {_PLATFORM_KEY.get(p, p) for p in keep}
 
         def kept(n: str) -> bool:
             pre = next((pre for pre in [""] + nested if _platform_of(n, pre)), None)
-            return pre is None or _platform_of(n, pre) in keep
+            return pre is None or _PLATFORM_KEY.get(_platform_of(n, pre), _platform_of(n, pre)) in keys
 
         if not keep:
             raise ValueError(f"{fmu.name}: no platform is carried by the container and every FMU inside it")
