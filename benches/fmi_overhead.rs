@@ -41,13 +41,37 @@ struct Case {
 
 const PD: Case = Case {
     name: "PdController",
-    inputs: &["q_w", "q_x", "q_y", "q_z", "w_x", "w_y", "w_z", "q_ref_w", "q_ref_x", "q_ref_y"],
-    outputs: &["torque_cmd_x", "torque_cmd_y", "torque_cmd_z", "k_x", "k_y", "k_z", "k_d_x", "k_d_y", "k_d_z", "torque_cmd_x"],
+    inputs: &[
+        "q_w", "q_x", "q_y", "q_z", "w_x", "w_y", "w_z", "q_ref_w", "q_ref_x", "q_ref_y",
+    ],
+    outputs: &[
+        "torque_cmd_x",
+        "torque_cmd_y",
+        "torque_cmd_z",
+        "k_x",
+        "k_y",
+        "k_z",
+        "k_d_x",
+        "k_d_y",
+        "k_d_z",
+        "torque_cmd_x",
+    ],
 };
 
 const PLANT: Case = Case {
     name: "AttitudePlant",
-    inputs: &["torque_cmd_x", "torque_cmd_y", "torque_cmd_z", "torque_dist_x", "torque_dist_y", "torque_dist_z", "torque_cmd_x", "torque_cmd_y", "torque_cmd_z", "torque_dist_x"],
+    inputs: &[
+        "torque_cmd_x",
+        "torque_cmd_y",
+        "torque_cmd_z",
+        "torque_dist_x",
+        "torque_dist_y",
+        "torque_dist_z",
+        "torque_cmd_x",
+        "torque_cmd_y",
+        "torque_cmd_z",
+        "torque_dist_x",
+    ],
     outputs: &["q_w", "q_x", "q_y", "q_z", "w_x", "w_y", "w_z", "roll", "pitch", "yaw"],
 };
 
@@ -85,7 +109,14 @@ fn direct_plant(reps: usize, n: usize) -> f64 {
     time_ns(reps, n, |k| {
         let u = input_values(&PLANT, k);
         let v = &mut m.v;
-        (v.torque_cmd.x, v.torque_cmd.y, v.torque_cmd.z, v.torque_dist.x, v.torque_dist.y, v.torque_dist.z) = (u[6], u[7], u[8], u[9], u[4], u[5]);
+        (
+            v.torque_cmd.x,
+            v.torque_cmd.y,
+            v.torque_cmd.z,
+            v.torque_dist.x,
+            v.torque_dist.y,
+            v.torque_dist.z,
+        ) = (u[6], u[7], u[8], u[9], u[4], u[5]);
         m.step(t, H).unwrap();
         t += H;
         m.outputs(t).unwrap();
@@ -101,12 +132,24 @@ fn direct_pd(reps: usize, n: usize) -> f64 {
     time_ns(reps, n, |k| {
         let u = input_values(&PD, k);
         let p = &mut m.v.ports;
-        (p.q.w, p.q.i, p.q.j, p.q.k, p.w.x, p.w.y, p.w.z, p.q_ref.w, p.q_ref.i, p.q_ref.j) = (u[0], u[1], u[2], u[3], u[4], u[5], u[6], u[7], u[8], u[9]);
+        (
+            p.q.w, p.q.i, p.q.j, p.q.k, p.w.x, p.w.y, p.w.z, p.q_ref.w, p.q_ref.i, p.q_ref.j,
+        ) = (u[0], u[1], u[2], u[3], u[4], u[5], u[6], u[7], u[8], u[9]);
         m.step(t, H).unwrap();
         t += H;
         m.outputs(t).unwrap();
         let v = &m.v;
-        black_box([v.ports.torque_cmd.x, v.ports.torque_cmd.y, v.ports.torque_cmd.z, v.k.x, v.k.y, v.k.z, v.k_d.x, v.k_d.y, v.k_d.z]);
+        black_box([
+            v.ports.torque_cmd.x,
+            v.ports.torque_cmd.y,
+            v.ports.torque_cmd.z,
+            v.k.x,
+            v.k.y,
+            v.k.z,
+            v.k_d.x,
+            v.k_d.y,
+            v.k_d.z,
+        ]);
     })
 }
 

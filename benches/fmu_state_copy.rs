@@ -46,7 +46,10 @@ fn min_time(reps: usize, mut f: impl FnMut()) -> f64 {
 
 fn main() {
     println!("FopidController state after n samples (lambda = 0.9, mu = 0.8, full memory): fmi2GetFMUstate copy and serialized size, min of 20");
-    println!("{:>8} {:>14} {:>14} {:>12} {:>12} {:>10}", "n", "old bytes", "new bytes", "old copy µs", "new copy µs", "ratio");
+    println!(
+        "{:>8} {:>14} {:>14} {:>12} {:>12} {:>10}",
+        "n", "old bytes", "new bytes", "old copy µs", "new copy µs", "ratio"
+    );
     for n in [2_000usize, 20_000, 200_000] {
         let mut m = Fmu::<FopidController>::default();
         (m.v.lambda, m.v.mu, m.v.theta_ref) = (0.9, 0.8, 0.5);
@@ -65,6 +68,11 @@ fn main() {
         let old_t = min_time(20, || {
             black_box(old.clone());
         });
-        println!("{n:>8} {old_bytes:>14} {new_bytes:>14} {:>12.1} {:>12.1} {:>10.1}", old_t * 1e6, new_t * 1e6, old_t / new_t);
+        println!(
+            "{n:>8} {old_bytes:>14} {new_bytes:>14} {:>12.1} {:>12.1} {:>10.1}",
+            old_t * 1e6,
+            new_t * 1e6,
+            old_t / new_t
+        );
     }
 }

@@ -7,14 +7,23 @@
 use std::hint::black_box;
 use std::time::Instant;
 
-use spacecraft_fmus::models::single_axis::shared::laws::{FopidLaw, FopidParams, PidLaw};
 use spacecraft_fmus::model::{Experiment, Fmu};
+use spacecraft_fmus::models::single_axis::shared::laws::{FopidLaw, FopidParams, PidLaw};
 use spacecraft_fmus::models::single_axis::SingleAxisPlant;
 
 const H: f64 = 0.001;
 
 fn params() -> FopidParams {
-    FopidParams { kp: 2.0, ki: 0.5, kd: 8.0, lambda: 0.9, mu: 0.8, h: H, memory: 0, history_before_start: false }
+    FopidParams {
+        kp: 2.0,
+        ki: 0.5,
+        kd: 8.0,
+        lambda: 0.9,
+        mu: 0.8,
+        h: H,
+        memory: 0,
+        history_before_start: false,
+    }
 }
 
 fn err(k: usize) -> f64 {
@@ -74,7 +83,9 @@ fn min_of<F: FnMut() -> f64>(reps: usize, mut f: F) -> f64 {
 }
 
 fn main() {
-    println!("per-step cost of FOPID (output + push, λ = 0.9, μ = 0.8, full memory) in the window [n, n + 2048), min of 3");
+    println!(
+        "per-step cost of FOPID (output + push, λ = 0.9, μ = 0.8, full memory) in the window [n, n + 2048), min of 3"
+    );
     println!("{:>8} {:>12} {:>12} {:>8}", "n", "direct µs", "fast µs", "ratio");
     for n in [1_000usize, 2_000, 5_000, 10_000, 20_000, 50_000, 100_000] {
         let d = min_of(3, || window(false, n, n + 2048));
@@ -83,7 +94,10 @@ fn main() {
     }
     println!();
     println!("whole runs at h = 1 ms (seconds, min of 3)");
-    println!("{:>8} {:>12} {:>12} {:>12} {:>12} {:>10}", "steps", "FOPID direct", "FOPID fast", "PID", "plant", "direct/fast");
+    println!(
+        "{:>8} {:>12} {:>12} {:>12} {:>12} {:>10}",
+        "steps", "FOPID direct", "FOPID fast", "PID", "plant", "direct/fast"
+    );
     for n in [20_000usize, 100_000] {
         let d = min_of(3, || run_fopid(false, n));
         let f = min_of(3, || run_fopid(true, n));

@@ -9,8 +9,8 @@ use std::ffi::{c_int, CString};
 use std::hint::black_box;
 use std::time::Instant;
 
-use spacecraft_fmus::model::guid::guid;
 use spacecraft_fmus::fmi::fmi2::*;
+use spacecraft_fmus::model::guid::guid;
 use spacecraft_fmus::model::{Experiment, Fmu, SlotMut, Variables};
 use spacecraft_fmus::models::attitude::plant::AttitudePlantVars;
 use spacecraft_fmus::models::attitude::AttitudePlant;
@@ -42,7 +42,11 @@ const REALS: &[(&str, f64)] = &[
 const INTS: &[(&str, i32)] = &[("actuator_mode", 1), ("mtq_enable", 1), ("gg_enable", 1)];
 
 fn vr(name: &str) -> u32 {
-    registry::find("AttitudePlant").unwrap().decl(name).unwrap_or_else(|| panic!("no variable {name}")).vr
+    registry::find("AttitudePlant")
+        .unwrap()
+        .decl(name)
+        .unwrap_or_else(|| panic!("no variable {name}"))
+        .vr
 }
 
 fn cmd(k: usize) -> [f64; 3] {
@@ -100,7 +104,16 @@ fn abi_instance() -> *mut std::ffi::c_void {
         step_finished: None,
         component_environment: std::ptr::null_mut(),
     }));
-    let c = fmi2Instantiate(spacecraft_fmus::registry::ALL, name.as_ptr(), 1, g.as_ptr(), std::ptr::null(), cb, 0, 0);
+    let c = fmi2Instantiate(
+        spacecraft_fmus::registry::ALL,
+        name.as_ptr(),
+        1,
+        g.as_ptr(),
+        std::ptr::null(),
+        cb,
+        0,
+        0,
+    );
     assert!(!c.is_null());
     assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), 0);
     assert_eq!(fmi2EnterInitializationMode(c), 0);
@@ -117,7 +130,21 @@ fn main() {
     println!("communication step {DT} s, RK4 internal step 0.01 s (10 internal steps); {ROUNDS} interleaved rounds of {BLOCK} steps\n");
     let in_vr = [vr("torque_cmd_x"), vr("torque_cmd_y"), vr("torque_cmd_z")];
     let in_ix = [index("torque_cmd_x"), index("torque_cmd_y"), index("torque_cmd_z")];
-    let out_names = ["q_w", "q_x", "q_y", "q_z", "w_x", "w_y", "w_z", "torque_applied_x", "torque_applied_y", "torque_applied_z", "h_wheel_x", "h_wheel_y", "h_wheel_z"];
+    let out_names = [
+        "q_w",
+        "q_x",
+        "q_y",
+        "q_z",
+        "w_x",
+        "w_y",
+        "w_z",
+        "torque_applied_x",
+        "torque_applied_y",
+        "torque_applied_z",
+        "h_wheel_x",
+        "h_wheel_y",
+        "h_wheel_z",
+    ];
     let out_vr: Vec<u32> = out_names.iter().map(|n| vr(n)).collect();
     let out_ix: Vec<usize> = out_names.iter().map(|n| index(n)).collect();
     let mut buf = vec![0.0; out_vr.len()];
@@ -196,7 +223,11 @@ fn main() {
     }
     println!("\nratio C ABI / direct (min), step only:  {:.3}", mins[1] / mins[0]);
     println!("ratio C ABI / direct (min), full cycle: {:.3}", mins[3] / mins[2]);
-    println!("C ABI overhead per step (min): {:.3} µs (step only), {:.3} µs (cycle)", (mins[1] - mins[0]) * 1e6, (mins[3] - mins[2]) * 1e6);
+    println!(
+        "C ABI overhead per step (min): {:.3} µs (step only), {:.3} µs (cycle)",
+        (mins[1] - mins[0]) * 1e6,
+        (mins[3] - mins[2]) * 1e6
+    );
     fmi2FreeInstance(c);
     fmi2FreeInstance(c2);
 }

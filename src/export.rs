@@ -63,8 +63,9 @@
 
 pub use crate::math;
 pub use crate::model::{
-    check, check_derived, check_finite_state, Bound, Causality, Experiment, Feedthrough, Fmu, Model, ModelEntry, ModelInfo, ModelResult,
-    ParamEnum, Start, StateDecl, VarDecl, VarKind, Variability, Variables, DERIVATIVE_VR_BASE, RESERVED_VR_START, STATE_VR_BASE, SWITCH,
+    check, check_derived, check_finite_state, Bound, Causality, Experiment, Feedthrough, Fmu, Model, ModelEntry,
+    ModelInfo, ModelResult, ParamEnum, Start, StateDecl, VarDecl, VarKind, Variability, Variables, DERIVATIVE_VR_BASE,
+    RESERVED_VR_START, STATE_VR_BASE, SWITCH,
 };
 pub use crate::models::attitude::control::shared::{check_unit_quaternions, AttitudeControllerPorts};
 pub use crate::{declare_variables, export_fmus, param_enum};
@@ -170,7 +171,11 @@ impl ModelDescription {
             feedthrough: match i.feedthrough {
                 Feedthrough::None => FeedthroughDescription::None,
                 Feedthrough::AllInputs => FeedthroughDescription::AllInputs,
-                Feedthrough::Some(l) => FeedthroughDescription::Some(l.iter().map(|(o, ins)| (o.to_string(), ins.iter().map(|s| s.to_string()).collect())).collect()),
+                Feedthrough::Some(l) => FeedthroughDescription::Some(
+                    l.iter()
+                        .map(|(o, ins)| (o.to_string(), ins.iter().map(|s| s.to_string()).collect()))
+                        .collect(),
+                ),
             },
             default_stop_time: i.default_stop_time,
             default_step: i.default_step,
@@ -227,7 +232,12 @@ impl ModelDescription {
             FeedthroughDescription::AllInputs => Feedthrough::AllInputs,
             FeedthroughDescription::Some(l) => Feedthrough::Some(Box::leak(
                 l.into_iter()
-                    .map(|(o, ins)| (leak(o), &*Box::leak(ins.into_iter().map(leak).collect::<Vec<_>>().into_boxed_slice())))
+                    .map(|(o, ins)| {
+                        (
+                            leak(o),
+                            &*Box::leak(ins.into_iter().map(leak).collect::<Vec<_>>().into_boxed_slice()),
+                        )
+                    })
                     .collect::<Vec<_>>()
                     .into_boxed_slice(),
             )),
@@ -266,22 +276,40 @@ impl ModelDescription {
             .collect();
         let states: Option<&'static [StateDecl]> = self.states.map(|l| {
             let decl = |x: StateDescription| {
-                let starts: &'static [&'static str] = Box::leak(x.starts_from.into_iter().map(leak).collect::<Vec<_>>().into_boxed_slice());
+                let starts: &'static [&'static str] = Box::leak(
+                    x.starts_from
+                        .into_iter()
+                        .map(leak)
+                        .collect::<Vec<_>>()
+                        .into_boxed_slice(),
+                );
                 let s = StateDecl::new(leak(x.name), leak(x.unit), leak(x.description)).starting_from(starts);
                 match x.depends {
-                    Some(d) => s.depends_on(Box::leak(d.into_iter().map(leak).collect::<Vec<_>>().into_boxed_slice())),
+                    Some(d) => s.depends_on(Box::leak(
+                        d.into_iter().map(leak).collect::<Vec<_>>().into_boxed_slice(),
+                    )),
                     None => s,
                 }
             };
             &*Box::leak(l.into_iter().map(decl).collect::<Vec<_>>().into_boxed_slice())
         });
-        ModelEntry { info, decls: Box::leak(decls.into_boxed_slice()), states, create: no_model }
+        ModelEntry {
+            info,
+            decls: Box::leak(decls.into_boxed_slice()),
+            states,
+            create: no_model,
+        }
     }
 }
 
 /// The catalogue of a list of models exported by `package`.
 pub fn catalogue(models: &[ModelEntry], package: PackageInfo) -> Catalogue {
-    Catalogue { format: CATALOGUE_FORMAT, runtime_version: RUNTIME_VERSION.into(), package, models: models.iter().map(ModelDescription::of).collect() }
+    Catalogue {
+        format: CATALOGUE_FORMAT,
+        runtime_version: RUNTIME_VERSION.into(),
+        package,
+        models: models.iter().map(ModelDescription::of).collect(),
+    }
 }
 
 /// The catalogue as bytes: the magic `SCFMUCAT`, then the postcard encoding of [`Catalogue`].
@@ -295,9 +323,12 @@ const CATALOGUE_MAGIC: &[u8; 8] = b"SCFMUCAT";
 
 /// Reads [`catalogue_bytes`] back; the message says what is wrong (not a catalogue, another format).
 pub fn read_catalogue(bytes: &[u8]) -> Result<Catalogue, String> {
-    let body = bytes.strip_prefix(CATALOGUE_MAGIC).ok_or("not a spacecraft_fmus catalogue (no SCFMUCAT header)")?;
+    let body = bytes
+        .strip_prefix(CATALOGUE_MAGIC)
+        .ok_or("not a spacecraft_fmus catalogue (no SCFMUCAT header)")?;
     // the format number is the first field: read it alone first, so a newer layout is named, not garbled
-    let (format, _) = postcard::take_from_bytes::<u32>(body).map_err(|e| format!("catalogue header unreadable: {e}"))?;
+    let (format, _) =
+        postcard::take_from_bytes::<u32>(body).map_err(|e| format!("catalogue header unreadable: {e}"))?;
     if format != CATALOGUE_FORMAT {
         return Err(format!("catalogue format {format}, this tool reads format {CATALOGUE_FORMAT} (rebuild the library and the tool from the same spacecraft_fmus)"));
     }
@@ -362,7 +393,12 @@ mod tests {
 
     #[test]
     fn the_catalogue_round_trips_and_gives_back_the_declarations_and_guids() {
-        let pkg = PackageInfo { name: "p".into(), version: "1.2.3".into(), authors: "A:B".into(), license: "MIT".into() };
+        let pkg = PackageInfo {
+            name: "p".into(),
+            version: "1.2.3".into(),
+            authors: "A:B".into(),
+            license: "MIT".into(),
+        };
         let bytes = catalogue_bytes(crate::registry::ALL, pkg.clone());
         let cat = read_catalogue(&bytes).unwrap();
         assert_eq!(cat.models.len(), crate::registry::COUNT);
@@ -375,10 +411,15 @@ mod tests {
             assert_eq!(guid, crate::model::guid::guid(e).as_str());
             assert_eq!(back.decls.len(), e.decls.len());
             for (a, b) in back.decls.iter().zip(e.decls) {
-                assert_eq!((a.vr, a.name, a.unit, a.bound, a.start), (b.vr, b.name, b.unit, b.bound, b.start));
+                assert_eq!(
+                    (a.vr, a.name, a.unit, a.bound, a.start),
+                    (b.vr, b.name, b.unit, b.bound, b.start)
+                );
             }
         }
-        assert!(read_catalogue(b"nonsense").unwrap_err().contains("not a spacecraft_fmus catalogue"));
+        assert!(read_catalogue(b"nonsense")
+            .unwrap_err()
+            .contains("not a spacecraft_fmus catalogue"));
         let mut other = CATALOGUE_MAGIC.to_vec();
         other.extend(postcard::to_stdvec(&7u32).unwrap());
         assert!(read_catalogue(&other).unwrap_err().contains("catalogue format 7"));

@@ -47,7 +47,13 @@ pub const FAMILIES: &[Family] = &[
     },
 ];
 
-const LISTS: [&[ModelEntry]; 5] = [FAMILIES[0].fmus, FAMILIES[1].fmus, FAMILIES[2].fmus, FAMILIES[3].fmus, FAMILIES[4].fmus];
+const LISTS: [&[ModelEntry]; 5] = [
+    FAMILIES[0].fmus,
+    FAMILIES[1].fmus,
+    FAMILIES[2].fmus,
+    FAMILIES[3].fmus,
+    FAMILIES[4].fmus,
+];
 const _: () = assert!(FAMILIES.len() == LISTS.len(), "every family goes into the registry");
 
 const LIST: [ModelEntry; total_len(&LISTS)] = concat(&LISTS, LISTS[0][0]);

@@ -13,7 +13,14 @@ pub struct BaseUnit {
 }
 
 const fn u(kg: i32, m: i32, s: i32, a: i32, rad: i32) -> BaseUnit {
-    BaseUnit { kg, m, s, a, rad, factor: 1.0 }
+    BaseUnit {
+        kg,
+        m,
+        s,
+        a,
+        rad,
+        factor: 1.0,
+    }
 }
 
 const DEG: f64 = std::f64::consts::PI / 180.0;
@@ -26,9 +33,30 @@ pub const UNITS: &[(&str, BaseUnit, &[(&str, f64)])] = &[
     ("rad", u(0, 0, 0, 0, 1), &[("deg", 1.0 / DEG)]),
     ("rad/s", u(0, 0, -1, 0, 1), &[("deg/s", 1.0 / DEG)]),
     ("rad/s2", u(0, 0, -2, 0, 1), &[]),
-    ("deg", BaseUnit { factor: DEG, ..u(0, 0, 0, 0, 1) }, &[]),
-    ("deg/s", BaseUnit { factor: DEG, ..u(0, 0, -1, 0, 1) }, &[]),
-    ("deg.s", BaseUnit { factor: DEG, ..u(0, 0, 1, 0, 1) }, &[]),
+    (
+        "deg",
+        BaseUnit {
+            factor: DEG,
+            ..u(0, 0, 0, 0, 1)
+        },
+        &[],
+    ),
+    (
+        "deg/s",
+        BaseUnit {
+            factor: DEG,
+            ..u(0, 0, -1, 0, 1)
+        },
+        &[],
+    ),
+    (
+        "deg.s",
+        BaseUnit {
+            factor: DEG,
+            ..u(0, 0, 1, 0, 1)
+        },
+        &[],
+    ),
     ("rad2.s", u(0, 0, 1, 0, 2), &[]),
     ("rad2/s", u(0, 0, -1, 0, 2), &[]),
     ("rad2/s3", u(0, 0, -3, 0, 2), &[]),

@@ -18,7 +18,13 @@ fn fmu_file(rel: &str) -> PathBuf {
 
 /// Simulates `fmu` from 0 to `stop` with output interval `dt` through fmi-rs; returns the time vector
 /// and the trajectories of `outputs` (Real variables), by name.
-fn simulate(fmu: &Path, stop: f64, dt: f64, start: &[(&str, &str)], outputs: &[&str]) -> (Vec<f64>, HashMap<String, Vec<f64>>) {
+fn simulate(
+    fmu: &Path,
+    stop: f64,
+    dt: f64,
+    start: &[(&str, &str)],
+    outputs: &[&str],
+) -> (Vec<f64>, HashMap<String, Vec<f64>>) {
     let stem = fmu.file_stem().unwrap().to_string_lossy().to_string();
     let dir = std::env::temp_dir().join(format!("scfmu_fmirs_{}_{}", std::process::id(), stem));
     let _ = std::fs::remove_dir_all(&dir);
@@ -26,7 +32,12 @@ fn simulate(fmu: &Path, stop: f64, dt: f64, start: &[(&str, &str)], outputs: &[&
     let md = Arc::new(ModelDescription::from_path(&dir.join("modelDescription.xml")).expect("modelDescription"));
     let indices: Vec<usize> = outputs
         .iter()
-        .map(|n| md.modelVariables.iter().position(|v| v.name == *n).unwrap_or_else(|| panic!("{stem}: no variable {n}")))
+        .map(|n| {
+            md.modelVariables
+                .iter()
+                .position(|v| v.name == *n)
+                .unwrap_or_else(|| panic!("{stem}: no variable {n}"))
+        })
         .collect();
     let recorder = Arc::new(Recorder::new(Trajectories::new(md.clone(), indices)));
     let settings = SimulationSettings {
@@ -52,7 +63,9 @@ fn simulate(fmu: &Path, stop: f64, dt: f64, start: &[(&str, &str)], outputs: &[&
     fmi_rs::sim::fmi2::cs::simulate(&settings, None, recorder.clone())
         .unwrap_or_else(|e| panic!("{stem}: fmi-rs simulation failed: {e}"));
     drop(settings);
-    let tr = Arc::try_unwrap(recorder).expect("recorder still shared").into_trajectories();
+    let tr = Arc::try_unwrap(recorder)
+        .expect("recorder still shared")
+        .into_trajectories();
     let mut out = HashMap::new();
     for (i, n) in outputs.iter().enumerate() {
         let col = tr
@@ -77,11 +90,18 @@ fn every_packaged_fmu_runs_in_fmi_rs() {
         let outputs: Vec<&str> = e
             .decls
             .iter()
-            .filter(|d| d.causality == spacecraft_fmus::model::Causality::Output && d.kind == spacecraft_fmus::model::VarKind::Real)
+            .filter(|d| {
+                d.causality == spacecraft_fmus::model::Causality::Output
+                    && d.kind == spacecraft_fmus::model::VarKind::Real
+            })
             .map(|d| d.name)
             .collect();
         // sampled controllers (PID, FOPID) require the communication step to equal their `step` parameter
-        let start: &[(&str, &str)] = if e.decl("step").is_some() { &[("step", "0.05")] } else { &[] };
+        let start: &[(&str, &str)] = if e.decl("step").is_some() {
+            &[("step", "0.05")]
+        } else {
+            &[]
+        };
         let (t, out) = simulate(&fmu_file(&format!("{name}.fmu")), 0.5, 0.05, start, &outputs);
         assert_eq!(t.len(), 11, "{name}: {t:?}");
         for (n, v) in &out {
@@ -93,11 +113,21 @@ fn every_packaged_fmu_runs_in_fmi_rs() {
 #[test]
 fn attitude_plant_rate_under_constant_torque_matches_closed_form() {
     // Torque about a principal axis from rest: ω × Jω = 0, so ω_x(t) = τ t / J_xx exactly.
-    let (t, out) = simulate(&fmu_file("AttitudePlant.fmu"), 2.0, 0.1, &[("torque_cmd_x", "2.5")], &["w_x", "w_y", "w_z"]);
+    let (t, out) = simulate(
+        &fmu_file("AttitudePlant.fmu"),
+        2.0,
+        0.1,
+        &[("torque_cmd_x", "2.5")],
+        &["w_x", "w_y", "w_z"],
+    );
     assert_eq!(t.len(), 21);
     for (k, tk) in t.iter().enumerate() {
         let want = 2.5 * tk / 1000.0;
-        assert!((out["w_x"][k] - want).abs() < 1e-12, "t = {tk}: w_x {} != {want}", out["w_x"][k]);
+        assert!(
+            (out["w_x"][k] - want).abs() < 1e-12,
+            "t = {tk}: w_x {} != {want}",
+            out["w_x"][k]
+        );
         assert_eq!((out["w_y"][k], out["w_z"][k]), (0.0, 0.0));
     }
 }
@@ -118,7 +148,13 @@ fn closed_loop_in_a_fmi_rs_master_equals_the_loop_fmu() {
 
     let (dt, n) = (0.01, 300usize);
     let loop_fmu = fmu_file("loops/default.fmu");
-    let (t_loop, loop_out) = simulate(&loop_fmu, n as f64 * dt, dt, &[], &["metrics.alpha_deg", "plant.w_x", "controller.torque_cmd_y"]);
+    let (t_loop, loop_out) = simulate(
+        &loop_fmu,
+        n as f64 * dt,
+        dt,
+        &[],
+        &["metrics.alpha_deg", "plant.w_x", "controller.torque_cmd_y"],
+    );
 
     // parameter values of the scenario, as carried by the loop FMU ("instance.parameter" start values)
     let ldir = std::env::temp_dir().join(format!("scfmu_fmirs_{}_loopmd", std::process::id()));
@@ -126,11 +162,18 @@ fn closed_loop_in_a_fmi_rs_master_equals_the_loop_fmu() {
     let lmd = ModelDescription::from_path(&ldir.join("modelDescription.xml")).unwrap();
     let _ = std::fs::remove_dir_all(&ldir);
     let start_of = |v: &VariableType| match v {
-        VariableType::Real { start, .. } | VariableType::Integer { start, .. } | VariableType::Boolean { start, .. } => start.clone(),
+        VariableType::Real { start, .. }
+        | VariableType::Integer { start, .. }
+        | VariableType::Boolean { start, .. } => start.clone(),
         _ => None,
     };
 
-    let instances = [("command", "AttitudeCommand"), ("controller", "PdController"), ("plant", "AttitudePlant"), ("metrics", "AttitudeMetrics")];
+    let instances = [
+        ("command", "AttitudeCommand"),
+        ("controller", "PdController"),
+        ("plant", "AttitudePlant"),
+        ("metrics", "AttitudeMetrics"),
+    ];
     let ok = |s: fmi2Status, what: &str| assert!(matches!(s, fmi2Status::Ok), "{what}: {s:?}");
     let mut fmus = vec![];
     for (inst, model) in instances {
@@ -138,10 +181,25 @@ fn closed_loop_in_a_fmi_rs_master_equals_the_loop_fmu() {
         let _ = std::fs::remove_dir_all(&dir);
         fmi_rs::zip::extract_zip_archive(fmu_file(&format!("{model}.fmu")), &dir).unwrap();
         let md = ModelDescription::from_path(&dir.join("modelDescription.xml")).unwrap();
-        let fmu = FMU2::<CS>::new(&dir, model, inst, &md.guid, false, false, false, Arc::new(DefaultLogger::default()), false).unwrap();
+        let fmu = FMU2::<CS>::new(
+            &dir,
+            model,
+            inst,
+            &md.guid,
+            false,
+            false,
+            false,
+            Arc::new(DefaultLogger::default()),
+            false,
+        )
+        .unwrap();
         ok(fmu.setupExperiment(None, 0.0, None), "setupExperiment");
         ok(fmu.enterInitializationMode(), "enterInitializationMode");
-        for v in lmd.modelVariables.iter().filter(|v| v.causality == Causality::Parameter) {
+        for v in lmd
+            .modelVariables
+            .iter()
+            .filter(|v| v.causality == Causality::Parameter)
+        {
             if let Some(p) = v.name.strip_prefix(&format!("{inst}.")) {
                 let nv = md.modelVariables.iter().find(|x| x.name == p).unwrap();
                 let value = parse_variable_value(&nv.variableType, &start_of(&v.variableType).unwrap()).unwrap();
@@ -160,7 +218,10 @@ fn closed_loop_in_a_fmi_rs_master_equals_the_loop_fmu() {
                 .enumerate()
                 .filter(|(s, _)| *s != d)
                 .filter_map(|(s, (_, smd, _, _))| {
-                    smd.modelVariables.iter().find(|v| v.causality == Causality::Output && v.name == inp.name).map(|v| (s, v.valueReference))
+                    smd.modelVariables
+                        .iter()
+                        .find(|v| v.causality == Causality::Output && v.name == inp.name)
+                        .map(|v| (s, v.valueReference))
                 })
                 .collect();
             assert!(src.len() <= 1, "{} has several sources", inp.name);
@@ -172,7 +233,15 @@ fn closed_loop_in_a_fmi_rs_master_equals_the_loop_fmu() {
     // into the controller: q, w (plant), q_ref, w_ref (command); into the plant: torque_cmd; into metrics the rest
     let per_dst: Vec<usize> = (0..4).map(|d| links.iter().filter(|l| l.0 == d).count()).collect();
     assert_eq!(per_dst, [0, 14, 3, 11], "links: {links:?}");
-    let vr_of = |i: usize, name: &str| fmus[i].1.modelVariables.iter().find(|v| v.name == name).unwrap().valueReference;
+    let vr_of = |i: usize, name: &str| {
+        fmus[i]
+            .1
+            .modelVariables
+            .iter()
+            .find(|v| v.name == name)
+            .unwrap()
+            .valueReference
+    };
     let (alpha, wx, tqy) = (vr_of(3, "alpha_deg"), vr_of(2, "w_x"), vr_of(1, "torque_cmd_y"));
     let mut rec = vec![];
     for k in 0..=n {
@@ -203,9 +272,18 @@ fn closed_loop_in_a_fmi_rs_master_equals_the_loop_fmu() {
         assert!((t_loop[k] - t).abs() < 1e-12);
         assert_eq!(
             (a, w, tq),
-            (loop_out["metrics.alpha_deg"][k], loop_out["plant.w_x"][k], loop_out["controller.torque_cmd_y"][k]),
+            (
+                loop_out["metrics.alpha_deg"][k],
+                loop_out["plant.w_x"][k],
+                loop_out["controller.torque_cmd_y"][k]
+            ),
             "t = {t}"
         );
     }
-    assert!(rec[n].1 < 0.5 * rec[0].1, "the slew reduces the eigenaxis error: {} -> {}", rec[0].1, rec[n].1);
+    assert!(
+        rec[n].1 < 0.5 * rec[0].1,
+        "the slew reduces the eigenaxis error: {} -> {}",
+        rec[0].1,
+        rec[n].1
+    );
 }

@@ -12,7 +12,16 @@ const OUTPUTS: &[&str] = &["q_w", "q_x", "q_y", "q_z", "w_x", "w_y", "w_z", "h_t
 
 fn tumbling_plant() -> TestFmu {
     let mut p = TestFmu::new("AttitudePlant");
-    p.init(&[("inertia_xy", 30.0), ("init_w_x", 0.1), ("init_w_y", -0.05), ("init_w_z", 0.2), ("u_max_y", 0.5)], &[]);
+    p.init(
+        &[
+            ("inertia_xy", 30.0),
+            ("init_w_x", 0.1),
+            ("init_w_y", -0.05),
+            ("init_w_z", 0.2),
+            ("u_max_y", 0.5),
+        ],
+        &[],
+    );
     p
 }
 
@@ -63,7 +72,12 @@ fn serialized_state_restores_in_a_new_instance_bit_identically() {
     // A fresh instance, never initialized by hand, continues from the bytes alone.
     let q = TestFmu::new("AttitudePlant");
     let mut s2: *mut c_void = std::ptr::null_mut();
-    assert_eq!(fmi2DeSerializeFMUstate(q.c, bytes.as_ptr() as *const _, bytes.len(), &mut s2), OK, "{:?}", q.messages());
+    assert_eq!(
+        fmi2DeSerializeFMUstate(q.c, bytes.as_ptr() as *const _, bytes.len(), &mut s2),
+        OK,
+        "{:?}",
+        q.messages()
+    );
     assert_eq!(fmi2SetFMUstate(q.c, s2), OK);
     assert_eq!(run(&q, 1.5, 25), expected);
     assert_eq!(fmi2FreeFMUstate(q.c, &mut s2), OK);
@@ -92,16 +106,30 @@ fn corrupted_or_foreign_bytes_are_refused() {
     assert_eq!(try_bytes(&bytes[..bytes.len() - 1]), ERROR);
     assert_eq!(try_bytes(&[]), ERROR);
     assert_eq!(try_bytes(&[0u8; 64]), ERROR);
-    assert!(q.last_message().contains("fmi2DeSerializeFMUstate"), "{}", q.last_message());
+    assert!(
+        q.last_message().contains("fmi2DeSerializeFMUstate"),
+        "{}",
+        q.last_message()
+    );
     // a state of another model is refused by name
     let other = TestFmu::new("AttitudeMetrics");
     let mut so: *mut c_void = std::ptr::null_mut();
     let b = serialize(&p, s);
-    assert_eq!(fmi2DeSerializeFMUstate(other.c, b.as_ptr() as *const _, b.len(), &mut so), ERROR);
-    assert!(other.last_message().contains("belongs to AttitudePlant"), "{}", other.last_message());
+    assert_eq!(
+        fmi2DeSerializeFMUstate(other.c, b.as_ptr() as *const _, b.len(), &mut so),
+        ERROR
+    );
+    assert!(
+        other.last_message().contains("belongs to AttitudePlant"),
+        "{}",
+        other.last_message()
+    );
     // the instance is still usable after the refusals
     let mut good: *mut c_void = std::ptr::null_mut();
-    assert_eq!(fmi2DeSerializeFMUstate(q.c, bytes.as_ptr() as *const _, bytes.len(), &mut good), OK);
+    assert_eq!(
+        fmi2DeSerializeFMUstate(q.c, bytes.as_ptr() as *const _, bytes.len(), &mut good),
+        OK
+    );
     assert_eq!(fmi2FreeFMUstate(q.c, &mut good), OK);
     let mut s = s;
     assert_eq!(fmi2FreeFMUstate(p.c, &mut s), OK);
@@ -160,14 +188,25 @@ fn event_iteration(p: &TestFmu) -> (bool, Option<f64>) {
     };
     assert_eq!(fmi2NewDiscreteStates(p.c, &mut info), OK, "{:?}", p.messages());
     assert_eq!(info.new_discrete_states_needed, 0);
-    (info.values_of_continuous_states_changed != 0, (info.next_event_time_defined != 0).then_some(info.next_event_time))
+    (
+        info.values_of_continuous_states_changed != 0,
+        (info.next_event_time_defined != 0).then_some(info.next_event_time),
+    )
 }
 
 /// A plant as Model Exchange with a fault at t = 2 s and noise held for 0.3 s (time events at
 /// 0.3, 0.6, …, 1.8, 2.0, 2.1, …), in continuous-time mode at t = 0.
 fn me_plant() -> TestFmu {
     let mut p = TestFmu::new_me("AttitudePlant");
-    p.init(&[("fault_time", 2.0), ("dist_noise_std_x", 1e-3), ("dist_noise_hold", 0.3), ("init_w_z", 0.01)], &[]);
+    p.init(
+        &[
+            ("fault_time", 2.0),
+            ("dist_noise_std_x", 1e-3),
+            ("dist_noise_hold", 0.3),
+            ("init_w_z", 0.01),
+        ],
+        &[],
+    );
     assert_eq!(event_iteration(&p).1, Some(0.3));
     assert_eq!(fmi2EnterContinuousTimeMode(p.c), OK);
     p
@@ -206,28 +245,48 @@ fn model_exchange_restore_brings_back_the_time_of_the_last_event() {
     assert_eq!(fmi2GetFMUstate(p.c, &mut b), OK);
     let b_bytes = serialize(&p, b);
     assert_eq!(fmi2SetTime(p.c, 1.5), ERROR, "before the last event");
-    assert!(p.last_message().contains("fmi2SetTime") && p.last_message().contains("before the last event at t = 2"), "{}", p.last_message());
+    assert!(
+        p.last_message().contains("fmi2SetTime") && p.last_message().contains("before the last event at t = 2"),
+        "{}",
+        p.last_message()
+    );
 
     // back to A: t = 0.45 lies after A's last event (0.3), so the solver may evaluate there
     assert_eq!(fmi2SetFMUstate(p.c, a), OK);
     assert_eq!(fmi2SetTime(p.c, 0.45), OK, "{:?}", p.last_message());
     assert_eq!(fmi2SetTime(p.c, 0.25), ERROR, "before A's last event at 0.3");
-    assert!(p.last_message().contains("before the last event at t = 0.3"), "{}", p.last_message());
+    assert!(
+        p.last_message().contains("before the last event at t = 0.3"),
+        "{}",
+        p.last_message()
+    );
     // the next time event comes from the restored model and time
     assert_eq!(event_at(&p, 0.5), Some(0.6));
 
     // B restored into a fresh instance through its bytes (that instance's own last event is at 0)
     let q = me_plant();
     let mut qb: *mut c_void = std::ptr::null_mut();
-    assert_eq!(fmi2DeSerializeFMUstate(q.c, b_bytes.as_ptr() as *const _, b_bytes.len(), &mut qb), OK, "{:?}", q.messages());
+    assert_eq!(
+        fmi2DeSerializeFMUstate(q.c, b_bytes.as_ptr() as *const _, b_bytes.len(), &mut qb),
+        OK,
+        "{:?}",
+        q.messages()
+    );
     assert_eq!(fmi2SetFMUstate(q.c, qb), OK);
     assert_eq!(fmi2SetTime(q.c, 1.5), ERROR, "before B's last event at 2");
-    assert!(q.last_message().contains("before the last event at t = 2"), "{}", q.last_message());
+    assert!(
+        q.last_message().contains("before the last event at t = 2"),
+        "{}",
+        q.last_message()
+    );
     assert_eq!(fmi2SetTime(q.c, 2.05), OK);
     assert_eq!(event_at(&q, 2.05), Some(2.1));
     // and A's bytes into it: back to 0.3 as the last event
     let mut qa: *mut c_void = std::ptr::null_mut();
-    assert_eq!(fmi2DeSerializeFMUstate(q.c, a_bytes.as_ptr() as *const _, a_bytes.len(), &mut qa), OK);
+    assert_eq!(
+        fmi2DeSerializeFMUstate(q.c, a_bytes.as_ptr() as *const _, a_bytes.len(), &mut qa),
+        OK
+    );
     assert_eq!(fmi2SetFMUstate(q.c, qa), OK);
     assert_eq!(fmi2SetTime(q.c, 0.4), OK, "{}", q.last_message());
     assert_eq!(event_at(&q, 0.4), Some(0.6));

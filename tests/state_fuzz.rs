@@ -53,12 +53,20 @@ impl Rng {
 
 fn real_inputs(p: &TestFmu) -> Vec<&'static str> {
     let e = registry::find(p.model).unwrap();
-    e.decls.iter().filter(|d| d.causality == Causality::Input && d.kind == VarKind::Real).map(|d| d.name).collect()
+    e.decls
+        .iter()
+        .filter(|d| d.causality == Causality::Input && d.kind == VarKind::Real)
+        .map(|d| d.name)
+        .collect()
 }
 
 fn real_outputs(model: &str) -> Vec<u32> {
     let e = registry::find(model).unwrap();
-    e.decls.iter().filter(|d| d.causality == Causality::Output && d.kind == VarKind::Real).map(|d| d.vr).collect()
+    e.decls
+        .iter()
+        .filter(|d| d.causality == Causality::Output && d.kind == VarKind::Real)
+        .map(|d| d.vr)
+        .collect()
 }
 
 /// An initialized instance after STEPS steps at the model's default step with small varying inputs
@@ -132,7 +140,12 @@ fn mutated_states_of_every_fmu_are_refused_or_usable() {
         let q = TestFmu::new(model);
         let outputs = real_outputs(model);
         let h = entry.info.default_step;
-        assert_eq!(try_state(&q, &good, &outputs, h), Ok(true), "{model}: the unchanged state is refused: {}", q.last_message());
+        assert_eq!(
+            try_state(&q, &good, &outputs, h),
+            Ok(true),
+            "{model}: the unchanged state is refused: {}",
+            q.last_message()
+        );
         let payload = 16..good.len() - 4;
         let (mut acc, mut refused) = (0, 0);
         for i in 0..per_model {
@@ -141,7 +154,11 @@ fn mutated_states_of_every_fmu_are_refused_or_usable() {
             let mut what = vec![];
             for _ in 0..n {
                 // half of the changes in the first 512 payload bytes (header, parameters, flags)
-                let span = if rng.next() % 2 == 0 { payload.len().min(512) } else { payload.len() };
+                let span = if rng.next() % 2 == 0 {
+                    payload.len().min(512)
+                } else {
+                    payload.len()
+                };
                 let at = payload.start + rng.below(span);
                 if rng.next() % 2 == 0 {
                     b[at] ^= 1 << rng.below(8);
@@ -156,13 +173,24 @@ fn mutated_states_of_every_fmu_are_refused_or_usable() {
                 Ok(false) => refused += 1,
                 Err(e) => panic!("{model}, mutation {i} at bytes {what:?}: {e}"),
             }
-            assert!(q.messages().iter().all(|(st, _)| *st != FATAL), "{model}, mutation {i} at {what:?}: {:?}", q.messages().last());
+            assert!(
+                q.messages().iter().all(|(st, _)| *st != FATAL),
+                "{model}, mutation {i} at {what:?}: {:?}",
+                q.messages().last()
+            );
         }
-        println!("{model:>30}: state {:>7} bytes, {per_model} mutations: {acc:>3} accepted and usable, {refused:>3} refused", good.len());
+        println!(
+            "{model:>30}: state {:>7} bytes, {per_model} mutations: {acc:>3} accepted and usable, {refused:>3} refused",
+            good.len()
+        );
         total_acc += acc;
         total_ref += refused;
     }
-    println!("{} FMUs, {} mutated states: {total_acc} accepted and usable, {total_ref} refused, 0 fatal", registry::COUNT, total_acc + total_ref);
+    println!(
+        "{} FMUs, {} mutated states: {total_acc} accepted and usable, {total_ref} refused, 0 fatal",
+        registry::COUNT,
+        total_acc + total_ref
+    );
 }
 
 #[test]
@@ -182,7 +210,9 @@ fn fopid_state_with_a_flipped_law_flag_is_refused_by_name() {
             Ok(_) => {}
             Err(e) => panic!("byte {at}: {e}"),
         }
-        if q.messages()[before..].iter().any(|(st, m)| *st == ERROR && m.contains("law.p.history_before_start") && m.contains("fmi2DeSerializeFMUstate")) {
+        if q.messages()[before..].iter().any(|(st, m)| {
+            *st == ERROR && m.contains("law.p.history_before_start") && m.contains("fmi2DeSerializeFMUstate")
+        }) {
             named += 1;
         }
     }
@@ -202,10 +232,16 @@ fn trailing_bytes_after_the_payload_are_refused_by_name() {
     b.extend_from_slice(&[0; 4]);
     fix_crc(&mut b);
     let mut s: *mut c_void = std::ptr::null_mut();
-    assert_eq!(fmi2DeSerializeFMUstate(q.c, b.as_ptr() as *const _, b.len(), &mut s), ERROR);
+    assert_eq!(
+        fmi2DeSerializeFMUstate(q.c, b.as_ptr() as *const _, b.len(), &mut s),
+        ERROR
+    );
     assert!(s.is_null());
     let m = q.last_message();
-    assert!(m.contains("fmi2DeSerializeFMUstate") && m.contains("70 trailing bytes"), "{m}");
+    assert!(
+        m.contains("fmi2DeSerializeFMUstate") && m.contains("70 trailing bytes"),
+        "{m}"
+    );
 }
 
 #[test]
@@ -215,7 +251,10 @@ fn a_tolerance_outside_the_honoured_range_is_clamped_with_a_warning() {
         assert_eq!(fmi2SetupExperiment(p.c, 1, tol, 0.0, 0, 0.0), WARNING, "{tol}");
         let (st, m) = p.messages().last().cloned().unwrap();
         assert_eq!(st, WARNING);
-        assert!(m.contains("fmi2SetupExperiment") && m.contains("tolerance") && m.contains(used), "{m}");
+        assert!(
+            m.contains("fmi2SetupExperiment") && m.contains("tolerance") && m.contains(used),
+            "{m}"
+        );
         // the experiment is set up: initialization proceeds
         assert_eq!(fmi2EnterInitializationMode(p.c), OK);
         assert_eq!(fmi2ExitInitializationMode(p.c), OK);

@@ -88,7 +88,10 @@ thread_local! {
 fn install_panic_hook() {
     std::panic::set_hook(Box::new(|info| {
         if IN_FFI.with(Cell::get) {
-            let loc = info.location().map(|l| format!(" at {}:{}", l.file(), l.line())).unwrap_or_default();
+            let loc = info
+                .location()
+                .map(|l| format!(" at {}:{}", l.file(), l.line()))
+                .unwrap_or_default();
             let msg = info
                 .payload()
                 .downcast_ref::<&str>()
@@ -97,8 +100,16 @@ fn install_panic_hook() {
                 .unwrap_or_else(|| "unknown panic".into());
             PANIC_MESSAGE.with(|m| *m.borrow_mut() = Some(format!("{msg}{loc}")));
         } else {
-            let msg = info.payload().downcast_ref::<&str>().copied().or_else(|| info.payload().downcast_ref::<String>().map(String::as_str));
-            eprintln!("panic: {}{}", msg.unwrap_or("unknown panic"), info.location().map(|l| format!(" at {l}")).unwrap_or_default());
+            let msg = info
+                .payload()
+                .downcast_ref::<&str>()
+                .copied()
+                .or_else(|| info.payload().downcast_ref::<String>().map(String::as_str));
+            eprintln!(
+                "panic: {}{}",
+                msg.unwrap_or("unknown panic"),
+                info.location().map(|l| format!(" at {l}")).unwrap_or_default()
+            );
         }
     }));
 }
@@ -108,7 +119,11 @@ pub fn guarded<T>(f: impl FnOnce() -> T) -> Result<T, String> {
     let was = IN_FFI.with(|x| x.replace(true));
     let r = catch_unwind(AssertUnwindSafe(f));
     IN_FFI.with(|x| x.set(was));
-    r.map_err(|_| PANIC_MESSAGE.with(|m| m.borrow_mut().take()).unwrap_or_else(|| "unknown panic".into()))
+    r.map_err(|_| {
+        PANIC_MESSAGE
+            .with(|m| m.borrow_mut().take())
+            .unwrap_or_else(|| "unknown panic".into())
+    })
 }
 
 // ----- pointer helpers ---------------------------------------------------------------------------
@@ -181,7 +196,9 @@ fn find_model(all: &'static [ModelEntry], requested: &str) -> Result<&'static Mo
             Err(format!("fmuGUID {requested} does not match {}'s GUID {want} (modelDescription.xml and binary are from different builds)", expected.info.name))
         };
     }
-    all.iter().find(|e| guid(e).as_str() == requested).ok_or_else(|| format!("fmuGUID {requested} matches no model in this binary"))
+    all.iter()
+        .find(|e| guid(e).as_str() == requested)
+        .ok_or_else(|| format!("fmuGUID {requested} matches no model in this binary"))
 }
 
 /// What an `fmi2Instantiate` / `fmi3Instantiate*` call asks for, in the version's own words.
@@ -218,10 +235,23 @@ pub fn instantiate(req: Request) -> Handle {
         if let Some(why) = (req.refuse_model)(entry) {
             return Err(why);
         }
-        let mut inst = Box::new(Instance::new(name.to_owned(), entry, req.logger, req.env, req.logging_on));
+        let mut inst = Box::new(Instance::new(
+            name.to_owned(),
+            entry,
+            req.logger,
+            req.env,
+            req.logging_on,
+        ));
         inst.fmi3 = req.fmi3;
         inst.model_exchange = req.model_exchange;
-        inst.trace(|| format!("{}: {} instance of {}", req.func, inst.name.to_string_lossy(), entry.info.name));
+        inst.trace(|| {
+            format!(
+                "{}: {} instance of {}",
+                req.func,
+                inst.name.to_string_lossy(),
+                entry.info.name
+            )
+        });
         Ok(register(inst))
     });
     let msg = match result {
@@ -239,10 +269,23 @@ pub fn log_without_instance(logger: Logger, env: *mut c_void, instance_name: *co
         Logger::None => {}
         Logger::Fmi2(log) => {
             // the FMI 2.0 logger takes a printf format: escape '%'
-            let text = CString::new(format!("{func}: {message}").replace('%', "%%").replace('\0', "")).unwrap_or_default();
-            let name = if instance_name.is_null() { c"?" } else { unsafe { CStr::from_ptr(instance_name) } };
+            let text =
+                CString::new(format!("{func}: {message}").replace('%', "%%").replace('\0', "")).unwrap_or_default();
+            let name = if instance_name.is_null() {
+                c"?"
+            } else {
+                unsafe { CStr::from_ptr(instance_name) }
+            };
             // SAFETY: master-provided callback with valid NUL-terminated strings.
-            unsafe { log(env, name.as_ptr(), Status::Error as c_int, c"logStatusError".as_ptr(), text.as_ptr()) };
+            unsafe {
+                log(
+                    env,
+                    name.as_ptr(),
+                    Status::Error as c_int,
+                    c"logStatusError".as_ptr(),
+                    text.as_ptr(),
+                )
+            };
         }
         Logger::Fmi3(log) => {
             let text = CString::new(format!("{func}: {message}").replace('\0', "")).unwrap_or_default();

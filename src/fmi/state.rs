@@ -67,12 +67,21 @@ impl Snapshot {
 
     pub fn restore_into(&self, inst: &mut Instance) -> CallResult {
         if self.model_name != inst.entry.info.name {
-            return Err(Fail::error(format!("FMU state belongs to {}, not to {}", self.model_name, inst.entry.info.name)));
+            return Err(Fail::error(format!(
+                "FMU state belongs to {}, not to {}",
+                self.model_name, inst.entry.info.name
+            )));
         }
         let me_state = matches!(self.run.fsm, FsmState::EventMode | FsmState::ContinuousTimeMode);
-        if (me_state && !inst.model_exchange) || (inst.model_exchange && matches!(self.run.fsm, FsmState::StepComplete | FsmState::StepFailed)) {
+        if (me_state && !inst.model_exchange)
+            || (inst.model_exchange && matches!(self.run.fsm, FsmState::StepComplete | FsmState::StepFailed))
+        {
             let kind = |me: bool| if me { "Model Exchange" } else { "Co-Simulation" };
-            return Err(Fail::error(format!("FMU state was taken from a {} instance; this instance runs {}", kind(me_state), kind(inst.model_exchange))));
+            return Err(Fail::error(format!(
+                "FMU state was taken from a {} instance; this instance runs {}",
+                kind(me_state),
+                kind(inst.model_exchange)
+            )));
         }
         inst.model = self.model.clone_box();
         inst.run = self.run;
@@ -94,7 +103,9 @@ impl Snapshot {
         }
         let table = live();
         if !table.contains_key(&(p as usize)) {
-            return Err(Fail::error(format!("FMUstate {p:p} was not created by this FMU or was already freed")));
+            return Err(Fail::error(format!(
+                "FMUstate {p:p} was not created by this FMU or was already freed"
+            )));
         }
         // SAFETY: the address is in the table, so it came from Box::into_raw and is not freed; the
         // lock held until the end of this function keeps every other thread away from it.
@@ -107,7 +118,9 @@ impl Snapshot {
     pub fn free_handle(p: *mut Snapshot) -> CallResult {
         let mut table = live();
         if table.remove(&(p as usize)).is_none() {
-            return Err(Fail::error(format!("FMUstate {p:p} was not created by this FMU or was already freed")));
+            return Err(Fail::error(format!(
+                "FMUstate {p:p} was not created by this FMU or was already freed"
+            )));
         }
         release_if_empty(&mut table);
         // SAFETY: it was in the table, so it is a Box we leaked and nobody else frees it.
@@ -132,7 +145,10 @@ impl Snapshot {
             model_name: self.model_name.to_string(),
             guid: guid.to_string(),
             run: self.run,
-            model: self.model.to_bytes().map_err(|e| Fail::error(format!("cannot encode model state: {e}")))?,
+            model: self
+                .model
+                .to_bytes()
+                .map_err(|e| Fail::error(format!("cannot encode model state: {e}")))?,
         };
         let body = postcard::to_stdvec(&payload).map_err(|e| Fail::error(format!("cannot encode FMU state: {e}")))?;
         let mut out = Vec::with_capacity(HEADER + body.len() + TRAILER);
@@ -149,41 +165,73 @@ impl Snapshot {
     /// decoded state is validated like parameters at initialization (see `Fmu::validate`).
     pub fn from_bytes(bytes: &[u8], inst: &Instance, guid: &str) -> CallResult<Snapshot> {
         if bytes.len() < HEADER + TRAILER {
-            return Err(Fail::error(format!("serialized state has {} bytes, too short to be one of ours", bytes.len())));
+            return Err(Fail::error(format!(
+                "serialized state has {} bytes, too short to be one of ours",
+                bytes.len()
+            )));
         }
         if &bytes[..8] != MAGIC {
-            return Err(Fail::error("serialized state does not start with this library's magic bytes"));
+            return Err(Fail::error(
+                "serialized state does not start with this library's magic bytes",
+            ));
         }
         let version = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
         if version != FORMAT_VERSION {
-            return Err(Fail::error(format!("serialized state has format version {version}, expected {FORMAT_VERSION}")));
+            return Err(Fail::error(format!(
+                "serialized state has format version {version}, expected {FORMAT_VERSION}"
+            )));
         }
         let len = u32::from_le_bytes(bytes[12..16].try_into().expect("4 bytes")) as usize;
         if HEADER + len + TRAILER != bytes.len() {
-            return Err(Fail::error(format!("serialized state length {} does not match its header ({})", bytes.len(), HEADER + len + TRAILER)));
+            return Err(Fail::error(format!(
+                "serialized state length {} does not match its header ({})",
+                bytes.len(),
+                HEADER + len + TRAILER
+            )));
         }
         let crc = u32::from_le_bytes(bytes[HEADER + len..].try_into().expect("4 bytes"));
         if crc32fast::hash(&bytes[..HEADER + len]) != crc {
             return Err(Fail::error("serialized state is corrupted (CRC-32 mismatch)"));
         }
-        let (p, rest): (Payload, &[u8]) =
-            postcard::take_from_bytes(&bytes[HEADER..HEADER + len]).map_err(|e| Fail::error(format!("serialized state does not decode: {e}")))?;
+        let (p, rest): (Payload, &[u8]) = postcard::take_from_bytes(&bytes[HEADER..HEADER + len])
+            .map_err(|e| Fail::error(format!("serialized state does not decode: {e}")))?;
         if !rest.is_empty() {
-            return Err(Fail::error(format!("serialized state has {} trailing bytes after its payload", rest.len())));
+            return Err(Fail::error(format!(
+                "serialized state has {} trailing bytes after its payload",
+                rest.len()
+            )));
         }
         if p.model_name != inst.entry.info.name {
-            return Err(Fail::error(format!("serialized state belongs to {}, not to {}", p.model_name, inst.entry.info.name)));
+            return Err(Fail::error(format!(
+                "serialized state belongs to {}, not to {}",
+                p.model_name, inst.entry.info.name
+            )));
         }
         if p.guid != guid {
-            return Err(Fail::error(format!("serialized state was written by a different version of {} (GUID {})", p.model_name, p.guid)));
+            return Err(Fail::error(format!(
+                "serialized state was written by a different version of {} (GUID {})",
+                p.model_name, p.guid
+            )));
         }
         let mut model = inst.model.clone_box();
         model.load_bytes(&p.model).map_err(Fail::error)?;
-        p.run.validate().map_err(|e| Fail::error(format!("serialized state is invalid: {e}")))?;
+        p.run
+            .validate()
+            .map_err(|e| Fail::error(format!("serialized state is invalid: {e}")))?;
         if !model.is_initialized() && !matches!(p.run.fsm, FsmState::Instantiated | FsmState::InitializationMode) {
-            return Err(Fail::error(format!("serialized state is invalid: state machine state {:?} without applied parameters", p.run.fsm)));
+            return Err(Fail::error(format!(
+                "serialized state is invalid: state machine state {:?} without applied parameters",
+                p.run.fsm
+            )));
         }
-        model.validate(&p.run.exp).map_err(|e| Fail::error(format!("serialized state is invalid: {e}")))?;
-        Ok(Snapshot { model_name: inst.entry.info.name, run: p.run, model, serialized: None })
+        model
+            .validate(&p.run.exp)
+            .map_err(|e| Fail::error(format!("serialized state is invalid: {e}")))?;
+        Ok(Snapshot {
+            model_name: inst.entry.info.name,
+            run: p.run,
+            model,
+            serialized: None,
+        })
     }
 }

@@ -68,7 +68,10 @@ pub(crate) fn serialize<'a>(
             None => snap.to_bytes(&guid(inst.entry))?,
         };
         if size != bytes.len() {
-            return Err(Fail::error(format!("size {size} differs from {size_function} = {}", bytes.len())));
+            return Err(Fail::error(format!(
+                "size {size} differs from {size_function} = {}",
+                bytes.len()
+            )));
         }
         buffer()?.copy_from_slice(&bytes);
         Ok(())

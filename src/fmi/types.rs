@@ -18,11 +18,18 @@ pub enum Status {
 }
 
 /// `fmi2CallbackLogger`: a C-variadic function; we always pass a fully formatted message.
-pub type LoggerFn =
-    unsafe extern "C" fn(env: *mut c_void, instance_name: *const c_char, status: c_int, category: *const c_char, message: *const c_char, ...);
+pub type LoggerFn = unsafe extern "C" fn(
+    env: *mut c_void,
+    instance_name: *const c_char,
+    status: c_int,
+    category: *const c_char,
+    message: *const c_char,
+    ...
+);
 
 /// `fmi3LogMessageCallback`: not variadic, the message is plain text (not a printf format).
-pub type Log3Fn = unsafe extern "C" fn(env: *mut c_void, status: c_int, category: *const c_char, message: *const c_char);
+pub type Log3Fn =
+    unsafe extern "C" fn(env: *mut c_void, status: c_int, category: *const c_char, message: *const c_char);
 
 /// Log categories declared in every modelDescription and accepted by `fmi2SetDebugLogging`.
 pub const LOG_CATEGORIES: &[(&str, &str)] = &[

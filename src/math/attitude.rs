@@ -15,7 +15,9 @@ pub const NORM_ROUNDOFF: f64 = 8.0 * f64::EPSILON;
 /// `floor`, else `floor`. A threshold tighter than the solver's own accuracy asks for an event after
 /// nearly every step.
 pub fn projection_threshold(tolerance: Option<f64>, floor: f64) -> f64 {
-    tolerance.filter(|t| t.is_finite() && *t > 0.0).map_or(floor, |t| t.min(1e-3).max(floor))
+    tolerance
+        .filter(|t| t.is_finite() && *t > 0.0)
+        .map_or(floor, |t| t.min(1e-3).max(floor))
 }
 
 pub fn skew(a: &Vector3<f64>) -> Matrix3<f64> {
@@ -68,7 +70,11 @@ pub fn euler321_from_quat(q: &Quaternion<f64>) -> [f64; 3] {
 /// Wraps an angle into (−π, π].
 pub fn wrap_pi(a: f64) -> f64 {
     let r = (a + PI).rem_euclid(2.0 * PI) - PI;
-    if r == -PI { PI } else { r }
+    if r == -PI {
+        PI
+    } else {
+        r
+    }
 }
 
 /// Error quaternion q_E = q* ⊗ q_ref: the reference relative to the body (paper 000 Eq. 16).
@@ -100,7 +106,12 @@ pub fn quat_from_dcm(a: &Matrix3<f64>) -> Quaternion<f64> {
     // Off-diagonal combinations for A(q) = (q_w² − |q_v|²) I + 2 q_v q_vᵀ − 2 q_w [q_v×]:
     // A23 − A32 = 4 q_w q_x, A31 − A13 = 4 q_w q_y, A12 − A21 = 4 q_w q_z,
     // A12 + A21 = 4 q_x q_y, A13 + A31 = 4 q_x q_z, A23 + A32 = 4 q_y q_z.
-    let cand = [1.0 + tr, 1.0 + 2.0 * a[(0, 0)] - tr, 1.0 + 2.0 * a[(1, 1)] - tr, 1.0 + 2.0 * a[(2, 2)] - tr];
+    let cand = [
+        1.0 + tr,
+        1.0 + 2.0 * a[(0, 0)] - tr,
+        1.0 + 2.0 * a[(1, 1)] - tr,
+        1.0 + 2.0 * a[(2, 2)] - tr,
+    ];
     let mut k = 0;
     for i in 1..4 {
         if cand[i] > cand[k] {
@@ -109,17 +120,41 @@ pub fn quat_from_dcm(a: &Matrix3<f64>) -> Quaternion<f64> {
     }
     let s = 2.0 * cand[k].max(0.0).sqrt(); // = 4 |pivot component|
     let (w, x, y, z) = match k {
-        0 => (0.25 * s, (a[(1, 2)] - a[(2, 1)]) / s, (a[(2, 0)] - a[(0, 2)]) / s, (a[(0, 1)] - a[(1, 0)]) / s),
-        1 => ((a[(1, 2)] - a[(2, 1)]) / s, 0.25 * s, (a[(0, 1)] + a[(1, 0)]) / s, (a[(0, 2)] + a[(2, 0)]) / s),
-        2 => ((a[(2, 0)] - a[(0, 2)]) / s, (a[(0, 1)] + a[(1, 0)]) / s, 0.25 * s, (a[(1, 2)] + a[(2, 1)]) / s),
-        _ => ((a[(0, 1)] - a[(1, 0)]) / s, (a[(0, 2)] + a[(2, 0)]) / s, (a[(1, 2)] + a[(2, 1)]) / s, 0.25 * s),
+        0 => (
+            0.25 * s,
+            (a[(1, 2)] - a[(2, 1)]) / s,
+            (a[(2, 0)] - a[(0, 2)]) / s,
+            (a[(0, 1)] - a[(1, 0)]) / s,
+        ),
+        1 => (
+            (a[(1, 2)] - a[(2, 1)]) / s,
+            0.25 * s,
+            (a[(0, 1)] + a[(1, 0)]) / s,
+            (a[(0, 2)] + a[(2, 0)]) / s,
+        ),
+        2 => (
+            (a[(2, 0)] - a[(0, 2)]) / s,
+            (a[(0, 1)] + a[(1, 0)]) / s,
+            0.25 * s,
+            (a[(1, 2)] + a[(2, 1)]) / s,
+        ),
+        _ => (
+            (a[(0, 1)] - a[(1, 0)]) / s,
+            (a[(0, 2)] + a[(2, 0)]) / s,
+            (a[(1, 2)] + a[(2, 1)]) / s,
+            0.25 * s,
+        ),
     };
     Quaternion::new(w, x, y, z)
 }
 
 /// q or −q, whichever is closer to `prev` (q·prev ≥ 0): keeps a quaternion output sign-continuous.
 pub fn align_sign(q: Quaternion<f64>, prev: &Quaternion<f64>) -> Quaternion<f64> {
-    if q.coords.dot(&prev.coords) < 0.0 { -q } else { q }
+    if q.coords.dot(&prev.coords) < 0.0 {
+        -q
+    } else {
+        q
+    }
 }
 
 /// Elementary rotation matrices of the README (frame rotations): R1(a) = A(q_x(a)) etc.
@@ -192,7 +227,11 @@ mod tests {
 
     #[test]
     fn a_of_q321_equals_a321() {
-        for &(r, p, y) in &[(0.3, -0.2, 1.1), (40f64.to_radians(), -40f64.to_radians(), -60f64.to_radians()), (-2.0, 1.2, 3.0)] {
+        for &(r, p, y) in &[
+            (0.3, -0.2, 1.1),
+            (40f64.to_radians(), -40f64.to_radians(), -60f64.to_radians()),
+            (-2.0, 1.2, 3.0),
+        ] {
             let d = attitude_matrix(&quat_from_euler321(r, p, y)) - a321(r, p, y);
             assert!(d.abs().max() < 1e-15, "{d}");
         }
@@ -218,7 +257,10 @@ mod tests {
     fn euler_round_trip() {
         for &(r, p, y) in &[(0.3, -0.2, 1.1), (-3.0, 1.5, -3.1), (0.0, 0.0, 0.0)] {
             let e = euler321_from_quat(&quat_from_euler321(r, p, y));
-            assert!(close(e[0], r, 1e-12) && close(e[1], p, 1e-12) && close(e[2], y, 1e-12), "{e:?}");
+            assert!(
+                close(e[0], r, 1e-12) && close(e[1], p, 1e-12) && close(e[2], y, 1e-12),
+                "{e:?}"
+            );
         }
     }
 
@@ -247,7 +289,10 @@ mod tests {
         let q = quat(1.0, 0.0, 0.0, 0.0);
         let r = quat_from_euler321(0.0, 0.0, 0.7);
         assert!(close(euler_axis_angle(&q, &r), 0.7, 1e-15));
-        assert!(close(euler_axis_angle(&q, &-r), 0.7, 1e-15), "sign of q_ref must not matter");
+        assert!(
+            close(euler_axis_angle(&q, &-r), 0.7, 1e-15),
+            "sign of q_ref must not matter"
+        );
     }
     fn sample_quats() -> Vec<Quaternion<f64>> {
         let mut v = vec![
@@ -292,7 +337,10 @@ mod tests {
     fn euler321_from_dcm_matches_readme() {
         for &(r, p, y) in &[(0.3, -0.2, 1.1), (-3.0, 1.5, -3.1), (0.0, 0.0, 0.0), (2.0, -0.4, -1.0)] {
             let e = euler321_from_dcm(&a321(r, p, y));
-            assert!(close(e[0], r, 1e-12) && close(e[1], p, 1e-12) && close(e[2], y, 1e-12), "{e:?}");
+            assert!(
+                close(e[0], r, 1e-12) && close(e[1], p, 1e-12) && close(e[2], y, 1e-12),
+                "{e:?}"
+            );
         }
         // elementary rotations are the README's frame rotations
         assert!((rot1(0.3) * rot2(-0.2) * rot3(1.1) - a321(0.3, -0.2, 1.1)).abs().max() < 1e-15);

@@ -73,7 +73,13 @@ mod tests {
     use super::*;
 
     fn leo() -> CircularOrbit {
-        CircularOrbit { mu: 3.986004418e14, radius: 7078137.0, inclination: 98f64.to_radians(), arg_lat0: 0.0, dipole: 7.96e15 }
+        CircularOrbit {
+            mu: 3.986004418e14,
+            radius: 7078137.0,
+            inclination: 98f64.to_radians(),
+            arg_lat0: 0.0,
+            dipole: 7.96e15,
+        }
     }
 
     #[test]

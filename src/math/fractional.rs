@@ -72,7 +72,9 @@ pub fn gl_sum_direct(weights: &[f64], e: &[f64], memory: usize) -> f64 {
 pub fn gl_series(alpha: f64, h: f64, e: &[f64], memory: usize) -> Vec<f64> {
     let w = gl_weights(alpha, if memory == 0 { e.len() } else { memory.min(e.len()) });
     let scale = h.powf(-alpha);
-    (0..e.len()).map(|n| scale * gl_sum_direct(&w, &e[..=n], memory)).collect()
+    (0..e.len())
+        .map(|n| scale * gl_sum_direct(&w, &e[..=n], memory))
+        .collect()
 }
 
 /// FFT plans and weight spectrum of one block level (rebuilt on demand, never serialized).
@@ -108,7 +110,14 @@ pub struct GlKernel {
 impl GlKernel {
     /// Order `alpha`, memory `memory` samples (0 = full), `fast` = block-FFT evaluation.
     pub fn new(alpha: f64, memory: usize, fast: bool) -> Self {
-        let mut c = GlKernel { alpha, memory, fast, weights: Vec::new(), far: Vec::new(), cache: FftCache::default() };
+        let mut c = GlKernel {
+            alpha,
+            memory,
+            fast,
+            weights: Vec::new(),
+            far: Vec::new(),
+            cache: FftCache::default(),
+        };
         c.ensure_weights(NEAR.max(2));
         c
     }
@@ -144,7 +153,11 @@ impl GlKernel {
     /// s_n with e_n = `e_now` after the samples `history` = e_0 … e_{n-1}. Does not change the state.
     pub fn eval(&self, history: &[f64], e_now: f64) -> f64 {
         let n = history.len();
-        let m = if self.memory == 0 { n + 1 } else { (n + 1).min(self.memory) };
+        let m = if self.memory == 0 {
+            n + 1
+        } else {
+            (n + 1).min(self.memory)
+        };
         if !self.fast {
             // direct: e_now * w_0 + Σ_{j=1}^{m-1} w_j e_{n-j}
             return e_now + gl_sum_direct(&self.weights[1..m], &history[n + 1 - m..], 0);
@@ -192,7 +205,11 @@ impl GlKernel {
         let mut buf: Vec<Complex<f64>> = (0..2 * l)
             .map(|i| {
                 let j = l + i;
-                let w = if i < l && (self.memory == 0 || j < self.memory) { self.weights[j] } else { 0.0 };
+                let w = if i < l && (self.memory == 0 || j < self.memory) {
+                    self.weights[j]
+                } else {
+                    0.0
+                };
                 Complex::new(w * scale, 0.0)
             })
             .collect();
@@ -211,7 +228,9 @@ impl GlKernel {
     fn add_block_product(&mut self, history: &[f64], k: usize, l: usize, n1: usize) {
         let lv = self.level(k, l);
         let Some(w_hat) = &lv.w_hat else { return };
-        let mut buf: Vec<Complex<f64>> = (0..2 * l).map(|i| Complex::new(if i < l { history[n1 - l + i] } else { 0.0 }, 0.0)).collect();
+        let mut buf: Vec<Complex<f64>> = (0..2 * l)
+            .map(|i| Complex::new(if i < l { history[n1 - l + i] } else { 0.0 }, 0.0))
+            .collect();
         lv.fwd.process(&mut buf);
         for (b, w) in buf.iter_mut().zip(w_hat) {
             *b *= *w;
@@ -228,7 +247,6 @@ impl GlKernel {
     }
 }
 
-
 /// [`GlKernel`] with its own history: the GL sum of one signal, for tests and single-sum uses.
 #[derive(Clone)]
 pub struct GlConvolution {
@@ -238,7 +256,10 @@ pub struct GlConvolution {
 
 impl GlConvolution {
     pub fn new(alpha: f64, memory: usize, fast: bool) -> Self {
-        GlConvolution { kernel: GlKernel::new(alpha, memory, fast), history: Vec::new() }
+        GlConvolution {
+            kernel: GlKernel::new(alpha, memory, fast),
+            history: Vec::new(),
+        }
     }
     pub fn len(&self) -> usize {
         self.history.len()
@@ -266,7 +287,9 @@ mod tests {
     use std::f64::consts::PI;
 
     fn signal(n: usize) -> Vec<f64> {
-        (0..n).map(|k| (0.013 * k as f64).sin() + 0.3 * (0.0071 * k as f64 * k as f64 % 7.0).cos() - 0.2).collect()
+        (0..n)
+            .map(|k| (0.013 * k as f64).sin() + 0.3 * (0.0071 * k as f64 * k as f64 % 7.0).cos() - 0.2)
+            .collect()
     }
 
     #[test]
@@ -282,7 +305,10 @@ mod tests {
                     den *= i as f64;
                 }
                 let expect = if j % 2 == 0 { num / den } else { -num / den };
-                assert!((wj - expect).abs() <= 1e-14 * expect.abs().max(1e-300) + 1e-300, "α={a} j={j}: {wj} vs {expect}");
+                assert!(
+                    (wj - expect).abs() <= 1e-14 * expect.abs().max(1e-300) + 1e-300,
+                    "α={a} j={j}: {wj} vs {expect}"
+                );
             }
         }
         assert_eq!(&gl_weights(1.0, 4), &[1.0, -1.0, 0.0, 0.0]);
@@ -304,20 +330,28 @@ mod tests {
         // D^α t^p = Γ(p+1)/Γ(p+1-α) t^{p-α}; at t = 1 with Γ(1/2) = √π, Γ(3/2) = √π/2, Γ(5/2) = 3√π/4
         let sp = PI.sqrt();
         let cases = [
-            (0.5, 1.0, 1.0 / (sp / 2.0)),        // Γ(2)/Γ(1.5)
-            (0.5, 2.0, 2.0 / (3.0 * sp / 4.0)),  // Γ(3)/Γ(2.5)
-            (1.5, 2.0, 2.0 / (sp / 2.0)),        // Γ(3)/Γ(1.5)
-            (-0.5, 1.0, 1.0 / (3.0 * sp / 4.0)), // Γ(2)/Γ(2.5)
+            (0.5, 1.0, 1.0 / (sp / 2.0)),         // Γ(2)/Γ(1.5)
+            (0.5, 2.0, 2.0 / (3.0 * sp / 4.0)),   // Γ(3)/Γ(2.5)
+            (1.5, 2.0, 2.0 / (sp / 2.0)),         // Γ(3)/Γ(1.5)
+            (-0.5, 1.0, 1.0 / (3.0 * sp / 4.0)),  // Γ(2)/Γ(2.5)
             (-1.5, 1.0, 1.0 / (15.0 * sp / 8.0)), // Γ(2)/Γ(3.5)
             (-1.0, 2.0, 1.0 / 3.0),               // Γ(3)/Γ(4): ∫ t² = t³/3
         ];
         for (alpha, p, exact) in cases {
             let (h1, h2) = (1e-3, 5e-4);
-            let (e1, e2) = ((gl_at_one(alpha, p, h1) - exact).abs(), (gl_at_one(alpha, p, h2) - exact).abs());
+            let (e1, e2) = (
+                (gl_at_one(alpha, p, h1) - exact).abs(),
+                (gl_at_one(alpha, p, h2) - exact).abs(),
+            );
             let order = (e1 / e2).ln() / (h1 / h2).ln();
-            println!("D^{alpha} t^{p} at t = 1: error {e1:.3e} (h = 1e-3), {e2:.3e} (h = 5e-4), fitted order {order:.4}");
+            println!(
+                "D^{alpha} t^{p} at t = 1: error {e1:.3e} (h = 1e-3), {e2:.3e} (h = 5e-4), fitted order {order:.4}"
+            );
             assert!(e1 < 5.0 * h1, "α={alpha} p={p}: error {e1}");
-            assert!((order - 1.0).abs() < 0.05, "α={alpha} p={p}: fitted order {order} ({e1}, {e2})");
+            assert!(
+                (order - 1.0).abs() < 0.05,
+                "α={alpha} p={p}: fitted order {order} ({e1}, {e2})"
+            );
         }
     }
 
@@ -352,7 +386,10 @@ mod tests {
                     let (a, b) = (fast.eval(x), direct.eval(x));
                     let m = if mem == 0 { n + 1 } else { (n + 1).min(mem) };
                     let mag = emax * wabs[m];
-                    assert!((a - b).abs() <= 1e-13 * mag.max(1e-300), "α={alpha} L={mem} n={n}: {a} vs {b}");
+                    assert!(
+                        (a - b).abs() <= 1e-13 * mag.max(1e-300),
+                        "α={alpha} L={mem} n={n}: {a} vs {b}"
+                    );
                     worst = worst.max((a - b).abs() / mag.max(1e-300));
                     if n % 997 == 0 {
                         // independent plain loop
@@ -376,5 +413,4 @@ mod tests {
         let s: f64 = (0..10).map(|j| w[j] * e[n - j]).sum();
         assert!((y[n] - s).abs() < 1e-14);
     }
-
 }

@@ -154,16 +154,25 @@ impl PdFuzzySystem {
     /// Output sets Small = gaussian(·, 0, σ), Big = gaussian(·, 1, σ) on [0, 1].
     pub fn new(half_width: f64, sigma: f64, defuzz: Defuzz) -> Result<Self, String> {
         if !(half_width.is_finite() && half_width >= 1.0 / 3.0 - 1e-12) {
-            return Err(format!("membership half-width {half_width} must be >= 1/3 (else gaps with no rule firing)"));
+            return Err(format!(
+                "membership half-width {half_width} must be >= 1/3 (else gaps with no rule firing)"
+            ));
         }
         if !(sigma.is_finite() && sigma > 0.0) {
             return Err(format!("output set width sigma = {sigma} must be > 0"));
         }
         let (c_small, c_big) = match defuzz {
             Defuzz::Singleton => (0.0, 1.0),
-            Defuzz::TruncatedCentroid => (truncated_gaussian_centroid(0.0, sigma, 0.0, 1.0), truncated_gaussian_centroid(1.0, sigma, 0.0, 1.0)),
+            Defuzz::TruncatedCentroid => (
+                truncated_gaussian_centroid(0.0, sigma, 0.0, 1.0),
+                truncated_gaussian_centroid(1.0, sigma, 0.0, 1.0),
+            ),
         };
-        Ok(Self { partition: Partition7 { half_width }, c_small, c_big })
+        Ok(Self {
+            partition: Partition7 { half_width },
+            c_small,
+            c_big,
+        })
     }
 
     /// (k'_p, k'_d) for normalised inputs (clamped to [−1, 1] here).
@@ -184,7 +193,14 @@ mod tests {
     #[test]
     fn erf_reference_values() {
         // Abramowitz & Stegun table values
-        for &(x, v) in &[(0.0, 0.0), (0.5, 0.5204998778130465), (1.0, 0.8427007929497149), (2.0, 0.9953222650189527), (2.8284271247461903, 0.9999366575163338), (3.5, 0.9999992569016276)] {
+        for &(x, v) in &[
+            (0.0, 0.0),
+            (0.5, 0.5204998778130465),
+            (1.0, 0.8427007929497149),
+            (2.0, 0.9953222650189527),
+            (2.8284271247461903, 0.9999366575163338),
+            (3.5, 0.9999992569016276),
+        ] {
             assert!((erf(x) - v).abs() < 4e-15, "erf({x}) = {} vs {v}", erf(x));
             assert!((erf(-x) + v).abs() < 1e-15);
         }
@@ -218,7 +234,8 @@ mod tests {
     #[test]
     fn truncated_centroid_matches_spec_formula_and_quadrature() {
         let sigma: f64 = 0.25;
-        let spec = sigma * (2.0 / PI).sqrt() * (1.0 - (-1.0 / (2.0 * sigma * sigma)).exp()) / erf(1.0 / (sigma * 2f64.sqrt()));
+        let spec =
+            sigma * (2.0 / PI).sqrt() * (1.0 - (-1.0 / (2.0 * sigma * sigma)).exp()) / erf(1.0 / (sigma * 2f64.sqrt()));
         let cs = truncated_gaussian_centroid(0.0, sigma, 0.0, 1.0);
         assert!((cs - spec).abs() < 1e-15, "{cs} vs {spec}");
         let cb = truncated_gaussian_centroid(1.0, sigma, 0.0, 1.0);
@@ -229,7 +246,13 @@ mod tests {
         let (mut num, mut den) = (0.0, 0.0);
         for i in 0..=n {
             let x = i as f64 * h;
-            let w = if i == 0 || i == n { 1.0 } else if i % 2 == 1 { 4.0 } else { 2.0 };
+            let w = if i == 0 || i == n {
+                1.0
+            } else if i % 2 == 1 {
+                4.0
+            } else {
+                2.0
+            };
             num += w * x * gaussian(x, 0.0, sigma);
             den += w * gaussian(x, 0.0, sigma);
         }
@@ -250,7 +273,13 @@ mod tests {
                 let (mut num, mut den) = (0.0, 0.0);
                 for i in 0..=n {
                     let y = i as f64 * h;
-                    let w = if i == 0 || i == n { 1.0 } else if i % 2 == 1 { 4.0 } else { 2.0 };
+                    let w = if i == 0 || i == n {
+                        1.0
+                    } else if i % 2 == 1 {
+                        4.0
+                    } else {
+                        2.0
+                    };
                     let mut agg = 0.0;
                     for j in 0..7 {
                         for k in 0..7 {
@@ -272,7 +301,7 @@ mod tests {
         assert_eq!(sys.infer(0.0, 0.0), (1.0, 0.0)); // ZO/ZO: k'_p = B, k'_d = S
         assert_eq!(sys.infer(1.0, 0.0), (1.0, 0.0)); // PB row: B / S
         assert_eq!(sys.infer(1.0 / 3.0, 1.0), (0.0, 1.0)); // PS/PB: S / B
-        // halfway between ZO and PS on e, ZO on ė: ½ (B + B) for k'_p, ½ (S + S) for k'_d
+                                                           // halfway between ZO and PS on e, ZO on ė: ½ (B + B) for k'_p, ½ (S + S) for k'_d
         let (kp, kd) = sys.infer(1.0 / 6.0, 0.0);
         assert!((kp - 1.0).abs() < 1e-15 && kd.abs() < 1e-15);
         // ZO row, between ZO and PS on ė: ½ (B + S) and ½ (S + B)

@@ -24,7 +24,12 @@ pub fn check_step_count(span: f64, max_step: f64) -> Result<(), String> {
 }
 
 /// One classical Runge–Kutta 4 step of ẋ = f(t, x).
-pub fn rk4<const N: usize>(f: &mut impl FnMut(f64, &SVector<f64, N>) -> SVector<f64, N>, t: f64, x: &SVector<f64, N>, h: f64) -> SVector<f64, N> {
+pub fn rk4<const N: usize>(
+    f: &mut impl FnMut(f64, &SVector<f64, N>) -> SVector<f64, N>,
+    t: f64,
+    x: &SVector<f64, N>,
+    h: f64,
+) -> SVector<f64, N> {
     let k1 = f(t, x);
     let k2 = f(t + 0.5 * h, &(x + k1 * (0.5 * h)));
     let k3 = f(t + 0.5 * h, &(x + k2 * (0.5 * h)));
@@ -33,7 +38,12 @@ pub fn rk4<const N: usize>(f: &mut impl FnMut(f64, &SVector<f64, N>) -> SVector<
 }
 
 /// One explicit Euler step.
-pub fn euler<const N: usize>(f: &mut impl FnMut(f64, &SVector<f64, N>) -> SVector<f64, N>, t: f64, x: &SVector<f64, N>, h: f64) -> SVector<f64, N> {
+pub fn euler<const N: usize>(
+    f: &mut impl FnMut(f64, &SVector<f64, N>) -> SVector<f64, N>,
+    t: f64,
+    x: &SVector<f64, N>,
+    h: f64,
+) -> SVector<f64, N> {
     x + f(t, x) * h
 }
 
@@ -54,9 +64,30 @@ const DP_A: [[f64; 6]; 7] = [
     [1.0 / 5.0, 0.0, 0.0, 0.0, 0.0, 0.0],
     [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
     [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0],
-    [19372.0 / 6561.0, -25360.0 / 2187.0, 64448.0 / 6561.0, -212.0 / 729.0, 0.0, 0.0],
-    [9017.0 / 3168.0, -355.0 / 33.0, 46732.0 / 5247.0, 49.0 / 176.0, -5103.0 / 18656.0, 0.0],
-    [35.0 / 384.0, 0.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0],
+    [
+        19372.0 / 6561.0,
+        -25360.0 / 2187.0,
+        64448.0 / 6561.0,
+        -212.0 / 729.0,
+        0.0,
+        0.0,
+    ],
+    [
+        9017.0 / 3168.0,
+        -355.0 / 33.0,
+        46732.0 / 5247.0,
+        49.0 / 176.0,
+        -5103.0 / 18656.0,
+        0.0,
+    ],
+    [
+        35.0 / 384.0,
+        0.0,
+        500.0 / 1113.0,
+        125.0 / 192.0,
+        -2187.0 / 6784.0,
+        11.0 / 84.0,
+    ],
 ];
 /// 5th-order weights minus 4th-order weights (error estimate).
 const DP_E: [f64; 7] = [
@@ -84,7 +115,12 @@ pub fn dopri5<const N: usize>(
     h_max: f64,
 ) -> Result<AdaptiveOutcome<N>, String> {
     let span = t1 - t0;
-    let mut out = AdaptiveOutcome { x: *x0, h_next: h0, accepted: 0, rejected: 0 };
+    let mut out = AdaptiveOutcome {
+        x: *x0,
+        h_next: h0,
+        accepted: 0,
+        rejected: 0,
+    };
     if span <= 0.0 {
         return Ok(out);
     }
@@ -127,7 +163,11 @@ pub fn dopri5<const N: usize>(
                 if !norm.is_finite() {
                     return Err(format!("adaptive integrator: non-finite error estimate at t = {t}"));
                 }
-                let fac = if norm == 0.0 { 5.0 } else { (0.9 * norm.powf(-0.2)).clamp(0.2, 5.0) };
+                let fac = if norm == 0.0 {
+                    5.0
+                } else {
+                    (0.9 * norm.powf(-0.2)).clamp(0.2, 5.0)
+                };
                 if norm <= 1.0 {
                     t = if last { t1 } else { t + step };
                     x = xs;
@@ -175,7 +215,12 @@ crate::param_enum! {
 pub fn pieces(t0: f64, h: f64, breakpoints: &[f64]) -> Vec<(f64, f64)> {
     let t1 = t0 + h;
     let mut edges = vec![t0];
-    edges.extend(breakpoints.iter().copied().filter(|b| *b > t0 + 1e-12 * h && *b < t1 - 1e-12 * h));
+    edges.extend(
+        breakpoints
+            .iter()
+            .copied()
+            .filter(|b| *b > t0 + 1e-12 * h && *b < t1 - 1e-12 * h),
+    );
     edges[1..].sort_by(f64::total_cmp);
     edges.push(t1);
     edges.windows(2).map(|p| (p[0], p[1] - p[0])).collect()
@@ -196,7 +241,12 @@ pub struct Stepper {
 
 impl Stepper {
     pub fn new(method: Method, max_step: f64, tol: f64) -> Self {
-        Stepper { method, max_step, tol, h_adapt: 0.0 }
+        Stepper {
+            method,
+            max_step,
+            tol,
+            h_adapt: 0.0,
+        }
     }
 
     /// Checks a restored stepper against `fresh`, the one the parameters give: same method, step and
@@ -209,7 +259,10 @@ impl Stepper {
             ));
         }
         if !(self.h_adapt.is_finite() && self.h_adapt >= 0.0) {
-            return Err(format!("adaptive step proposal {} is not a finite non-negative number", self.h_adapt));
+            return Err(format!(
+                "adaptive step proposal {} is not a finite non-negative number",
+                self.h_adapt
+            ));
         }
         Ok(())
     }
@@ -217,7 +270,11 @@ impl Stepper {
     /// The stepper a plant's `integrator` and `max_internal_step` parameters select; the adaptive
     /// tolerance comes from `fmi2SetupExperiment` (default 1e-8).
     pub fn for_plant(integrator: i32, max_internal_step: f64, exp: &Experiment) -> Result<Self, String> {
-        Ok(Stepper::new(Method::from_param("integrator", integrator)?, max_internal_step, exp.tolerance_or_default()))
+        Ok(Stepper::new(
+            Method::from_param("integrator", integrator)?,
+            max_internal_step,
+            exp.tolerance_or_default(),
+        ))
     }
 
     /// Advances a plant's state over one communication step [t, t + h] with the inputs held. The step
@@ -274,7 +331,11 @@ impl Stepper {
                 let dt = len / n as f64;
                 for k in 0..n {
                     let tk = ts + k as f64 * dt;
-                    *x = if fixed == Method::Euler { euler(f, tk, x, dt) } else { rk4(f, tk, x, dt) };
+                    *x = if fixed == Method::Euler {
+                        euler(f, tk, x, dt)
+                    } else {
+                        rk4(f, tk, x, dt)
+                    };
                     after_step(x, tk + dt)?;
                 }
                 Ok(())
@@ -343,7 +404,10 @@ mod tests {
         for &tol in &[1e-6, 1e-9, 1e-12] {
             let r = dopri5(&mut f, 0.0, &Vector2::new(1.0, 0.0), 20.0, tol, tol, 0.0, 0.0).unwrap();
             let err = (r.x[0] - 20f64.cos()).abs().max((r.x[1] + 20f64.sin()).abs());
-            println!("dopri5 tol {tol:e}: error {err:.2e}, {} accepted, {} rejected", r.accepted, r.rejected);
+            println!(
+                "dopri5 tol {tol:e}: error {err:.2e}, {} accepted, {} rejected",
+                r.accepted, r.rejected
+            );
             assert!(err < 200.0 * tol, "tol {tol}: error {err}");
         }
     }

@@ -68,7 +68,11 @@ pub fn controllability(a: &DMatrix<f64>, b: &DVector<f64>) -> DMatrix<f64> {
 pub fn ackermann(a: &DMatrix<f64>, b: &DVector<f64>, coeffs: &[f64]) -> Result<DVector<f64>, String> {
     let n = a.nrows();
     if n == 0 || a.ncols() != n || b.len() != n {
-        return Err(format!("A must be n x n and b of length n, got {:?} and {}", a.shape(), b.len()));
+        return Err(format!(
+            "A must be n x n and b of length n, got {:?} and {}",
+            a.shape(),
+            b.len()
+        ));
     }
     if coeffs.len() != n {
         return Err(format!("need {n} polynomial coefficients, got {}", coeffs.len()));
@@ -90,7 +94,10 @@ pub fn ackermann(a: &DMatrix<f64>, b: &DVector<f64>, coeffs: &[f64]) -> Result<D
     let smax = svd.singular_values.max();
     let smin = svd.singular_values.min();
     if !(smin > 1e-12 * smax) {
-        return Err(format!("pair (A, b) is not controllable (controllability matrix condition {:e})", smax / smin));
+        return Err(format!(
+            "pair (A, b) is not controllable (controllability matrix condition {:e})",
+            smax / smin
+        ));
     }
     let y = svd.solve(&en, 0.0).map_err(|e| e.to_string())?;
     Ok(phi.transpose() * y)
@@ -125,9 +132,20 @@ mod tests {
 
     #[test]
     fn closed_loop_poles_are_the_requested_ones() {
-        let a = DMatrix::from_row_slice(4, 4, &[0.0, 1.0, 0.0, 0.0, 0.3, -0.1, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 0.0, -2.0, 0.5]);
+        let a = DMatrix::from_row_slice(
+            4,
+            4,
+            &[
+                0.0, 1.0, 0.0, 0.0, 0.3, -0.1, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 0.0, -2.0, 0.5,
+            ],
+        );
         let b = DVector::from_vec(vec![0.0, 0.5, 0.0, 1.0]);
-        let poles = [Complex::new(-1.0, 0.5), Complex::new(-1.0, -0.5), Complex::new(-2.0, 0.0), Complex::new(-0.5, 0.0)];
+        let poles = [
+            Complex::new(-1.0, 0.5),
+            Complex::new(-1.0, -0.5),
+            Complex::new(-2.0, 0.0),
+            Complex::new(-0.5, 0.0),
+        ];
         let k = place(&a, &b, &poles).unwrap();
         let acl = &a - &b * k.transpose();
         let got = sorted_eigs(&acl);

@@ -65,7 +65,13 @@ mod tests {
         let mut g = [0.0f64; 3]; // ∫ τ²/2 · (1, τ, τ²/2) dτ
         for k in 0..=n {
             let tau = t1 + k as f64 * hstep;
-            let w = if k == 0 || k == n { 1.0 } else if k % 2 == 1 { 4.0 } else { 2.0 };
+            let w = if k == 0 || k == n {
+                1.0
+            } else if k % 2 == 1 {
+                4.0
+            } else {
+                2.0
+            };
             let b = [1.0, tau, tau * tau / 2.0];
             for (gi, bi) in g.iter_mut().zip(b) {
                 *gi += w * hstep / 3.0 * tau * tau / 2.0 * bi;

@@ -37,7 +37,13 @@ impl LeaderOrbit {
         if !(e.is_finite() && (0.0..1.0).contains(&e)) {
             return Err(format!("parameter eccentricity = {e} must lie in [0, 1)"));
         }
-        Ok(LeaderOrbit { mu, a, e, n: (mu / (a * a * a)).sqrt(), p: a * (1.0 - e * e) })
+        Ok(LeaderOrbit {
+            mu,
+            a,
+            e,
+            n: (mu / (a * a * a)).sqrt(),
+            p: a * (1.0 - e * e),
+        })
     }
 
     /// Orbital rate θ̇ = n (1 + e cos ν)² / (1 − e²)^{3/2} (paper 001 Eq. 4); = ν̇ for Kepler motion.
@@ -72,12 +78,19 @@ impl LeaderOrbit {
         let q = 2.0 * r * rho.x + rho.norm_squared();
         let rf2 = r * r + q;
         if !(rf2.is_finite() && rf2 > 0.0) {
-            return Err(format!("follower at the Earth's centre or non-finite (rho = {:?})", rho.as_slice()));
+            return Err(format!(
+                "follower at the Earth's centre or non-finite (rho = {:?})",
+                rho.as_slice()
+            ));
         }
         let rf = rf2.sqrt();
         let rf3 = rf2 * rf;
         let num_x = q * (rf2 + rf * r + r * r) / (rf + r) - r * r * rho.x;
-        Ok(Vector3::new(self.mu * num_x / (r * r * rf3), -self.mu * rho.y / rf3, -self.mu * rho.z / rf3))
+        Ok(Vector3::new(
+            self.mu * num_x / (r * r * rf3),
+            -self.mu * rho.y / rf3,
+            -self.mu * rho.z / rf3,
+        ))
     }
 
     /// G(ρ, ρ̇) of ρ̈ + G = F/m + d (the relative-orbit equations of the formation family; third row μ z/ρ_f³):
@@ -96,7 +109,13 @@ impl LeaderOrbit {
     }
 
     /// Relative acceleration ρ̈ = −G(ρ, ρ̇) + a_ext (a_ext = F/m + d).
-    pub fn relative_acceleration(&self, nu: f64, rho: &Vector3<f64>, rho_dot: &Vector3<f64>, a_ext: &Vector3<f64>) -> Result<Vector3<f64>, String> {
+    pub fn relative_acceleration(
+        &self,
+        nu: f64,
+        rho: &Vector3<f64>,
+        rho_dot: &Vector3<f64>,
+        a_ext: &Vector3<f64>,
+    ) -> Result<Vector3<f64>, String> {
         Ok(a_ext - self.g_term(nu, rho, rho_dot)?)
     }
 
@@ -108,7 +127,11 @@ impl LeaderOrbit {
 
 /// Eccentric anomaly from mean anomaly: Newton iteration on E − e sin E = M (0 ≤ e < 1).
 pub fn eccentric_anomaly(mean_anomaly: f64, e: f64) -> f64 {
-    let mut ea = if e < 0.8 { mean_anomaly } else { std::f64::consts::PI.copysign(mean_anomaly) };
+    let mut ea = if e < 0.8 {
+        mean_anomaly
+    } else {
+        std::f64::consts::PI.copysign(mean_anomaly)
+    };
     for _ in 0..50 {
         let f = ea - e * ea.sin() - mean_anomaly;
         let d = f / (1.0 - e * ea.cos());
@@ -156,7 +179,11 @@ mod tests {
         for nu in [0.0, 0.7, 2.0, 3.5, 5.9] {
             let h = 1e-5;
             let d = (o.theta_dot(nu + h) - o.theta_dot(nu - h)) / (2.0 * h) * o.theta_dot(nu);
-            assert!((d - o.theta_ddot(nu)).abs() < 1e-9 * o.n * o.n, "nu {nu}: {d} vs {}", o.theta_ddot(nu));
+            assert!(
+                (d - o.theta_ddot(nu)).abs() < 1e-9 * o.n * o.n,
+                "nu {nu}: {d} vs {}",
+                o.theta_ddot(nu)
+            );
         }
     }
 
@@ -176,7 +203,10 @@ mod tests {
         for e in [0.0, 0.1, 0.5] {
             let o = orbit(e);
             for nu in [0.0, 1.3, 4.0] {
-                assert_eq!(o.g_term(nu, &Vector3::zeros(), &Vector3::zeros()).unwrap(), Vector3::zeros());
+                assert_eq!(
+                    o.g_term(nu, &Vector3::zeros(), &Vector3::zeros()).unwrap(),
+                    Vector3::zeros()
+                );
                 // against the printed (cancelling) form, for a large offset where cancellation is mild
                 let rho = Vector3::new(3.0e4, -2.0e4, 1.0e4);
                 let v = Vector3::new(1.0, -2.0, 0.5);
@@ -189,7 +219,10 @@ mod tests {
                     2.0 * td * v.x + tdd * rho.x - td * td * rho.y + o.mu * rho.y / rf3,
                     o.mu * rho.z / rf3,
                 );
-                assert!((g - direct).norm() < 1e-9 * direct.norm(), "e {e} nu {nu}: {g:?} vs {direct:?}");
+                assert!(
+                    (g - direct).norm() < 1e-9 * direct.norm(),
+                    "e {e} nu {nu}: {g:?} vs {direct:?}"
+                );
             }
         }
     }
@@ -204,7 +237,10 @@ mod tests {
         let g = o.g_term(0.0, &rho, &v).unwrap();
         let cw = Vector3::new(-2.0 * n * v.y - 3.0 * n * n * rho.x, 2.0 * n * v.x, n * n * rho.z);
         // second-order terms ~ n² |ρ|²/R
-        assert!((g - cw).norm() < 10.0 * n * n * rho.norm_squared() / o.a, "{g:?} vs {cw:?}");
+        assert!(
+            (g - cw).norm() < 10.0 * n * n * rho.norm_squared() / o.a,
+            "{g:?} vs {cw:?}"
+        );
     }
 
     #[test]

@@ -21,7 +21,11 @@ pub fn care_residual(a: &DMatrix<f64>, s: &DMatrix<f64>, q: &DMatrix<f64>, p: &D
     let psp = p * s * p;
     let res = &atp + &pa + q - &psp;
     let scale = atp.norm() + pa.norm() + q.norm() + psp.norm();
-    if scale == 0.0 { res.norm() } else { res.norm() / scale }
+    if scale == 0.0 {
+        res.norm()
+    } else {
+        res.norm() / scale
+    }
 }
 
 /// Solves Aᵀ X + X A = −M for X (M symmetric) through (I ⊗ Aᵀ + Aᵀ ⊗ I) vec X = −vec M.
@@ -31,27 +35,42 @@ pub fn lyapunov(a: &DMatrix<f64>, m: &DMatrix<f64>) -> Result<DMatrix<f64>, Stri
     let eye = DMatrix::<f64>::identity(n, n);
     let big = eye.kronecker(&at) + at.kronecker(&eye);
     let rhs = DMatrix::from_column_slice(n * n, 1, (-m).as_slice());
-    let sol = big.lu().solve(&rhs).ok_or("Lyapunov equation is singular (A has eigenvalues λi + λj = 0)")?;
+    let sol = big
+        .lu()
+        .solve(&rhs)
+        .ok_or("Lyapunov equation is singular (A has eigenvalues λi + λj = 0)")?;
     let x = DMatrix::from_column_slice(n, n, sol.as_slice());
     Ok((&x + x.transpose()) * 0.5)
 }
 
 /// Largest real part of the eigenvalues of a square matrix.
 pub fn spectral_abscissa(a: &DMatrix<f64>) -> f64 {
-    a.clone().complex_eigenvalues().iter().map(|z| z.re).fold(f64::NEG_INFINITY, f64::max)
+    a.clone()
+        .complex_eigenvalues()
+        .iter()
+        .map(|z| z.re)
+        .fold(f64::NEG_INFINITY, f64::max)
 }
 
 fn check_dims(a: &DMatrix<f64>, b: &DMatrix<f64>, q: &DMatrix<f64>, r: &DMatrix<f64>) -> Result<(), String> {
     let n = a.nrows();
     let m = b.ncols();
     if n == 0 || a.ncols() != n {
-        return Err(format!("A must be square and non-empty, got {}x{}", a.nrows(), a.ncols()));
+        return Err(format!(
+            "A must be square and non-empty, got {}x{}",
+            a.nrows(),
+            a.ncols()
+        ));
     }
     if b.nrows() != n || m == 0 {
         return Err(format!("B must be {n}xm with m >= 1, got {}x{}", b.nrows(), b.ncols()));
     }
     if q.shape() != (n, n) || r.shape() != (m, m) {
-        return Err(format!("Q must be {n}x{n} and R {m}x{m}, got {:?} and {:?}", q.shape(), r.shape()));
+        return Err(format!(
+            "Q must be {n}x{n} and R {m}x{m}, got {:?} and {:?}",
+            q.shape(),
+            r.shape()
+        ));
     }
     let all = a.iter().chain(b.iter()).chain(q.iter()).chain(r.iter());
     if all.into_iter().any(|v| !v.is_finite()) {
@@ -76,7 +95,11 @@ fn matrix_sign(h: &DMatrix<f64>) -> Result<DMatrix<f64>, String> {
         let lu = z.clone().lu();
         let det = lu.determinant();
         let zinv = lu.try_inverse().ok_or("Hamiltonian matrix has eigenvalues on the imaginary axis: no stabilising Riccati solution (check stabilisability/detectability)")?;
-        let c = if scale && det.is_finite() && det != 0.0 { det.abs().powf(-1.0 / n2 as f64) } else { 1.0 };
+        let c = if scale && det.is_finite() && det != 0.0 {
+            det.abs().powf(-1.0 / n2 as f64)
+        } else {
+            1.0
+        };
         let znew = (&z * c + zinv / c) * 0.5;
         if !znew.iter().all(|v| v.is_finite()) {
             return Err("matrix sign iteration diverged".into());
@@ -102,7 +125,12 @@ fn matrix_sign(h: &DMatrix<f64>) -> Result<DMatrix<f64>, String> {
 
 /// Stabilising solution P of the CARE. `r` must be symmetric positive definite, `q` symmetric
 /// positive semi-definite, (A, B) stabilisable and (Q, A) detectable (else `Err`).
-pub fn solve_care(a: &DMatrix<f64>, b: &DMatrix<f64>, q: &DMatrix<f64>, r: &DMatrix<f64>) -> Result<DMatrix<f64>, String> {
+pub fn solve_care(
+    a: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    q: &DMatrix<f64>,
+    r: &DMatrix<f64>,
+) -> Result<DMatrix<f64>, String> {
     check_dims(a, b, q, r)?;
     let n = a.nrows();
     let chol = r.clone().cholesky().ok_or("R must be positive definite")?;
@@ -123,9 +151,13 @@ pub fn solve_care(a: &DMatrix<f64>, b: &DMatrix<f64>, q: &DMatrix<f64>, r: &DMat
     lhs.view_mut((0, 0), (n, n)).copy_from(&w.view((0, n), (n, n)));
     lhs.view_mut((n, 0), (n, n)).copy_from(&(w.view((n, n), (n, n)) + &eye));
     let mut rhs = DMatrix::<f64>::zeros(2 * n, n);
-    rhs.view_mut((0, 0), (n, n)).copy_from(&(-(w.view((0, 0), (n, n)) + &eye)));
+    rhs.view_mut((0, 0), (n, n))
+        .copy_from(&(-(w.view((0, 0), (n, n)) + &eye)));
     rhs.view_mut((n, 0), (n, n)).copy_from(&(-w.view((n, 0), (n, n))));
-    let p0 = lhs.svd(true, true).solve(&rhs, 1e-14).map_err(|e| format!("stable subspace extraction failed: {e}"))?;
+    let p0 = lhs
+        .svd(true, true)
+        .solve(&rhs, 1e-14)
+        .map_err(|e| format!("stable subspace extraction failed: {e}"))?;
     let mut p = (&p0 + p0.transpose()) * 0.5;
 
     // Newton–Kleinman refinement
@@ -156,13 +188,20 @@ pub fn solve_care(a: &DMatrix<f64>, b: &DMatrix<f64>, q: &DMatrix<f64>, r: &DMat
     let acl = a - &s * &p;
     let abscissa = spectral_abscissa(&acl);
     if !(abscissa < 0.0) {
-        return Err(format!("Riccati solution is not stabilising (closed-loop spectral abscissa {abscissa:e})"));
+        return Err(format!(
+            "Riccati solution is not stabilising (closed-loop spectral abscissa {abscissa:e})"
+        ));
     }
     Ok(p)
 }
 
 /// LQR gain K = R⁻¹ Bᵀ P and the Riccati solution P (u = −K x minimises ∫ xᵀQx + uᵀRu dt).
-pub fn lqr(a: &DMatrix<f64>, b: &DMatrix<f64>, q: &DMatrix<f64>, r: &DMatrix<f64>) -> Result<(DMatrix<f64>, DMatrix<f64>), String> {
+pub fn lqr(
+    a: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    q: &DMatrix<f64>,
+    r: &DMatrix<f64>,
+) -> Result<(DMatrix<f64>, DMatrix<f64>), String> {
     let p = solve_care(a, b, q, r)?;
     let chol = r.clone().cholesky().ok_or("R must be positive definite")?;
     let k = chol.solve(&(b.transpose() * &p));
@@ -196,7 +235,11 @@ mod tests {
     fn double_integrator_closed_form() {
         // A = [0 1; 0 0], B = [0; b], Q = diag(q1, q2), R = r: p12 = sqrt(q1 r)/b,
         // p22 = sqrt(r (q2 + 2 p12))/b, p11 = b² p12 p22 / r.
-        for &(q1, q2, r, inertia) in &[(1.0, 2.0, 1.0 / 1e6, 1000.0), (3.0, 0.5, 2.0, 7.0), (0.2, 5.0, 1e-3, 250.0)] {
+        for &(q1, q2, r, inertia) in &[
+            (1.0, 2.0, 1.0 / 1e6, 1000.0),
+            (3.0, 0.5, 2.0, 7.0),
+            (0.2, 5.0, 1e-3, 250.0),
+        ] {
             let b = 1.0 / inertia;
             let a = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, 0.0, 0.0]);
             let bm = DMatrix::from_row_slice(2, 1, &[0.0, b]);
@@ -206,7 +249,13 @@ mod tests {
             let p12 = (q1 * r).sqrt() / b;
             let p22 = (r * (q2 + 2.0 * p12)).sqrt() / b;
             let p11 = b * b * p12 * p22 / r;
-            for (got, want) in [(p[(0, 0)], p11), (p[(0, 1)], p12), (p[(1, 1)], p22), (k[(0, 0)], b * p12 / r), (k[(0, 1)], b * p22 / r)] {
+            for (got, want) in [
+                (p[(0, 0)], p11),
+                (p[(0, 1)], p12),
+                (p[(1, 1)], p22),
+                (k[(0, 0)], b * p12 / r),
+                (k[(0, 1)], b * p22 / r),
+            ] {
                 assert!((got - want).abs() <= 1e-12 * want.abs(), "{got} vs {want}");
             }
         }
@@ -216,7 +265,10 @@ mod tests {
         let bm = DMatrix::from_row_slice(2, 1, &[0.0, 1.0 / i]);
         let q = DMatrix::from_row_slice(2, 2, &[1.0, 0.0, 0.0, 2.0]);
         let (k, _) = lqr(&a, &bm, &q, &DMatrix::from_element(1, 1, 1.0 / (i * i))).unwrap();
-        assert!((k[(0, 0)] - i).abs() < 1e-12 * i && (k[(0, 1)] - 2.0 * i).abs() < 1e-12 * i, "{k}");
+        assert!(
+            (k[(0, 0)] - i).abs() < 1e-12 * i && (k[(0, 1)] - 2.0 * i).abs() < 1e-12 * i,
+            "{k}"
+        );
     }
 
     #[test]
@@ -249,9 +301,19 @@ mod tests {
     fn scalar_case() {
         // a p + p a + q − p² b²/r = 0 → p = r (a + sqrt(a² + q b²/r)) / b²
         for &(a, b, q, r) in &[(1.0, 1.0, 1.0, 1.0), (-2.0, 0.5, 3.0, 0.1), (5.0, 2.0, 0.0, 1.0)] {
-            let p = solve_care(&DMatrix::from_element(1, 1, a), &DMatrix::from_element(1, 1, b), &DMatrix::from_element(1, 1, q), &DMatrix::from_element(1, 1, r)).unwrap();
+            let p = solve_care(
+                &DMatrix::from_element(1, 1, a),
+                &DMatrix::from_element(1, 1, b),
+                &DMatrix::from_element(1, 1, q),
+                &DMatrix::from_element(1, 1, r),
+            )
+            .unwrap();
             let want = r * (a + (a * a + q * b * b / r).sqrt()) / (b * b);
-            assert!((p[(0, 0)] - want).abs() < 1e-13 * want.abs().max(1.0), "{} vs {want}", p[(0, 0)]);
+            assert!(
+                (p[(0, 0)] - want).abs() < 1e-13 * want.abs().max(1.0),
+                "{} vs {want}",
+                p[(0, 0)]
+            );
         }
     }
 
@@ -260,13 +322,25 @@ mod tests {
         let a = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, 0.0, 0.0]);
         let b = DMatrix::from_row_slice(2, 1, &[0.0, 1.0]);
         let q = DMatrix::identity(2, 2);
-        assert!(solve_care(&a, &b, &q, &DMatrix::from_element(1, 1, 0.0)).is_err(), "R = 0");
-        assert!(solve_care(&a, &b, &q, &DMatrix::from_element(1, 1, -1.0)).is_err(), "R < 0");
+        assert!(
+            solve_care(&a, &b, &q, &DMatrix::from_element(1, 1, 0.0)).is_err(),
+            "R = 0"
+        );
+        assert!(
+            solve_care(&a, &b, &q, &DMatrix::from_element(1, 1, -1.0)).is_err(),
+            "R < 0"
+        );
         // uncontrollable unstable mode: A = diag(1, 1), B = [1; 0]
         let a2 = DMatrix::from_row_slice(2, 2, &[1.0, 0.0, 0.0, 1.0]);
         let b2 = DMatrix::from_row_slice(2, 1, &[1.0, 0.0]);
-        assert!(solve_care(&a2, &b2, &q, &DMatrix::from_element(1, 1, 1.0)).is_err(), "not stabilisable");
-        assert!(solve_care(&a, &b, &DMatrix::identity(3, 3), &DMatrix::from_element(1, 1, 1.0)).is_err(), "dims");
+        assert!(
+            solve_care(&a2, &b2, &q, &DMatrix::from_element(1, 1, 1.0)).is_err(),
+            "not stabilisable"
+        );
+        assert!(
+            solve_care(&a, &b, &DMatrix::identity(3, 3), &DMatrix::from_element(1, 1, 1.0)).is_err(),
+            "dims"
+        );
     }
 
     #[test]

@@ -141,11 +141,19 @@ mod tests {
                 assert_eq!(on_grid(t, per, t), Some(k as i64 * ratio), "h = {h}, step {k}, t = {t}");
                 t += h;
             }
-            assert!(worst > 1e-11, "the sum drifts ({worst}): the test exercises the tolerance");
+            assert!(
+                worst > 1e-11,
+                "the sum drifts ({worst}): the test exercises the tolerance"
+            );
             let stop = n as f64 * h;
             // the last step clipped to the stop time, from the sum before it
             let t_last = summed(h, n - 1);
-            assert_eq!(samples_in(stop - t_last, per, stop), Some(ratio), "h = {h}: last step {}", stop - t_last);
+            assert_eq!(
+                samples_in(stop - t_last, per, stop),
+                Some(ratio),
+                "h = {h}: last step {}",
+                stop - t_last
+            );
             // a step of rounding size after a sum that fell short of the stop time takes no sample
             if t < stop {
                 assert_eq!(samples_in(stop - t, per, stop), Some(0));
@@ -170,16 +178,28 @@ mod tests {
 
     #[test]
     fn counter_checks_point_and_step() {
-        let c = SampleCounter { start: 0.0, period: 0.001 };
+        let c = SampleCounter {
+            start: 0.0,
+            period: 0.001,
+        };
         assert_eq!(c.step(0, 0.0, 0.001, "x"), Ok(1));
         assert_eq!(c.step(3, 0.003, 0.002, "x"), Ok(2));
         // the OMSimulator step: t = 19.99900000000146, h = 0.0009999999985410568
         assert_eq!(c.step(19_999, 19.99900000000146, 0.0009999999985410568, "x"), Ok(1));
         let e = c.step(3, 0.003, 0.0015, "the history is sampled at step").unwrap_err();
-        assert!(e.contains("not an integer multiple of the sample time parameter step = 0.001 s"), "{e}");
+        assert!(
+            e.contains("not an integer multiple of the sample time parameter step = 0.001 s"),
+            "{e}"
+        );
         let e = c.step(3, 0.0035, 0.001, "x").unwrap_err();
-        assert!(e.contains("communication point 0.0035 s is not the next sample instant"), "{e}");
-        let c = SampleCounter { start: 2.5, period: 0.1 };
+        assert!(
+            e.contains("communication point 0.0035 s is not the next sample instant"),
+            "{e}"
+        );
+        let c = SampleCounter {
+            start: 2.5,
+            period: 0.1,
+        };
         assert_eq!(c.step(10, 3.5000000000000004, 0.1, "x"), Ok(1));
     }
 }

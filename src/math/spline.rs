@@ -45,7 +45,13 @@ impl NotAKnotSpline {
             return Err(format!("spline: node {} is not finite", i % n));
         }
         if let Some(i) = (1..n).find(|&i| t[i] <= t[i - 1]) {
-            return Err(format!("spline: node times must increase strictly (t[{}] = {} ≤ t[{}] = {})", i, t[i], i - 1, t[i - 1]));
+            return Err(format!(
+                "spline: node times must increase strictly (t[{}] = {} ≤ t[{}] = {})",
+                i,
+                t[i],
+                i - 1,
+                t[i - 1]
+            ));
         }
         let m = match n {
             2 => vec![0.0, 0.0],
@@ -57,7 +63,11 @@ impl NotAKnotSpline {
             }
             _ => Self::moments(t, y)?,
         };
-        Ok(NotAKnotSpline { t: t.to_vec(), y: y.to_vec(), m })
+        Ok(NotAKnotSpline {
+            t: t.to_vec(),
+            y: y.to_vec(),
+            m,
+        })
     }
 
     fn moments(t: &[f64], y: &[f64]) -> Result<Vec<f64>, String> {
@@ -98,7 +108,7 @@ impl NotAKnotSpline {
         let (y0, y1) = (self.y[i], self.y[i + 1]);
         let a = t - self.t[i]; // distance from the left node
         let b = self.t[i + 1] - t; // distance to the right node
-        // s = M0 b³/(6h) + M1 a³/(6h) + (y0/h − M0 h/6) b + (y1/h − M1 h/6) a
+                                   // s = M0 b³/(6h) + M1 a³/(6h) + (y0/h − M0 h/6) b + (y1/h − M1 h/6) a
         let c0 = y0 / h - m0 * h / 6.0;
         let c1 = y1 / h - m1 * h / 6.0;
         let s = (m0 * b * b * b + m1 * a * a * a) / (6.0 * h) + c0 * b + c1 * a;
@@ -175,8 +185,12 @@ mod tests {
     #[test]
     fn rejects_bad_nodes() {
         assert!(NotAKnotSpline::new(&[0.0], &[1.0]).unwrap_err().contains("at least 2"));
-        assert!(NotAKnotSpline::new(&[0.0, 1.0, 1.0], &[1.0, 2.0, 3.0]).unwrap_err().contains("increase"));
-        assert!(NotAKnotSpline::new(&[0.0, 1.0], &[1.0, f64::NAN]).unwrap_err().contains("not finite"));
+        assert!(NotAKnotSpline::new(&[0.0, 1.0, 1.0], &[1.0, 2.0, 3.0])
+            .unwrap_err()
+            .contains("increase"));
+        assert!(NotAKnotSpline::new(&[0.0, 1.0], &[1.0, f64::NAN])
+            .unwrap_err()
+            .contains("not finite"));
         assert!(NotAKnotSpline::new(&[0.0, 1.0], &[1.0]).unwrap_err().contains("values"));
     }
 

@@ -47,7 +47,10 @@ pub fn km_exhaustive(y: &[f64], f_lo: &[f64], f_up: &[f64]) -> Option<(f64, f64)
     let ys: Vec<f64> = idx.iter().map(|&i| y[i]).collect();
     let lo: Vec<f64> = idx.iter().map(|&i| f_lo[i]).collect();
     let up: Vec<f64> = idx.iter().map(|&i| f_up[i]).collect();
-    Some((switch_extreme(&ys, &up, &lo, false)?, switch_extreme(&ys, &lo, &up, true)?))
+    Some((
+        switch_extreme(&ys, &up, &lo, false)?,
+        switch_extreme(&ys, &lo, &up, true)?,
+    ))
 }
 
 /// min (or max) over the switch point k = 0..n of
@@ -122,14 +125,24 @@ impl SmcGainFuzzy {
                 }
             }
         }
-        Ok(SmcGainFuzzy { sigma_lo, sigma_up, table })
+        Ok(SmcGainFuzzy {
+            sigma_lo,
+            sigma_up,
+            table,
+        })
     }
 
     /// Firing intervals and consequents of the nine rules, in row-major order (e set, ė set).
     pub fn rules(&self, e_bar: f64, edot_bar: f64) -> ([f64; 9], [f64; 9], [f64; 9]) {
         const C: [f64; 3] = [-1.0, 0.0, 1.0];
-        let me: Vec<(f64, f64)> = C.iter().map(|&c| interval_gaussian(e_bar, c, self.sigma_lo, self.sigma_up)).collect();
-        let md: Vec<(f64, f64)> = C.iter().map(|&c| interval_gaussian(edot_bar, c, self.sigma_lo, self.sigma_up)).collect();
+        let me: Vec<(f64, f64)> = C
+            .iter()
+            .map(|&c| interval_gaussian(e_bar, c, self.sigma_lo, self.sigma_up))
+            .collect();
+        let md: Vec<(f64, f64)> = C
+            .iter()
+            .map(|&c| interval_gaussian(edot_bar, c, self.sigma_lo, self.sigma_up))
+            .collect();
         let (mut y, mut lo, mut up) = ([0.0; 9], [0.0; 9], [0.0; 9]);
         for i in 0..3 {
             for j in 0..3 {
@@ -147,7 +160,11 @@ impl SmcGainFuzzy {
     pub fn infer(&self, e_bar: f64, edot_bar: f64) -> Option<Type2Output> {
         let (y, lo, up) = self.rules(e_bar, edot_bar);
         let (y_l, y_r) = km_exhaustive(&y, &lo, &up)?;
-        Some(Type2Output { y_l, y_r, y: 0.5 * (y_l + y_r) })
+        Some(Type2Output {
+            y_l,
+            y_r,
+            y: 0.5 * (y_l + y_r),
+        })
     }
 }
 
@@ -208,19 +225,36 @@ mod tests {
         let mut g = Gen(0x9E3779B97F4A7C15);
         for case in 0..400 {
             let n = 1 + case % 9;
-            let y: Vec<f64> = (0..n).map(|_| if case % 2 == 0 { (g.next() * 3.0).floor() - 1.0 } else { g.next() * 4.0 - 2.0 }).collect();
+            let y: Vec<f64> = (0..n)
+                .map(|_| {
+                    if case % 2 == 0 {
+                        (g.next() * 3.0).floor() - 1.0
+                    } else {
+                        g.next() * 4.0 - 2.0
+                    }
+                })
+                .collect();
             let lo: Vec<f64> = (0..n).map(|_| g.next() * 0.5 + 1e-3).collect();
             let up: Vec<f64> = lo.iter().map(|l| l + g.next() * 0.8).collect();
             let (yl, yr) = km_exhaustive(&y, &lo, &up).unwrap();
             let (bl, br) = brute_force(&y, &lo, &up);
             let (dl, dr) = switch_points_direct(&y, &lo, &up);
-            assert!((yl - bl).abs() <= 1e-12 && (yr - br).abs() <= 1e-12, "case {case}: KM ({yl}, {yr}) vs vertices ({bl}, {br})");
-            assert!((yl - dl).abs() <= 1e-12 && (yr - dr).abs() <= 1e-12, "case {case}: running sums vs direct");
+            assert!(
+                (yl - bl).abs() <= 1e-12 && (yr - br).abs() <= 1e-12,
+                "case {case}: KM ({yl}, {yr}) vs vertices ({bl}, {br})"
+            );
+            assert!(
+                (yl - dl).abs() <= 1e-12 && (yr - dr).abs() <= 1e-12,
+                "case {case}: running sums vs direct"
+            );
             // every weighted average with interior firing strengths lies in [y_l, y_r]
             for _ in 0..20 {
                 let f: Vec<f64> = lo.iter().zip(&up).map(|(l, u)| l + (u - l) * g.next()).collect();
                 let v = wavg(&y, &f);
-                assert!(v >= yl - 1e-12 && v <= yr + 1e-12, "case {case}: {v} outside [{yl}, {yr}]");
+                assert!(
+                    v >= yl - 1e-12 && v <= yr + 1e-12,
+                    "case {case}: {v} outside [{yl}, {yr}]"
+                );
             }
         }
     }
@@ -251,7 +285,11 @@ mod tests {
                     }
                 }
                 let o = f.infer(e, d).unwrap();
-                assert!((o.y_l - num / den).abs() < 1e-13 && (o.y_r - num / den).abs() < 1e-13, "({e}, {d}): {o:?} vs {}", num / den);
+                assert!(
+                    (o.y_l - num / den).abs() < 1e-13 && (o.y_r - num / den).abs() < 1e-13,
+                    "({e}, {d}): {o:?} vs {}",
+                    num / den
+                );
             }
         }
     }

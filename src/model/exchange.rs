@@ -24,17 +24,29 @@ impl StateDecl {
     /// A state whose derivative may depend on every input and state (declare less with
     /// [`Self::depends_on`]) and whose start depends on the parameters only.
     pub const fn new(name: &'static str, unit: &'static str, description: &'static str) -> Self {
-        StateDecl { name, unit, description, depends: None, starts_from: &[] }
+        StateDecl {
+            name,
+            unit,
+            description,
+            depends: None,
+            starts_from: &[],
+        }
     }
 
     /// The exact list of inputs and states the derivative depends on (an empty list: on none).
     pub const fn depends_on(self, names: &'static [&'static str]) -> Self {
-        StateDecl { depends: Some(names), ..self }
+        StateDecl {
+            depends: Some(names),
+            ..self
+        }
     }
 
     /// The inputs the start value reads ([`StateDecl::starts_from`]).
     pub const fn starting_from(self, inputs: &'static [&'static str]) -> Self {
-        StateDecl { starts_from: inputs, ..self }
+        StateDecl {
+            starts_from: inputs,
+            ..self
+        }
     }
 }
 

@@ -19,25 +19,49 @@ fn fingerprint(entry: &ModelEntry) -> String {
     let info = entry.info;
     let mut s = String::new();
     let _ = writeln!(s, "spacecraft_fmus {}", env!("CARGO_PKG_VERSION"));
-    let _ = writeln!(s, "{}|{}|{}|{:?}|{:?}|{:?}", info.name, info.description, info.variable_step, info.default_stop_time, info.default_step, info.feedthrough_text());
+    let _ = writeln!(
+        s,
+        "{}|{}|{}|{:?}|{:?}|{:?}",
+        info.name,
+        info.description,
+        info.variable_step,
+        info.default_stop_time,
+        info.default_step,
+        info.feedthrough_text()
+    );
     for d in entry.decls {
         let start = match d.start {
             Start::Real(x) => format!("{x:?}"),
             Start::Integer(x) => x.to_string(),
             Start::Boolean(x) => x.to_string(),
         };
-        let unit = crate::units::lookup(d.unit).map(|(_, b, disp)| format!("{b:?}{disp:?}")).unwrap_or_default();
+        let unit = crate::units::lookup(d.unit)
+            .map(|(_, b, disp)| format!("{b:?}{disp:?}"))
+            .unwrap_or_default();
         let _ = writeln!(
             s,
             "{}|{}|{:?}|{:?}|{:?}|{}|{}|{}|{:?}|{}",
-            d.vr, d.name, d.kind, d.causality, d.variability, d.unit, unit, d.description, d.bound.min_max(), start
+            d.vr,
+            d.name,
+            d.kind,
+            d.causality,
+            d.variability,
+            d.unit,
+            unit,
+            d.description,
+            d.bound.min_max(),
+            start
         );
     }
     // Model Exchange models only, so that a Co-Simulation-only model keeps its GUID.
     if let Some(states) = entry.states {
         let _ = writeln!(s, "model exchange: {} states", states.len());
         for x in states {
-            let _ = writeln!(s, "state|{}|{}|{}|{:?}|{:?}", x.name, x.unit, x.description, x.depends, x.starts_from);
+            let _ = writeln!(
+                s,
+                "state|{}|{}|{}|{:?}|{:?}",
+                x.name, x.unit, x.description, x.depends, x.starts_from
+            );
         }
     }
     s

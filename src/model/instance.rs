@@ -16,7 +16,10 @@ pub struct Fmu<M: Model> {
 
 impl<M: Model> Default for Fmu<M> {
     fn default() -> Self {
-        Fmu { v: M::Vars::default(), state: None }
+        Fmu {
+            v: M::Vars::default(),
+            state: None,
+        }
     }
 }
 
@@ -68,7 +71,10 @@ impl<M: Model> Fmu<M> {
                     _ => a == b,
                 };
                 if !same {
-                    return Err(format!("restored state: calculated parameter {} = {:?} does not match the parameters (they give {:?})", d.name, a, b));
+                    return Err(format!(
+                        "restored state: calculated parameter {} = {:?} does not match the parameters (they give {:?})",
+                        d.name, a, b
+                    ));
                 }
             }
             leaves::check_restored(&*state, &fresh, M::EVOLVING)?;
@@ -191,7 +197,8 @@ impl<M: Model> DynModel for Fmu<M> {
         postcard::to_stdvec(self).map_err(|e| e.to_string())
     }
     fn load_bytes(&mut self, bytes: &[u8]) -> ModelResult {
-        let (decoded, rest): (Fmu<M>, &[u8]) = postcard::take_from_bytes(bytes).map_err(|e| format!("model state does not decode: {e}"))?;
+        let (decoded, rest): (Fmu<M>, &[u8]) =
+            postcard::take_from_bytes(bytes).map_err(|e| format!("model state does not decode: {e}"))?;
         if !rest.is_empty() {
             return Err(format!("model state has {} trailing bytes after its end", rest.len()));
         }

@@ -79,7 +79,11 @@ impl ser::Error for Error {
 
 impl Leaves {
     pub fn of<T: Serialize + ?Sized>(value: &T) -> Result<Leaves, String> {
-        let mut l = Leaves { paths: vec![String::new()], leaves: Vec::new(), stack: vec![0] };
+        let mut l = Leaves {
+            paths: vec![String::new()],
+            leaves: Vec::new(),
+            stack: vec![0],
+        };
         value.serialize(&mut l).map_err(|e| e.0)?;
         Ok(l)
     }
@@ -99,7 +103,11 @@ impl Leaves {
 
     fn enter(&mut self, field: &str) {
         let parent = &self.paths[self.cur() as usize];
-        let path = if parent.is_empty() { field.to_string() } else { format!("{parent}.{field}") };
+        let path = if parent.is_empty() {
+            field.to_string()
+        } else {
+            format!("{parent}.{field}")
+        };
         // paths repeat (every element of a sequence of structs): reuse the index of the last use
         let idx = match self.paths.iter().rposition(|p| *p == path) {
             Some(i) => i as u32,
@@ -207,7 +215,13 @@ impl ser::Serializer for &mut Leaves {
     fn serialize_newtype_struct<T: Serialize + ?Sized>(self, _name: &'static str, value: &T) -> R {
         value.serialize(self)
     }
-    fn serialize_newtype_variant<T: Serialize + ?Sized>(self, _name: &'static str, index: u32, variant: &'static str, value: &T) -> R {
+    fn serialize_newtype_variant<T: Serialize + ?Sized>(
+        self,
+        _name: &'static str,
+        index: u32,
+        variant: &'static str,
+        value: &T,
+    ) -> R {
         self.push(Leaf::Variant(index));
         self.enter(variant);
         value.serialize(&mut *self)?;
@@ -225,7 +239,13 @@ impl ser::Serializer for &mut Leaves {
     fn serialize_tuple_struct(self, _name: &'static str, _len: usize) -> Result<Self, Error> {
         Ok(self)
     }
-    fn serialize_tuple_variant(self, _name: &'static str, index: u32, variant: &'static str, _len: usize) -> Result<Self, Error> {
+    fn serialize_tuple_variant(
+        self,
+        _name: &'static str,
+        index: u32,
+        variant: &'static str,
+        _len: usize,
+    ) -> Result<Self, Error> {
         self.push(Leaf::Variant(index));
         self.enter(variant);
         Ok(self)
@@ -238,7 +258,13 @@ impl ser::Serializer for &mut Leaves {
     fn serialize_struct(self, _name: &'static str, _len: usize) -> Result<Self, Error> {
         Ok(self)
     }
-    fn serialize_struct_variant(self, _name: &'static str, index: u32, variant: &'static str, _len: usize) -> Result<Self, Error> {
+    fn serialize_struct_variant(
+        self,
+        _name: &'static str,
+        index: u32,
+        variant: &'static str,
+        _len: usize,
+    ) -> Result<Self, Error> {
         self.push(Leaf::Variant(index));
         self.enter(variant);
         Ok(self)
@@ -329,7 +355,9 @@ impl ser::SerializeStructVariant for &mut Leaves {
 
 /// Whether `path` lies under one of the `prefixes` (equal, or followed by a '.').
 pub fn under(path: &str, prefixes: &[&str]) -> bool {
-    prefixes.iter().any(|p| path == *p || (path.starts_with(p) && path.as_bytes().get(p.len()) == Some(&b'.')))
+    prefixes
+        .iter()
+        .any(|p| path == *p || (path.starts_with(p) && path.as_bytes().get(p.len()) == Some(&b'.')))
 }
 
 /// The check of a restored state against a fresh one: every leaf outside `evolving` equal (same
@@ -352,13 +380,22 @@ pub fn check_restored<T: Serialize>(restored: &T, fresh: &T, evolving: &[&str]) 
         match fi.next() {
             Some((fp, fl)) if f.path(*fp) == path && fl == leaf => {}
             Some((fp, fl)) if f.path(*fp) == path => {
-                return Err(format!("restored state: {path} = {leaf} does not match the parameters (they give {fl})"));
+                return Err(format!(
+                    "restored state: {path} = {leaf} does not match the parameters (they give {fl})"
+                ));
             }
-            _ => return Err(format!("restored state: {path} does not match the parameters (different structure)")),
+            _ => {
+                return Err(format!(
+                    "restored state: {path} does not match the parameters (different structure)"
+                ))
+            }
         }
     }
     if let Some((fp, _)) = fi.next() {
-        return Err(format!("restored state: {} is missing (different structure)", f.path(*fp)));
+        return Err(format!(
+            "restored state: {} is missing (different structure)",
+            f.path(*fp)
+        ));
     }
     Ok(())
 }
@@ -366,7 +403,13 @@ pub fn check_restored<T: Serialize>(restored: &T, fresh: &T, evolving: &[&str]) 
 /// Test support: every leaf path outside `evolving`, for registry-wide checks of restored states.
 pub fn derived_paths<T: Serialize>(value: &T, evolving: &[&str]) -> Result<Vec<String>, String> {
     let l = Leaves::of(value)?;
-    let mut out: Vec<String> = l.leaves.iter().map(|(p, _)| l.path(*p)).filter(|p| !under(p, evolving)).map(str::to_string).collect();
+    let mut out: Vec<String> = l
+        .leaves
+        .iter()
+        .map(|(p, _)| l.path(*p))
+        .filter(|p| !under(p, evolving))
+        .map(str::to_string)
+        .collect();
     out.dedup();
     Ok(out)
 }
@@ -392,11 +435,21 @@ mod tests {
     enum Mode {
         #[allow(dead_code)]
         A,
-        B { k: f64 },
+        B {
+            k: f64,
+        },
     }
 
     fn sample() -> Outer {
-        Outer { law: Inner { a: 1.0, hist: vec![1.0, 2.0], flag: false }, e0: Some(0.5), mode: Mode::B { k: 3.0 } }
+        Outer {
+            law: Inner {
+                a: 1.0,
+                hist: vec![1.0, 2.0],
+                flag: false,
+            },
+            e0: Some(0.5),
+            mode: Mode::B { k: 3.0 },
+        }
     }
 
     #[test]
@@ -404,7 +457,10 @@ mod tests {
         let s = sample();
         let l = Leaves::of(&s).unwrap();
         let names: Vec<&str> = l.leaves.iter().map(|(p, _)| l.path(*p)).collect();
-        assert_eq!(names, ["law.a", "law.hist", "law.hist", "law.hist", "law.flag", "e0", "e0", "mode", "mode.B.k"]);
+        assert_eq!(
+            names,
+            ["law.a", "law.hist", "law.hist", "law.hist", "law.flag", "e0", "e0", "mode", "mode.B.k"]
+        );
         let ev = ["law.hist", "e0"];
         assert!(check_restored(&s, &sample(), &ev).is_ok());
         // evolving parts may differ, even in length
@@ -414,11 +470,15 @@ mod tests {
         assert!(check_restored(&r, &sample(), &ev).is_ok());
         // but must be finite
         r.law.hist[0] = f64::NAN;
-        assert!(check_restored(&r, &sample(), &ev).unwrap_err().contains("law.hist = NaN is not finite"));
+        assert!(check_restored(&r, &sample(), &ev)
+            .unwrap_err()
+            .contains("law.hist = NaN is not finite"));
         // a derived flag that differs is named
         let mut r = sample();
         r.law.flag = true;
-        assert!(check_restored(&r, &sample(), &ev).unwrap_err().contains("law.flag = true does not match"));
+        assert!(check_restored(&r, &sample(), &ev)
+            .unwrap_err()
+            .contains("law.flag = true does not match"));
         let mut r = sample();
         r.mode = Mode::A;
         assert!(check_restored(&r, &sample(), &ev).unwrap_err().contains("mode"));

@@ -13,8 +13,8 @@ mod param;
 #[cfg(test)]
 mod restore_tests;
 
-pub use exchange::{StateDecl, DERIVATIVE_VR_BASE, RESERVED_VR_START, STATE_VR_BASE};
 pub use declare::{concat, field_problem, no_duplicate_names, no_duplicate_vrs, same_str, total_len};
+pub use exchange::{StateDecl, DERIVATIVE_VR_BASE, RESERVED_VR_START, STATE_VR_BASE};
 pub use instance::{DynModel, Fmu};
 pub use param::ParamEnum;
 
@@ -123,8 +123,12 @@ impl Bound {
     /// Checks an Integer value.
     pub fn check_integer(self, name: &str, v: i32) -> Result<(), String> {
         match self {
-            Bound::Choice(codes) if !codes.contains(&v) => Err(format!("parameter {name} = {v} is not one of {codes:?}")),
-            Bound::Range(lo, hi) if !((v as f64) >= lo && (v as f64) <= hi) => Err(format!("parameter {name} = {v} must lie in [{lo}, {hi}]")),
+            Bound::Choice(codes) if !codes.contains(&v) => {
+                Err(format!("parameter {name} = {v} is not one of {codes:?}"))
+            }
+            Bound::Range(lo, hi) if !((v as f64) >= lo && (v as f64) <= hi) => {
+                Err(format!("parameter {name} = {v} must lie in [{lo}, {hi}]"))
+            }
             Bound::Positive if v <= 0 => Err(format!("parameter {name} = {v} must be > 0")),
             Bound::NonNegative | Bound::Limit if v < 0 => Err(format!("parameter {name} = {v} must be >= 0")),
             _ => Ok(()),
@@ -171,7 +175,10 @@ impl Bound {
             Bound::Any | Bound::Positive => (None, None),
             Bound::NonNegative | Bound::Limit => (Some(0.0), None),
             Bound::Range(lo, hi) => (Some(lo), Some(hi)),
-            Bound::Choice(codes) => (codes.iter().min().map(|&c| c as f64), codes.iter().max().map(|&c| c as f64)),
+            Bound::Choice(codes) => (
+                codes.iter().min().map(|&c| c as f64),
+                codes.iter().max().map(|&c| c as f64),
+            ),
         }
     }
 }
@@ -285,7 +292,10 @@ pub trait Variables: Clone + Default + Serialize + DeserializeOwned + Send + 'st
             if d.causality == Causality::CalculatedParameter {
                 if let Some(Value::Real(x)) = self.value(i) {
                     if !x.is_finite() {
-                        return Err(format!("calculated parameter {} = {x} is not finite (check the parameters it is derived from)", d.name));
+                        return Err(format!(
+                            "calculated parameter {} = {x} is not finite (check the parameters it is derived from)",
+                            d.name
+                        ));
                     }
                 }
             }
@@ -356,7 +366,9 @@ impl Experiment {
     /// Relative tolerance for adaptive integrators: the master's, clamped into [1e-14, 0.1] (a tighter
     /// value cannot be met in double precision, a looser one is meaningless), or 1e-8.
     pub fn tolerance_or_default(&self) -> f64 {
-        self.tolerance.filter(|x| *x > 0.0).map_or(1e-8, |x| x.clamp(TOLERANCE_MIN, TOLERANCE_MAX))
+        self.tolerance
+            .filter(|x| *x > 0.0)
+            .map_or(1e-8, |x| x.clamp(TOLERANCE_MIN, TOLERANCE_MAX))
     }
 }
 
@@ -365,12 +377,20 @@ pub type ModelResult = Result<(), String>;
 
 /// For [`Model::validate`]: the named parts of a restored state must be finite.
 pub fn check_finite_state<'a>(what: &str, values: impl IntoIterator<Item = &'a f64>) -> ModelResult {
-    if values.into_iter().all(|x| x.is_finite()) { Ok(()) } else { Err(format!("restored state: {what} is not finite")) }
+    if values.into_iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err(format!("restored state: {what} is not finite"))
+    }
 }
 
 /// For [`Model::validate`]: a part derived from the parameters must equal the freshly derived one.
 pub fn check_derived<T: PartialEq>(what: &str, restored: &T, fresh: &T) -> ModelResult {
-    if restored == fresh { Ok(()) } else { Err(format!("restored state: {what} does not match the parameters")) }
+    if restored == fresh {
+        Ok(())
+    } else {
+        Err(format!("restored state: {what} does not match the parameters"))
+    }
 }
 
 /// A model: a variable block plus an internal state built from the parameters.
@@ -456,7 +476,12 @@ pub struct ModelEntry {
 
 impl ModelEntry {
     pub const fn of<M: Model>() -> Self {
-        ModelEntry { info: &M::INFO, decls: M::Vars::DECLS, states: M::STATES, create: || Box::new(Fmu::<M>::default()) }
+        ModelEntry {
+            info: &M::INFO,
+            decls: M::Vars::DECLS,
+            states: M::STATES,
+            create: || Box::new(Fmu::<M>::default()),
+        }
     }
 
     /// Whether the model offers Model Exchange.
@@ -488,7 +513,13 @@ impl ModelEntry {
 pub mod check {
     /// `lo <= hi` for two parameters that span a range.
     pub fn ordered(lo_name: &str, lo: f64, hi_name: &str, hi: f64) -> Result<(), String> {
-        if lo <= hi { Ok(()) } else { Err(format!("parameters {lo_name} = {lo} and {hi_name} = {hi}: need {lo_name} <= {hi_name}")) }
+        if lo <= hi {
+            Ok(())
+        } else {
+            Err(format!(
+                "parameters {lo_name} = {lo} and {hi_name} = {hi}: need {lo_name} <= {hi_name}"
+            ))
+        }
     }
 }
 

@@ -15,7 +15,11 @@ fn targets(v: &J, path: &str, ptr: &str, out: &mut Vec<(String, String, bool)>) 
     match v {
         J::Object(m) => {
             for (k, x) in m {
-                let p = if path.is_empty() { k.clone() } else { format!("{path}.{k}") };
+                let p = if path.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{path}.{k}")
+                };
                 targets(x, &p, &format!("{ptr}/{k}"), out);
             }
         }
@@ -58,7 +62,8 @@ fn stepped(entry: &'static crate::model::ModelEntry, exp: &Experiment) -> Box<dy
     let h = entry.info.default_step;
     for k in 0..20 {
         m.update_outputs(k as f64 * h).unwrap();
-        m.do_step(k as f64 * h, h).unwrap_or_else(|e| panic!("{}: {e}", entry.info.name));
+        m.do_step(k as f64 * h, h)
+            .unwrap_or_else(|e| panic!("{}: {e}", entry.info.name));
     }
     m
 }
@@ -71,13 +76,17 @@ fn every_changed_derived_field_of_every_model_is_refused() {
         let name = entry.info.name;
         let m = stepped(entry, &exp);
         let mut same = m.clone_box();
-        same.validate(&exp).unwrap_or_else(|e| panic!("{name}: an unchanged state is refused: {e}"));
+        same.validate(&exp)
+            .unwrap_or_else(|e| panic!("{name}: an unchanged state is refused: {e}"));
         let json = m.state_json();
         let mut t = vec![];
         targets(&json, "", "", &mut t);
         let paths: Vec<&str> = t.iter().map(|(p, _, _)| p.as_str()).collect();
         for ev in m.evolving() {
-            assert!(paths.iter().any(|p| under(p, &[ev])), "{name}: EVOLVING path {ev} names no field of the state ({paths:?})");
+            assert!(
+                paths.iter().any(|p| under(p, &[ev])),
+                "{name}: EVOLVING path {ev} names no field of the state ({paths:?})"
+            );
         }
         let mut checked = 0;
         for (path, ptr, array) in &t {
@@ -93,7 +102,11 @@ fn every_changed_derived_field_of_every_model_is_refused() {
                 checked += 1; // refused by the decoder itself
                 continue;
             }
-            assert!(r.validate(&exp).is_err(), "{name}: a restored state with {path} changed{} is accepted", if *array { " (length)" } else { "" });
+            assert!(
+                r.validate(&exp).is_err(),
+                "{name}: a restored state with {path} changed{} is accepted",
+                if *array { " (length)" } else { "" }
+            );
             checked += 1;
         }
         // calculated parameters
@@ -108,13 +121,21 @@ fn every_changed_derived_field_of_every_model_is_refused() {
                 Some(SlotMut::Boolean(x)) => *x = !*x,
                 None => unreachable!(),
             }
-            let e = r.validate(&exp).expect_err(&format!("{name}: calculated parameter {} changed is accepted", d.name));
+            let e = r
+                .validate(&exp)
+                .expect_err(&format!("{name}: calculated parameter {} changed is accepted", d.name));
             assert!(e.contains(d.name), "{e}");
-            assert!(matches!(m.value(i), Some(Value::Real(_) | Value::Integer(_) | Value::Boolean(_))));
+            assert!(matches!(
+                m.value(i),
+                Some(Value::Real(_) | Value::Integer(_) | Value::Boolean(_))
+            ));
             checked += 1;
         }
         println!("{name}: {checked} changed derived fields refused");
         total += checked;
     }
-    println!("{} models, {total} changed derived fields, all refused", registry::COUNT);
+    println!(
+        "{} models, {total} changed derived fields, all refused",
+        registry::COUNT
+    );
 }

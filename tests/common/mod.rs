@@ -5,9 +5,9 @@
 use std::ffi::{c_char, c_int, c_void, CStr, CString};
 use std::sync::Mutex;
 
-use spacecraft_fmus::model::guid::guid;
 use spacecraft_fmus::fmi::fmi2::*;
 use spacecraft_fmus::fmi::types::LoggerFn;
+use spacecraft_fmus::model::guid::guid;
 use spacecraft_fmus::registry;
 
 pub const OK: c_int = 0;
@@ -20,7 +20,13 @@ pub type Log = Mutex<Vec<(c_int, String)>>;
 /// A non-variadic logger: fmi2CallbackLogger is C-variadic, which stable Rust cannot define. Every
 /// message we send is fully formatted, so the variadic part is never read; on the x86-64 and AArch64
 /// C ABIs a callee with the fixed arguments only is call-compatible (fmpy's ctypes logger is the same).
-unsafe extern "C" fn record(env: *mut c_void, _name: *const c_char, status: c_int, _cat: *const c_char, msg: *const c_char) {
+unsafe extern "C" fn record(
+    env: *mut c_void,
+    _name: *const c_char,
+    status: c_int,
+    _cat: *const c_char,
+    msg: *const c_char,
+) {
     let log = unsafe { &*(env as *const Log) };
     let text = unsafe { CStr::from_ptr(msg) }.to_string_lossy().replace("%%", "%");
     log.lock().unwrap().push((status, text));
@@ -28,7 +34,12 @@ unsafe extern "C" fn record(env: *mut c_void, _name: *const c_char, status: c_in
 
 pub fn logger() -> LoggerFn {
     // SAFETY: see `record`.
-    unsafe { std::mem::transmute::<unsafe extern "C" fn(*mut c_void, *const c_char, c_int, *const c_char, *const c_char), LoggerFn>(record) }
+    unsafe {
+        std::mem::transmute::<
+            unsafe extern "C" fn(*mut c_void, *const c_char, c_int, *const c_char, *const c_char),
+            LoggerFn,
+        >(record)
+    }
 }
 
 pub struct TestFmu {
@@ -66,12 +77,30 @@ impl TestFmu {
         });
         let name = CString::new(format!("test_{model}")).unwrap();
         let g = CString::new(guid).unwrap();
-        let c = fmi2Instantiate(registry::ALL, name.as_ptr(), fmu_type, g.as_ptr(), std::ptr::null(), &*callbacks, 0, 0);
-        TestFmu { c, model, log, callbacks }
+        let c = fmi2Instantiate(
+            registry::ALL,
+            name.as_ptr(),
+            fmu_type,
+            g.as_ptr(),
+            std::ptr::null(),
+            &*callbacks,
+            0,
+            0,
+        );
+        TestFmu {
+            c,
+            model,
+            log,
+            callbacks,
+        }
     }
 
     pub fn vr(&self, name: &str) -> u32 {
-        registry::find(self.model).unwrap().decl(name).unwrap_or_else(|| panic!("no variable {name}")).vr
+        registry::find(self.model)
+            .unwrap()
+            .decl(name)
+            .unwrap_or_else(|| panic!("no variable {name}"))
+            .vr
     }
 
     pub fn init(&mut self, reals: &[(&str, f64)], ints: &[(&str, i32)]) {
@@ -87,12 +116,22 @@ impl TestFmu {
     }
 
     pub fn set(&self, name: &str, v: f64) {
-        assert_eq!(fmi2SetReal(self.c, &self.vr(name), 1, &v), OK, "set {name}: {:?}", self.messages());
+        assert_eq!(
+            fmi2SetReal(self.c, &self.vr(name), 1, &v),
+            OK,
+            "set {name}: {:?}",
+            self.messages()
+        );
     }
 
     pub fn get(&self, name: &str) -> f64 {
         let mut v = f64::NAN;
-        assert_eq!(fmi2GetReal(self.c, &self.vr(name), 1, &mut v), OK, "get {name}: {:?}", self.messages());
+        assert_eq!(
+            fmi2GetReal(self.c, &self.vr(name), 1, &mut v),
+            OK,
+            "get {name}: {:?}",
+            self.messages()
+        );
         v
     }
 

@@ -65,7 +65,11 @@ s   = min(1, torque_limit / max_i |T_i|)</pre>",
         };
         let t = v.k.component_mul(&e) + v.k_d.component_mul(&v.ports.w);
         let peak = t.amax();
-        v.scale = if peak > v.torque_limit { v.torque_limit / peak } else { 1.0 };
+        v.scale = if peak > v.torque_limit {
+            v.torque_limit / peak
+        } else {
+            1.0
+        };
         v.ports.torque_cmd = if v.scale < 1.0 { t * v.scale } else { t };
         Ok(())
     }
@@ -108,7 +112,10 @@ mod tests {
                 m.v.ports.q_ref = rotation(alpha, n);
                 m.outputs(0.0).unwrap();
                 let expected = m.v.k.component_mul(&(n * size));
-                assert!((m.v.ports.torque_cmd - expected).norm() < 1e-12 * expected.norm(), "kind {kind}, alpha {alpha}");
+                assert!(
+                    (m.v.ports.torque_cmd - expected).norm() < 1e-12 * expected.norm(),
+                    "kind {kind}, alpha {alpha}"
+                );
             }
         }
     }
@@ -146,7 +153,10 @@ mod tests {
     fn bad_parameters_and_unconnected_quaternions_are_errors_naming_them() {
         let mut m = Fmu::<SaturationAwarePd>::default();
         m.v.torque_limit = -1.0;
-        assert!(m.initialize(&Experiment::default()).unwrap_err().contains("torque_limit"));
+        assert!(m
+            .initialize(&Experiment::default())
+            .unwrap_err()
+            .contains("torque_limit"));
         let mut m = controller(0, 1e30);
         m.v.ports.q = Quaternion::new(0.0, 0.0, 0.0, 0.0);
         assert!(m.outputs(0.0).unwrap_err().contains("quaternion q"));

@@ -37,16 +37,40 @@ pub struct CallbackFunctions {
 pub mod mask {
     use crate::fmi::types::mask_of as m;
     use crate::fmi::types::FsmState::*;
-    pub const SET_DEBUG_LOGGING: u16 =
-        m(&[Instantiated, InitializationMode, StepComplete, StepFailed, StepCanceled, Terminated, Error, EventMode, ContinuousTimeMode]);
+    pub const SET_DEBUG_LOGGING: u16 = m(&[
+        Instantiated,
+        InitializationMode,
+        StepComplete,
+        StepFailed,
+        StepCanceled,
+        Terminated,
+        Error,
+        EventMode,
+        ContinuousTimeMode,
+    ]);
     pub const FREE_INSTANCE: u16 = SET_DEBUG_LOGGING; // fmi2FreeInstance itself is always honoured (also after fmi2Fatal)
     pub const SETUP_EXPERIMENT: u16 = m(&[Instantiated]);
     pub const ENTER_INITIALIZATION_MODE: u16 = m(&[Instantiated]);
     pub const EXIT_INITIALIZATION_MODE: u16 = m(&[InitializationMode]);
     pub const TERMINATE: u16 = m(&[StepComplete, StepFailed, EventMode, ContinuousTimeMode]);
     pub const RESET: u16 = FREE_INSTANCE;
-    pub const GET: u16 = m(&[InitializationMode, StepComplete, StepFailed, StepCanceled, Terminated, Error, EventMode, ContinuousTimeMode]);
-    pub const SET: u16 = m(&[Instantiated, InitializationMode, StepComplete, EventMode, ContinuousTimeMode]);
+    pub const GET: u16 = m(&[
+        InitializationMode,
+        StepComplete,
+        StepFailed,
+        StepCanceled,
+        Terminated,
+        Error,
+        EventMode,
+        ContinuousTimeMode,
+    ]);
+    pub const SET: u16 = m(&[
+        Instantiated,
+        InitializationMode,
+        StepComplete,
+        EventMode,
+        ContinuousTimeMode,
+    ]);
     pub const FMU_STATE: u16 = FREE_INSTANCE;
     pub const DIRECTIONAL_DERIVATIVE: u16 = GET;
     pub const SET_INPUT_DERIVATIVES: u16 = m(&[Instantiated, InitializationMode, StepComplete]);
@@ -79,8 +103,18 @@ pub(crate) fn call(c: Component, func: &str, allowed: u16, f: impl FnOnce(&mut I
         return Status::Error as c_int;
     };
     if allowed & inst.run.fsm.bit() == 0 {
-        let status = if inst.run.fsm == FsmState::Fatal { Status::Fatal } else { Status::Error };
-        inst.log_fail(func, &Fail { status, reason: format!("not allowed in state {:?} (illegal call sequence)", inst.run.fsm) });
+        let status = if inst.run.fsm == FsmState::Fatal {
+            Status::Fatal
+        } else {
+            Status::Error
+        };
+        inst.log_fail(
+            func,
+            &Fail {
+                status,
+                reason: format!("not allowed in state {:?} (illegal call sequence)", inst.run.fsm),
+            },
+        );
         return status as c_int;
     }
     match guarded(|| f(&mut *inst)) {
@@ -91,7 +125,13 @@ pub(crate) fn call(c: Component, func: &str, allowed: u16, f: impl FnOnce(&mut I
         }
         Err(panic) => {
             inst.run.fsm = FsmState::Fatal;
-            inst.log_fail(func, &Fail { status: Status::Fatal, reason: format!("internal error (panic): {panic}") });
+            inst.log_fail(
+                func,
+                &Fail {
+                    status: Status::Fatal,
+                    reason: format!("internal error (panic): {panic}"),
+                },
+            );
             Status::Fatal as c_int
         }
     }
@@ -139,11 +179,17 @@ pub fn fmi2Instantiate(
         model_exchange: fmu_type == 0,
         check_arguments: &|| match fmu_type {
             0 | 1 => Ok(()),
-            _ => Err(format!("fmuType {fmu_type} is neither fmi2ModelExchange (0) nor fmi2CoSimulation (1)")),
+            _ => Err(format!(
+                "fmuType {fmu_type} is neither fmi2ModelExchange (0) nor fmi2CoSimulation (1)"
+            )),
         },
         refuse_model: &|entry| {
-            (fmu_type == 0 && !entry.model_exchange())
-                .then(|| format!("fmuType fmi2ModelExchange requested, but {} supports only Co-Simulation (fmi2CoSimulation = 1)", entry.info.name))
+            (fmu_type == 0 && !entry.model_exchange()).then(|| {
+                format!(
+                    "fmuType fmi2ModelExchange requested, but {} supports only Co-Simulation (fmi2CoSimulation = 1)",
+                    entry.info.name
+                )
+            })
         },
     })
 }
@@ -152,7 +198,12 @@ pub extern "C" fn fmi2FreeInstance(c: Component) {
     boundary::free_instance(c, false)
 }
 
-pub extern "C" fn fmi2SetDebugLogging(c: Component, logging_on: c_int, n: usize, categories: *const *const c_char) -> c_int {
+pub extern "C" fn fmi2SetDebugLogging(
+    c: Component,
+    logging_on: c_int,
+    n: usize,
+    categories: *const *const c_char,
+) -> c_int {
     call(c, "fmi2SetDebugLogging", mask::SET_DEBUG_LOGGING, |inst| {
         let ptrs = unsafe { slice(categories, n, "categories[]")? };
         let mut names = Vec::with_capacity(n);
@@ -167,19 +218,40 @@ pub extern "C" fn fmi2SetDebugLogging(c: Component, logging_on: c_int, n: usize,
     })
 }
 
-pub extern "C" fn fmi2SetupExperiment(c: Component, tol_defined: c_int, tol: f64, start: f64, stop_defined: c_int, stop: f64) -> c_int {
+pub extern "C" fn fmi2SetupExperiment(
+    c: Component,
+    tol_defined: c_int,
+    tol: f64,
+    start: f64,
+    stop_defined: c_int,
+    stop: f64,
+) -> c_int {
     call(c, "fmi2SetupExperiment", mask::SETUP_EXPERIMENT, |inst| {
         inst.trace(|| format!("fmi2SetupExperiment(toleranceDefined={tol_defined}, tolerance={tol}, startTime={start}, stopTimeDefined={stop_defined}, stopTime={stop})"));
-        inst.setup_experiment((tol_defined != 0).then_some(tol), start, (stop_defined != 0).then_some(stop))
+        inst.setup_experiment(
+            (tol_defined != 0).then_some(tol),
+            start,
+            (stop_defined != 0).then_some(stop),
+        )
     })
 }
 
 pub extern "C" fn fmi2EnterInitializationMode(c: Component) -> c_int {
-    call(c, "fmi2EnterInitializationMode", mask::ENTER_INITIALIZATION_MODE, |inst| inst.enter_initialization_mode())
+    call(
+        c,
+        "fmi2EnterInitializationMode",
+        mask::ENTER_INITIALIZATION_MODE,
+        |inst| inst.enter_initialization_mode(),
+    )
 }
 
 pub extern "C" fn fmi2ExitInitializationMode(c: Component) -> c_int {
-    call(c, "fmi2ExitInitializationMode", mask::EXIT_INITIALIZATION_MODE, |inst| inst.exit_initialization_mode())
+    call(
+        c,
+        "fmi2ExitInitializationMode",
+        mask::EXIT_INITIALIZATION_MODE,
+        |inst| inst.exit_initialization_mode(),
+    )
 }
 
 pub extern "C" fn fmi2Terminate(c: Component) -> c_int {
@@ -214,7 +286,15 @@ fn get_typed<T: Copy>(
     })
 }
 
-fn set_typed<T: Copy>(c: Component, func: &str, kind: VarKind, vr: *const u32, n: usize, value: *const T, conv: impl Fn(T) -> Value) -> c_int {
+fn set_typed<T: Copy>(
+    c: Component,
+    func: &str,
+    kind: VarKind,
+    vr: *const u32,
+    n: usize,
+    value: *const T,
+    conv: impl Fn(T) -> Value,
+) -> c_int {
     call(c, func, mask::SET, |inst| {
         let vrs = unsafe { slice(vr, n, "vr[]")? };
         let vals = unsafe { slice(value, n, "value[]")? };
@@ -223,15 +303,29 @@ fn set_typed<T: Copy>(c: Component, func: &str, kind: VarKind, vr: *const u32, n
 }
 
 pub extern "C" fn fmi2GetReal(c: Component, vr: *const u32, n: usize, value: *mut f64) -> c_int {
-    get_typed(c, "fmi2GetReal", VarKind::Real, vr, n, value, |v| if let Value::Real(x) = v { x } else { f64::NAN })
+    get_typed(c, "fmi2GetReal", VarKind::Real, vr, n, value, |v| {
+        if let Value::Real(x) = v {
+            x
+        } else {
+            f64::NAN
+        }
+    })
 }
 
 pub extern "C" fn fmi2GetInteger(c: Component, vr: *const u32, n: usize, value: *mut c_int) -> c_int {
-    get_typed(c, "fmi2GetInteger", VarKind::Integer, vr, n, value, |v| if let Value::Integer(x) = v { x } else { 0 })
+    get_typed(c, "fmi2GetInteger", VarKind::Integer, vr, n, value, |v| {
+        if let Value::Integer(x) = v {
+            x
+        } else {
+            0
+        }
+    })
 }
 
 pub extern "C" fn fmi2GetBoolean(c: Component, vr: *const u32, n: usize, value: *mut c_int) -> c_int {
-    get_typed(c, "fmi2GetBoolean", VarKind::Boolean, vr, n, value, |v| matches!(v, Value::Boolean(true)) as c_int)
+    get_typed(c, "fmi2GetBoolean", VarKind::Boolean, vr, n, value, |v| {
+        matches!(v, Value::Boolean(true)) as c_int
+    })
 }
 
 pub extern "C" fn fmi2GetString(c: Component, vr: *const u32, n: usize, value: *mut *const c_char) -> c_int {
@@ -240,7 +334,9 @@ pub extern "C" fn fmi2GetString(c: Component, vr: *const u32, n: usize, value: *
         unsafe { slice_mut(value, n, "value[]")? };
         match vrs.first() {
             None => Ok(()),
-            Some(v) => Err(Fail::error(format!("unknown String value reference {v} (this FMU has no String variables)"))),
+            Some(v) => Err(Fail::error(format!(
+                "unknown String value reference {v} (this FMU has no String variables)"
+            ))),
         }
     })
 }
@@ -254,7 +350,9 @@ pub extern "C" fn fmi2SetInteger(c: Component, vr: *const u32, n: usize, value: 
 }
 
 pub extern "C" fn fmi2SetBoolean(c: Component, vr: *const u32, n: usize, value: *const c_int) -> c_int {
-    set_typed(c, "fmi2SetBoolean", VarKind::Boolean, vr, n, value, |b| Value::Boolean(b != 0))
+    set_typed(c, "fmi2SetBoolean", VarKind::Boolean, vr, n, value, |b| {
+        Value::Boolean(b != 0)
+    })
 }
 
 pub extern "C" fn fmi2SetString(c: Component, vr: *const u32, n: usize, value: *const *const c_char) -> c_int {
@@ -263,7 +361,9 @@ pub extern "C" fn fmi2SetString(c: Component, vr: *const u32, n: usize, value: *
         unsafe { slice(value, n, "value[]")? };
         match vrs.first() {
             None => Ok(()),
-            Some(v) => Err(Fail::error(format!("unknown String value reference {v} (this FMU has no String variables)"))),
+            Some(v) => Err(Fail::error(format!(
+                "unknown String value reference {v} (this FMU has no String variables)"
+            ))),
         }
     })
 }
@@ -276,9 +376,17 @@ mod tests {
 
     type Log = StdMutex<Vec<(c_int, String)>>;
 
-    unsafe extern "C" fn record(env: *mut c_void, _n: *const c_char, status: c_int, _c: *const c_char, msg: *const c_char) {
+    unsafe extern "C" fn record(
+        env: *mut c_void,
+        _n: *const c_char,
+        status: c_int,
+        _c: *const c_char,
+        msg: *const c_char,
+    ) {
         let log = unsafe { &*(env as *const Log) };
-        log.lock().unwrap().push((status, unsafe { CStr::from_ptr(msg) }.to_string_lossy().into_owned()));
+        log.lock()
+            .unwrap()
+            .push((status, unsafe { CStr::from_ptr(msg) }.to_string_lossy().into_owned()));
     }
 
     /// A panic inside a call becomes fmi2Fatal with a logged message, and the instance refuses
@@ -297,13 +405,27 @@ mod tests {
         };
         let entry = crate::registry::find("AttitudeMetrics").unwrap();
         let g = CString::new(crate::model::guid::guid(entry).as_str()).unwrap();
-        let c = fmi2Instantiate(crate::registry::ALL, c"p".as_ptr(), 1, g.as_ptr(), std::ptr::null(), &cb, 0, 0);
+        let c = fmi2Instantiate(
+            crate::registry::ALL,
+            c"p".as_ptr(),
+            1,
+            g.as_ptr(),
+            std::ptr::null(),
+            &cb,
+            0,
+            0,
+        );
         assert!(!c.is_null());
-        let st = call(c, "fmi2Probe", mask::SETUP_EXPERIMENT, |_| panic!("deliberate test panic"));
+        let st = call(c, "fmi2Probe", mask::SETUP_EXPERIMENT, |_| {
+            panic!("deliberate test panic")
+        });
         assert_eq!(st, Status::Fatal as c_int);
         let (status, msg) = log.lock().unwrap().last().cloned().unwrap();
         assert_eq!(status, Status::Fatal as c_int);
-        assert!(msg.contains("fmi2Probe") && msg.contains("deliberate test panic"), "{msg}");
+        assert!(
+            msg.contains("fmi2Probe") && msg.contains("deliberate test panic"),
+            "{msg}"
+        );
         assert_eq!(fmi2EnterInitializationMode(c), Status::Fatal as c_int);
         fmi2FreeInstance(c);
     }

@@ -9,13 +9,27 @@ use crate::fmi::boundary::out_ptr;
 use crate::fmi::instance::{CallResult, Fail, Instance};
 use crate::fmi::types::FsmState;
 
-pub extern "C" fn fmi2SetRealInputDerivatives(c: Component, _vr: *const u32, _n: usize, _order: *const c_int, _value: *const f64) -> c_int {
+pub extern "C" fn fmi2SetRealInputDerivatives(
+    c: Component,
+    _vr: *const u32,
+    _n: usize,
+    _order: *const c_int,
+    _value: *const f64,
+) -> c_int {
     call(c, "fmi2SetRealInputDerivatives", mask::SET_INPUT_DERIVATIVES, |_| {
-        Err(Fail::error("not supported: canInterpolateInputs = false, inputs are held constant over a step"))
+        Err(Fail::error(
+            "not supported: canInterpolateInputs = false, inputs are held constant over a step",
+        ))
     })
 }
 
-pub extern "C" fn fmi2GetRealOutputDerivatives(c: Component, _vr: *const u32, _n: usize, _order: *const c_int, _value: *mut f64) -> c_int {
+pub extern "C" fn fmi2GetRealOutputDerivatives(
+    c: Component,
+    _vr: *const u32,
+    _n: usize,
+    _order: *const c_int,
+    _value: *mut f64,
+) -> c_int {
     call(c, "fmi2GetRealOutputDerivatives", mask::GET_OUTPUT_DERIVATIVES, |_| {
         Err(Fail::error("not supported: maxOutputDerivativeOrder = 0"))
     })
@@ -42,7 +56,9 @@ fn status_query(c: Component, func: &str, f: impl FnOnce(&mut Instance) -> CallR
 pub extern "C" fn fmi2GetStatus(c: Component, kind: c_int, value: *mut c_int) -> c_int {
     status_query(c, "fmi2GetStatus", |_| {
         out_ptr(value, "value")?;
-        Err(Fail::discard(format!("status kind {kind} is not available: no asynchronous step is ever pending")))
+        Err(Fail::discard(format!(
+            "status kind {kind} is not available: no asynchronous step is ever pending"
+        )))
     })
 }
 
@@ -53,7 +69,9 @@ pub extern "C" fn fmi2GetRealStatus(c: Component, kind: c_int, value: *mut f64) 
             *out = inst.run.time;
             Ok(())
         } else {
-            Err(Fail::discard(format!("status kind {kind} has no Real value (only fmi2LastSuccessfulTime)")))
+            Err(Fail::discard(format!(
+                "status kind {kind} has no Real value (only fmi2LastSuccessfulTime)"
+            )))
         }
     })
 }
@@ -72,7 +90,9 @@ pub extern "C" fn fmi2GetBooleanStatus(c: Component, kind: c_int, value: *mut c_
             *out = (inst.run.fsm == FsmState::Terminated) as c_int;
             Ok(())
         } else {
-            Err(Fail::discard(format!("status kind {kind} has no Boolean value (only fmi2Terminated)")))
+            Err(Fail::discard(format!(
+                "status kind {kind} has no Boolean value (only fmi2Terminated)"
+            )))
         }
     })
 }
@@ -80,7 +100,8 @@ pub extern "C" fn fmi2GetBooleanStatus(c: Component, kind: c_int, value: *mut c_
 pub extern "C" fn fmi2GetStringStatus(c: Component, kind: c_int, value: *mut *const c_char) -> c_int {
     status_query(c, "fmi2GetStringStatus", |_| {
         out_ptr(value, "value")?;
-        Err(Fail::discard(format!("status kind {kind} is not available: no asynchronous step is ever pending")))
+        Err(Fail::discard(format!(
+            "status kind {kind} is not available: no asynchronous step is ever pending"
+        )))
     })
 }
-

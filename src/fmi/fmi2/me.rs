@@ -33,14 +33,19 @@ fn me_call(c: Component, func: &str, allowed: u16, f: impl FnOnce(&mut Instance)
     call(c, func, mask::SET_DEBUG_LOGGING, |inst| {
         inst.require_model_exchange()?;
         if allowed & inst.run.fsm.bit() == 0 {
-            return Err(Fail::error(format!("not allowed in state {:?} (illegal call sequence)", inst.run.fsm)));
+            return Err(Fail::error(format!(
+                "not allowed in state {:?} (illegal call sequence)",
+                inst.run.fsm
+            )));
         }
         f(inst)
     })
 }
 
 pub extern "C" fn fmi2EnterEventMode(c: Component) -> c_int {
-    me_call(c, "fmi2EnterEventMode", mask::ENTER_EVENT_MODE, |inst| inst.enter_event_mode())
+    me_call(c, "fmi2EnterEventMode", mask::ENTER_EVENT_MODE, |inst| {
+        inst.enter_event_mode()
+    })
 }
 
 pub extern "C" fn fmi2NewDiscreteStates(c: Component, info: *mut EventInfo2) -> c_int {
@@ -61,17 +66,32 @@ pub extern "C" fn fmi2NewDiscreteStates(c: Component, info: *mut EventInfo2) -> 
 }
 
 pub extern "C" fn fmi2EnterContinuousTimeMode(c: Component) -> c_int {
-    me_call(c, "fmi2EnterContinuousTimeMode", mask::ENTER_CONTINUOUS_TIME_MODE, |inst| inst.enter_continuous_time_mode())
+    me_call(
+        c,
+        "fmi2EnterContinuousTimeMode",
+        mask::ENTER_CONTINUOUS_TIME_MODE,
+        |inst| inst.enter_continuous_time_mode(),
+    )
 }
 
-pub extern "C" fn fmi2CompletedIntegratorStep(c: Component, _no_set_prior: c_int, enter_event_mode: *mut c_int, terminate: *mut c_int) -> c_int {
-    me_call(c, "fmi2CompletedIntegratorStep", mask::COMPLETED_INTEGRATOR_STEP, |inst| {
-        let enter = out_ptr(enter_event_mode, "enterEventMode")?;
-        let term = out_ptr(terminate, "terminateSimulation")?;
-        *enter = inst.completed_integrator_step()? as c_int;
-        *term = 0;
-        Ok(())
-    })
+pub extern "C" fn fmi2CompletedIntegratorStep(
+    c: Component,
+    _no_set_prior: c_int,
+    enter_event_mode: *mut c_int,
+    terminate: *mut c_int,
+) -> c_int {
+    me_call(
+        c,
+        "fmi2CompletedIntegratorStep",
+        mask::COMPLETED_INTEGRATOR_STEP,
+        |inst| {
+            let enter = out_ptr(enter_event_mode, "enterEventMode")?;
+            let term = out_ptr(terminate, "terminateSimulation")?;
+            *enter = inst.completed_integrator_step()? as c_int;
+            *term = 0;
+            Ok(())
+        },
+    )
 }
 
 pub extern "C" fn fmi2SetTime(c: Component, t: f64) -> c_int {

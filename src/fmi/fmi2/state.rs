@@ -12,28 +12,43 @@ use crate::fmi::state_calls;
 // ----- FMU state -----------------------------------------------------------------------------------
 
 pub extern "C" fn fmi2GetFMUstate(c: Component, state: *mut *mut c_void) -> c_int {
-    call(c, "fmi2GetFMUstate", mask::FMU_STATE, |inst| state_calls::get(inst, out_ptr(state, "FMUstate")?, c as usize))
+    call(c, "fmi2GetFMUstate", mask::FMU_STATE, |inst| {
+        state_calls::get(inst, out_ptr(state, "FMUstate")?, c as usize)
+    })
 }
 
 pub extern "C" fn fmi2SetFMUstate(c: Component, state: *mut c_void) -> c_int {
-    call(c, "fmi2SetFMUstate", mask::FMU_STATE, |inst| state_calls::set(inst, state))
+    call(c, "fmi2SetFMUstate", mask::FMU_STATE, |inst| {
+        state_calls::set(inst, state)
+    })
 }
 
 pub extern "C" fn fmi2FreeFMUstate(c: Component, state: *mut *mut c_void) -> c_int {
-    call(c, "fmi2FreeFMUstate", mask::FMU_STATE, |_inst| state_calls::free(out_ptr(state, "FMUstate")?))
+    call(c, "fmi2FreeFMUstate", mask::FMU_STATE, |_inst| {
+        state_calls::free(out_ptr(state, "FMUstate")?)
+    })
 }
 
 pub extern "C" fn fmi2SerializedFMUstateSize(c: Component, state: *mut c_void, size: *mut usize) -> c_int {
-    call(c, "fmi2SerializedFMUstateSize", mask::FMU_STATE, |inst| state_calls::serialized_size(inst, state, out_ptr(size, "size")?))
+    call(c, "fmi2SerializedFMUstateSize", mask::FMU_STATE, |inst| {
+        state_calls::serialized_size(inst, state, out_ptr(size, "size")?)
+    })
 }
 
 pub extern "C" fn fmi2SerializeFMUstate(c: Component, state: *mut c_void, buffer: *mut c_char, size: usize) -> c_int {
     call(c, "fmi2SerializeFMUstate", mask::FMU_STATE, |inst| {
-        state_calls::serialize(inst, state, size, "fmi2SerializedFMUstateSize", || unsafe { slice_mut(buffer as *mut u8, size, "serializedState[]") })
+        state_calls::serialize(inst, state, size, "fmi2SerializedFMUstateSize", || unsafe {
+            slice_mut(buffer as *mut u8, size, "serializedState[]")
+        })
     })
 }
 
-pub extern "C" fn fmi2DeSerializeFMUstate(c: Component, buffer: *const c_char, size: usize, state: *mut *mut c_void) -> c_int {
+pub extern "C" fn fmi2DeSerializeFMUstate(
+    c: Component,
+    buffer: *const c_char,
+    size: usize,
+    state: *mut *mut c_void,
+) -> c_int {
     call(c, "fmi2DeSerializeFMUstate", mask::FMU_STATE, |inst| {
         let slot = out_ptr(state, "FMUstate")?;
         let bytes = unsafe { slice(buffer as *const u8, size, "serializedState[]")? };
@@ -52,14 +67,18 @@ pub extern "C" fn fmi2GetDirectionalDerivative(
     dv_known: *const f64,
     dv_unknown: *mut f64,
 ) -> c_int {
-    call(c, "fmi2GetDirectionalDerivative", mask::DIRECTIONAL_DERIVATIVE, |inst| {
-        let unknowns = unsafe { slice(v_unknown, n_unknown, "vUnknown_ref[]")? };
-        let knowns = unsafe { slice(v_known, n_known, "vKnown_ref[]")? };
-        let seed = unsafe { slice(dv_known, n_known, "dvKnown[]")? };
-        let out = unsafe { slice_mut(dv_unknown, n_unknown, "dvUnknown[]")? };
-        let d = inst.directional_derivative(unknowns, knowns, seed)?;
-        out.copy_from_slice(&d);
-        Ok(())
-    })
+    call(
+        c,
+        "fmi2GetDirectionalDerivative",
+        mask::DIRECTIONAL_DERIVATIVE,
+        |inst| {
+            let unknowns = unsafe { slice(v_unknown, n_unknown, "vUnknown_ref[]")? };
+            let knowns = unsafe { slice(v_known, n_known, "vKnown_ref[]")? };
+            let seed = unsafe { slice(dv_known, n_known, "dvKnown[]")? };
+            let out = unsafe { slice_mut(dv_unknown, n_unknown, "dvUnknown[]")? };
+            let d = inst.directional_derivative(unknowns, knowns, seed)?;
+            out.copy_from_slice(&d);
+            Ok(())
+        },
+    )
 }
-

@@ -10,7 +10,12 @@
 //! parameters, no intermediate update), nor is Event Mode by a Co-Simulation instance
 //! (`hasEventMode = false`). `fmi3Boolean` arguments are read as bytes (any non-zero byte is true), so
 //! a master passing a value other than 0 or 1 cannot cause undefined behaviour.
-#![allow(non_snake_case, clippy::missing_safety_doc, clippy::not_unsafe_ptr_arg_deref, clippy::too_many_arguments)]
+#![allow(
+    non_snake_case,
+    clippy::missing_safety_doc,
+    clippy::not_unsafe_ptr_arg_deref,
+    clippy::too_many_arguments
+)]
 
 use std::ffi::{c_char, c_int, c_void, CStr};
 
@@ -34,13 +39,38 @@ pub mod mask3 {
     use crate::fmi::types::FsmState::*;
     // Event Mode and Continuous-Time Mode are reached by Model Exchange instances only (`fmi3_me`).
     /// Every state but Fatal (the super state "FMU State Settable" plus Terminated).
-    pub const ANY: u16 = m(&[Instantiated, InitializationMode, StepComplete, Terminated, EventMode, ContinuousTimeMode]);
+    pub const ANY: u16 = m(&[
+        Instantiated,
+        InitializationMode,
+        StepComplete,
+        Terminated,
+        EventMode,
+        ContinuousTimeMode,
+    ]);
     pub const ENTER_INITIALIZATION_MODE: u16 = m(&[Instantiated]);
     pub const EXIT_INITIALIZATION_MODE: u16 = m(&[InitializationMode]);
     pub const TERMINATE: u16 = m(&[StepComplete, EventMode, ContinuousTimeMode]);
-    pub const GET: u16 = m(&[InitializationMode, StepComplete, Terminated, EventMode, ContinuousTimeMode]);
-    pub const SET: u16 = m(&[Instantiated, InitializationMode, StepComplete, EventMode, ContinuousTimeMode]);
-    pub const DIRECTIONAL_DERIVATIVE: u16 = m(&[InitializationMode, StepComplete, Terminated, EventMode, ContinuousTimeMode]);
+    pub const GET: u16 = m(&[
+        InitializationMode,
+        StepComplete,
+        Terminated,
+        EventMode,
+        ContinuousTimeMode,
+    ]);
+    pub const SET: u16 = m(&[
+        Instantiated,
+        InitializationMode,
+        StepComplete,
+        EventMode,
+        ContinuousTimeMode,
+    ]);
+    pub const DIRECTIONAL_DERIVATIVE: u16 = m(&[
+        InitializationMode,
+        StepComplete,
+        Terminated,
+        EventMode,
+        ContinuousTimeMode,
+    ]);
     pub const DO_STEP: u16 = m(&[StepComplete]);
     pub const OUTPUT_DERIVATIVES: u16 = m(&[StepComplete, Terminated]);
 }
@@ -59,7 +89,13 @@ pub mod mask3me {
     /// `fmi3GetNominalsOfContinuousStates`.
     pub const GET_ME_VALUES: u16 = m(&[InitializationMode, EventMode, ContinuousTimeMode, Terminated]);
     /// `fmi3GetNumberOfContinuousStates`, `fmi3GetNumberOfEventIndicators`: any state but Fatal.
-    pub const NUMBER_OF: u16 = m(&[Instantiated, InitializationMode, EventMode, ContinuousTimeMode, Terminated]);
+    pub const NUMBER_OF: u16 = m(&[
+        Instantiated,
+        InitializationMode,
+        EventMode,
+        ContinuousTimeMode,
+        Terminated,
+    ]);
 }
 
 /// Runs an FMI 3.0 call on an instance: state check, panic guard, logging; `fmi3Error` moves the
@@ -74,12 +110,25 @@ pub fn call3(c: Instance3, func: &str, allowed: u16, f: impl FnOnce(&mut Instanc
         inst.run.fsm = FsmState::Terminated;
     }
     let result = if allowed & inst.run.fsm.bit() == 0 {
-        let status = if inst.run.fsm == FsmState::Fatal { Status::Fatal } else { Status::Error };
-        Err(Fail { status, reason: format!("not allowed in state {} (illegal call sequence)", state_name(inst.run.fsm)) })
+        let status = if inst.run.fsm == FsmState::Fatal {
+            Status::Fatal
+        } else {
+            Status::Error
+        };
+        Err(Fail {
+            status,
+            reason: format!(
+                "not allowed in state {} (illegal call sequence)",
+                state_name(inst.run.fsm)
+            ),
+        })
     } else {
         match guarded(|| f(&mut *inst)) {
             Ok(r) => r,
-            Err(panic) => Err(Fail { status: Status::Fatal, reason: format!("internal error (panic): {panic}") }),
+            Err(panic) => Err(Fail {
+                status: Status::Fatal,
+                reason: format!("internal error (panic): {panic}"),
+            }),
         }
     };
     match result {
@@ -90,8 +139,17 @@ pub fn call3(c: Instance3, func: &str, allowed: u16, f: impl FnOnce(&mut Instanc
                 Status::Error => inst.run.fsm = FsmState::Terminated,
                 _ => {}
             }
-            let reason = fail.reason.replace("fmi2SetupExperiment", "fmi3EnterInitializationMode").replace("fmi2SetContinuousStates", "fmi3SetContinuousStates");
-            inst.log_fail(func, &Fail { status: fail.status, reason });
+            let reason = fail
+                .reason
+                .replace("fmi2SetupExperiment", "fmi3EnterInitializationMode")
+                .replace("fmi2SetContinuousStates", "fmi3SetContinuousStates");
+            inst.log_fail(
+                func,
+                &Fail {
+                    status: fail.status,
+                    reason,
+                },
+            );
             fail.status as c_int
         }
     }
@@ -112,7 +170,13 @@ pub fn state_name(s: FsmState) -> &'static str {
 
 /// An error message through the master's FMI 3.0 logger when there is no instance to log with.
 pub fn log_without_instance3(logger: Option<Log3Fn>, env: *mut c_void, func: &str, message: &str) {
-    boundary::log_without_instance(logger.map_or(Logger::None, Logger::Fmi3), env, std::ptr::null(), func, message);
+    boundary::log_without_instance(
+        logger.map_or(Logger::None, Logger::Fmi3),
+        env,
+        std::ptr::null(),
+        func,
+        message,
+    );
 }
 
 /// A call of a function whose feature this FMU does not provide: refused with the reason.
@@ -129,7 +193,9 @@ pub fn is_model_exchange(c: Instance3) -> bool {
 /// Refuses a Co-Simulation function on a Model Exchange instance (used inside the CS functions).
 pub fn require_co_simulation(inst: &Instance) -> CallResult {
     if inst.model_exchange {
-        return Err(Fail::error("Co-Simulation function, but this instance was created by fmi3InstantiateModelExchange"));
+        return Err(Fail::error(
+            "Co-Simulation function, but this instance was created by fmi3InstantiateModelExchange",
+        ));
     }
     Ok(())
 }
@@ -144,33 +210,64 @@ pub extern "C" fn fmi3FreeInstance(c: Instance3) {
     boundary::free_instance(c, true)
 }
 
-pub extern "C" fn fmi3SetDebugLogging(c: Instance3, logging_on: u8, n: usize, categories: *const *const c_char) -> c_int {
+pub extern "C" fn fmi3SetDebugLogging(
+    c: Instance3,
+    logging_on: u8,
+    n: usize,
+    categories: *const *const c_char,
+) -> c_int {
     call3(c, "fmi3SetDebugLogging", mask3::ANY, |inst| {
         let ptrs = unsafe { slice(categories, n, "categories[]")? };
         let mut names = Vec::with_capacity(n);
         for (i, p) in ptrs.iter().enumerate() {
-            names.push(c_str(*p, &format!("categories[{i}]")).map_err(Fail::error)?.to_string_lossy().into_owned());
+            names.push(
+                c_str(*p, &format!("categories[{i}]"))
+                    .map_err(Fail::error)?
+                    .to_string_lossy()
+                    .into_owned(),
+            );
         }
         inst.set_debug_logging(logging_on != 0, &names)
     })
 }
 
-pub extern "C" fn fmi3EnterInitializationMode(c: Instance3, tol_defined: u8, tol: f64, start: f64, stop_defined: u8, stop: f64) -> c_int {
-    call3(c, "fmi3EnterInitializationMode", mask3::ENTER_INITIALIZATION_MODE, |inst| {
-        inst.trace(|| format!("fmi3EnterInitializationMode(toleranceDefined={tol_defined}, tolerance={tol}, startTime={start}, stopTimeDefined={stop_defined}, stopTime={stop})"));
-        let setup = inst.setup_experiment((tol_defined != 0).then_some(tol), start, (stop_defined != 0).then_some(stop));
-        if let Err(f) = &setup {
-            if f.status > Status::Warning {
-                return setup;
+pub extern "C" fn fmi3EnterInitializationMode(
+    c: Instance3,
+    tol_defined: u8,
+    tol: f64,
+    start: f64,
+    stop_defined: u8,
+    stop: f64,
+) -> c_int {
+    call3(
+        c,
+        "fmi3EnterInitializationMode",
+        mask3::ENTER_INITIALIZATION_MODE,
+        |inst| {
+            inst.trace(|| format!("fmi3EnterInitializationMode(toleranceDefined={tol_defined}, tolerance={tol}, startTime={start}, stopTimeDefined={stop_defined}, stopTime={stop})"));
+            let setup = inst.setup_experiment(
+                (tol_defined != 0).then_some(tol),
+                start,
+                (stop_defined != 0).then_some(stop),
+            );
+            if let Err(f) = &setup {
+                if f.status > Status::Warning {
+                    return setup;
+                }
             }
-        }
-        inst.enter_initialization_mode()?;
-        setup // Ok, or the tolerance warning
-    })
+            inst.enter_initialization_mode()?;
+            setup // Ok, or the tolerance warning
+        },
+    )
 }
 
 pub extern "C" fn fmi3ExitInitializationMode(c: Instance3) -> c_int {
-    call3(c, "fmi3ExitInitializationMode", mask3::EXIT_INITIALIZATION_MODE, |inst| inst.exit_initialization_mode())
+    call3(
+        c,
+        "fmi3ExitInitializationMode",
+        mask3::EXIT_INITIALIZATION_MODE,
+        |inst| inst.exit_initialization_mode(),
+    )
 }
 
 pub extern "C" fn fmi3Terminate(c: Instance3) -> c_int {
@@ -186,4 +283,3 @@ pub extern "C" fn fmi3Reset(c: Instance3) -> c_int {
         Ok(())
     })
 }
-

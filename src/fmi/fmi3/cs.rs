@@ -1,6 +1,11 @@
 //! FMI 3.0 Co-Simulation only: `fmi3InstantiateCoSimulation`, `fmi3DoStep`, and the Step Mode functions
 //! of features these FMUs do not declare.
-#![allow(non_snake_case, clippy::missing_safety_doc, clippy::not_unsafe_ptr_arg_deref, clippy::too_many_arguments)]
+#![allow(
+    non_snake_case,
+    clippy::missing_safety_doc,
+    clippy::not_unsafe_ptr_arg_deref,
+    clippy::too_many_arguments
+)]
 
 use std::ffi::{c_char, c_int, c_void};
 
@@ -44,7 +49,14 @@ pub fn fmi3InstantiateCoSimulation(
                 return Err("eventModeUsed = true, but this FMU has no Event Mode (hasEventMode = false)".into());
             }
             if n_required_intermediate > 0 {
-                let vrs = unsafe { slice(required_intermediate, n_required_intermediate, "requiredIntermediateVariables[]") }.map_err(|f| f.reason)?;
+                let vrs = unsafe {
+                    slice(
+                        required_intermediate,
+                        n_required_intermediate,
+                        "requiredIntermediateVariables[]",
+                    )
+                }
+                .map_err(|f| f.reason)?;
                 return Err(format!("requiredIntermediateVariables {vrs:?}: this FMU provides no intermediate update (providesIntermediateUpdate = false)"));
             }
             Ok(())
@@ -66,7 +78,10 @@ pub extern "C" fn fmi3DoStep(
     call3(c, "fmi3DoStep", mask3::ANY, |inst| {
         require_co_simulation(inst)?;
         if mask3::DO_STEP & inst.run.fsm.bit() == 0 {
-            return Err(Fail::error(format!("not allowed in state {} (illegal call sequence)", state_name(inst.run.fsm))));
+            return Err(Fail::error(format!(
+                "not allowed in state {} (illegal call sequence)",
+                state_name(inst.run.fsm)
+            )));
         }
         inst.trace(|| format!("fmi3DoStep(currentCommunicationPoint={t}, communicationStepSize={h})"));
         let ev = out_ptr(event_handling_needed, "eventHandlingNeeded")?;
@@ -81,10 +96,26 @@ pub extern "C" fn fmi3DoStep(
 }
 
 pub extern "C" fn fmi3EnterStepMode(c: Instance3) -> c_int {
-    refuse(c, "fmi3EnterStepMode", mask3::ANY, "Event Mode is never entered: fmi3ExitInitializationMode leads to Step Mode directly")
+    refuse(
+        c,
+        "fmi3EnterStepMode",
+        mask3::ANY,
+        "Event Mode is never entered: fmi3ExitInitializationMode leads to Step Mode directly",
+    )
 }
 
-pub extern "C" fn fmi3GetOutputDerivatives(c: Instance3, _vr: *const u32, _n: usize, _order: *const i32, _v: *mut f64, _nv: usize) -> c_int {
-    refuse(c, "fmi3GetOutputDerivatives", mask3::OUTPUT_DERIVATIVES, "maxOutputDerivativeOrder = 0")
+pub extern "C" fn fmi3GetOutputDerivatives(
+    c: Instance3,
+    _vr: *const u32,
+    _n: usize,
+    _order: *const i32,
+    _v: *mut f64,
+    _nv: usize,
+) -> c_int {
+    refuse(
+        c,
+        "fmi3GetOutputDerivatives",
+        mask3::OUTPUT_DERIVATIVES,
+        "maxOutputDerivativeOrder = 0",
+    )
 }
-

@@ -11,7 +11,12 @@
 //!
 //! A Model Exchange function called on a Co-Simulation instance is refused (fmi3Error, with a message
 //! saying so), as is a Co-Simulation function on a Model Exchange instance.
-#![allow(non_snake_case, clippy::missing_safety_doc, clippy::not_unsafe_ptr_arg_deref, clippy::too_many_arguments)]
+#![allow(
+    non_snake_case,
+    clippy::missing_safety_doc,
+    clippy::not_unsafe_ptr_arg_deref,
+    clippy::too_many_arguments
+)]
 
 use std::ffi::{c_char, c_int, c_void};
 
@@ -26,7 +31,10 @@ fn not_me_reason(inst: &Instance) -> String {
     if inst.entry.model_exchange() {
         "Model Exchange function, but this instance was created by fmi3InstantiateCoSimulation".into()
     } else {
-        format!("Model Exchange function, but {} provides Co-Simulation only (no <ModelExchange> element)", inst.entry.info.name)
+        format!(
+            "Model Exchange function, but {} provides Co-Simulation only (no <ModelExchange> element)",
+            inst.entry.info.name
+        )
     }
 }
 
@@ -38,7 +46,10 @@ fn me3(c: Instance3, func: &str, allowed: u16, f: impl FnOnce(&mut Instance) -> 
             return Err(Fail::error(not_me_reason(inst)));
         }
         if allowed & inst.run.fsm.bit() == 0 {
-            return Err(Fail::error(format!("not allowed in state {} (illegal call sequence)", state_name(inst.run.fsm))));
+            return Err(Fail::error(format!(
+                "not allowed in state {} (illegal call sequence)",
+                state_name(inst.run.fsm)
+            )));
         }
         f(inst)
     })
@@ -85,7 +96,9 @@ pub fn fmi3InstantiateModelExchange(
 
 /// `fmi3EnterEventMode` on a Model Exchange instance.
 fn enter_event_mode(c: Instance3) -> c_int {
-    me3(c, "fmi3EnterEventMode", mask3me::ENTER_EVENT_MODE, |inst| inst.enter_event_mode())
+    me3(c, "fmi3EnterEventMode", mask3me::ENTER_EVENT_MODE, |inst| {
+        inst.enter_event_mode()
+    })
 }
 
 /// `fmi3UpdateDiscreteStates` on a Model Exchange instance: one pass of the event iteration.
@@ -118,17 +131,29 @@ fn update_discrete_states(
 }
 
 pub extern "C" fn fmi3EnterContinuousTimeMode(c: Instance3) -> c_int {
-    me3(c, "fmi3EnterContinuousTimeMode", mask3me::EVENT_MODE, |inst| inst.enter_continuous_time_mode())
+    me3(c, "fmi3EnterContinuousTimeMode", mask3me::EVENT_MODE, |inst| {
+        inst.enter_continuous_time_mode()
+    })
 }
 
-pub extern "C" fn fmi3CompletedIntegratorStep(c: Instance3, _no_set_prior: u8, enter_event_mode: *mut u8, terminate_simulation: *mut u8) -> c_int {
-    me3(c, "fmi3CompletedIntegratorStep", mask3me::CONTINUOUS_TIME_MODE, |inst| {
-        let enter = out_ptr(enter_event_mode, "enterEventMode")?;
-        let term = out_ptr(terminate_simulation, "terminateSimulation")?;
-        *enter = inst.completed_integrator_step()? as u8;
-        *term = 0;
-        Ok(())
-    })
+pub extern "C" fn fmi3CompletedIntegratorStep(
+    c: Instance3,
+    _no_set_prior: u8,
+    enter_event_mode: *mut u8,
+    terminate_simulation: *mut u8,
+) -> c_int {
+    me3(
+        c,
+        "fmi3CompletedIntegratorStep",
+        mask3me::CONTINUOUS_TIME_MODE,
+        |inst| {
+            let enter = out_ptr(enter_event_mode, "enterEventMode")?;
+            let term = out_ptr(terminate_simulation, "terminateSimulation")?;
+            *enter = inst.completed_integrator_step()? as u8;
+            *term = 0;
+            Ok(())
+        },
+    )
 }
 
 // ----- time, states, derivatives ---------------------------------------------------------------------
@@ -191,7 +216,13 @@ pub extern "C" fn fmi3GetNumberOfEventIndicators(c: Instance3, n: *mut usize) ->
 
 /// The shared Model Exchange methods name the FMI 2.0 arguments (`x[]`, `x_nominal[]`): give the FMI 3.0 names.
 fn rename_x(name: &'static str) -> impl Fn(Fail) -> Fail {
-    move |f| Fail { status: f.status, reason: f.reason.replace("x_nominal[]", name).replace("x[", &name[..name.len() - 1]) }
+    move |f| Fail {
+        status: f.status,
+        reason: f
+            .reason
+            .replace("x_nominal[]", name)
+            .replace("x[", &name[..name.len() - 1]),
+    }
 }
 
 // ----- functions both interfaces export, with the Model Exchange rules on an ME instance ---------------
@@ -201,21 +232,48 @@ pub extern "C" fn fmi3EnterEventMode(c: Instance3) -> c_int {
     if is_model_exchange(c) {
         return enter_event_mode(c);
     }
-    refuse(c, "fmi3EnterEventMode", mask3::ANY, "hasEventMode = false (instantiate with eventModeUsed = false)")
+    refuse(
+        c,
+        "fmi3EnterEventMode",
+        mask3::ANY,
+        "hasEventMode = false (instantiate with eventModeUsed = false)",
+    )
 }
 
 pub extern "C" fn fmi3EvaluateDiscreteStates(c: Instance3) -> c_int {
     if is_model_exchange(c) {
-        return refuse(c, "fmi3EvaluateDiscreteStates", mask3::ANY, "providesEvaluateDiscreteStates = false (fmi3UpdateDiscreteStates evaluates them)");
+        return refuse(
+            c,
+            "fmi3EvaluateDiscreteStates",
+            mask3::ANY,
+            "providesEvaluateDiscreteStates = false (fmi3UpdateDiscreteStates evaluates them)",
+        );
     }
-    refuse(c, "fmi3EvaluateDiscreteStates", mask3::ANY, "this Co-Simulation FMU has no Event Mode")
+    refuse(
+        c,
+        "fmi3EvaluateDiscreteStates",
+        mask3::ANY,
+        "this Co-Simulation FMU has no Event Mode",
+    )
 }
 
 /// Model Exchange: one pass of the event iteration. Co-Simulation: refused (no Event Mode).
-pub extern "C" fn fmi3UpdateDiscreteStates(c: Instance3, need: *mut u8, terminate: *mut u8, nominals_changed: *mut u8, values_changed: *mut u8, defined: *mut u8, t: *mut f64) -> c_int {
+pub extern "C" fn fmi3UpdateDiscreteStates(
+    c: Instance3,
+    need: *mut u8,
+    terminate: *mut u8,
+    nominals_changed: *mut u8,
+    values_changed: *mut u8,
+    defined: *mut u8,
+    t: *mut f64,
+) -> c_int {
     if is_model_exchange(c) {
         return update_discrete_states(c, need, terminate, nominals_changed, values_changed, defined, t);
     }
-    refuse(c, "fmi3UpdateDiscreteStates", mask3::ANY, "this Co-Simulation FMU has no Event Mode")
+    refuse(
+        c,
+        "fmi3UpdateDiscreteStates",
+        mask3::ANY,
+        "this Co-Simulation FMU has no Event Mode",
+    )
 }
-

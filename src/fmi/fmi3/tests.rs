@@ -6,8 +6,8 @@ use std::ffi::{c_char, c_int, c_void, CStr, CString};
 use std::sync::Mutex;
 
 use super::*;
-use crate::fmi::types::{FsmState, Status};
 use crate::export::*;
+use crate::fmi::types::{FsmState, Status};
 
 declare_variables! {
     /// Variables of a switchable gain.
@@ -24,7 +24,12 @@ pub struct Switch;
 
 impl Model for Switch {
     type Vars = SwitchVars;
-    const INFO: ModelInfo = ModelInfo { name: "Fmi3TestSwitch", description: "y = gain u if on", feedthrough: Feedthrough::AllInputs, ..ModelInfo::DEFAULT };
+    const INFO: ModelInfo = ModelInfo {
+        name: "Fmi3TestSwitch",
+        description: "y = gain u if on",
+        feedthrough: Feedthrough::AllInputs,
+        ..ModelInfo::DEFAULT
+    };
     const EVOLVING: &'static [&'static str] = &[];
     fn initialize(_v: &mut SwitchVars, _e: &Experiment) -> Result<Self, String> {
         Ok(Switch)
@@ -44,12 +49,28 @@ type Log = Mutex<Vec<(c_int, String)>>;
 
 unsafe extern "C" fn record(env: *mut c_void, status: c_int, _cat: *const c_char, msg: *const c_char) {
     let log = unsafe { &*(env as *const Log) };
-    log.lock().unwrap().push((status, unsafe { CStr::from_ptr(msg) }.to_string_lossy().into_owned()));
+    log.lock()
+        .unwrap()
+        .push((status, unsafe { CStr::from_ptr(msg) }.to_string_lossy().into_owned()));
 }
 
 fn new(log: &Log) -> Instance3 {
     let token = CString::new(crate::model::guid::guid(&MODELS[0]).as_str()).unwrap();
-    let c = fmi3InstantiateCoSimulation(MODELS, c"t".as_ptr(), token.as_ptr(), std::ptr::null(), 0, 0, 0, 0, std::ptr::null(), 0, log as *const Log as *mut c_void, Some(record), std::ptr::null());
+    let c = fmi3InstantiateCoSimulation(
+        MODELS,
+        c"t".as_ptr(),
+        token.as_ptr(),
+        std::ptr::null(),
+        0,
+        0,
+        0,
+        0,
+        std::ptr::null(),
+        0,
+        log as *const Log as *mut c_void,
+        Some(record),
+        std::ptr::null(),
+    );
     assert!(!c.is_null());
     c
 }
@@ -92,7 +113,18 @@ fn booleans_are_one_byte_and_any_nonzero_byte_is_true() {
     assert_eq!(fmi3GetNumberOfVariableDependencies(c, 2, &mut n), OK);
     assert_eq!(n, 2);
     let (mut e1, mut ind, mut e2, mut k) = ([9usize; 2], [9u32; 2], [9usize; 2], [9 as c_int; 2]);
-    assert_eq!(fmi3GetVariableDependencies(c, 2, e1.as_mut_ptr(), ind.as_mut_ptr(), e2.as_mut_ptr(), k.as_mut_ptr(), 2), OK);
+    assert_eq!(
+        fmi3GetVariableDependencies(
+            c,
+            2,
+            e1.as_mut_ptr(),
+            ind.as_mut_ptr(),
+            e2.as_mut_ptr(),
+            k.as_mut_ptr(),
+            2
+        ),
+        OK
+    );
     assert_eq!((e1, ind, e2, k), ([0, 0], [0, 1], [0, 0], [5, 5]));
     fmi3FreeInstance(c);
 }
@@ -102,13 +134,20 @@ fn an_error_terminates_and_reset_recovers() {
     let log: Box<Log> = Box::default();
     let c = new(&log);
     assert_eq!(fmi3SetBoolean(c, [0u32].as_ptr(), 1, [1u8].as_ptr(), 1), ERROR);
-    assert!(last(&log).contains("fmi3SetBoolean") && last(&log).contains("value reference 0 is u"), "{}", last(&log));
+    assert!(
+        last(&log).contains("fmi3SetBoolean") && last(&log).contains("value reference 0 is u"),
+        "{}",
+        last(&log)
+    );
     let inst = crate::fmi::boundary::instance_of(c, true).unwrap();
     assert_eq!(inst.run.fsm, FsmState::Terminated);
     assert_eq!(fmi3EnterInitializationMode(c, 0, 0.0, 0.0, 0, 0.0), ERROR);
     assert!(last(&log).contains("not allowed in state Terminated"), "{}", last(&log));
     assert_eq!(fmi3Reset(c), OK);
-    assert_eq!(crate::fmi::boundary::instance_of(c, true).unwrap().run.fsm, FsmState::Instantiated);
+    assert_eq!(
+        crate::fmi::boundary::instance_of(c, true).unwrap().run.fsm,
+        FsmState::Instantiated
+    );
     // an FMI 2.0 function does not know an FMI 3.0 instance, and the other way round
     assert_eq!(crate::fmi::fmi2::fmi2EnterInitializationMode(c), ERROR);
     assert!(crate::fmi::boundary::instance_of(c, false).is_none());
@@ -122,7 +161,11 @@ fn a_panic_is_fatal_and_only_free_instance_is_honoured() {
     assert_eq!(fmi3SetFloat64(c, [100u32].as_ptr(), 1, [1e10].as_ptr(), 1), OK);
     assert_eq!(fmi3EnterInitializationMode(c, 0, 0.0, 0.0, 0, 0.0), OK);
     assert_eq!(fmi3ExitInitializationMode(c), Status::Fatal as c_int);
-    assert!(last(&log).contains("fmi3ExitInitializationMode") && last(&log).contains("deliberate test panic"), "{}", last(&log));
+    assert!(
+        last(&log).contains("fmi3ExitInitializationMode") && last(&log).contains("deliberate test panic"),
+        "{}",
+        last(&log)
+    );
     assert_eq!(fmi3Reset(c), Status::Fatal as c_int);
     fmi3FreeInstance(c);
 }

@@ -3,7 +3,12 @@
 //! because the standard's importers (fmpy, FMI Library) resolve every `fmi3*` symbol when they load a
 //! binary; each one refuses with `fmi3Error` and a logged reason, as the standard prescribes for a call
 //! the model description does not allow.
-#![allow(non_snake_case, clippy::missing_safety_doc, clippy::not_unsafe_ptr_arg_deref, clippy::too_many_arguments)]
+#![allow(
+    non_snake_case,
+    clippy::missing_safety_doc,
+    clippy::not_unsafe_ptr_arg_deref,
+    clippy::too_many_arguments
+)]
 
 use std::ffi::{c_char, c_int, c_void};
 
@@ -12,16 +17,41 @@ use crate::fmi::boundary::slice;
 use crate::fmi::instance::Fail;
 use crate::fmi::types::Log3Fn;
 
-pub extern "C" fn fmi3GetAdjointDerivative(c: Instance3, _u: *const u32, _nu: usize, _k: *const u32, _nk: usize, _s: *const f64, _ns: usize, _out: *mut f64, _no: usize) -> c_int {
-    refuse(c, "fmi3GetAdjointDerivative", mask3::DIRECTIONAL_DERIVATIVE, "providesAdjointDerivatives = false")
+pub extern "C" fn fmi3GetAdjointDerivative(
+    c: Instance3,
+    _u: *const u32,
+    _nu: usize,
+    _k: *const u32,
+    _nk: usize,
+    _s: *const f64,
+    _ns: usize,
+    _out: *mut f64,
+    _no: usize,
+) -> c_int {
+    refuse(
+        c,
+        "fmi3GetAdjointDerivative",
+        mask3::DIRECTIONAL_DERIVATIVE,
+        "providesAdjointDerivatives = false",
+    )
 }
 
 pub extern "C" fn fmi3EnterConfigurationMode(c: Instance3) -> c_int {
-    refuse(c, "fmi3EnterConfigurationMode", mask3::ANY, "this FMU has no structural parameters")
+    refuse(
+        c,
+        "fmi3EnterConfigurationMode",
+        mask3::ANY,
+        "this FMU has no structural parameters",
+    )
 }
 
 pub extern "C" fn fmi3ExitConfigurationMode(c: Instance3) -> c_int {
-    refuse(c, "fmi3ExitConfigurationMode", mask3::ANY, "this FMU has no structural parameters (Configuration Mode is never entered)")
+    refuse(
+        c,
+        "fmi3ExitConfigurationMode",
+        mask3::ANY,
+        "this FMU has no structural parameters (Configuration Mode is never entered)",
+    )
 }
 
 /// Variables of a type this FMU does not have: a call with values is refused (naming the first value
@@ -31,7 +61,9 @@ fn no_such_type(c: Instance3, func: &str, allowed: u16, ty: &str, vr: *const u32
         let vrs = unsafe { slice(vr, n, "valueReferences[]")? };
         match vrs.first() {
             None => Ok(()),
-            Some(v) => Err(Fail::error(format!("unknown {ty} value reference {v}: this FMU has no variables of type {ty}"))),
+            Some(v) => Err(Fail::error(format!(
+                "unknown {ty} value reference {v}: this FMU has no variables of type {ty}"
+            ))),
         }
     })
 }
@@ -59,11 +91,25 @@ other_types! {
     fmi3GetString, fmi3SetString, *const c_char, "String";
 }
 
-pub extern "C" fn fmi3GetBinary(c: Instance3, vr: *const u32, n: usize, _sizes: *mut usize, _v: *mut *const u8, _nv: usize) -> c_int {
+pub extern "C" fn fmi3GetBinary(
+    c: Instance3,
+    vr: *const u32,
+    n: usize,
+    _sizes: *mut usize,
+    _v: *mut *const u8,
+    _nv: usize,
+) -> c_int {
     no_such_type(c, "fmi3GetBinary", mask3::GET, "Binary", vr, n)
 }
 
-pub extern "C" fn fmi3SetBinary(c: Instance3, vr: *const u32, n: usize, _sizes: *const usize, _v: *const *const u8, _nv: usize) -> c_int {
+pub extern "C" fn fmi3SetBinary(
+    c: Instance3,
+    vr: *const u32,
+    n: usize,
+    _sizes: *const usize,
+    _v: *const *const u8,
+    _nv: usize,
+) -> c_int {
     no_such_type(c, "fmi3SetBinary", mask3::SET, "Binary", vr, n)
 }
 
@@ -75,11 +121,24 @@ pub extern "C" fn fmi3SetClock(c: Instance3, vr: *const u32, n: usize, _v: *cons
     no_such_type(c, "fmi3SetClock", mask3::ANY, "Clock", vr, n)
 }
 
-pub extern "C" fn fmi3GetIntervalDecimal(c: Instance3, vr: *const u32, n: usize, _i: *mut f64, _q: *mut c_int) -> c_int {
+pub extern "C" fn fmi3GetIntervalDecimal(
+    c: Instance3,
+    vr: *const u32,
+    n: usize,
+    _i: *mut f64,
+    _q: *mut c_int,
+) -> c_int {
     no_such_type(c, "fmi3GetIntervalDecimal", mask3::ANY, "Clock", vr, n)
 }
 
-pub extern "C" fn fmi3GetIntervalFraction(c: Instance3, vr: *const u32, n: usize, _counters: *mut u64, _r: *mut u64, _q: *mut c_int) -> c_int {
+pub extern "C" fn fmi3GetIntervalFraction(
+    c: Instance3,
+    vr: *const u32,
+    n: usize,
+    _counters: *mut u64,
+    _r: *mut u64,
+    _q: *mut c_int,
+) -> c_int {
     no_such_type(c, "fmi3GetIntervalFraction", mask3::ANY, "Clock", vr, n)
 }
 
@@ -87,7 +146,13 @@ pub extern "C" fn fmi3GetShiftDecimal(c: Instance3, vr: *const u32, n: usize, _s
     no_such_type(c, "fmi3GetShiftDecimal", mask3::ANY, "Clock", vr, n)
 }
 
-pub extern "C" fn fmi3GetShiftFraction(c: Instance3, vr: *const u32, n: usize, _counters: *mut u64, _r: *mut u64) -> c_int {
+pub extern "C" fn fmi3GetShiftFraction(
+    c: Instance3,
+    vr: *const u32,
+    n: usize,
+    _counters: *mut u64,
+    _r: *mut u64,
+) -> c_int {
     no_such_type(c, "fmi3GetShiftFraction", mask3::ANY, "Clock", vr, n)
 }
 
@@ -95,7 +160,13 @@ pub extern "C" fn fmi3SetIntervalDecimal(c: Instance3, vr: *const u32, n: usize,
     no_such_type(c, "fmi3SetIntervalDecimal", mask3::ANY, "Clock", vr, n)
 }
 
-pub extern "C" fn fmi3SetIntervalFraction(c: Instance3, vr: *const u32, n: usize, _counters: *const u64, _r: *const u64) -> c_int {
+pub extern "C" fn fmi3SetIntervalFraction(
+    c: Instance3,
+    vr: *const u32,
+    n: usize,
+    _counters: *const u64,
+    _r: *const u64,
+) -> c_int {
     no_such_type(c, "fmi3SetIntervalFraction", mask3::ANY, "Clock", vr, n)
 }
 
@@ -103,7 +174,13 @@ pub extern "C" fn fmi3SetShiftDecimal(c: Instance3, vr: *const u32, n: usize, _s
     no_such_type(c, "fmi3SetShiftDecimal", mask3::ANY, "Clock", vr, n)
 }
 
-pub extern "C" fn fmi3SetShiftFraction(c: Instance3, vr: *const u32, n: usize, _counters: *const u64, _r: *const u64) -> c_int {
+pub extern "C" fn fmi3SetShiftFraction(
+    c: Instance3,
+    vr: *const u32,
+    n: usize,
+    _counters: *const u64,
+    _r: *const u64,
+) -> c_int {
     no_such_type(c, "fmi3SetShiftFraction", mask3::ANY, "Clock", vr, n)
 }
 
@@ -121,10 +198,20 @@ pub extern "C" fn fmi3InstantiateScheduledExecution(
     _lock: *const c_void,
     _unlock: *const c_void,
 ) -> Instance3 {
-    log_without_instance3(log_message, env, "fmi3InstantiateScheduledExecution", "this FMU provides no Scheduled Execution (no <ScheduledExecution> element)");
+    log_without_instance3(
+        log_message,
+        env,
+        "fmi3InstantiateScheduledExecution",
+        "this FMU provides no Scheduled Execution (no <ScheduledExecution> element)",
+    );
     std::ptr::null_mut()
 }
 
 pub extern "C" fn fmi3ActivateModelPartition(c: Instance3, _clock: u32, _t: f64) -> c_int {
-    refuse(c, "fmi3ActivateModelPartition", mask3::ANY, "Scheduled Execution function; this FMU provides Co-Simulation only")
+    refuse(
+        c,
+        "fmi3ActivateModelPartition",
+        mask3::ANY,
+        "Scheduled Execution function; this FMU provides Co-Simulation only",
+    )
 }

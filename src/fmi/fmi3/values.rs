@@ -2,7 +2,12 @@
 //! shared instance, the independent variable `time`, and the Model Exchange rules for setting values in
 //! Event and Continuous-Time Mode (continuous states by value reference, discrete variables refused in
 //! Continuous-Time Mode).
-#![allow(non_snake_case, clippy::missing_safety_doc, clippy::not_unsafe_ptr_arg_deref, clippy::too_many_arguments)]
+#![allow(
+    non_snake_case,
+    clippy::missing_safety_doc,
+    clippy::not_unsafe_ptr_arg_deref,
+    clippy::too_many_arguments
+)]
 
 use std::ffi::c_int;
 
@@ -16,12 +21,23 @@ use crate::model::{Causality, Value, VarKind, Variability};
 
 fn scalar_count(n_vr: usize, n_values: usize) -> CallResult {
     if n_vr != n_values {
-        return Err(Fail::error(format!("nValues = {n_values} differs from nValueReferences = {n_vr} (every variable of this FMU is a scalar)")));
+        return Err(Fail::error(format!(
+            "nValues = {n_values} differs from nValueReferences = {n_vr} (every variable of this FMU is a scalar)"
+        )));
     }
     Ok(())
 }
 
-fn get3<T: Copy>(c: Instance3, func: &str, kind: VarKind, vr: *const u32, n: usize, value: *mut T, nv: usize, conv: impl Fn(Value) -> T) -> c_int {
+fn get3<T: Copy>(
+    c: Instance3,
+    func: &str,
+    kind: VarKind,
+    vr: *const u32,
+    n: usize,
+    value: *mut T,
+    nv: usize,
+    conv: impl Fn(Value) -> T,
+) -> c_int {
     call3(c, func, mask3::GET, |inst| {
         scalar_count(n, nv)?;
         let vrs = unsafe { slice(vr, n, "valueReferences[]")? };
@@ -30,7 +46,16 @@ fn get3<T: Copy>(c: Instance3, func: &str, kind: VarKind, vr: *const u32, n: usi
     })
 }
 
-fn set3<T: Copy>(c: Instance3, func: &str, kind: VarKind, vr: *const u32, n: usize, value: *const T, nv: usize, conv: impl Fn(T) -> Value) -> c_int {
+fn set3<T: Copy>(
+    c: Instance3,
+    func: &str,
+    kind: VarKind,
+    vr: *const u32,
+    n: usize,
+    value: *const T,
+    nv: usize,
+    conv: impl Fn(T) -> Value,
+) -> c_int {
     call3(c, func, mask3::SET, |inst| {
         scalar_count(n, nv)?;
         let vrs = unsafe { slice(vr, n, "valueReferences[]")? };
@@ -66,7 +91,11 @@ pub extern "C" fn fmi3GetFloat64(c: Instance3, vr: *const u32, n: usize, value: 
 }
 
 fn time_not_settable(inst: &Instance) -> String {
-    let how = if inst.model_exchange { "it is set with fmi3SetTime" } else { "it advances with fmi3DoStep" };
+    let how = if inst.model_exchange {
+        "it is set with fmi3SetTime"
+    } else {
+        "it advances with fmi3DoStep"
+    };
     format!("value reference {TIME_VR} is time, the independent variable: it cannot be set ({how})")
 }
 
@@ -95,7 +124,13 @@ pub extern "C" fn fmi3SetFloat64(c: Instance3, vr: *const u32, n: usize, value: 
 }
 
 pub extern "C" fn fmi3GetInt32(c: Instance3, vr: *const u32, n: usize, value: *mut i32, nv: usize) -> c_int {
-    get3(c, "fmi3GetInt32", VarKind::Integer, vr, n, value, nv, |v| if let Value::Integer(x) = v { x } else { 0 })
+    get3(c, "fmi3GetInt32", VarKind::Integer, vr, n, value, nv, |v| {
+        if let Value::Integer(x) = v {
+            x
+        } else {
+            0
+        }
+    })
 }
 
 pub extern "C" fn fmi3SetInt32(c: Instance3, vr: *const u32, n: usize, value: *const i32, nv: usize) -> c_int {
@@ -104,11 +139,15 @@ pub extern "C" fn fmi3SetInt32(c: Instance3, vr: *const u32, n: usize, value: *c
 
 /// `fmi3Boolean` is a C `bool` (one byte): written as 0 or 1, read as "non-zero is true".
 pub extern "C" fn fmi3GetBoolean(c: Instance3, vr: *const u32, n: usize, value: *mut u8, nv: usize) -> c_int {
-    get3(c, "fmi3GetBoolean", VarKind::Boolean, vr, n, value, nv, |v| matches!(v, Value::Boolean(true)) as u8)
+    get3(c, "fmi3GetBoolean", VarKind::Boolean, vr, n, value, nv, |v| {
+        matches!(v, Value::Boolean(true)) as u8
+    })
 }
 
 pub extern "C" fn fmi3SetBoolean(c: Instance3, vr: *const u32, n: usize, value: *const u8, nv: usize) -> c_int {
-    set3(c, "fmi3SetBoolean", VarKind::Boolean, vr, n, value, nv, |b| Value::Boolean(b != 0))
+    set3(c, "fmi3SetBoolean", VarKind::Boolean, vr, n, value, nv, |b| {
+        Value::Boolean(b != 0)
+    })
 }
 
 // ----- fmi3SetFloat64 on a Model Exchange instance ----------------------------------------------------
@@ -125,7 +164,10 @@ fn set_float64_me(inst: &mut Instance, vrs: &[u32], vals: &[f64]) -> CallResult 
             Some(LayerVar::State(k)) => {
                 let name = inst.entry.state_decls()[k].name;
                 if !vals[i].is_finite() {
-                    return Err(Fail::error(format!("value {} for continuous state {name} is not finite", vals[i])));
+                    return Err(Fail::error(format!(
+                        "value {} for continuous state {name} is not finite",
+                        vals[i]
+                    )));
                 }
                 let x = match states.as_mut() {
                     Some(x) => x,
@@ -138,7 +180,10 @@ fn set_float64_me(inst: &mut Instance, vrs: &[u32], vals: &[f64]) -> CallResult 
                 x[k] = vals[i];
             }
             Some(LayerVar::Derivative(k)) => {
-                return Err(Fail::error(format!("der({}) is a state derivative and cannot be set", inst.entry.state_decls()[k].name)));
+                return Err(Fail::error(format!(
+                    "der({}) is a state derivative and cannot be set",
+                    inst.entry.state_decls()[k].name
+                )));
             }
             None => {
                 if continuous_time {
@@ -173,4 +218,3 @@ fn refuse_discrete_in_continuous_time(inst: &Instance, ty: &str, vrs: &[u32]) ->
     }
     Ok(())
 }
-

@@ -24,8 +24,14 @@ impl Instance {
         // states and derivatives take part only on a Model Exchange instance that names one of them
         let with_states = self.model_exchange && unknowns.iter().chain(knowns).any(|vr| self.layer_var(*vr).is_some());
         self.ensure_outputs()?;
-        let ks = knowns.iter().map(|vr| self.known(*vr, with_states)).collect::<CallResult<Vec<_>>>()?;
-        let us = unknowns.iter().map(|vr| self.unknown(*vr, with_states)).collect::<CallResult<Vec<_>>>()?;
+        let ks = knowns
+            .iter()
+            .map(|vr| self.known(*vr, with_states))
+            .collect::<CallResult<Vec<_>>>()?;
+        let us = unknowns
+            .iter()
+            .map(|vr| self.unknown(*vr, with_states))
+            .collect::<CallResult<Vec<_>>>()?;
         if let Some(x) = seed.iter().find(|x| !x.is_finite()) {
             return Err(Fail::error(format!("seed value {x} is not finite")));
         }
@@ -66,13 +72,20 @@ impl Instance {
             }
             m.update_outputs(t).map_err(Fail::error)?;
             if with_states {
-                m.derivatives(t, &mut dx).map_err(|e| Fail::error(format!("derivatives at t = {t}: {e}")))?;
+                m.derivatives(t, &mut dx)
+                    .map_err(|e| Fail::error(format!("derivatives at t = {t}: {e}")))?;
             }
             Ok(us
                 .iter()
                 .map(|u| match u {
                     Unknown::Derivative(k) => dx[*k],
-                    Unknown::Output(i) => if let Some(Value::Real(y)) = m.value(*i) { y } else { f64::NAN },
+                    Unknown::Output(i) => {
+                        if let Some(Value::Real(y)) = m.value(*i) {
+                            y
+                        } else {
+                            f64::NAN
+                        }
+                    }
                 })
                 .collect())
         };
@@ -80,7 +93,9 @@ impl Instance {
         let minus = eval(-1.0)?;
         let d: Vec<f64> = plus.iter().zip(&minus).map(|(p, m)| (p - m) / (2.0 * eps)).collect();
         if let Some(v) = d.iter().find(|v| !v.is_finite()) {
-            return Err(Fail::error(format!("directional derivative {v} at t = {t} is not finite")));
+            return Err(Fail::error(format!(
+                "directional derivative {v} at t = {t} is not finite"
+            )));
         }
         Ok(d)
     }
@@ -90,7 +105,9 @@ impl Instance {
             return match (self.layer_var(vr), self.real_decl(vr)) {
                 (Some(LayerVar::State(k)), _) => Ok(Known::State(k)),
                 (None, Some(i)) if self.entry.decls[i].causality == Causality::Input => Ok(Known::Input(i)),
-                _ => Err(Fail::error(format!("known {vr} is neither a Real input nor a continuous state"))),
+                _ => Err(Fail::error(format!(
+                    "known {vr} is neither a Real input nor a continuous state"
+                ))),
             };
         }
         let (i, d) = self.decl(VarKind::Real, vr)?;
@@ -105,7 +122,9 @@ impl Instance {
             return match (self.layer_var(vr), self.real_decl(vr)) {
                 (Some(LayerVar::Derivative(k)), _) => Ok(Unknown::Derivative(k)),
                 (None, Some(i)) if self.entry.decls[i].causality == Causality::Output => Ok(Unknown::Output(i)),
-                _ => Err(Fail::error(format!("unknown {vr} is neither a Real output nor a state derivative"))),
+                _ => Err(Fail::error(format!(
+                    "unknown {vr} is neither a Real output nor a state derivative"
+                ))),
             };
         }
         let (i, d) = self.decl(VarKind::Real, vr)?;
@@ -117,6 +136,9 @@ impl Instance {
 
     /// Declaration index of a Real variable.
     fn real_decl(&self, vr: u32) -> Option<usize> {
-        self.entry.decls.iter().position(|d| d.vr == vr && d.kind == VarKind::Real)
+        self.entry
+            .decls
+            .iter()
+            .position(|d| d.vr == vr && d.kind == VarKind::Real)
     }
 }

@@ -34,7 +34,10 @@ impl Instance {
     fn check_len(&self, what: &str, n: usize) -> CallResult {
         let nx = self.n_states();
         if n != nx {
-            return Err(Fail::error(format!("{what} has {n} elements, but {} has {nx} continuous states", self.entry.info.name)));
+            return Err(Fail::error(format!(
+                "{what} has {n} elements, but {} has {nx} continuous states",
+                self.entry.info.name
+            )));
         }
         Ok(())
     }
@@ -56,7 +59,10 @@ impl Instance {
         // instants increase, FMI 2.0 section 3.1): checked against the event itself (up to round-off),
         // in event mode too, so that no sequence of small steps back walks past it.
         if t < self.run.event_time - 1e-9 * self.run.event_time.abs().max(1.0) {
-            return Err(Fail::error(format!("time {t} lies before the last event at t = {}", self.run.event_time)));
+            return Err(Fail::error(format!(
+                "time {t} lies before the last event at t = {}",
+                self.run.event_time
+            )));
         }
         self.run.time = t;
         self.run.outputs_dirty = true;
@@ -66,7 +72,10 @@ impl Instance {
     pub fn set_continuous_states(&mut self, x: &[f64]) -> CallResult {
         self.check_len("x[]", x.len())?;
         if let Some((k, v)) = x.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return Err(Fail::error(format!("x[{k}] ({}) = {v} is not finite", self.entry.state_decls()[k].name)));
+            return Err(Fail::error(format!(
+                "x[{k}] ({}) = {v} is not finite",
+                self.entry.state_decls()[k].name
+            )));
         }
         self.model.set_states(x).map_err(Fail::error)?;
         self.run.outputs_dirty = true;
@@ -87,9 +96,15 @@ impl Instance {
 
     fn derivatives_into(&mut self, dx: &mut [f64]) -> CallResult {
         self.ensure_outputs()?;
-        self.model.derivatives(self.run.time, dx).map_err(|e| Fail::error(format!("derivatives at t = {}: {e}", self.run.time)))?;
+        self.model
+            .derivatives(self.run.time, dx)
+            .map_err(|e| Fail::error(format!("derivatives at t = {}: {e}", self.run.time)))?;
         if let Some((k, v)) = dx.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return Err(Fail::error(format!("der({}) = {v} at t = {}", self.entry.state_decls()[k].name, self.run.time)));
+            return Err(Fail::error(format!(
+                "der({}) = {v} at t = {}",
+                self.entry.state_decls()[k].name,
+                self.run.time
+            )));
         }
         Ok(())
     }
@@ -101,7 +116,10 @@ impl Instance {
 
     pub fn get_event_indicators(&mut self, z: &[f64]) -> CallResult {
         if !z.is_empty() {
-            return Err(Fail::error(format!("eventIndicators[] has {} elements, but numberOfEventIndicators = 0", z.len())));
+            return Err(Fail::error(format!(
+                "eventIndicators[] has {} elements, but numberOfEventIndicators = 0",
+                z.len()
+            )));
         }
         Ok(())
     }
@@ -116,11 +134,18 @@ impl Instance {
     pub fn new_discrete_states(&mut self) -> CallResult<EventInfo> {
         self.ensure_outputs()?;
         let t = self.run.time;
-        let changed = self.model.event_update(t).map_err(|e| Fail::error(format!("event at t = {t}: {e}")))?;
+        let changed = self
+            .model
+            .event_update(t)
+            .map_err(|e| Fail::error(format!("event at t = {t}: {e}")))?;
         self.run.event_time = t;
         self.run.outputs_dirty = true;
         let next = self.model.next_time_event(t).filter(|te| te.is_finite() && *te > t);
-        Ok(EventInfo { values_changed: changed, next_event_time: next, ..EventInfo::default() })
+        Ok(EventInfo {
+            values_changed: changed,
+            next_event_time: next,
+            ..EventInfo::default()
+        })
     }
 
     pub fn enter_continuous_time_mode(&mut self) -> CallResult {

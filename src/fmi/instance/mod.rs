@@ -21,7 +21,10 @@ pub enum Logger {
     Fmi2(LoggerFn),
     Fmi3(Log3Fn),
 }
-use crate::model::{Causality, DynModel, Experiment, RESERVED_VR_START, TOLERANCE_MAX, TOLERANCE_MIN, ModelEntry, SlotMut, Value, VarDecl, VarKind, Variability};
+use crate::model::{
+    Causality, DynModel, Experiment, ModelEntry, SlotMut, Value, VarDecl, VarKind, Variability, RESERVED_VR_START,
+    TOLERANCE_MAX, TOLERANCE_MIN,
+};
 
 /// Failure of an FMI call: the status to return and the reason to log.
 #[derive(Debug)]
@@ -32,10 +35,16 @@ pub struct Fail {
 
 impl Fail {
     pub fn error(reason: impl Into<String>) -> Self {
-        Fail { status: Status::Error, reason: reason.into() }
+        Fail {
+            status: Status::Error,
+            reason: reason.into(),
+        }
     }
     pub fn discard(reason: impl Into<String>) -> Self {
-        Fail { status: Status::Discard, reason: reason.into() }
+        Fail {
+            status: Status::Discard,
+            reason: reason.into(),
+        }
     }
 }
 
@@ -101,26 +110,53 @@ impl Run {
         if !self.time.is_finite() {
             return Err(format!("time {} is not finite", self.time));
         }
-        if !(self.event_time == f64::NEG_INFINITY || (self.event_time.is_finite() && self.event_time <= self.time + 2e-9 * self.event_time.abs().max(1.0))) {
-            return Err(format!("time of the last event {} is not finite or lies after the time {}", self.event_time, self.time));
+        if !(self.event_time == f64::NEG_INFINITY
+            || (self.event_time.is_finite() && self.event_time <= self.time + 2e-9 * self.event_time.abs().max(1.0)))
+        {
+            return Err(format!(
+                "time of the last event {} is not finite or lies after the time {}",
+                self.event_time, self.time
+            ));
         }
         let e = &self.exp;
-        if !e.start_time.is_finite() || e.tolerance.is_some_and(|t| !(t.is_finite() && t > 0.0)) || e.stop_time.is_some_and(|s| !(s.is_finite() && s >= e.start_time)) {
+        if !e.start_time.is_finite()
+            || e.tolerance.is_some_and(|t| !(t.is_finite() && t > 0.0))
+            || e.stop_time.is_some_and(|s| !(s.is_finite() && s >= e.start_time))
+        {
             return Err(format!("experiment {e:?} is not valid"));
         }
         // only the states in which fmi2GetFMUstate can be called on this FMU (StepFailed and
         // StepCanceled are never entered: fmi2DoStep never returns fmi2Pending or fmi2Discard)
         if !matches!(
             self.fsm,
-            FsmState::Instantiated | FsmState::InitializationMode | FsmState::StepComplete | FsmState::Terminated | FsmState::Error | FsmState::EventMode | FsmState::ContinuousTimeMode
+            FsmState::Instantiated
+                | FsmState::InitializationMode
+                | FsmState::StepComplete
+                | FsmState::Terminated
+                | FsmState::Error
+                | FsmState::EventMode
+                | FsmState::ContinuousTimeMode
         ) {
-            return Err(format!("state machine state {:?} cannot be restored (no FMU state can be taken in it)", self.fsm));
+            return Err(format!(
+                "state machine state {:?} cannot be restored (no FMU state can be taken in it)",
+                self.fsm
+            ));
         }
         Ok(())
     }
 
-    pub const INSTANTIATED: Run =
-        Run { fsm: FsmState::Instantiated, time: 0.0, exp: Experiment { start_time: 0.0, tolerance: None, stop_time: None }, outputs_dirty: true, params_dirty: true, event_time: f64::NEG_INFINITY };
+    pub const INSTANTIATED: Run = Run {
+        fsm: FsmState::Instantiated,
+        time: 0.0,
+        exp: Experiment {
+            start_time: 0.0,
+            tolerance: None,
+            stop_time: None,
+        },
+        outputs_dirty: true,
+        params_dirty: true,
+        event_time: f64::NEG_INFINITY,
+    };
 }
 
 pub struct Instance {
@@ -172,7 +208,9 @@ impl Instance {
         if matches!(self.logger, Logger::None) {
             return;
         }
-        if status < Status::Warning && !(self.debug_logging && (self.categories.contains(category) || self.categories.contains("logAll"))) {
+        if status < Status::Warning
+            && !(self.debug_logging && (self.categories.contains(category) || self.categories.contains("logAll")))
+        {
             return;
         }
         let cat = CString::new(category).unwrap_or_default();
@@ -183,11 +221,20 @@ impl Instance {
                 let text = CString::new(message.replace('%', "%%").replace('\0', "")).unwrap_or_default();
                 // SAFETY: the logger is the master's callback with the fmi2CallbackLogger signature; all
                 // strings are valid NUL-terminated for the duration of the call.
-                unsafe { logger(self.env, self.name.as_ptr(), status as c_int, cat.as_ptr(), text.as_ptr()) };
+                unsafe {
+                    logger(
+                        self.env,
+                        self.name.as_ptr(),
+                        status as c_int,
+                        cat.as_ptr(),
+                        text.as_ptr(),
+                    )
+                };
             }
             Logger::Fmi3(logger) => {
                 // FMI 3.0 messages are plain text (no printf format) and carry no instance name: prefix it.
-                let text = CString::new(format!("{}: {}", self.name.to_string_lossy(), message).replace('\0', "")).unwrap_or_default();
+                let text = CString::new(format!("{}: {}", self.name.to_string_lossy(), message).replace('\0', ""))
+                    .unwrap_or_default();
                 // SAFETY: the master's fmi3LogMessageCallback; strings valid for the duration of the call.
                 unsafe { logger(self.env, status as c_int, cat.as_ptr(), text.as_ptr()) };
             }
@@ -212,14 +259,21 @@ impl Instance {
     pub fn set_debug_logging(&mut self, on: bool, categories: &[String]) -> CallResult {
         let known: Vec<&'static str> = LOG_CATEGORIES.iter().map(|(n, _)| *n).collect();
         if let Some(bad) = categories.iter().find(|c| !known.contains(&c.as_str())) {
-            return Err(Fail::error(format!("unknown log category '{bad}' (declared: {})", known.join(", "))));
+            return Err(Fail::error(format!(
+                "unknown log category '{bad}' (declared: {})",
+                known.join(", ")
+            )));
         }
         self.debug_logging = on;
         if categories.is_empty() {
             self.categories = known.into_iter().collect();
         } else {
             for c in categories {
-                let c = known.iter().find(|k| **k == c.as_str()).copied().expect("checked above");
+                let c = known
+                    .iter()
+                    .find(|k| **k == c.as_str())
+                    .copied()
+                    .expect("checked above");
                 if on {
                     self.categories.insert(c);
                 } else {
@@ -248,7 +302,12 @@ impl Instance {
             .filter(|k| *k != kind)
             .find_map(|k| self.index.get(k, vr).map(|i| &self.entry.decls[i]));
         Err(match other {
-            Some(d) => Fail::error(format!("value reference {vr} is {} ({}), not {}", d.name, kind_name(d.kind), kind_name(kind))),
+            Some(d) => Fail::error(format!(
+                "value reference {vr} is {} ({}), not {}",
+                d.name,
+                kind_name(d.kind),
+                kind_name(kind)
+            )),
             None => Fail::error(format!("unknown {} value reference {vr}", kind_name(kind))),
         })
     }
@@ -268,7 +327,10 @@ impl Instance {
             return Ok(());
         }
         Err(Fail::error(match d.causality {
-            Causality::Parameter => format!("parameter {} is fixed and cannot be set after initialization (state {:?})", d.name, self.run.fsm),
+            Causality::Parameter => format!(
+                "parameter {} is fixed and cannot be set after initialization (state {:?})",
+                d.name, self.run.fsm
+            ),
             Causality::Output => format!("{} is an output and cannot be set", d.name),
             Causality::CalculatedParameter => format!("{} is a calculated parameter and cannot be set", d.name),
             _ => format!("{} ({:?}, {:?}) cannot be set", d.name, d.causality, d.variability),
@@ -285,7 +347,9 @@ impl Instance {
                     let (LayerVar::State(k) | LayerVar::Derivative(k)) = var;
                     let name = self.entry.state_decls()[k].name;
                     return Err(Fail::error(match var {
-                        LayerVar::State(_) => format!("{name} is a continuous state: set it with fmi2SetContinuousStates (Model Exchange)"),
+                        LayerVar::State(_) => format!(
+                            "{name} is a continuous state: set it with fmi2SetContinuousStates (Model Exchange)"
+                        ),
                         LayerVar::Derivative(_) => format!("der({name}) is a state derivative and cannot be set"),
                     }));
                 }
@@ -294,7 +358,10 @@ impl Instance {
             self.check_settable(d)?;
             if let Value::Real(x) = value(i) {
                 if !x.is_finite() {
-                    return Err(Fail::error(format!("value {x} for {} is not finite (use 1e30 for \"no limit\")", d.name)));
+                    return Err(Fail::error(format!(
+                        "value {x} for {} is not finite (use 1e30 for \"no limit\")",
+                        d.name
+                    )));
                 }
             }
             sets_parameter |= d.causality == Causality::Parameter;
@@ -306,7 +373,11 @@ impl Instance {
                 (Some(SlotMut::Real(s)), Value::Real(x)) => *s = x,
                 (Some(SlotMut::Integer(s)), Value::Integer(x)) => *s = x,
                 (Some(SlotMut::Boolean(s)), Value::Boolean(x)) => *s = x,
-                _ => return Err(Fail::error(format!("internal: storage of value reference {vr} does not match its declaration"))),
+                _ => {
+                    return Err(Fail::error(format!(
+                        "internal: storage of value reference {vr} does not match its declaration"
+                    )))
+                }
             }
         }
         self.run.params_dirty |= sets_parameter;
@@ -341,11 +412,17 @@ impl Instance {
                 }
             }
             let (index, d) = self.decl(kind, *vr)?;
-            let v = self.model.value(index).ok_or_else(|| Fail::error(format!("internal: no storage for {}", d.name)))?;
+            let v = self
+                .model
+                .value(index)
+                .ok_or_else(|| Fail::error(format!("internal: no storage for {}", d.name)))?;
             if let Value::Real(x) = v {
                 if !x.is_finite() && d.causality == Causality::Output {
                     self.run.fsm = FsmState::Error;
-                    return Err(Fail::error(format!("output {} is {x} at t = {}", d.name, self.run.time)));
+                    return Err(Fail::error(format!(
+                        "output {} is {x} at t = {}",
+                        d.name, self.run.time
+                    )));
                 }
             }
             write(i, v);
@@ -366,10 +443,16 @@ impl Instance {
         }
         if let Some(stop) = stop {
             if !(stop.is_finite() && stop >= start) {
-                return Err(Fail::error(format!("stopTime {stop} must be finite and >= startTime {start}")));
+                return Err(Fail::error(format!(
+                    "stopTime {stop} must be finite and >= startTime {start}"
+                )));
             }
         }
-        self.run.exp = Experiment { start_time: start, tolerance, stop_time: stop };
+        self.run.exp = Experiment {
+            start_time: start,
+            tolerance,
+            stop_time: stop,
+        };
         self.run.time = start;
         // the adaptive integrators honour [TOLERANCE_MIN, TOLERANCE_MAX] only: say so when clamping
         if let Some(tol) = tolerance {
@@ -400,7 +483,11 @@ impl Instance {
         self.run.params_dirty = false;
         self.run.outputs_dirty = true;
         self.ensure_outputs()?;
-        self.run.fsm = if self.model_exchange { FsmState::EventMode } else { FsmState::StepComplete };
+        self.run.fsm = if self.model_exchange {
+            FsmState::EventMode
+        } else {
+            FsmState::StepComplete
+        };
         self.run.event_time = self.run.time;
         Ok(())
     }
@@ -411,11 +498,17 @@ impl Instance {
         }
         let tol = 1e-9 * self.run.time.abs().max(1.0);
         if !t.is_finite() || (t - self.run.time).abs() > tol {
-            return Err(Fail::error(format!("currentCommunicationPoint {t} does not match the FMU time {}", self.run.time)));
+            return Err(Fail::error(format!(
+                "currentCommunicationPoint {t} does not match the FMU time {}",
+                self.run.time
+            )));
         }
         if let Some(stop) = self.run.exp.stop_time {
             if t + h > stop + 1e-9 * stop.abs().max(1.0) {
-                return Err(Fail::error(format!("step to {} goes beyond stopTime {stop} set in fmi2SetupExperiment", t + h)));
+                return Err(Fail::error(format!(
+                    "step to {} goes beyond stopTime {stop} set in fmi2SetupExperiment",
+                    t + h
+                )));
             }
         }
         if let Err(reason) = self.model.do_step(t, h) {
@@ -452,6 +545,8 @@ impl Instance {
     pub fn layer_var(&self, vr: u32) -> Option<LayerVar> {
         let n = self.n_states();
         let k = |base: u32| vr.checked_sub(base).map(|k| k as usize).filter(|k| *k < n);
-        k(STATE_VR_BASE).map(LayerVar::State).or_else(|| k(DERIVATIVE_VR_BASE).map(LayerVar::Derivative))
+        k(STATE_VR_BASE)
+            .map(LayerVar::State)
+            .or_else(|| k(DERIVATIVE_VR_BASE).map(LayerVar::Derivative))
     }
 }

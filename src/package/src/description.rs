@@ -14,12 +14,13 @@ use quick_xml::Writer;
 use spacecraft_fmus::export::PackageInfo;
 use spacecraft_fmus::fmi::LOG_CATEGORIES;
 use spacecraft_fmus::model::{
-    Bound, Causality, Feedthrough, Initial, ModelEntry, ModelInfo, Start, VarDecl, VarKind, Variability, DERIVATIVE_VR_BASE, RESERVED_VR_START, STATE_VR_BASE,
+    Bound, Causality, Feedthrough, Initial, ModelEntry, ModelInfo, Start, VarDecl, VarKind, Variability,
+    DERIVATIVE_VR_BASE, RESERVED_VR_START, STATE_VR_BASE,
 };
 use spacecraft_fmus::units;
 
-pub use crate::structure::{derivative_dependencies, initial_unknowns, output_dependencies, state_indices};
 use crate::structure::input_index;
+pub use crate::structure::{derivative_dependencies, initial_unknowns, output_dependencies, state_indices};
 
 pub const GENERATION_TOOL: &str = concat!("spacecraft_fmus fmu-package ", env!("CARGO_PKG_VERSION"));
 
@@ -66,7 +67,11 @@ pub(crate) fn start_str(s: Start) -> String {
 }
 
 pub(crate) fn bound_str(kind: VarKind, v: f64) -> String {
-    if kind == VarKind::Integer { (v as i32).to_string() } else { fmt_real(v) }
+    if kind == VarKind::Integer {
+        (v as i32).to_string()
+    } else {
+        fmt_real(v)
+    }
 }
 
 fn join(ix: &[usize]) -> String {
@@ -84,11 +89,17 @@ pub fn check_declarations(entry: &ModelEntry) -> Result<(), String> {
             }
             // Unique across kinds too: the generated slot/value dispatch matches on the number only.
             if a.vr == b.vr {
-                return Err(format!("{name}: {} and {} share value reference {}", a.name, b.name, a.vr));
+                return Err(format!(
+                    "{name}: {} and {} share value reference {}",
+                    a.name, b.name, a.vr
+                ));
             }
         }
         if a.vr == spacecraft_fmus::fmi::fmi3::TIME_VR {
-            return Err(format!("{name}: {} uses value reference {}, reserved for time in FMI 3.0", a.name, a.vr));
+            return Err(format!(
+                "{name}: {} uses value reference {}, reserved for time in FMI 3.0",
+                a.name, a.vr
+            ));
         }
         if !a.unit.is_empty() && units::lookup(a.unit).is_none() {
             return Err(format!("{name}: variable {} uses undefined unit {}", a.name, a.unit));
@@ -123,18 +134,30 @@ pub fn check_declarations(entry: &ModelEntry) -> Result<(), String> {
     let states = entry.state_decls();
     for (i, x) in states.iter().enumerate() {
         let der = format!("der({})", x.name);
-        if entry.decl(x.name).is_some() || entry.decl(&der).is_some() || states[i + 1..].iter().any(|y| y.name == x.name) {
-            return Err(format!("{name}: continuous state {} clashes with another variable name", x.name));
+        if entry.decl(x.name).is_some()
+            || entry.decl(&der).is_some()
+            || states[i + 1..].iter().any(|y| y.name == x.name)
+        {
+            return Err(format!(
+                "{name}: continuous state {} clashes with another variable name",
+                x.name
+            ));
         }
         if !x.unit.is_empty() && units::lookup(x.unit).is_none() {
-            return Err(format!("{name}: continuous state {} uses undefined unit {}", x.name, x.unit));
+            return Err(format!(
+                "{name}: continuous state {} uses undefined unit {}",
+                x.name, x.unit
+            ));
         }
         if x.description.is_empty() {
             return Err(format!("{name}: continuous state {} has no description", x.name));
         }
         for d in x.starts_from {
             if input_index(entry, d).is_none() {
-                return Err(format!("{name}: the start of continuous state {} is taken from {d}, which is not an input", x.name));
+                return Err(format!(
+                    "{name}: the start of continuous state {} is taken from {d}, which is not an input",
+                    x.name
+                ));
             }
         }
         for d in x.depends.unwrap_or(&[]) {
@@ -145,7 +168,10 @@ pub fn check_declarations(entry: &ModelEntry) -> Result<(), String> {
         }
     }
     if states.len() > (DERIVATIVE_VR_BASE - STATE_VR_BASE) as usize {
-        return Err(format!("{name}: {} continuous states are more than the layer can number", states.len()));
+        return Err(format!(
+            "{name}: {} continuous states are more than the layer can number",
+            states.len()
+        ));
     }
     if let Feedthrough::Some(list) = entry.info.feedthrough {
         for (o, ins) in list {
@@ -215,7 +241,11 @@ pub(crate) fn value_attrs(d: &VarDecl) -> Vec<(&'static str, String)> {
 pub(crate) fn write_categories_and_experiment(w: &mut Writer<Cursor<Vec<u8>>>, info: &ModelInfo) {
     w.write_event(Event::Start(elem("LogCategories", &[]))).unwrap();
     for (name, desc) in LOG_CATEGORIES {
-        w.write_event(Event::Empty(elem("Category", &[("name", (*name).into()), ("description", (*desc).into())]))).unwrap();
+        w.write_event(Event::Empty(elem(
+            "Category",
+            &[("name", (*name).into()), ("description", (*desc).into())],
+        )))
+        .unwrap();
     }
     w.write_event(Event::End(BytesEnd::new("LogCategories"))).unwrap();
     let experiment = [
@@ -224,12 +254,17 @@ pub(crate) fn write_categories_and_experiment(w: &mut Writer<Cursor<Vec<u8>>>, i
         ("tolerance", "1e-8".into()),
         ("stepSize", fmt_real(info.default_step)),
     ];
-    w.write_event(Event::Empty(elem("DefaultExperiment", &experiment))).unwrap();
+    w.write_event(Event::Empty(elem("DefaultExperiment", &experiment)))
+        .unwrap();
 }
 
 pub(crate) fn write_unit_definitions(w: &mut W, entry: &ModelEntry) {
-    let used: Vec<_> =
-        units::UNITS.iter().filter(|(n, _, _)| entry.decls.iter().any(|d| d.unit == *n) || entry.state_decls().iter().any(|x| x.unit == *n)).collect();
+    let used: Vec<_> = units::UNITS
+        .iter()
+        .filter(|(n, _, _)| {
+            entry.decls.iter().any(|d| d.unit == *n) || entry.state_decls().iter().any(|x| x.unit == *n)
+        })
+        .collect();
     if !used.is_empty() {
         start(w, "UnitDefinitions", &[]);
         for (name, b, display) in used {
@@ -251,7 +286,6 @@ pub(crate) fn write_unit_definitions(w: &mut W, entry: &ModelEntry) {
         }
         end(w, "UnitDefinitions");
     }
-
 }
 
 /// Writes the complete model description with the given GUID.
@@ -259,7 +293,8 @@ fn write_xml(entry: &ModelEntry, guid: &str, package: &PackageInfo) -> String {
     let info = entry.info;
     let mut w = Writer::new_with_indent(Cursor::new(Vec::new()), b' ', 2);
 
-    w.write_event(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None))).unwrap();
+    w.write_event(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None)))
+        .unwrap();
     start(
         &mut w,
         "fmiModelDescription",
@@ -315,7 +350,8 @@ fn write_xml(entry: &ModelEntry, guid: &str, package: &PackageInfo) -> String {
 
     start(&mut w, "ModelVariables", &[]);
     for (i, d) in entry.decls.iter().enumerate() {
-        w.write_event(Event::Comment(BytesText::new(&format!(" index {} ", i + 1)))).unwrap();
+        w.write_event(Event::Comment(BytesText::new(&format!(" index {} ", i + 1))))
+            .unwrap();
         let mut attrs: Vec<(&str, String)> = vec![
             ("name", d.name.into()),
             ("valueReference", d.vr.to_string()),
@@ -339,7 +375,12 @@ fn write_xml(entry: &ModelEntry, guid: &str, package: &PackageInfo) -> String {
     let n_decl = entry.decls.len();
     let states = entry.state_decls();
     for (k, x) in states.iter().enumerate() {
-        w.write_event(Event::Comment(BytesText::new(&format!(" index {}: continuous state {} ", n_decl + k + 1, k + 1)))).unwrap();
+        w.write_event(Event::Comment(BytesText::new(&format!(
+            " index {}: continuous state {} ",
+            n_decl + k + 1,
+            k + 1
+        ))))
+        .unwrap();
         let attrs: Vec<(&str, String)> = vec![
             ("name", x.name.into()),
             ("valueReference", (STATE_VR_BASE + k as u32).to_string()),
@@ -349,12 +390,21 @@ fn write_xml(entry: &ModelEntry, guid: &str, package: &PackageInfo) -> String {
             ("initial", "calculated".into()),
         ];
         start(&mut w, "ScalarVariable", &attrs);
-        let t: Vec<(&str, String)> = if x.unit.is_empty() { vec![] } else { vec![("unit", x.unit.into())] };
+        let t: Vec<(&str, String)> = if x.unit.is_empty() {
+            vec![]
+        } else {
+            vec![("unit", x.unit.into())]
+        };
         empty(&mut w, "Real", &t);
         end(&mut w, "ScalarVariable");
     }
     for (k, x) in states.iter().enumerate() {
-        w.write_event(Event::Comment(BytesText::new(&format!(" index {}: derivative of state {} ", n_decl + states.len() + k + 1, k + 1)))).unwrap();
+        w.write_event(Event::Comment(BytesText::new(&format!(
+            " index {}: derivative of state {} ",
+            n_decl + states.len() + k + 1,
+            k + 1
+        ))))
+        .unwrap();
         let attrs: Vec<(&str, String)> = vec![
             ("name", format!("der({})", x.name)),
             ("valueReference", (DERIVATIVE_VR_BASE + k as u32).to_string()),
@@ -370,8 +420,13 @@ fn write_xml(entry: &ModelEntry, guid: &str, package: &PackageInfo) -> String {
     end(&mut w, "ModelVariables");
 
     start(&mut w, "ModelStructure", &[]);
-    let outputs: Vec<(usize, &VarDecl)> =
-        entry.decls.iter().enumerate().filter(|(_, d)| d.causality == Causality::Output).map(|(i, d)| (i + 1, d)).collect();
+    let outputs: Vec<(usize, &VarDecl)> = entry
+        .decls
+        .iter()
+        .enumerate()
+        .filter(|(_, d)| d.causality == Causality::Output)
+        .map(|(i, d)| (i + 1, d))
+        .collect();
     if !outputs.is_empty() {
         start(&mut w, "Outputs", &[]);
         for (ix, d) in &outputs {
@@ -379,14 +434,25 @@ fn write_xml(entry: &ModelEntry, guid: &str, package: &PackageInfo) -> String {
             let mut deps = output_dependencies(entry, d);
             // with Model Exchange the states are variables too: an output may depend on any of them
             deps.extend(state_indices(entry));
-            empty(&mut w, "Unknown", &[("index", ix.to_string()), ("dependencies", join(&deps))]);
+            empty(
+                &mut w,
+                "Unknown",
+                &[("index", ix.to_string()), ("dependencies", join(&deps))],
+            );
         }
         end(&mut w, "Outputs");
     }
     if !states.is_empty() {
         start(&mut w, "Derivatives", &[]);
         for (k, deps) in derivative_dependencies(entry) {
-            empty(&mut w, "Unknown", &[("index", (n_decl + states.len() + k + 1).to_string()), ("dependencies", join(&deps))]);
+            empty(
+                &mut w,
+                "Unknown",
+                &[
+                    ("index", (n_decl + states.len() + k + 1).to_string()),
+                    ("dependencies", join(&deps)),
+                ],
+            );
         }
         end(&mut w, "Derivatives");
     }
@@ -395,7 +461,11 @@ fn write_xml(entry: &ModelEntry, guid: &str, package: &PackageInfo) -> String {
         start(&mut w, "InitialUnknowns", &[]);
         for (ix, deps) in initial_unknowns {
             // Always written: a missing attribute would mean "depends on every known" (inputs included).
-            empty(&mut w, "Unknown", &[("index", ix.to_string()), ("dependencies", join(&deps))]);
+            empty(
+                &mut w,
+                "Unknown",
+                &[("index", ix.to_string()), ("dependencies", join(&deps))],
+            );
         }
         end(&mut w, "InitialUnknowns");
     }
@@ -430,7 +500,11 @@ pub(crate) trait Author {
 
 impl Author for PackageInfo {
     fn author(&self) -> String {
-        if self.authors.trim().is_empty() { format!("{} authors", self.name) } else { self.authors.split(':').collect::<Vec<_>>().join(", ") }
+        if self.authors.trim().is_empty() {
+            format!("{} authors", self.name)
+        } else {
+            self.authors.split(':').collect::<Vec<_>>().join(", ")
+        }
     }
 }
 
@@ -446,7 +520,10 @@ pub(crate) fn bound_text(b: Bound) -> String {
 }
 
 pub(crate) fn html_escape(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
 }
 
 /// documentation/index.html: purpose, source, equations, variable tables.
@@ -479,15 +556,27 @@ pub fn documentation_html(entry: &ModelEntry, guid: &str) -> String {
     h.push_str("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n");
     h.push_str(&format!("<title>{}</title>\n", info.name));
     h.push_str("<style>body{font-family:sans-serif;max-width:60em;margin:2em auto;line-height:1.4}table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:2px 6px;text-align:left;vertical-align:top}pre{background:#f4f4f4;padding:0.5em;overflow-x:auto}code{background:#f4f4f4}</style>\n</head>\n<body>\n");
-    h.push_str(&format!("<h1>{}</h1>\n<p>{}</p>\n", info.name, html_escape(info.description)));
+    h.push_str(&format!(
+        "<h1>{}</h1>\n<p>{}</p>\n",
+        info.name,
+        html_escape(info.description)
+    ));
     h.push_str(&format!("<p><b>Source:</b> {}</p>\n", html_escape(info.source)));
-    h.push_str(&format!("<p><b>GUID:</b> <code>{}</code> &middot; <b>Generated by:</b> {}</p>\n", guid, GENERATION_TOOL));
-    h.push_str(&format!("<p><b>Interfaces:</b> {}</p>\n", html_escape(&interfaces_text(entry))));
+    h.push_str(&format!(
+        "<p><b>GUID:</b> <code>{}</code> &middot; <b>Generated by:</b> {}</p>\n",
+        guid, GENERATION_TOOL
+    ));
+    h.push_str(&format!(
+        "<p><b>Interfaces:</b> {}</p>\n",
+        html_escape(&interfaces_text(entry))
+    ));
     h.push_str("<h2>Equations</h2>\n");
     h.push_str(info.equations_html);
     h.push_str("\n<h2>Conventions</h2>\n<ul><li>SI units on every port; degrees only where the name ends in <code>_deg</code>.</li>");
     h.push_str("<li>Quaternions are scalar-first Hamilton quaternions (q_w, q_x, q_y, q_z) of the body frame relative to the reference frame; A(q) maps reference components into body components.</li>");
-    h.push_str("<li>Parameters are read at fmi2ExitInitializationMode; invalid values give fmi2Error with a log message.</li>");
+    h.push_str(
+        "<li>Parameters are read at fmi2ExitInitializationMode; invalid values give fmi2Error with a log message.</li>",
+    );
     h.push_str("<li>\"No limit\" is encoded as 1e30.</li></ul>\n");
     for (title, caus) in VARIABLE_SECTIONS {
         let rows: Vec<&VarDecl> = entry.decls.iter().filter(|d| d.causality == caus).collect();
@@ -496,7 +585,11 @@ pub fn documentation_html(entry: &ModelEntry, guid: &str) -> String {
         }
         h.push_str(&format!("<h2>{title}</h2>\n<table>\n<tr><th>name</th><th>vr</th><th>type</th><th>variability</th><th>start</th><th>unit</th><th>admissible</th><th>meaning</th></tr>\n"));
         for d in rows {
-            let start = if d.has_start() { start_str(d.start) } else { String::new() };
+            let start = if d.has_start() {
+                start_str(d.start)
+            } else {
+                String::new()
+            };
             h.push_str(&format!(
                 "<tr><td><code>{}</code></td><td>{}</td><td>{:?}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
                 d.name,
@@ -515,7 +608,11 @@ pub fn documentation_html(entry: &ModelEntry, guid: &str) -> String {
     if !cited.is_empty() {
         h.push_str("<h2>References</h2>\n<ul>\n");
         for r in cited {
-            h.push_str(&format!("<li><b>[{}]</b> {}</li>\n", r.key, html_escape(&crate::references::citation(r))));
+            h.push_str(&format!(
+                "<li><b>[{}]</b> {}</li>\n",
+                r.key,
+                html_escape(&crate::references::citation(r))
+            ));
         }
         h.push_str("</ul>\n");
     }
@@ -539,8 +636,13 @@ mod tests {
         let e = spacecraft_fmus::registry::find("PdController").unwrap();
         let mut decls = e.decls.to_vec();
         decls[0].vr = spacecraft_fmus::fmi::fmi3::TIME_VR;
-        let bad = ModelEntry { decls: Box::leak(decls.into_boxed_slice()), ..*e };
-        assert!(check_declarations(&bad).unwrap_err().contains("reserved for time in FMI 3.0"));
+        let bad = ModelEntry {
+            decls: Box::leak(decls.into_boxed_slice()),
+            ..*e
+        };
+        assert!(check_declarations(&bad)
+            .unwrap_err()
+            .contains("reserved for time in FMI 3.0"));
     }
 
     #[test]

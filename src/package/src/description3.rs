@@ -19,8 +19,9 @@ use quick_xml::events::{BytesDecl, Event};
 use quick_xml::Writer;
 
 use crate::description::{
-    causality_str, derivative_dependencies, empty, end, initial_str, initial_unknowns, output_dependencies, start, state_indices, value_attrs, variability_str,
-    write_categories_and_experiment, write_unit_definitions, Author, GENERATION_TOOL,
+    causality_str, derivative_dependencies, empty, end, initial_str, initial_unknowns, output_dependencies, start,
+    state_indices, value_attrs, variability_str, write_categories_and_experiment, write_unit_definitions, Author,
+    GENERATION_TOOL,
 };
 use spacecraft_fmus::export::PackageInfo;
 use spacecraft_fmus::fmi::fmi3::TIME_VR;
@@ -34,7 +35,11 @@ fn vrs(list: &[u32]) -> String {
 /// then the continuous states, then their derivatives (the order of the FMI 2.0 description).
 fn vr_of_index(entry: &ModelEntry, ix: usize) -> u32 {
     let (n, ns) = (entry.decls.len(), entry.state_decls().len());
-    assert!(ix >= 1 && ix <= n + 2 * ns, "{}: ScalarVariable index {ix} out of range", entry.info.name);
+    assert!(
+        ix >= 1 && ix <= n + 2 * ns,
+        "{}: ScalarVariable index {ix} out of range",
+        entry.info.name
+    );
     if ix <= n {
         entry.decls[ix - 1].vr
     } else if ix <= n + ns {
@@ -52,7 +57,8 @@ fn vrs_of(entry: &ModelEntry, ix: &[usize]) -> String {
 pub fn model_description3(entry: &ModelEntry, token: &str, package: &PackageInfo) -> String {
     let info = entry.info;
     let mut w = Writer::new_with_indent(Cursor::new(Vec::new()), b' ', 2);
-    w.write_event(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None))).unwrap();
+    w.write_event(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None)))
+        .unwrap();
     start(
         &mut w,
         "fmiModelDescription",
@@ -169,21 +175,47 @@ pub fn model_description3(entry: &ModelEntry, token: &str, package: &PackageInfo
     end(&mut w, "ModelVariables");
 
     start(&mut w, "ModelStructure", &[]);
-    for (i, d) in entry.decls.iter().enumerate().filter(|(_, d)| d.causality == Causality::Output) {
+    for (i, d) in entry
+        .decls
+        .iter()
+        .enumerate()
+        .filter(|(_, d)| d.causality == Causality::Output)
+    {
         // an empty list is meaningful: "depends on no input" (state or time only); with Model Exchange
         // the states are variables too, and an output may depend on any of them (as in FMI 2.0)
         let mut deps = output_dependencies(entry, d);
         deps.extend(state_indices(entry));
         debug_assert_eq!(vr_of_index(entry, i + 1), d.vr);
-        empty(&mut w, "Output", &[("valueReference", d.vr.to_string()), ("dependencies", vrs_of(entry, &deps))]);
+        empty(
+            &mut w,
+            "Output",
+            &[
+                ("valueReference", d.vr.to_string()),
+                ("dependencies", vrs_of(entry, &deps)),
+            ],
+        );
     }
     // every state's derivative, in state order (the order of fmi3GetContinuousStates and friends)
     for (k, deps) in derivative_dependencies(entry) {
-        empty(&mut w, "ContinuousStateDerivative", &[("valueReference", (DERIVATIVE_VR_BASE + k as u32).to_string()), ("dependencies", vrs_of(entry, &deps))]);
+        empty(
+            &mut w,
+            "ContinuousStateDerivative",
+            &[
+                ("valueReference", (DERIVATIVE_VR_BASE + k as u32).to_string()),
+                ("dependencies", vrs_of(entry, &deps)),
+            ],
+        );
     }
     // outputs and calculated parameters, then the states and derivatives (initial = "calculated")
     for (ix, deps) in initial_unknowns(entry) {
-        empty(&mut w, "InitialUnknown", &[("valueReference", vr_of_index(entry, ix).to_string()), ("dependencies", vrs_of(entry, &deps))]);
+        empty(
+            &mut w,
+            "InitialUnknown",
+            &[
+                ("valueReference", vr_of_index(entry, ix).to_string()),
+                ("dependencies", vrs_of(entry, &deps)),
+            ],
+        );
     }
     end(&mut w, "ModelStructure");
     end(&mut w, "fmiModelDescription");
@@ -206,7 +238,11 @@ mod tests {
         assert_eq!(x.matches(r#"causality="independent""#).count(), 1);
         assert!(!x.contains("ScalarVariable") && !x.contains("index="));
         for d in e.decls {
-            assert!(x.contains(&format!(r#"name="{}" valueReference="{}""#, d.name, d.vr)), "{}", d.name);
+            assert!(
+                x.contains(&format!(r#"name="{}" valueReference="{}""#, d.name, d.vr)),
+                "{}",
+                d.name
+            );
             assert_ne!(d.vr, TIME_VR);
         }
     }
@@ -223,13 +259,28 @@ mod tests {
             assert_eq!(x.matches("<ContinuousStateDerivative ").count(), n, "{}", e.info.name);
             for (k, s) in e.state_decls().iter().enumerate() {
                 let (svr, dvr) = (STATE_VR_BASE + k as u32, DERIVATIVE_VR_BASE + k as u32);
-                assert!(x.contains(&format!(r#"name="{}" valueReference="{svr}""#, s.name)), "{}", s.name);
-                assert!(x.contains(&format!(r#"name="der({})" valueReference="{dvr}""#, s.name)), "{}", s.name);
+                assert!(
+                    x.contains(&format!(r#"name="{}" valueReference="{svr}""#, s.name)),
+                    "{}",
+                    s.name
+                );
+                assert!(
+                    x.contains(&format!(r#"name="der({})" valueReference="{dvr}""#, s.name)),
+                    "{}",
+                    s.name
+                );
                 assert!(x.contains(&format!(r#"derivative="{svr}"/>"#)), "{}", s.name);
-                assert!(x.contains(&format!(r#"<InitialUnknown valueReference="{svr}""#)) && x.contains(&format!(r#"<InitialUnknown valueReference="{dvr}""#)));
+                assert!(
+                    x.contains(&format!(r#"<InitialUnknown valueReference="{svr}""#))
+                        && x.contains(&format!(r#"<InitialUnknown valueReference="{dvr}""#))
+                );
             }
             // the schema's order of the ModelStructure elements
-            let (o, c, i) = (x.rfind("<Output "), x.find("<ContinuousStateDerivative "), x.find("<InitialUnknown "));
+            let (o, c, i) = (
+                x.rfind("<Output "),
+                x.find("<ContinuousStateDerivative "),
+                x.find("<InitialUnknown "),
+            );
             if let (Some(o), Some(c)) = (o, c) {
                 assert!(o < c, "{}", e.info.name);
             }

@@ -7,10 +7,9 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use crate::description::{bound_text, start_str, variability_str};
-use spacecraft_fmus::model::{ModelEntry, VarDecl};
 use crate::references::{self, Reference};
+use spacecraft_fmus::model::{ModelEntry, VarDecl};
 use spacecraft_fmus::registry::{Family, FAMILIES};
-
 
 fn cell(s: &str) -> String {
     s.replace('|', "\\|").replace('\n', " ")
@@ -24,7 +23,11 @@ fn variable_table(out: &mut String, title: &str, rows: &[&VarDecl]) {
     out.push_str("| name | vr | type | variability | start | unit | admissible | meaning |\n");
     out.push_str("|---|---|---|---|---|---|---|---|\n");
     for d in rows {
-        let start = if d.has_start() { start_str(d.start) } else { String::new() };
+        let start = if d.has_start() {
+            start_str(d.start)
+        } else {
+            String::new()
+        };
         let _ = writeln!(
             out,
             "| `{}` | {} | {:?} | {} | {} | {} | {} | {} |",
@@ -56,7 +59,13 @@ pub fn family_markdown(f: &Family) -> String {
     out.push_str(f.overview.trim());
     out.push_str("\n\n| FMU | purpose |\n|---|---|\n");
     for e in f.fmus {
-        let _ = writeln!(out, "| [{0}](#{1}) | {2} |", e.info.name, e.info.name.to_lowercase(), cell(e.info.description));
+        let _ = writeln!(
+            out,
+            "| [{0}](#{1}) | {2} |",
+            e.info.name,
+            e.info.name.to_lowercase(),
+            cell(e.info.description)
+        );
     }
     out.push('\n');
     for e in f.fmus {
@@ -67,7 +76,11 @@ pub fn family_markdown(f: &Family) -> String {
             "Default experiment: stop time {} s, communication step {} s; variable communication step: {}.\n",
             i.default_stop_time,
             i.default_step,
-            if i.variable_step { "yes" } else { "no (the step must equal the declared sample time)" }
+            if i.variable_step {
+                "yes"
+            } else {
+                "no (the step must equal the declared sample time)"
+            }
         );
         let _ = writeln!(out, "Interfaces: {}\n", crate::description::interfaces_text(e));
         if !i.equations_html.trim().is_empty() {
@@ -78,7 +91,13 @@ pub fn family_markdown(f: &Family) -> String {
             variable_table(&mut out, title, &rows);
         }
     }
-    let cited = references::cited_in(f.fmus.iter().flat_map(ModelEntry::texts).chain([f.overview]).collect::<Vec<_>>());
+    let cited = references::cited_in(
+        f.fmus
+            .iter()
+            .flat_map(ModelEntry::texts)
+            .chain([f.overview])
+            .collect::<Vec<_>>(),
+    );
     if !cited.is_empty() {
         out.push_str("## References\n\n");
         references_list(&mut out, &cited);
@@ -96,13 +115,26 @@ pub fn references_markdown() -> String {
          which reading we chose (\"project choice\").\n\n",
     );
     for r in references::ALL {
-        let _ = writeln!(out, "## [{}]\n\n{}\n\nUsed for: {}.\n", r.key, references::citation(r), r.used_for);
+        let _ = writeln!(
+            out,
+            "## [{}]\n\n{}\n\nUsed for: {}.\n",
+            r.key,
+            references::citation(r),
+            r.used_for
+        );
         let tag = format!("[{}]", r.key);
         let users: Vec<String> = FAMILIES
             .iter()
             .flat_map(|f| f.fmus.iter().map(move |e| (f, e)))
             .filter(|(_, e)| e.texts().iter().any(|t| t.contains(&tag)))
-            .map(|(f, e)| format!("[{0}](models/{1}.md#{2})", e.info.name, f.slug, e.info.name.to_lowercase()))
+            .map(|(f, e)| {
+                format!(
+                    "[{0}](models/{1}.md#{2})",
+                    e.info.name,
+                    f.slug,
+                    e.info.name.to_lowercase()
+                )
+            })
             .collect();
         if !users.is_empty() {
             let _ = writeln!(out, "FMUs: {}.\n", users.join(", "));
@@ -113,8 +145,10 @@ pub fn references_markdown() -> String {
 
 /// (relative path, content) of every generated page under `docs/`.
 pub fn pages() -> Vec<(String, String)> {
-    let mut p: Vec<(String, String)> =
-        FAMILIES.iter().map(|f| (format!("models/{}.md", f.slug), family_markdown(f))).collect();
+    let mut p: Vec<(String, String)> = FAMILIES
+        .iter()
+        .map(|f| (format!("models/{}.md", f.slug), family_markdown(f)))
+        .collect();
     p.push(("references.md".into(), references_markdown()));
     p
 }
@@ -150,7 +184,10 @@ mod tests {
     fn committed_pages_are_up_to_date() {
         let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs");
         let stale = stale_pages(&docs);
-        assert!(stale.is_empty(), "stale generated docs (run scripts/build_fmus.sh): {stale:?}");
+        assert!(
+            stale.is_empty(),
+            "stale generated docs (run scripts/build_fmus.sh): {stale:?}"
+        );
     }
 
     #[test]
@@ -160,7 +197,12 @@ mod tests {
             for e in f.fmus {
                 assert!(md.contains(&format!("## {}\n", e.info.name)));
                 for d in e.decls {
-                    assert!(md.contains(&format!("| `{}` | {} |", d.name, d.vr)), "{} {}", e.info.name, d.name);
+                    assert!(
+                        md.contains(&format!("| `{}` | {} |", d.name, d.vr)),
+                        "{} {}",
+                        e.info.name,
+                        d.name
+                    );
                 }
             }
         }

@@ -43,7 +43,11 @@ impl Unit {
     /// A model of this process's registry (the project's own models, for pages and tests).
     pub fn registered(entry: &ModelEntry) -> Unit {
         static PROJECT: std::sync::OnceLock<PackageInfo> = std::sync::OnceLock::new();
-        Unit { entry: *entry, guid: Box::leak(spacecraft_fmus::model::guid::guid(entry).as_str().into()), package: PROJECT.get_or_init(description::project_package) }
+        Unit {
+            entry: *entry,
+            guid: Box::leak(spacecraft_fmus::model::guid::guid(entry).as_str().into()),
+            package: PROJECT.get_or_init(description::project_package),
+        }
     }
 
     pub fn name(&self) -> &'static str {
@@ -123,7 +127,12 @@ fn write_rendered(units: &[Unit], dir: &Path, render: Render) -> std::io::Result
 fn stale_rendered(units: &[Unit], dir: &Path, render: Render, prefix: &str) -> Vec<String> {
     units
         .iter()
-        .filter(|u| fs::read_to_string(dir.join(format!("{}.xml", u.name()))).ok().as_deref() != Some(render(&u.entry, u.guid, u.package).as_str()))
+        .filter(|u| {
+            fs::read_to_string(dir.join(format!("{}.xml", u.name())))
+                .ok()
+                .as_deref()
+                != Some(render(&u.entry, u.guid, u.package).as_str())
+        })
         .map(|u| format!("{prefix}{}", u.name()))
         .collect()
 }
@@ -167,7 +176,11 @@ pub struct Binary<'a> {
 impl<'a> Binary<'a> {
     /// The build for the platform this code was compiled for.
     pub fn host(bytes: &'a [u8]) -> Self {
-        Binary { platform: PLATFORM, ext: LIB_EXT, bytes }
+        Binary {
+            platform: PLATFORM,
+            ext: LIB_EXT,
+            bytes,
+        }
     }
 }
 
@@ -178,8 +191,16 @@ pub fn write_fmu(unit: &Unit, binaries: &[Binary], out_dir: &Path) -> std::io::R
     let name = unit.entry.info.name;
     let builds: Vec<(&str, &[u8])> = binaries.iter().map(|b| (b.platform, b.bytes)).collect();
     let folders = platforms::fmi2_binaries(&builds).map_err(std::io::Error::other)?;
-    let files: Vec<(String, &[u8])> = folders.iter().map(|(dir, ext, bytes)| (format!("binaries/{dir}/{name}.{ext}"), bytes.as_ref())).collect();
-    write_archive(unit, &model_description(&unit.entry, unit.guid, unit.package), &files, out_dir)
+    let files: Vec<(String, &[u8])> = folders
+        .iter()
+        .map(|(dir, ext, bytes)| (format!("binaries/{dir}/{name}.{ext}"), bytes.as_ref()))
+        .collect();
+    write_archive(
+        unit,
+        &model_description(&unit.entry, unit.guid, unit.package),
+        &files,
+        out_dir,
+    )
 }
 
 /// Writes one FMI 3.0 `.fmu` archive: the FMI 3.0 model description, the same binaries under FMI 3.0
@@ -189,16 +210,28 @@ pub fn write_fmu3(unit: &Unit, binaries: &[Binary], out_dir: &Path) -> std::io::
     let files = binaries
         .iter()
         .map(|b| {
-            let tuple = platform_tuple(b).ok_or_else(|| std::io::Error::other(format!("no FMI 3.0 platform tuple for the {} binary", b.platform)))?;
+            let tuple = platform_tuple(b).ok_or_else(|| {
+                std::io::Error::other(format!("no FMI 3.0 platform tuple for the {} binary", b.platform))
+            })?;
             Ok((format!("binaries/{tuple}/{name}.{}", b.ext), b.bytes))
         })
         .collect::<std::io::Result<Vec<_>>>()?;
-    write_archive(unit, &model_description3(&unit.entry, unit.guid, unit.package), &files, out_dir)
+    write_archive(
+        unit,
+        &model_description3(&unit.entry, unit.guid, unit.package),
+        &files,
+        out_dir,
+    )
 }
 
 /// The archive both FMI versions share: `modelDescription.xml`, the binaries at their paths, then
 /// `documentation/index.html`, with fixed timestamps and order.
-fn write_archive(unit: &Unit, description: &str, binaries: &[(String, &[u8])], out_dir: &Path) -> std::io::Result<std::path::PathBuf> {
+fn write_archive(
+    unit: &Unit,
+    description: &str,
+    binaries: &[(String, &[u8])],
+    out_dir: &Path,
+) -> std::io::Result<std::path::PathBuf> {
     let entry = &unit.entry;
     if binaries.is_empty() {
         return Err(std::io::Error::other("no binary to package"));
@@ -206,16 +239,24 @@ fn write_archive(unit: &Unit, description: &str, binaries: &[(String, &[u8])], o
     fs::create_dir_all(out_dir)?;
     let path = out_dir.join(format!("{}.fmu", entry.info.name));
     let mut zip = ZipWriter::new(fs::File::create(&path)?);
-    let opts = SimpleFileOptions::default().compression_method(CompressionMethod::Deflated).last_modified_time(DateTime::default());
+    let opts = SimpleFileOptions::default()
+        .compression_method(CompressionMethod::Deflated)
+        .last_modified_time(DateTime::default());
     let add = |zip: &mut ZipWriter<fs::File>, name: &str, data: &[u8], mode: u32| -> std::io::Result<()> {
-        zip.start_file(name, opts.unix_permissions(mode)).map_err(std::io::Error::other)?;
+        zip.start_file(name, opts.unix_permissions(mode))
+            .map_err(std::io::Error::other)?;
         zip.write_all(data)
     };
     add(&mut zip, "modelDescription.xml", description.as_bytes(), 0o644)?;
     for (name, bytes) in binaries {
         add(&mut zip, name, bytes, 0o755)?;
     }
-    add(&mut zip, "documentation/index.html", documentation_html(entry, unit.guid).as_bytes(), 0o644)?;
+    add(
+        &mut zip,
+        "documentation/index.html",
+        documentation_html(entry, unit.guid).as_bytes(),
+        0o644,
+    )?;
     zip.finish().map_err(std::io::Error::other)?;
     Ok(path)
 }
@@ -230,19 +271,32 @@ mod tests {
         let entry = &unit.entry;
         let dir = std::env::temp_dir().join(format!("scfmu-package-test-{}", std::process::id()));
         let bins = [
-            Binary { platform: "linux64", ext: "so", bytes: b"ELF..." },
-            Binary { platform: "win64", ext: "dll", bytes: b"MZ..." },
+            Binary {
+                platform: "linux64",
+                ext: "so",
+                bytes: b"ELF...",
+            },
+            Binary {
+                platform: "win64",
+                ext: "dll",
+                bytes: b"MZ...",
+            },
         ];
         let path = write_fmu(&unit, &bins, &dir).unwrap();
         let mut zip = zip::ZipArchive::new(fs::File::open(&path).unwrap()).unwrap();
-        let names: Vec<String> = (0..zip.len()).map(|i| zip.by_index(i).unwrap().name().unwrap().to_string()).collect();
+        let names: Vec<String> = (0..zip.len())
+            .map(|i| zip.by_index(i).unwrap().name().unwrap().to_string())
+            .collect();
         let n = entry.info.name;
-        assert_eq!(names, vec![
-            "modelDescription.xml".to_string(),
-            format!("binaries/linux64/{n}.so"),
-            format!("binaries/win64/{n}.dll"),
-            "documentation/index.html".to_string(),
-        ]);
+        assert_eq!(
+            names,
+            vec![
+                "modelDescription.xml".to_string(),
+                format!("binaries/linux64/{n}.so"),
+                format!("binaries/win64/{n}.dll"),
+                "documentation/index.html".to_string(),
+            ]
+        );
         let mut dll = vec![];
         std::io::Read::read_to_end(&mut zip.by_name(&format!("binaries/win64/{n}.dll")).unwrap(), &mut dll).unwrap();
         assert_eq!(dll, b"MZ...");
@@ -252,15 +306,44 @@ mod tests {
         // FMI 3.0: the same binaries under platform tuples
         let path3 = write_fmu3(&unit, &bins, &dir.join("fmi3")).unwrap();
         let mut zip3 = zip::ZipArchive::new(fs::File::open(&path3).unwrap()).unwrap();
-        let names3: Vec<String> = (0..zip3.len()).map(|i| zip3.by_index(i).unwrap().name().unwrap().to_string()).collect();
-        assert_eq!(names3[1..3], [format!("binaries/x86_64-linux/{n}.so"), format!("binaries/x86_64-windows/{n}.dll")]);
+        let names3: Vec<String> = (0..zip3.len())
+            .map(|i| zip3.by_index(i).unwrap().name().unwrap().to_string())
+            .collect();
+        assert_eq!(
+            names3[1..3],
+            [
+                format!("binaries/x86_64-linux/{n}.so"),
+                format!("binaries/x86_64-windows/{n}.dll")
+            ]
+        );
         let mut x = String::new();
         std::io::Read::read_to_string(&mut zip3.by_name("modelDescription.xml").unwrap(), &mut x).unwrap();
         assert!(x.contains(r#"fmiVersion="3.0""#));
         let mac = |cpu: u8| [0xcf, 0xfa, 0xed, 0xfe, cpu, 0, 0, 0x01];
-        assert_eq!(platform_tuple(&Binary { platform: "darwin64", ext: "dylib", bytes: &mac(0x0c) }), Some("aarch64-darwin"));
-        assert_eq!(platform_tuple(&Binary { platform: "darwin64", ext: "dylib", bytes: &mac(0x07) }), Some("x86_64-darwin"));
-        assert_eq!(platform_tuple(&Binary { platform: "darwin64", ext: "dylib", bytes: b"junk" }), None);
+        assert_eq!(
+            platform_tuple(&Binary {
+                platform: "darwin64",
+                ext: "dylib",
+                bytes: &mac(0x0c)
+            }),
+            Some("aarch64-darwin")
+        );
+        assert_eq!(
+            platform_tuple(&Binary {
+                platform: "darwin64",
+                ext: "dylib",
+                bytes: &mac(0x07)
+            }),
+            Some("x86_64-darwin")
+        );
+        assert_eq!(
+            platform_tuple(&Binary {
+                platform: "darwin64",
+                ext: "dylib",
+                bytes: b"junk"
+            }),
+            None
+        );
         fs::remove_dir_all(&dir).ok();
         assert_eq!(platform_lib_ext("win32"), None);
     }

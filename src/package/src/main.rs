@@ -25,8 +25,8 @@ use std::process::ExitCode;
 
 use spacecraft_fmus_package::build::{cargo_build, win64_available, win64_build};
 use spacecraft_fmus_package::{
-    platform_lib_ext, stale_model_descriptions, stale_model_descriptions3, units_of_library, write_fmu, write_fmu3, write_model_descriptions, write_model_descriptions3, Binary,
-    PLATFORM,
+    platform_lib_ext, stale_model_descriptions, stale_model_descriptions3, units_of_library, write_fmu, write_fmu3,
+    write_model_descriptions, write_model_descriptions3, Binary, PLATFORM,
 };
 
 struct Args {
@@ -41,7 +41,16 @@ struct Args {
 }
 
 fn parse() -> Result<Args, String> {
-    let mut a = Args { krate: None, lib: None, out: None, xml: None, win64: "auto".into(), extra: vec![], locked: false, check: false };
+    let mut a = Args {
+        krate: None,
+        lib: None,
+        out: None,
+        xml: None,
+        win64: "auto".into(),
+        extra: vec![],
+        locked: false,
+        check: false,
+    };
     let mut args = std::env::args().skip(1);
     while let Some(arg) = args.next() {
         let mut value = |name: &str| args.next().ok_or_else(|| format!("{name} needs a value"));
@@ -59,14 +68,29 @@ fn parse() -> Result<Args, String> {
             "--add-lib" => {
                 let spec = value("--add-lib")?;
                 match spec.split_once('=') {
-                    Some((platform, path)) if platform_lib_ext(platform).is_some() && !path.is_empty() => a.extra.push((platform.into(), PathBuf::from(path))),
-                    _ => return Err(format!("--add-lib wants PLATFORM=PATH with PLATFORM {}, got {spec:?}", spacecraft_fmus_package::platforms::KEYS)),
+                    Some((platform, path)) if platform_lib_ext(platform).is_some() && !path.is_empty() => {
+                        a.extra.push((platform.into(), PathBuf::from(path)))
+                    }
+                    _ => {
+                        return Err(format!(
+                            "--add-lib wants PLATFORM=PATH with PLATFORM {}, got {spec:?}",
+                            spacecraft_fmus_package::platforms::KEYS
+                        ))
+                    }
                 }
             }
             "--locked" => a.locked = true,
             "--check" => a.check = true,
             "-h" | "--help" => {
-                println!("{}", include_str!("main.rs").lines().take_while(|l| l.starts_with("//!")).map(|l| l.trim_start_matches("//!").strip_prefix(' ').unwrap_or("")).collect::<Vec<_>>().join("\n"));
+                println!(
+                    "{}",
+                    include_str!("main.rs")
+                        .lines()
+                        .take_while(|l| l.starts_with("//!"))
+                        .map(|l| l.trim_start_matches("//!").strip_prefix(' ').unwrap_or(""))
+                        .collect::<Vec<_>>()
+                        .join("\n")
+                );
                 std::process::exit(0);
             }
             other => return Err(format!("unknown argument {other} (see --help)")),
@@ -90,9 +114,15 @@ fn main() -> ExitCode {
 
 fn run() -> Result<(), String> {
     let args = parse()?;
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").canonicalize().map_err(|e| format!("the project folder: {e}"))?;
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .canonicalize()
+        .map_err(|e| format!("the project folder: {e}"))?;
     let project_crate = root.join("src/cdylib");
-    let krate = args.krate.clone().or_else(|| args.lib.is_none().then(|| project_crate.clone()));
+    let krate = args
+        .krate
+        .clone()
+        .or_else(|| args.lib.is_none().then(|| project_crate.clone()));
     let is_project = match &krate {
         Some(k) => k.canonicalize().ok() == project_crate.canonicalize().ok(),
         None => false,
@@ -100,7 +130,10 @@ fn run() -> Result<(), String> {
     let manifest = krate.as_ref().map(|k| k.join("Cargo.toml"));
     if let Some(m) = &manifest {
         if !m.is_file() {
-            return Err(format!("{} not found: --crate wants the folder of a Cargo package", m.display()));
+            return Err(format!(
+                "{} not found: --crate wants the folder of a Cargo package",
+                m.display()
+            ));
         }
     }
     let lib = match (&args.lib, &manifest) {
@@ -109,7 +142,10 @@ fn run() -> Result<(), String> {
         (None, None) => unreachable!("a crate or a library is always given"),
     };
     let units = units_of_library(&lib)?;
-    let xml = args.xml.clone().or_else(|| is_project.then(|| root.join("modelDescription")));
+    let xml = args
+        .xml
+        .clone()
+        .or_else(|| is_project.then(|| root.join("modelDescription")));
     let docs = is_project.then(|| root.join("docs"));
 
     if args.check {
@@ -122,7 +158,11 @@ fn run() -> Result<(), String> {
             stale.extend(spacecraft_fmus_package::docs::stale_pages(d));
         }
         if stale.is_empty() {
-            println!("model descriptions{} are up to date ({} models)", if docs.is_some() { " and docs/" } else { "" }, units.len());
+            println!(
+                "model descriptions{} are up to date ({} models)",
+                if docs.is_some() { " and docs/" } else { "" },
+                units.len()
+            );
             return Ok(());
         }
         return Err(format!("stale generated files: {}", stale.join(", ")));
@@ -131,7 +171,8 @@ fn run() -> Result<(), String> {
     let host = std::fs::read(&lib).map_err(|e| format!("cannot read {} ({e})", lib.display()))?;
     let mut extra: Vec<(String, Vec<u8>)> = vec![];
     for (platform, path) in &args.extra {
-        let bytes = std::fs::read(path).map_err(|e| format!("cannot read the {platform} library {} ({e})", path.display()))?;
+        let bytes =
+            std::fs::read(path).map_err(|e| format!("cannot read the {platform} library {} ({e})", path.display()))?;
         extra.push((platform.clone(), bytes));
     }
     let no_win64 = args.win64 == "no" || std::env::var("SCFMU_NO_WIN64").as_deref() == Ok("1");
@@ -139,10 +180,17 @@ fn run() -> Result<(), String> {
         match (&manifest, win64_available()) {
             (Some(m), Ok(())) => {
                 let dll = win64_build(m, &lib)?;
-                extra.push(("win64".into(), std::fs::read(&dll).map_err(|e| format!("cannot read {} ({e})", dll.display()))?));
+                extra.push((
+                    "win64".into(),
+                    std::fs::read(&dll).map_err(|e| format!("cannot read {} ({e})", dll.display()))?,
+                ));
             }
-            (_, Err(why)) if args.win64 == "yes" => return Err(format!("--win64 yes, but the cross toolchain is not usable: {why}")),
-            (None, Ok(())) if args.win64 == "yes" => return Err("--win64 yes needs --crate (the crate is cross-built)".into()),
+            (_, Err(why)) if args.win64 == "yes" => {
+                return Err(format!("--win64 yes, but the cross toolchain is not usable: {why}"))
+            }
+            (None, Ok(())) if args.win64 == "yes" => {
+                return Err("--win64 yes needs --crate (the crate is cross-built)".into())
+            }
             (_, Err(why)) => eprintln!("fmu-package: no Windows binaries ({why}); packaging {PLATFORM} only"),
             (None, Ok(())) => {}
         }
@@ -152,20 +200,37 @@ fn run() -> Result<(), String> {
         if binaries.iter().any(|b| b.platform == platform) {
             return Err(format!("two binaries for {platform}"));
         }
-        binaries.push(Binary { platform, ext: platform_lib_ext(platform).unwrap_or("so"), bytes });
+        binaries.push(Binary {
+            platform,
+            ext: platform_lib_ext(platform).unwrap_or("so"),
+            bytes,
+        });
     }
 
     if let Some(x) = &xml {
-        write_model_descriptions(&units, x).map_err(|e| format!("cannot write model descriptions to {}: {e}", x.display()))?;
-        write_model_descriptions3(&units, &x.join("fmi3")).map_err(|e| format!("cannot write FMI 3.0 model descriptions to {}/fmi3: {e}", x.display()))?;
+        write_model_descriptions(&units, x)
+            .map_err(|e| format!("cannot write model descriptions to {}: {e}", x.display()))?;
+        write_model_descriptions3(&units, &x.join("fmi3"))
+            .map_err(|e| format!("cannot write FMI 3.0 model descriptions to {}/fmi3: {e}", x.display()))?;
     }
     if let Some(d) = &docs {
-        spacecraft_fmus_package::docs::write_pages(d).map_err(|e| format!("cannot write docs/models and docs/references.md: {e}"))?;
+        spacecraft_fmus_package::docs::write_pages(d)
+            .map_err(|e| format!("cannot write docs/models and docs/references.md: {e}"))?;
     }
-    let out = args.out.clone().unwrap_or_else(|| if is_project { root.join("fmus") } else { krate.clone().unwrap_or_default().join("fmus") });
+    let out = args.out.clone().unwrap_or_else(|| {
+        if is_project {
+            root.join("fmus")
+        } else {
+            krate.clone().unwrap_or_default().join("fmus")
+        }
+    });
     for u in &units {
         let p = write_fmu(u, &binaries, &out).map_err(|e| format!("{}: {e}", u.name()))?;
-        println!("wrote {} ({})", p.display(), binaries.iter().map(|b| b.platform).collect::<Vec<_>>().join(" + "));
+        println!(
+            "wrote {} ({})",
+            p.display(),
+            binaries.iter().map(|b| b.platform).collect::<Vec<_>>().join(" + ")
+        );
         let p3 = write_fmu3(u, &binaries, &out.join("fmi3")).map_err(|e| format!("{} (FMI 3.0): {e}", u.name()))?;
         println!("wrote {} (FMI 3.0)", p3.display());
     }

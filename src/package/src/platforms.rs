@@ -75,8 +75,16 @@ pub fn universal_macho(slices: &[&[u8]]) -> Result<Vec<u8>, String> {
         let sub = u32::from_le_bytes(s[8..12].try_into().unwrap());
         header.extend(cpu.to_be_bytes());
         header.extend(sub.to_be_bytes());
-        header.extend(u32::try_from(offset).map_err(|_| "a macOS build is too large")?.to_be_bytes());
-        header.extend(u32::try_from(s.len()).map_err(|_| "a macOS build is too large")?.to_be_bytes());
+        header.extend(
+            u32::try_from(offset)
+                .map_err(|_| "a macOS build is too large")?
+                .to_be_bytes(),
+        );
+        header.extend(
+            u32::try_from(s.len())
+                .map_err(|_| "a macOS build is too large")?
+                .to_be_bytes(),
+        );
         header.extend(ALIGN.to_be_bytes());
         body.resize(offset - (1 << ALIGN), 0);
         body.extend_from_slice(s);
@@ -89,8 +97,14 @@ pub fn universal_macho(slices: &[&[u8]]) -> Result<Vec<u8>, String> {
 
 /// The FMI 2.0 archive's binaries: `(folder, extension, bytes)` in the order given, the two macOS builds
 /// joined into one universal `darwin64` file at the place of the first.
-pub fn fmi2_binaries<'a>(builds: &[(&'a str, &'a [u8])]) -> Result<Vec<(&'static str, &'static str, Cow<'a, [u8]>)>, String> {
-    let macs: Vec<&[u8]> = builds.iter().filter(|(k, _)| matches!(*k, "x86_64-darwin" | "aarch64-darwin")).map(|(_, b)| *b).collect();
+pub fn fmi2_binaries<'a>(
+    builds: &[(&'a str, &'a [u8])],
+) -> Result<Vec<(&'static str, &'static str, Cow<'a, [u8]>)>, String> {
+    let macs: Vec<&[u8]> = builds
+        .iter()
+        .filter(|(k, _)| matches!(*k, "x86_64-darwin" | "aarch64-darwin"))
+        .map(|(_, b)| *b)
+        .collect();
     if !macs.is_empty() && builds.iter().any(|(k, _)| *k == "darwin64") {
         return Err("give darwin64 or the x86_64-darwin/aarch64-darwin builds, not both".into());
     }
@@ -107,7 +121,11 @@ pub fn fmi2_binaries<'a>(builds: &[(&'a str, &'a [u8])]) -> Result<Vec<(&'static
                     continue;
                 }
                 mac_done = true;
-                let joined = if macs.len() == 1 { Cow::Borrowed(macs[0]) } else { Cow::Owned(universal_macho(&macs)?) };
+                let joined = if macs.len() == 1 {
+                    Cow::Borrowed(macs[0])
+                } else {
+                    Cow::Owned(universal_macho(&macs)?)
+                };
                 out.push(("darwin64", "dylib", joined));
                 continue;
             }
@@ -152,7 +170,13 @@ mod tests {
     #[test]
     fn folders_of_every_platform() {
         let (x, a) = (thin(CPU_X86_64, 64), thin(CPU_ARM64, 64));
-        let builds: Vec<(&str, &[u8])> = vec![("linux64", b"ELF"), ("x86_64-darwin", &x), ("win64", b"MZ"), ("aarch64-linux", b"ELFa"), ("aarch64-darwin", &a)];
+        let builds: Vec<(&str, &[u8])> = vec![
+            ("linux64", b"ELF"),
+            ("x86_64-darwin", &x),
+            ("win64", b"MZ"),
+            ("aarch64-linux", b"ELFa"),
+            ("aarch64-darwin", &a),
+        ];
         let f = fmi2_binaries(&builds).unwrap();
         let names: Vec<_> = f.iter().map(|(d, e, _)| format!("{d}.{e}")).collect();
         assert_eq!(names, ["linux64.so", "darwin64.dylib", "win64.dll", "aarch64-linux.so"]);
@@ -162,7 +186,16 @@ mod tests {
         assert!(fmi2_binaries(&[("darwin64", &a), ("x86_64-darwin", &x)]).is_err());
         assert!(fmi2_binaries(&[("win32", b"MZ")]).is_err());
         let t: Vec<_> = builds.iter().map(|(k, b)| tuple(k, b).unwrap()).collect();
-        assert_eq!(t, ["x86_64-linux", "x86_64-darwin", "x86_64-windows", "aarch64-linux", "aarch64-darwin"]);
+        assert_eq!(
+            t,
+            [
+                "x86_64-linux",
+                "x86_64-darwin",
+                "x86_64-windows",
+                "aarch64-linux",
+                "aarch64-darwin"
+            ]
+        );
         assert_eq!(tuple("darwin64", &a), Some("aarch64-darwin"));
         assert_eq!(tuple("darwin64", b"junk"), None);
         assert_eq!(lib_ext("aarch64-linux"), Some("so"));

@@ -112,8 +112,11 @@ pub fn tags_in(text: &str) -> Vec<&str> {
     while let Some(i) = rest.find('[') {
         let after = &rest[i + 1..];
         match after.find(']') {
-            Some(j) if j > 0 && after[..j].chars().all(|c| c.is_ascii_alphanumeric() || c == '-')
-                && after[..j].chars().any(|c| c.is_ascii_alphabetic()) && after[..j].contains('-') =>
+            Some(j)
+                if j > 0
+                    && after[..j].chars().all(|c| c.is_ascii_alphanumeric() || c == '-')
+                    && after[..j].chars().any(|c| c.is_ascii_alphabetic())
+                    && after[..j].contains('-') =>
             {
                 out.push(&after[..j]);
                 rest = &after[j + 1..];
@@ -161,7 +164,11 @@ mod tests {
             let mut cited = 0;
             for t in &texts {
                 for tag in tags_in(t) {
-                    assert!(ALL.iter().any(|r| r.key == tag), "{}: unknown reference [{tag}]", e.info.name);
+                    assert!(
+                        ALL.iter().any(|r| r.key == tag),
+                        "{}: unknown reference [{tag}]",
+                        e.info.name
+                    );
                     cited += 1;
                 }
             }

@@ -16,7 +16,14 @@ pub fn output_dependencies(entry: &ModelEntry, out: &VarDecl) -> Vec<usize> {
             .unwrap_or_else(|| panic!("{}: feedthrough names unknown variable {name}", entry.info.name))
             + 1
     };
-    let inputs = || entry.decls.iter().enumerate().filter(|(_, d)| d.causality == Causality::Input).map(|(i, _)| i + 1);
+    let inputs = || {
+        entry
+            .decls
+            .iter()
+            .enumerate()
+            .filter(|(_, d)| d.causality == Causality::Input)
+            .map(|(i, _)| i + 1)
+    };
     match entry.info.feedthrough {
         Feedthrough::None => vec![],
         Feedthrough::AllInputs => inputs().collect(),
@@ -51,9 +58,10 @@ pub fn initial_unknowns(entry: &ModelEntry) -> Vec<(usize, Vec<usize>)> {
         .filter_map(|(i, d)| {
             let inputs = match d.causality {
                 // its feed-through, and the inputs any state starts from (an output may read every state)
-                Causality::Output if d.initial() != Some(Initial::Exact) => {
-                    output_dependencies(entry, d).into_iter().chain(entry.state_decls().iter().flat_map(|x| start_inputs(entry, x))).collect()
-                }
+                Causality::Output if d.initial() != Some(Initial::Exact) => output_dependencies(entry, d)
+                    .into_iter()
+                    .chain(entry.state_decls().iter().flat_map(|x| start_inputs(entry, x)))
+                    .collect(),
                 Causality::CalculatedParameter => vec![],
                 _ => return None,
             };
@@ -74,8 +82,17 @@ pub fn initial_unknowns(entry: &ModelEntry) -> Vec<(usize, Vec<usize>)> {
         }))
         .chain(derivative_dependencies(entry).into_iter().map(|(k, on)| {
             let (n_decl, states) = (entry.decls.len(), entry.state_decls());
-            let via_states = on.iter().filter(|i| **i > n_decl).flat_map(|i| start_inputs(entry, &states[i - n_decl - 1]));
-            let mut deps: Vec<usize> = on.iter().copied().filter(|i| *i <= n_decl).chain(via_states).chain(params.iter().copied()).collect();
+            let via_states = on
+                .iter()
+                .filter(|i| **i > n_decl)
+                .flat_map(|i| start_inputs(entry, &states[i - n_decl - 1]));
+            let mut deps: Vec<usize> = on
+                .iter()
+                .copied()
+                .filter(|i| *i <= n_decl)
+                .chain(via_states)
+                .chain(params.iter().copied())
+                .collect();
             deps.sort_unstable();
             deps.dedup();
             (entry.decls.len() + entry.state_decls().len() + k + 1, deps)
@@ -95,11 +112,20 @@ fn start_inputs<'a>(entry: &'a ModelEntry, x: &'a StateDecl) -> impl Iterator<It
 }
 
 pub(crate) fn input_index(entry: &ModelEntry, name: &str) -> Option<usize> {
-    entry.decls.iter().position(|d| d.name == name && d.causality == Causality::Input).map(|i| i + 1)
+    entry
+        .decls
+        .iter()
+        .position(|d| d.name == name && d.causality == Causality::Input)
+        .map(|i| i + 1)
 }
 
 fn input_indices(entry: &ModelEntry) -> impl Iterator<Item = usize> + '_ {
-    entry.decls.iter().enumerate().filter(|(_, d)| d.causality == Causality::Input).map(|(i, _)| i + 1)
+    entry
+        .decls
+        .iter()
+        .enumerate()
+        .filter(|(_, d)| d.causality == Causality::Input)
+        .map(|(i, _)| i + 1)
 }
 
 /// `<Derivatives>`: for each state k, the ScalarVariable indices of the inputs and states its
@@ -108,7 +134,14 @@ fn input_indices(entry: &ModelEntry) -> impl Iterator<Item = usize> + '_ {
 pub fn derivative_dependencies(entry: &ModelEntry) -> Vec<(usize, Vec<usize>)> {
     let states = entry.state_decls();
     let all: Vec<usize> = input_indices(entry).chain(state_indices(entry)).collect();
-    let index = |n: &str| input_index(entry, n).or_else(|| states.iter().position(|x| x.name == n).map(|k| entry.decls.len() + k + 1));
+    let index = |n: &str| {
+        input_index(entry, n).or_else(|| {
+            states
+                .iter()
+                .position(|x| x.name == n)
+                .map(|k| entry.decls.len() + k + 1)
+        })
+    };
     states
         .iter()
         .enumerate()
@@ -124,4 +157,3 @@ pub fn derivative_dependencies(entry: &ModelEntry) -> Vec<(usize, Vec<usize>)> {
         })
         .collect()
 }
-

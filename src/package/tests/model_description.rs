@@ -18,7 +18,10 @@ fn committed_model_descriptions_are_not_stale() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../modelDescription");
     let units: Vec<Unit> = registry::ALL.iter().map(Unit::registered).collect();
     let stale = stale_model_descriptions(&units, &dir);
-    assert!(stale.is_empty(), "stale modelDescription/ for {stale:?}: run scripts/build_fmus.sh and commit");
+    assert!(
+        stale.is_empty(),
+        "stale modelDescription/ for {stale:?}: run scripts/build_fmus.sh and commit"
+    );
 }
 
 #[test]
@@ -26,7 +29,10 @@ fn committed_fmi3_model_descriptions_are_not_stale() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../modelDescription/fmi3");
     let units: Vec<Unit> = registry::ALL.iter().map(Unit::registered).collect();
     let stale = stale_model_descriptions3(&units, &dir);
-    assert!(stale.is_empty(), "stale modelDescription/fmi3/ for {stale:?}: run scripts/build_fmus.sh and commit");
+    assert!(
+        stale.is_empty(),
+        "stale modelDescription/fmi3/ for {stale:?}: run scripts/build_fmus.sh and commit"
+    );
 }
 
 #[test]
@@ -44,7 +50,8 @@ fn fmi_rs_validation_finds_no_problem() {
 fn fmi_schema_reads_every_variable_back() {
     for e in registry::ALL {
         let xml = xml(e);
-        let md = fmi_schema::fmi2::Fmi2ModelDescription::from_str(&xml).unwrap_or_else(|err| panic!("{}: {err}", e.info.name));
+        let md = fmi_schema::fmi2::Fmi2ModelDescription::from_str(&xml)
+            .unwrap_or_else(|err| panic!("{}: {err}", e.info.name));
         assert_eq!(md.model_name, e.info.name);
         // the declared variables, then (Model Exchange) each continuous state and its derivative
         let states = e.state_decls();
@@ -52,9 +59,18 @@ fn fmi_schema_reads_every_variable_back() {
         assert_eq!(md.model_exchange.is_some(), e.model_exchange(), "{}", e.info.name);
         let extra = &md.model_variables.variables[e.decls.len()..];
         for (k, x) in states.iter().enumerate() {
-            assert_eq!((extra[k].name.as_str(), extra[k].value_reference), (x.name, spacecraft_fmus::model::STATE_VR_BASE + k as u32));
+            assert_eq!(
+                (extra[k].name.as_str(), extra[k].value_reference),
+                (x.name, spacecraft_fmus::model::STATE_VR_BASE + k as u32)
+            );
             let der = &extra[states.len() + k];
-            assert_eq!((der.name.as_str(), der.value_reference), (format!("der({})", x.name).as_str(), spacecraft_fmus::model::DERIVATIVE_VR_BASE + k as u32));
+            assert_eq!(
+                (der.name.as_str(), der.value_reference),
+                (
+                    format!("der({})", x.name).as_str(),
+                    spacecraft_fmus::model::DERIVATIVE_VR_BASE + k as u32
+                )
+            );
         }
         let cs = md.co_simulation.as_ref().expect("CoSimulation element");
         assert_eq!(cs.model_identifier, e.info.name);
@@ -82,11 +98,16 @@ fn every_parameter_keeps_one_value_reference_within_a_family() {
     for (family, fmus) in &groups {
         let mut seen: BTreeMap<&str, (u32, &str)> = BTreeMap::new();
         for e in fmus {
-            for d in e.decls.iter().filter(|d| matches!(d.causality, Causality::Parameter | Causality::CalculatedParameter)) {
+            for d in e
+                .decls
+                .iter()
+                .filter(|d| matches!(d.causality, Causality::Parameter | Causality::CalculatedParameter))
+            {
                 match seen.get(d.name) {
-                    Some((vr, first)) if *vr != d.vr => {
-                        problems.push(format!("{family}: {} is {} in {first} but {} in {}", d.name, vr, d.vr, e.info.name))
-                    }
+                    Some((vr, first)) if *vr != d.vr => problems.push(format!(
+                        "{family}: {} is {} in {first} but {} in {}",
+                        d.name, vr, d.vr, e.info.name
+                    )),
                     Some(_) => shared += 1,
                     None => {
                         seen.insert(d.name, (d.vr, e.info.name));
@@ -96,5 +117,8 @@ fn every_parameter_keeps_one_value_reference_within_a_family() {
         }
     }
     assert!(problems.is_empty(), "{problems:#?}");
-    assert!(shared > 20, "only {shared} parameters shared within families: the check sees too little");
+    assert!(
+        shared > 20,
+        "only {shared} parameters shared within families: the check sees too little"
+    );
 }

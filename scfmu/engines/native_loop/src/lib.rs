@@ -250,8 +250,27 @@ pub unsafe extern "C" fn scfmu_loop_run(
     let mut where_ = [-1i64; 3];
     let r = catch_unwind(AssertUnwindSafe(|| {
         let a = Args {
-            n_fmus, comps, info, fns, me_params, n_ops, ops, n_vrs, vrs, n_real_buf, n_int_buf, n_log, log_fmu,
-            log_vr, log_type, n_steps, t0, dt, out, out_len, max_ok,
+            n_fmus,
+            comps,
+            info,
+            fns,
+            me_params,
+            n_ops,
+            ops,
+            n_vrs,
+            vrs,
+            n_real_buf,
+            n_int_buf,
+            n_log,
+            log_fmu,
+            log_vr,
+            log_type,
+            n_steps,
+            t0,
+            dt,
+            out,
+            out_len,
+            max_ok,
         };
         run(&a, &mut where_)
     }));
@@ -353,7 +372,13 @@ unsafe fn run(a: &Args, where_: &mut [i64; 3]) -> i32 {
         if needed.iter().any(|&s| table[s].is_null()) {
             return ERR_NULL;
         }
-        fmus.push(Fmu { comp: comps[i], v3: version == 3, fns: table, scratch: Vec::new(), tmp: Vec::new() });
+        fmus.push(Fmu {
+            comp: comps[i],
+            v3: version == 3,
+            fns: table,
+            scratch: Vec::new(),
+            tmp: Vec::new(),
+        });
         solvers.push(if interface == 1 {
             let p = &me_params[i * ME_FIELDS..(i + 1) * ME_FIELDS];
             if !(p[0] > 0.0 && p[1] > 0.0) || !(p[3] == 0.0 || p[3] == 1.0) || !(p[4] >= 0.0) {
@@ -370,8 +395,18 @@ unsafe fn run(a: &Args, where_: &mut [i64; 3]) -> i32 {
     }
     let mut plan = Vec::with_capacity(a.n_ops);
     for o in ops.chunks_exact(OP_FIELDS) {
-        let op = Op { kind: o[0], fmu: o[1], vr: o[2], n: o[3], buf: o[4] };
-        let n_buf = if op.kind <= K_SET_REAL { a.n_real_buf } else { a.n_int_buf };
+        let op = Op {
+            kind: o[0],
+            fmu: o[1],
+            vr: o[2],
+            n: o[3],
+            buf: o[4],
+        };
+        let n_buf = if op.kind <= K_SET_REAL {
+            a.n_real_buf
+        } else {
+            a.n_int_buf
+        };
         let vr_ok = op.vr.checked_add(op.n).is_some_and(|e| e <= a.n_vrs);
         let buf_ok = op.buf.checked_add(op.n).is_some_and(|e| e <= n_buf);
         if op.kind > K_SET_BOOL || op.fmu >= n_fmus || !vr_ok || !buf_ok {
@@ -387,7 +422,11 @@ unsafe fn run(a: &Args, where_: &mut [i64; 3]) -> i32 {
         return ERR_SIZE;
     };
     if rows.checked_mul(a.n_log) != Some(a.out_len) || (a.out_len > 0 && a.out.is_null()) {
-        return if a.out.is_null() && a.out_len > 0 { ERR_NULL } else { ERR_SIZE };
+        return if a.out.is_null() && a.out_len > 0 {
+            ERR_NULL
+        } else {
+            ERR_SIZE
+        };
     }
     let mut groups: Vec<LogGroup> = Vec::new();
     for (col, (&f, &ty)) in log_fmu.iter().zip(log_type.iter()).enumerate() {
@@ -489,9 +528,9 @@ mod tests {
 
     #[derive(Default)]
     struct Toy {
-        x: f64,     // plant state, or controller output
-        u: f64,     // input
-        gain: f64,  // controller gain (0 for the plant)
+        x: f64,    // plant state, or controller output
+        u: f64,    // input
+        gain: f64, // controller gain (0 for the plant)
         plant: bool,
         steps: usize,
         fail_at_step: Option<usize>,
@@ -557,28 +596,59 @@ mod tests {
         let info = [2usize, 0, 0, 0, /**/ 2, 0, 0, 0];
         let fns: Vec<*const c_void> = [table(get, set, step), table(get, set, step)].concat();
         // controller.u <- plant.y; plant.u <- controller.y (Gauss–Seidel: controller first)
-        let ops = [0, 1, 0, 1, 0, /**/ 1, 0, 1, 1, 0, /**/ 0, 0, 0, 1, 1, /**/ 1, 1, 2, 1, 1];
+        let ops = [
+            0, 1, 0, 1, 0, /**/ 1, 0, 1, 1, 0, /**/ 0, 0, 0, 1, 1, /**/ 1, 1, 2, 1, 1,
+        ];
         let vrs = [0u32, 1, 1];
         let log_fmu = [1usize, 0];
         let log_vr = [0u32, 0];
         let log_type = [T_REAL, T_REAL];
         unsafe {
             scfmu_loop_run(
-                2, comps.as_ptr(), info.as_ptr(), fns.as_ptr(), std::ptr::null(), 4, ops.as_ptr(), 3, vrs.as_ptr(), 2,
-                0, 2, log_fmu.as_ptr(), log_vr.as_ptr(), log_type.as_ptr(), n_steps, 0.0, 0.1, out.as_mut_ptr(),
-                out.len(), 1, fail.as_mut_ptr(),
+                2,
+                comps.as_ptr(),
+                info.as_ptr(),
+                fns.as_ptr(),
+                std::ptr::null(),
+                4,
+                ops.as_ptr(),
+                3,
+                vrs.as_ptr(),
+                2,
+                0,
+                2,
+                log_fmu.as_ptr(),
+                log_vr.as_ptr(),
+                log_type.as_ptr(),
+                n_steps,
+                0.0,
+                0.1,
+                out.as_mut_ptr(),
+                out.len(),
+                1,
+                fail.as_mut_ptr(),
             )
         }
     }
 
     #[test]
     fn gauss_seidel_sequence_and_values() {
-        let (mut p, mut c) = (Toy { x: 1.0, plant: true, ..Default::default() }, Toy { gain: 2.0, ..Default::default() });
+        let (mut p, mut c) = (
+            Toy {
+                x: 1.0,
+                plant: true,
+                ..Default::default()
+            },
+            Toy {
+                gain: 2.0,
+                ..Default::default()
+            },
+        );
         let n = 5;
         let mut out = vec![f64::NAN; (n + 1) * 2];
         let mut fail = [0i64; 3];
         assert_eq!(run_toys(&mut p, &mut c, n, &mut out, &mut fail), 1); // the warning is reported
-        // by hand: at each t_k, u = -g·x (same point), log (x, u), then x += dt·u
+                                                                         // by hand: at each t_k, u = -g·x (same point), log (x, u), then x += dt·u
         let mut x = 1.0f64;
         for k in 0..=n {
             let u = -2.0 * x;
@@ -596,8 +666,16 @@ mod tests {
     #[test]
     fn failing_status_stops_at_its_step() {
         let (mut p, mut c) = (
-            Toy { x: 1.0, plant: true, fail_at_step: Some(3), ..Default::default() },
-            Toy { gain: 2.0, ..Default::default() },
+            Toy {
+                x: 1.0,
+                plant: true,
+                fail_at_step: Some(3),
+                ..Default::default()
+            },
+            Toy {
+                gain: 2.0,
+                ..Default::default()
+            },
         );
         let mut out = vec![f64::NAN; 11 * 2];
         let mut fail = [0i64; 3];
@@ -608,16 +686,41 @@ mod tests {
 
     #[test]
     fn bad_arguments_are_refused_before_any_call() {
-        let (mut p, mut c) = (Toy { plant: true, ..Default::default() }, Toy::default());
+        let (mut p, mut c) = (
+            Toy {
+                plant: true,
+                ..Default::default()
+            },
+            Toy::default(),
+        );
         let mut out = vec![0.0; 5]; // wrong length for 2 steps × 2 columns
         let mut fail = [0i64; 3];
         assert_eq!(run_toys(&mut p, &mut c, 2, &mut out, &mut fail), ERR_SIZE);
         assert!(p.calls.is_empty() && c.calls.is_empty());
         let null = unsafe {
             scfmu_loop_run(
-                1, std::ptr::null(), std::ptr::null(), std::ptr::null(), std::ptr::null(), 0, std::ptr::null(), 0,
-                std::ptr::null(), 0, 0, 0, std::ptr::null(), std::ptr::null(), std::ptr::null(), 3, 0.0, 0.1,
-                std::ptr::null_mut(), 0, 1, std::ptr::null_mut(),
+                1,
+                std::ptr::null(),
+                std::ptr::null(),
+                std::ptr::null(),
+                std::ptr::null(),
+                0,
+                std::ptr::null(),
+                0,
+                std::ptr::null(),
+                0,
+                0,
+                0,
+                std::ptr::null(),
+                std::ptr::null(),
+                std::ptr::null(),
+                3,
+                0.0,
+                0.1,
+                std::ptr::null_mut(),
+                0,
+                1,
+                std::ptr::null_mut(),
             )
         };
         assert_eq!(null, ERR_NULL);
@@ -724,8 +827,16 @@ mod tests {
         // x(0) = 1, a = 1: x reaches 0.5 at ln 2 (state event; x halves to 0.25); at t_ev = 1.0 the rate
         // becomes a2 = 3; closed form at t = 2: 0.25·e^{-(1 - ln 2)}·e^{-3·1}
         let mut m = MeToy {
-            t: 0.0, x: 1.0, a: 1.0, a2: 3.0, level: 0.5, t_ev: 1.0, time_event_done: false, crossings: vec![],
-            time_events: vec![], completed: 0,
+            t: 0.0,
+            x: 1.0,
+            a: 1.0,
+            a2: 3.0,
+            level: 0.5,
+            t_ev: 1.0,
+            time_event_done: false,
+            crossings: vec![],
+            time_events: vec![],
+            completed: 0,
         };
         let comps = [&mut m as *mut MeToy as *mut c_void];
         let info = [2usize, 1, 1, 1];
@@ -749,15 +860,38 @@ mod tests {
         let mut fail = [0i64; 3];
         let st = unsafe {
             scfmu_loop_run(
-                1, comps.as_ptr(), info.as_ptr(), t.as_ptr(), params.as_ptr(), 0, std::ptr::null(), 0,
-                std::ptr::null(), 0, 0, 1, log_fmu.as_ptr(), log_vr.as_ptr(), log_type.as_ptr(), n, 0.0, dt,
-                out.as_mut_ptr(), out.len(), 1, fail.as_mut_ptr(),
+                1,
+                comps.as_ptr(),
+                info.as_ptr(),
+                t.as_ptr(),
+                params.as_ptr(),
+                0,
+                std::ptr::null(),
+                0,
+                std::ptr::null(),
+                0,
+                0,
+                1,
+                log_fmu.as_ptr(),
+                log_vr.as_ptr(),
+                log_type.as_ptr(),
+                n,
+                0.0,
+                dt,
+                out.as_mut_ptr(),
+                out.len(),
+                1,
+                fail.as_mut_ptr(),
             )
         };
         assert_eq!(st, 0, "{fail:?}");
         let ln2 = std::f64::consts::LN_2;
         assert_eq!(m.crossings.len(), 1);
-        assert!((m.crossings[0] - ln2).abs() < 1e-9, "state event at {} (expected ln 2)", m.crossings[0]);
+        assert!(
+            (m.crossings[0] - ln2).abs() < 1e-9,
+            "state event at {} (expected ln 2)",
+            m.crossings[0]
+        );
         assert_eq!(m.time_events, vec![1.0]);
         let exact = |t: f64| {
             if t < ln2 {
@@ -771,9 +905,12 @@ mod tests {
         for k in 0..=n {
             let tk = k as f64 * dt;
             let e = exact(tk);
-            assert!((out[k] - e).abs() <= 1e-8 * e.abs().max(1e-3), "t = {tk}: {} vs {e}", out[k]);
+            assert!(
+                (out[k] - e).abs() <= 1e-8 * e.abs().max(1e-3),
+                "t = {tk}: {} vs {e}",
+                out[k]
+            );
         }
         assert!(m.completed >= n);
     }
 }
-

@@ -28,7 +28,8 @@ type Vector = unsafe extern "C" fn(*mut c_void, *mut f64, usize) -> i32;
 type Plain = unsafe extern "C" fn(*mut c_void) -> i32;
 type Completed2 = unsafe extern "C" fn(*mut c_void, i32, *mut i32, *mut i32) -> i32;
 type Completed3 = unsafe extern "C" fn(*mut c_void, bool, *mut bool, *mut bool) -> i32;
-type Update3 = unsafe extern "C" fn(*mut c_void, *mut bool, *mut bool, *mut bool, *mut bool, *mut bool, *mut f64) -> i32;
+type Update3 =
+    unsafe extern "C" fn(*mut c_void, *mut bool, *mut bool, *mut bool, *mut bool, *mut bool, *mut f64) -> i32;
 
 /// `fmi2EventInfo`.
 #[repr(C)]
@@ -49,20 +50,76 @@ const A: [[f64; 5]; 6] = [
     [1.0 / 5.0, 0.0, 0.0, 0.0, 0.0],
     [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0],
     [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0],
-    [19372.0 / 6561.0, -25360.0 / 2187.0, 64448.0 / 6561.0, -212.0 / 729.0, 0.0],
-    [9017.0 / 3168.0, -355.0 / 33.0, 46732.0 / 5247.0, 49.0 / 176.0, -5103.0 / 18656.0],
+    [
+        19372.0 / 6561.0,
+        -25360.0 / 2187.0,
+        64448.0 / 6561.0,
+        -212.0 / 729.0,
+        0.0,
+    ],
+    [
+        9017.0 / 3168.0,
+        -355.0 / 33.0,
+        46732.0 / 5247.0,
+        49.0 / 176.0,
+        -5103.0 / 18656.0,
+    ],
 ];
-const B: [f64; 6] = [35.0 / 384.0, 0.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0];
-const E: [f64; 7] =
-    [-71.0 / 57600.0, 0.0, 71.0 / 16695.0, -71.0 / 1920.0, 17253.0 / 339200.0, -22.0 / 525.0, 1.0 / 40.0];
+const B: [f64; 6] = [
+    35.0 / 384.0,
+    0.0,
+    500.0 / 1113.0,
+    125.0 / 192.0,
+    -2187.0 / 6784.0,
+    11.0 / 84.0,
+];
+const E: [f64; 7] = [
+    -71.0 / 57600.0,
+    0.0,
+    71.0 / 16695.0,
+    -71.0 / 1920.0,
+    17253.0 / 339200.0,
+    -22.0 / 525.0,
+    1.0 / 40.0,
+];
 const P: [[f64; 4]; 7] = [
-    [1.0, -8048581381.0 / 2820520608.0, 8663915743.0 / 2820520608.0, -12715105075.0 / 11282082432.0],
+    [
+        1.0,
+        -8048581381.0 / 2820520608.0,
+        8663915743.0 / 2820520608.0,
+        -12715105075.0 / 11282082432.0,
+    ],
     [0.0, 0.0, 0.0, 0.0],
-    [0.0, 131558114200.0 / 32700410799.0, -68118460800.0 / 10900136933.0, 87487479700.0 / 32700410799.0],
-    [0.0, -1754552775.0 / 470086768.0, 14199869525.0 / 1410260304.0, -10690763975.0 / 1880347072.0],
-    [0.0, 127303824393.0 / 49829197408.0, -318862633887.0 / 49829197408.0, 701980252875.0 / 199316789632.0],
-    [0.0, -282668133.0 / 205662961.0, 2019193451.0 / 616988883.0, -1453857185.0 / 822651844.0],
-    [0.0, 40617522.0 / 29380423.0, -110615467.0 / 29380423.0, 69997945.0 / 29380423.0],
+    [
+        0.0,
+        131558114200.0 / 32700410799.0,
+        -68118460800.0 / 10900136933.0,
+        87487479700.0 / 32700410799.0,
+    ],
+    [
+        0.0,
+        -1754552775.0 / 470086768.0,
+        14199869525.0 / 1410260304.0,
+        -10690763975.0 / 1880347072.0,
+    ],
+    [
+        0.0,
+        127303824393.0 / 49829197408.0,
+        -318862633887.0 / 49829197408.0,
+        701980252875.0 / 199316789632.0,
+    ],
+    [
+        0.0,
+        -282668133.0 / 205662961.0,
+        2019193451.0 / 616988883.0,
+        -1453857185.0 / 822651844.0,
+    ],
+    [
+        0.0,
+        40617522.0 / 29380423.0,
+        -110615467.0 / 29380423.0,
+        69997945.0 / 29380423.0,
+    ],
 ];
 const SAFETY: f64 = 0.9;
 const MIN_FACTOR: f64 = 0.2;
@@ -134,7 +191,11 @@ impl Solver {
         if self.nx == 0 {
             return Ok(0);
         }
-        ok(transmute::<*const c_void, Vector>(f.fns[F_GET_DERIVATIVES])(f.comp, dx.as_mut_ptr(), self.nx))
+        ok(transmute::<*const c_void, Vector>(f.fns[F_GET_DERIVATIVES])(
+            f.comp,
+            dx.as_mut_ptr(),
+            self.nx,
+        ))
     }
 
     /// Classic Runge–Kutta 4 with a fixed step of at most `max_step` (0: the communication step).
@@ -155,8 +216,12 @@ impl Solver {
             let mut ks = std::mem::take(&mut self.k[s]);
             let r = if s == 2 {
                 // the same time as stage 2: only the states are set
-                ok(transmute::<*const c_void, Vector>(f.fns[F_SET_STATES])(f.comp, y.as_ptr() as *mut f64, n))
-                    .and_then(|a| self.derivatives_here(f, &mut ks).map(|b| a.max(b)))
+                ok(transmute::<*const c_void, Vector>(f.fns[F_SET_STATES])(
+                    f.comp,
+                    y.as_ptr() as *mut f64,
+                    n,
+                ))
+                .and_then(|a| self.derivatives_here(f, &mut ks).map(|b| a.max(b)))
             } else {
                 self.rhs(f, t + c * h, &y, &mut ks)
             };
@@ -165,7 +230,8 @@ impl Solver {
             w = w.max(r?);
         }
         for i in 0..n {
-            self.x_new[i] = self.x[i] + h / 6.0 * (self.k[0][i] + 2.0 * self.k[1][i] + 2.0 * self.k[2][i] + self.k[3][i]);
+            self.x_new[i] =
+                self.x[i] + h / 6.0 * (self.k[0][i] + 2.0 * self.k[1][i] + 2.0 * self.k[2][i] + self.k[3][i]);
         }
         Ok(w)
     }
@@ -173,7 +239,11 @@ impl Solver {
     unsafe fn set(&self, f: &Fmu, t: f64, x: &[f64]) -> Result<i32, Fail> {
         let mut w = ok(transmute::<*const c_void, SetTime>(f.fns[F_SET_TIME])(f.comp, t))?;
         if self.nx > 0 {
-            w = w.max(ok(transmute::<*const c_void, Vector>(f.fns[F_SET_STATES])(f.comp, x.as_ptr() as *mut f64, self.nx))?);
+            w = w.max(ok(transmute::<*const c_void, Vector>(f.fns[F_SET_STATES])(
+                f.comp,
+                x.as_ptr() as *mut f64,
+                self.nx,
+            ))?);
         }
         Ok(w)
     }
@@ -184,21 +254,33 @@ impl Solver {
         if self.nx == 0 {
             return Ok(w);
         }
-        Ok(w.max(ok(transmute::<*const c_void, Vector>(f.fns[F_GET_DERIVATIVES])(f.comp, dx.as_mut_ptr(), self.nx))?))
+        Ok(w.max(ok(transmute::<*const c_void, Vector>(f.fns[F_GET_DERIVATIVES])(
+            f.comp,
+            dx.as_mut_ptr(),
+            self.nx,
+        ))?))
     }
 
     unsafe fn indicators(&self, f: &Fmu, z: &mut [f64]) -> Result<i32, Fail> {
         if self.nz == 0 {
             return Ok(0);
         }
-        ok(transmute::<*const c_void, Vector>(f.fns[F_GET_INDICATORS])(f.comp, z.as_mut_ptr(), self.nz))
+        ok(transmute::<*const c_void, Vector>(f.fns[F_GET_INDICATORS])(
+            f.comp,
+            z.as_mut_ptr(),
+            self.nz,
+        ))
     }
 
     unsafe fn read_states(&mut self, f: &Fmu) -> Result<i32, Fail> {
         if self.nx == 0 {
             return Ok(0);
         }
-        ok(transmute::<*const c_void, Vector>(f.fns[F_GET_STATES])(f.comp, self.x.as_mut_ptr(), self.nx))
+        ok(transmute::<*const c_void, Vector>(f.fns[F_GET_STATES])(
+            f.comp,
+            self.x.as_mut_ptr(),
+            self.nx,
+        ))
     }
 
     /// (enterEventMode, status) after an accepted step.
@@ -228,14 +310,22 @@ impl Solver {
         for _ in 0..1000 {
             let (needed, term, defined, next) = if f.v3 {
                 let (mut n, mut t, mut nc, mut vc, mut d, mut nt) = (false, false, false, false, false, 0.0f64);
-                w = w.max(ok(transmute::<*const c_void, Update3>(upd)(f.comp, &mut n, &mut t, &mut nc, &mut vc, &mut d, &mut nt))?);
+                w = w.max(ok(transmute::<*const c_void, Update3>(upd)(
+                    f.comp, &mut n, &mut t, &mut nc, &mut vc, &mut d, &mut nt,
+                ))?);
                 (n, t, d, nt)
             } else {
                 let mut ei = EventInfo2::default();
-                w = w.max(ok(transmute::<*const c_void, unsafe extern "C" fn(*mut c_void, *mut EventInfo2) -> i32>(upd)(
-                    f.comp, &mut ei,
-                ))?);
-                (ei.new_discrete_states_needed != 0, ei.terminate_simulation != 0, ei.next_event_time_defined != 0, ei.next_event_time)
+                w = w.max(ok(transmute::<
+                    *const c_void,
+                    unsafe extern "C" fn(*mut c_void, *mut EventInfo2) -> i32,
+                >(upd)(f.comp, &mut ei))?);
+                (
+                    ei.new_discrete_states_needed != 0,
+                    ei.terminate_simulation != 0,
+                    ei.next_event_time_defined != 0,
+                    ei.next_event_time,
+                )
             };
             if term {
                 return Err((3, PHASE_TERMINATE));
@@ -280,7 +370,11 @@ impl Solver {
         self.rhs(f, t + h0, &y, &mut f1)?;
         let diff: Vec<f64> = f1.iter().zip(&self.k[0]).map(|(a, b)| a - b).collect();
         let d2 = rms(&diff) / h0;
-        let h1 = if d1 <= 1e-15 && d2 <= 1e-15 { (h0 * 1e-3).max(1e-6) } else { (0.01 / d1.max(d2)).powf(1.0 / 5.0) };
+        let h1 = if d1 <= 1e-15 && d2 <= 1e-15 {
+            (h0 * 1e-3).max(1e-6)
+        } else {
+            (0.01 / d1.max(d2)).powf(1.0 / 5.0)
+        };
         Ok((100.0 * h0).min(h1).min(span))
     }
 
@@ -382,7 +476,11 @@ impl Solver {
                     let xn = self.x_new.clone();
                     if t_new == t + h {
                         // the unit's time is already t + h (the last stage): only the states are set
-                        let st = transmute::<*const c_void, Vector>(f.fns[F_SET_STATES])(f.comp, xn.as_ptr() as *mut f64, self.nx);
+                        let st = transmute::<*const c_void, Vector>(f.fns[F_SET_STATES])(
+                            f.comp,
+                            xn.as_ptr() as *mut f64,
+                            self.nx,
+                        );
                         w = w.max(ok(st)?);
                     } else {
                         w = w.max(self.set(f, t_new, &xn)?);
@@ -484,11 +582,19 @@ impl Solver {
                     }
                     let en = self.norm(&self.y, &self.x, &self.x_new);
                     if en <= 1.0 {
-                        let mut fac = if en == 0.0 { MAX_FACTOR } else { (SAFETY * en.powf(-0.2)).min(MAX_FACTOR) };
+                        let mut fac = if en == 0.0 {
+                            MAX_FACTOR
+                        } else {
+                            (SAFETY * en.powf(-0.2)).min(MAX_FACTOR)
+                        };
                         if rejected_now {
                             fac = fac.min(1.0);
                         }
-                        self.h = if truncated && !rejected_now { self.h.max(h * fac) } else { h * fac };
+                        self.h = if truncated && !rejected_now {
+                            self.h.max(h * fac)
+                        } else {
+                            h * fac
+                        };
                         break;
                     }
                     self.rejected += 1;

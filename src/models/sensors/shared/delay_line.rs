@@ -53,17 +53,32 @@ pub struct DelayLine<T> {
 impl<T: Clone> DelayLine<T> {
     /// A line whose first sample has index `first` (the interval of the start time).
     pub fn new(initial: T, first: i64) -> Self {
-        DelayLine { last: first - 1, queue: Vec::new(), held: initial }
+        DelayLine {
+            last: first - 1,
+            queue: Vec::new(),
+            held: initial,
+        }
     }
 
     /// The output at t: (sample, usable). `fresh(k)` computes sample k from the current inputs (used
     /// when sample k is due now and not latched yet).
-    pub fn at(&self, t: f64, period: f64, delay: f64, fresh: impl FnOnce(i64) -> T, usable: impl Fn(&T) -> bool) -> (T, bool) {
+    pub fn at(
+        &self,
+        t: f64,
+        period: f64,
+        delay: f64,
+        fresh: impl FnOnce(i64) -> T,
+        usable: impl Fn(&T) -> bool,
+    ) -> (T, bool) {
         let kd = delivered_index(t, delay, period);
         if kd < 0 {
             return (self.held.clone(), false);
         }
-        let s = if kd > self.last { Some(fresh(kd)) } else { self.queue.iter().find(|(k, _)| *k == kd).map(|(_, s)| s.clone()) };
+        let s = if kd > self.last {
+            Some(fresh(kd))
+        } else {
+            self.queue.iter().find(|(k, _)| *k == kd).map(|(_, s)| s.clone())
+        };
         match s {
             Some(s) if usable(&s) => (s, true),
             _ => (self.latest_usable_before(kd, &usable), false),
@@ -72,18 +87,32 @@ impl<T: Clone> DelayLine<T> {
 
     /// The last usable sample delivered before index kd (queue entries below kd, else `held`).
     fn latest_usable_before(&self, kd: i64, usable: &impl Fn(&T) -> bool) -> T {
-        self.queue.iter().rev().find(|(k, s)| *k < kd && usable(s)).map_or_else(|| self.held.clone(), |(_, s)| s.clone())
+        self.queue
+            .iter()
+            .rev()
+            .find(|(k, s)| *k < kd && usable(s))
+            .map_or_else(|| self.held.clone(), |(_, s)| s.clone())
     }
 
     /// Latches the samples of [t, t + h) (`sample(k)` with the held inputs) and drops the ones superseded
     /// at t + h (updating `held`). Refuses more than `MAX_SAMPLES_PER_CALL` samples.
-    pub fn advance(&mut self, t: f64, h: f64, period: f64, delay: f64, mut sample: impl FnMut(i64) -> T,
-                   usable: impl Fn(&T) -> bool) -> ModelResult {
+    pub fn advance(
+        &mut self,
+        t: f64,
+        h: f64,
+        period: f64,
+        delay: f64,
+        mut sample: impl FnMut(i64) -> T,
+        usable: impl Fn(&T) -> bool,
+    ) -> ModelResult {
         let k_end = last_sample_before(t + h, period);
         let first = self.last + 1;
         if k_end - first >= MAX_SAMPLES_PER_CALL {
-            return Err(format!("a step to t = {} takes {} samples of period {period} s (at most {MAX_SAMPLES_PER_CALL} per step)",
-                               t + h, k_end - first + 1));
+            return Err(format!(
+                "a step to t = {} takes {} samples of period {period} s (at most {MAX_SAMPLES_PER_CALL} per step)",
+                t + h,
+                k_end - first + 1
+            ));
         }
         let kd = delivered_index(t + h, delay, period);
         // drop what is superseded at t + h: entries below kd (the last usable of them becomes `held`),
@@ -108,7 +137,11 @@ impl<T: Clone> DelayLine<T> {
     /// Invariants of a restored line: ascending indices not above `last`, at most `max_len` entries.
     pub fn check(&self, max_len: usize, first: i64) -> ModelResult {
         if self.last < first - 1 || self.queue.len() > max_len {
-            return Err(format!("restored state: delay line with last index {} and {} entries (at most {max_len})", self.last, self.queue.len()));
+            return Err(format!(
+                "restored state: delay line with last index {} and {} entries (at most {max_len})",
+                self.last,
+                self.queue.len()
+            ));
         }
         if self.queue.windows(2).any(|w| w[0].0 >= w[1].0) || self.queue.last().is_some_and(|(k, _)| *k > self.last) {
             return Err("restored state: delay line indices are not ascending up to the last latched sample".into());
@@ -165,14 +198,26 @@ mod tests {
         for n in 0..12 {
             let t = n as f64 * h;
             // samples 2 and 3 are unusable (negative)
-            let u = |k: i64| if (2..=3).contains(&k) { -(k as f64) } else { k as f64 + 10.0 };
+            let u = |k: i64| {
+                if (2..=3).contains(&k) {
+                    -(k as f64)
+                } else {
+                    k as f64 + 10.0
+                }
+            };
             out.push(line.at(t, period, 0.0, |k| u(k), |s| *s >= 0.0));
             line.advance(t, h, period, 0.0, u, |s| *s >= 0.0).unwrap();
         }
         let ys: Vec<f64> = out.iter().map(|(y, _)| *y).collect();
         let oks: Vec<bool> = out.iter().map(|(_, ok)| *ok).collect();
-        assert_eq!(ys, [10.0, 10.0, 11.0, 11.0, 11.0, 11.0, 11.0, 11.0, 14.0, 14.0, 15.0, 15.0]);
-        assert_eq!(oks, [true, true, true, true, false, false, false, false, true, true, true, true]);
+        assert_eq!(
+            ys,
+            [10.0, 10.0, 11.0, 11.0, 11.0, 11.0, 11.0, 11.0, 14.0, 14.0, 15.0, 15.0]
+        );
+        assert_eq!(
+            oks,
+            [true, true, true, true, false, false, false, false, true, true, true, true]
+        );
     }
 
     #[test]

@@ -31,7 +31,9 @@ pub fn quat_of_rotation(theta: &Vector3<f64>) -> Quaternion<f64> {
 pub fn check_unit(name: &str, q: &Quaternion<f64>) -> Result<(), String> {
     let n = q.norm();
     if (n - 1.0).abs() > 1e-3 {
-        return Err(format!("input quaternion {name} has norm {n}, expected 1 (is it connected?)"));
+        return Err(format!(
+            "input quaternion {name} has norm {n}, expected 1 (is it connected?)"
+        ));
     }
     Ok(())
 }
@@ -49,6 +51,8 @@ mod tests {
         let h = std::f64::consts::FRAC_PI_4;
         assert!((q.w - h.cos()).abs() < 1e-15 && (q.k - h.sin()).abs() < 1e-15);
         assert_eq!(quat_of_rotation(&Vector3::zeros()), Quaternion::new(1.0, 0.0, 0.0, 0.0));
-        assert!(check_unit("q", &Quaternion::new(0.0, 0.0, 0.0, 0.0)).unwrap_err().contains("q has norm 0"));
+        assert!(check_unit("q", &Quaternion::new(0.0, 0.0, 0.0, 0.0))
+            .unwrap_err()
+            .contains("q has norm 0"));
     }
 }

@@ -49,7 +49,10 @@ impl FopidParams {
             return Err(format!("parameter step = {} must be > 0", self.h));
         }
         if self.memory > MAX_MEMORY {
-            return Err(format!("parameter gl_memory = {} must lie in [0, {MAX_MEMORY}]", self.memory));
+            return Err(format!(
+                "parameter gl_memory = {} must lie in [0, {MAX_MEMORY}]",
+                self.memory
+            ));
         }
         Ok(())
     }
@@ -89,7 +92,12 @@ pub struct FopidLaw {
 
 impl Serialize for FopidLaw {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        StoredRef { p: &self.p, fast: self.fast, history: &self.history }.serialize(s)
+        StoredRef {
+            p: &self.p,
+            fast: self.fast,
+            history: &self.history,
+        }
+        .serialize(s)
     }
 }
 
@@ -115,9 +123,22 @@ impl FopidLaw {
     /// The law after the samples `history` were pushed one by one (bit-identical to the online pushes).
     pub fn from_history(p: FopidParams, fast: bool, history: Vec<f64>) -> Result<Self, String> {
         p.validate()?;
-        let integral = if p.ki != 0.0 { GlKernel::rebuild(-p.lambda, p.memory, fast, &history) } else { GlKernel::new(-p.lambda, p.memory, fast) };
+        let integral = if p.ki != 0.0 {
+            GlKernel::rebuild(-p.lambda, p.memory, fast, &history)
+        } else {
+            GlKernel::new(-p.lambda, p.memory, fast)
+        };
         let derivative = GlKernel::rebuild(p.mu, p.memory, fast, &history);
-        let mut law = FopidLaw { p, fast, history, integral, derivative, wsum: Vec::new(), scale_i: p.h.powf(p.lambda), scale_d: p.h.powf(-p.mu) };
+        let mut law = FopidLaw {
+            p,
+            fast,
+            history,
+            integral,
+            derivative,
+            wsum: Vec::new(),
+            scale_i: p.h.powf(p.lambda),
+            scale_d: p.h.powf(-p.mu),
+        };
         if p.history_before_start {
             law.extend_wsum(if p.memory > 0 { p.memory } else { 1 });
             law.extend_wsum(law.history.len() + 1);
@@ -141,7 +162,11 @@ impl FopidLaw {
 
     /// D^{-λ} e_n and D^μ e_n for the current error e_n (state unchanged).
     pub fn terms(&self, e: f64) -> (f64, f64) {
-        let i = if self.p.ki != 0.0 { self.scale_i * self.integral.eval(&self.history, e) } else { 0.0 };
+        let i = if self.p.ki != 0.0 {
+            self.scale_i * self.integral.eval(&self.history, e)
+        } else {
+            0.0
+        };
         let mut d = self.derivative.eval(&self.history, e);
         if self.p.history_before_start {
             // e_k = e_0 for k < 0 adds e_0 Σ_{j=n+1}^{L-1} w_j (full memory: Σ_{j>n} w_j = S_∞ - S_n,
@@ -158,7 +183,11 @@ impl FopidLaw {
         let s = &self.wsum;
         let mem = self.p.memory;
         if mem > 0 {
-            if n + 1 >= mem { 0.0 } else { s[mem - 1] - s[n] }
+            if n + 1 >= mem {
+                0.0
+            } else {
+                s[mem - 1] - s[n]
+            }
         } else {
             let s_inf = if self.p.mu == 0.0 { 1.0 } else { 0.0 };
             s_inf - s[n]
@@ -207,7 +236,12 @@ pub struct PidLaw {
 
 impl Serialize for PidLaw {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        StoredRef { p: &self.p, fast: true, history: &self.history }.serialize(s)
+        StoredRef {
+            p: &self.p,
+            fast: true,
+            history: &self.history,
+        }
+        .serialize(s)
     }
 }
 
@@ -216,7 +250,9 @@ impl<'de> Deserialize<'de> for PidLaw {
         let s = Stored::deserialize(d)?;
         // the PID is the λ = μ = 1 law with the exact running sum: anything else is not its state
         if !s.fast || s.p.lambda != 1.0 || s.p.mu != 1.0 {
-            return Err(serde::de::Error::custom("PID law state with orders other than 1 or without fast = true"));
+            return Err(serde::de::Error::custom(
+                "PID law state with orders other than 1 or without fast = true",
+            ));
         }
         PidLaw::from_history(s.p, s.history).map_err(serde::de::Error::custom)
     }
@@ -232,7 +268,11 @@ impl PidLaw {
         p.lambda = 1.0;
         p.mu = 1.0;
         p.validate()?;
-        let mut law = PidLaw { p, history: Vec::with_capacity(history.len()), sum: 0.0 };
+        let mut law = PidLaw {
+            p,
+            history: Vec::with_capacity(history.len()),
+            sum: 0.0,
+        };
         for e in history {
             law.push(e);
         }
@@ -253,7 +293,11 @@ impl PidLaw {
         let n = self.history.len();
         let mem = self.p.memory;
         // window Σ_{j=0}^{min(n, L-1)} e_{n-j}
-        let dropped = if mem > 0 && n + 1 > mem { self.history[n - mem] } else { 0.0 };
+        let dropped = if mem > 0 && n + 1 > mem {
+            self.history[n - mem]
+        } else {
+            0.0
+        };
         let window = self.sum + e - dropped;
         let prev = match self.history.last() {
             Some(&x) => x,
@@ -282,23 +326,41 @@ mod tests {
     use crate::math::fractional::gl_weights;
 
     fn signal(n: usize) -> Vec<f64> {
-        (0..n).map(|k| (0.013 * k as f64).sin() + 0.3 * (0.0071 * k as f64 * k as f64 % 7.0).cos() - 0.2).collect()
+        (0..n)
+            .map(|k| (0.013 * k as f64).sin() + 0.3 * (0.0071 * k as f64 * k as f64 % 7.0).cos() - 0.2)
+            .collect()
     }
 
     fn params(kp: f64, ki: f64, kd: f64, lambda: f64, mu: f64) -> FopidParams {
-        FopidParams { kp, ki, kd, lambda, mu, h: 0.001, memory: 0, history_before_start: false }
+        FopidParams {
+            kp,
+            ki,
+            kd,
+            lambda,
+            mu,
+            h: 0.001,
+            memory: 0,
+            history_before_start: false,
+        }
     }
 
     #[test]
     fn fopid_with_unit_orders_equals_pid() {
         for hbs in [false, true] {
             for mem in [0usize, 1, 2, 50, 3000] {
-                let p = FopidParams { memory: mem, history_before_start: hbs, ..params(2.0, 0.1, 8.0, 1.0, 1.0) };
+                let p = FopidParams {
+                    memory: mem,
+                    history_before_start: hbs,
+                    ..params(2.0, 0.1, 8.0, 1.0, 1.0)
+                };
                 let mut f = FopidLaw::new(p).unwrap();
                 let mut q = PidLaw::new(p).unwrap();
                 for (n, &e) in signal(20_000).iter().enumerate() {
                     let (a, b) = (f.output(e), q.output(e));
-                    assert!((a - b).abs() < 1e-12 * b.abs().max(1.0), "L={mem} hbs={hbs} n={n}: {a} vs {b}");
+                    assert!(
+                        (a - b).abs() < 1e-12 * b.abs().max(1.0),
+                        "L={mem} hbs={hbs} n={n}: {a} vs {b}"
+                    );
                     f.push(e);
                     q.push(e);
                 }
@@ -311,22 +373,41 @@ mod tests {
         let e0 = 0.5;
         for mu in [1.0, 0.7, 1.5] {
             for mem in [0usize, 30] {
-                let p = FopidParams { memory: mem, history_before_start: true, ..params(0.0, 0.0, 1.0, 1.0, mu) };
+                let p = FopidParams {
+                    memory: mem,
+                    history_before_start: true,
+                    ..params(0.0, 0.0, 1.0, 1.0, mu)
+                };
                 let mut f = FopidLaw::new(p).unwrap();
                 // constant error that has always been there: full memory gives D^μ = 0; short memory
                 // gives the truncated sum e_0 h^{-μ} Σ_{j<L} w_j from the first sample on (no kick)
-                let expect = if mem == 0 { 0.0 } else { e0 * 1000f64.powf(mu) * gl_weights(mu, mem).iter().sum::<f64>() };
+                let expect = if mem == 0 {
+                    0.0
+                } else {
+                    e0 * 1000f64.powf(mu) * gl_weights(mu, mem).iter().sum::<f64>()
+                };
                 for _ in 0..200 {
-                    assert!((f.output(e0) - expect).abs() < 1e-9 * expect.abs().max(1.0), "μ={mu} L={mem}: {} vs {expect}", f.output(e0));
+                    assert!(
+                        (f.output(e0) - expect).abs() < 1e-9 * expect.abs().max(1.0),
+                        "μ={mu} L={mem}: {} vs {expect}",
+                        f.output(e0)
+                    );
                     f.push(e0);
                 }
-                let p0 = FopidParams { history_before_start: false, ..p };
+                let p0 = FopidParams {
+                    history_before_start: false,
+                    ..p
+                };
                 let f0 = FopidLaw::new(p0).unwrap();
                 assert!((f0.output(e0) - e0 * 1000f64.powf(mu)).abs() < 1e-9);
             }
         }
         // μ = 0: D^0 e = e whatever the option
-        let f = FopidLaw::new(FopidParams { history_before_start: true, ..params(0.0, 0.0, 1.0, 1.0, 0.0) }).unwrap();
+        let f = FopidLaw::new(FopidParams {
+            history_before_start: true,
+            ..params(0.0, 0.0, 1.0, 1.0, 0.0)
+        })
+        .unwrap();
         assert!((f.output(0.3) - 0.3).abs() < 1e-15);
     }
 
@@ -342,7 +423,9 @@ mod tests {
 
     #[test]
     fn serialized_state_continues_bit_identically() {
-        let p = FopidParams { ..params(2.0, 0.3, 5.0, 0.8, 1.3) };
+        let p = FopidParams {
+            ..params(2.0, 0.3, 5.0, 0.8, 1.3)
+        };
         let mut a = FopidLaw::new(p).unwrap();
         let e = signal(6000);
         for &x in &e[..2500] {
@@ -360,8 +443,17 @@ mod tests {
     #[test]
     fn state_is_the_history_once_and_restores_bit_identically() {
         let e = signal(20_000);
-        for (hbs, mem, ki) in [(false, 0usize, 0.3), (true, 0, 0.3), (true, 300, 0.0), (false, 5000, 0.2)] {
-            let p = FopidParams { memory: mem, history_before_start: hbs, ..params(2.0, ki, 5.0, 0.8, 1.3) };
+        for (hbs, mem, ki) in [
+            (false, 0usize, 0.3),
+            (true, 0, 0.3),
+            (true, 300, 0.0),
+            (false, 5000, 0.2),
+        ] {
+            let p = FopidParams {
+                memory: mem,
+                history_before_start: hbs,
+                ..params(2.0, ki, 5.0, 0.8, 1.3)
+            };
             let mut a = FopidLaw::new(p).unwrap();
             let mut q = PidLaw::new(p).unwrap();
             for &x in &e[..12_345] {
@@ -370,7 +462,11 @@ mod tests {
             }
             let bytes = postcard::to_allocvec(&a).unwrap();
             // 8 bytes per sample plus the parameters
-            assert!(bytes.len() <= 8 * 12_345 + 80, "{} bytes for 12,345 samples", bytes.len());
+            assert!(
+                bytes.len() <= 8 * 12_345 + 80,
+                "{} bytes for 12,345 samples",
+                bytes.len()
+            );
             let mut b: FopidLaw = postcard::from_bytes(&bytes).unwrap();
             let qb = postcard::to_allocvec(&q).unwrap();
             assert!(qb.len() <= 8 * 12_345 + 80);
@@ -385,8 +481,17 @@ mod tests {
             }
         }
         // absurd parameters in a decoded state are refused before anything is allocated
-        let p = FopidParams { memory: usize::MAX / 2, history_before_start: true, ..params(1.0, 1.0, 1.0, 0.5, 0.5) };
-        let bytes = postcard::to_allocvec(&StoredRef { p: &p, fast: true, history: &[0.1, 0.2] }).unwrap();
+        let p = FopidParams {
+            memory: usize::MAX / 2,
+            history_before_start: true,
+            ..params(1.0, 1.0, 1.0, 0.5, 0.5)
+        };
+        let bytes = postcard::to_allocvec(&StoredRef {
+            p: &p,
+            fast: true,
+            history: &[0.1, 0.2],
+        })
+        .unwrap();
         let err = postcard::from_bytes::<FopidLaw>(&bytes).err().unwrap();
         let _ = err;
         assert!(FopidLaw::new(p).err().unwrap().contains("gl_memory"));

@@ -9,8 +9,26 @@ pub use crate::math::sample_grid::SampleCounter;
 
 /// Law parameters from the declared variables (the bounds were checked by the FMI layer).
 #[allow(clippy::too_many_arguments)]
-pub fn law_params(kp: f64, ki: f64, kd: f64, lambda: f64, mu: f64, step: f64, gl_memory: i32, history_before_start: i32) -> FopidParams {
-    FopidParams { kp, ki, kd, lambda, mu, h: step, memory: gl_memory.max(0) as usize, history_before_start: history_before_start == 1 }
+pub fn law_params(
+    kp: f64,
+    ki: f64,
+    kd: f64,
+    lambda: f64,
+    mu: f64,
+    step: f64,
+    gl_memory: i32,
+    history_before_start: i32,
+) -> FopidParams {
+    FopidParams {
+        kp,
+        ki,
+        kd,
+        lambda,
+        mu,
+        h: step,
+        memory: gl_memory.max(0) as usize,
+        history_before_start: history_before_start == 1,
+    }
 }
 
 /// Most samples one communication step may take (as the plants' internal steps): bounds the work
@@ -74,7 +92,14 @@ pub fn sampled_output(law: &impl SampledLaw, theta_ref: f64, theta: f64) -> Resu
 
 /// One communication step doStep(t, h) of k samples (see [`samples_in_step`]): the inputs are held
 /// over the step, so the error of t_n joins the history k times (the law is sampled at t_n, t_n + step, …).
-pub fn sampled_step(law: &mut impl SampledLaw, clock: &SampleCounter, t: f64, h: f64, theta_ref: f64, theta: f64) -> Result<(), String> {
+pub fn sampled_step(
+    law: &mut impl SampledLaw,
+    clock: &SampleCounter,
+    t: f64,
+    h: f64,
+    theta_ref: f64,
+    theta: f64,
+) -> Result<(), String> {
     let k = samples_in_step(clock, law.samples(), t, h)?;
     let e = theta_ref - theta;
     for _ in 0..k {

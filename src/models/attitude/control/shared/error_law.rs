@@ -87,7 +87,12 @@ impl DcmError {
 /// The per-axis linear law of paper 000's PD, LQR and pole-placement controllers:
 /// T = k_e ⊙ e + k_w ⊙ ω, with e from `law` (≈ commanded minus actual angle). In the paper's
 /// convention the rate gain k_w is negative (it adds +k_d·rate with k_d < 0).
-pub fn linear_law(law: ErrorLaw, p: &AttitudeControllerPorts, k_e: &Vector3<f64>, k_w: &Vector3<f64>) -> Result<Vector3<f64>, String> {
+pub fn linear_law(
+    law: ErrorLaw,
+    p: &AttitudeControllerPorts,
+    k_e: &Vector3<f64>,
+    k_w: &Vector3<f64>,
+) -> Result<Vector3<f64>, String> {
     check_unit_quaternions(p)?;
     Ok(k_e.component_mul(&law.error(p)) + k_w.component_mul(&p.w))
 }

@@ -62,7 +62,11 @@ pub fn quat_vec_rate(q: &Quaternion<f64>, w: &Vector3<f64>) -> Vector3<f64> {
 /// Gyroscopic coupling per unit inertia, g = (G1 ω_y ω_z, G2 ω_x ω_z, G3 ω_x ω_y).
 pub fn gyro(w: &Vector3<f64>, inertia: &Vector3<f64>) -> Vector3<f64> {
     let (ix, iy, iz) = (inertia.x, inertia.y, inertia.z);
-    Vector3::new((iy - iz) / ix * w.y * w.z, (iz - ix) / iy * w.x * w.z, (ix - iy) / iz * w.x * w.y)
+    Vector3::new(
+        (iy - iz) / ix * w.y * w.z,
+        (iz - ix) / iy * w.x * w.z,
+        (ix - iy) / iz * w.x * w.y,
+    )
 }
 
 /// χ = −¼ q_v |ω|² + ½ M(q) g: the part of q̈_v that does not depend on the torque.
@@ -93,14 +97,23 @@ pub fn outer_loop(q: &Quaternion<f64>, w: &Vector3<f64>, r: &Reference, k: &Gain
 }
 
 /// Torque command of the feedback-linearising law: I ⊙ 2 M(q)⁻¹ (u'' − χ)   (paper 004 Eqs. 1–3).
-pub fn control_torque(q: &Quaternion<f64>, w: &Vector3<f64>, r: &Reference, inertia: &Vector3<f64>, k: &Gains) -> Result<Vector3<f64>, String> {
+pub fn control_torque(
+    q: &Quaternion<f64>,
+    w: &Vector3<f64>,
+    r: &Reference,
+    inertia: &Vector3<f64>,
+    k: &Gains,
+) -> Result<Vector3<f64>, String> {
     let rhs = (outer_loop(q, w, r, k) - chi(q, w, inertia)) * 2.0;
     let u_prime = solve_m(q, &rhs)?;
     let torque = inertia.component_mul(&u_prime);
     if torque.iter().all(|x| x.is_finite()) {
         Ok(torque)
     } else {
-        Err(format!("feedback linearisation produced a non-finite torque {:?}", torque.as_slice()))
+        Err(format!(
+            "feedback linearisation produced a non-finite torque {:?}",
+            torque.as_slice()
+        ))
     }
 }
 
@@ -162,7 +175,8 @@ impl OpenLoopCopy {
         e0_dot: &Vector3<f64>,
     ) -> Result<Self, String> {
         let i = Matrix3::from_diagonal(inertia);
-        let chol = nalgebra::Cholesky::new(i).ok_or_else(|| format!("inertia {:?} is not positive definite", inertia.as_slice()))?;
+        let chol = nalgebra::Cholesky::new(i)
+            .ok_or_else(|| format!("inertia {:?} is not positive definite", inertia.as_slice()))?;
         if max_step.is_nan() || max_step <= 0.0 {
             return Err(format!("max_internal_step = {max_step} must be positive"));
         }
@@ -171,7 +185,14 @@ impl OpenLoopCopy {
         x.as_mut_slice()[4..7].copy_from_slice(w0.as_slice());
         x.as_mut_slice()[7..10].copy_from_slice(e0.as_slice());
         x.as_mut_slice()[10..13].copy_from_slice(e0_dot.as_slice());
-        Ok(OpenLoopCopy { x, inertia: i, inertia_inv: chol.inverse(), limit: *limit, gains, max_step })
+        Ok(OpenLoopCopy {
+            x,
+            inertia: i,
+            inertia_inv: chol.inverse(),
+            limit: *limit,
+            gains,
+            max_step,
+        })
     }
 
     pub fn q(&self) -> Quaternion<f64> {
@@ -230,11 +251,17 @@ impl OpenLoopCopy {
             let mut f = |_t: f64, xx: &CopyState| self.derivative(xx, &tau);
             x = rk4(&mut f, tk, &x, dt);
             if !x.iter().all(|c| c.is_finite()) {
-                return Err(format!("reference corrector: open-loop state became non-finite at t = {}", tk + dt));
+                return Err(format!(
+                    "reference corrector: open-loop state became non-finite at t = {}",
+                    tk + dt
+                ));
             }
             let nq = x.fixed_rows::<4>(0).norm();
             if nq <= 0.0 {
-                return Err(format!("reference corrector: quaternion norm became zero at t = {}", tk + dt));
+                return Err(format!(
+                    "reference corrector: quaternion norm became zero at t = {}",
+                    tk + dt
+                ));
             }
             x.fixed_rows_mut::<4>(0).unscale_mut(nq);
         }
@@ -261,7 +288,10 @@ mod tests {
     use crate::math::attitude::quat_from_euler321;
 
     fn gains() -> Gains {
-        Gains { k_q: Vector3::repeat(0.5), k_qdot: Vector3::repeat(2.0) }
+        Gains {
+            k_q: Vector3::repeat(0.5),
+            k_qdot: Vector3::repeat(2.0),
+        }
     }
     const I4: [f64; 3] = [449.5, 264.5, 312.5];
 
@@ -340,7 +370,10 @@ mod tests {
     #[test]
     fn zero_error_at_rest_gives_zero_torque() {
         let q = quat_from_euler321(0.1, 0.2, 0.3);
-        let r = Reference { q_v: q.vector().into_owned(), ..Default::default() };
+        let r = Reference {
+            q_v: q.vector().into_owned(),
+            ..Default::default()
+        };
         let t = control_torque(&q, &Vector3::zeros(), &r, &inertia(), &gains()).unwrap();
         assert!(t.norm() < 1e-12);
     }
@@ -351,7 +384,17 @@ mod tests {
         let g = gains();
         let lim = Vector3::repeat(1.0);
         let q0 = quat_from_euler321(0.14, -0.07, 0.1);
-        let mut copy = OpenLoopCopy::new(&inertia(), &lim, g, 0.01, &q0, &Vector3::new(0.01, 0.0, -0.02), &Vector3::zeros(), &Vector3::zeros()).unwrap();
+        let mut copy = OpenLoopCopy::new(
+            &inertia(),
+            &lim,
+            g,
+            0.01,
+            &q0,
+            &Vector3::new(0.01, 0.0, -0.02),
+            &Vector3::zeros(),
+            &Vector3::zeros(),
+        )
+        .unwrap();
         for k in 0..50 {
             let u = Vector3::new(0.8 * (0.1 * k as f64).sin(), -1.7, 0.3);
             let r = copy.reference(&u);
@@ -367,8 +410,17 @@ mod tests {
         // ë + 2 ė + 0.5 e = 0 → e(t) = c1 e^{p1 t} + c2 e^{p2 t}, p = −1 ± √2/2
         let g = gains();
         let e0 = Vector3::new(0.01, -0.02, 0.005);
-        let mut copy =
-            OpenLoopCopy::new(&inertia(), &Vector3::repeat(1.0), g, 0.01, &Quaternion::identity(), &Vector3::zeros(), &e0, &Vector3::zeros()).unwrap();
+        let mut copy = OpenLoopCopy::new(
+            &inertia(),
+            &Vector3::repeat(1.0),
+            g,
+            0.01,
+            &Quaternion::identity(),
+            &Vector3::zeros(),
+            &e0,
+            &Vector3::zeros(),
+        )
+        .unwrap();
         let (p1, p2) = (-1.0 + 0.5f64.sqrt(), -1.0 - 0.5f64.sqrt());
         // e(0) = e0, ė(0) = 0: c1 = −p2 e0/(p1 − p2), c2 = p1 e0/(p1 − p2)
         let t_end = 5.0;

@@ -51,7 +51,11 @@ impl Mrac {
     }
 
     /// Writes the torque and the common MRAC outputs; returns the signals for model-specific outputs.
-    pub fn outputs(&self, ports: &mut AttitudeControllerPorts, vars: &mut MracVariables) -> Result<MracOutputs, String> {
+    pub fn outputs(
+        &self,
+        ports: &mut AttitudeControllerPorts,
+        vars: &mut MracVariables,
+    ) -> Result<MracOutputs, String> {
         let o = mrac_outputs(&self.core, &self.st, ports)?;
         ports.torque_cmd = o.torque;
         vars.set_outputs(&o);
@@ -73,9 +77,15 @@ impl Mrac {
 impl MracState {
     /// Invariants of a restored state: finite, estimate not below its bound.
     pub fn validate(&self, core: &MracCore) -> Result<(), String> {
-        crate::model::check_finite_state("reference model and inertia estimate", self.xm.iter().chain(&self.xm_dot).chain(&self.ihat))?;
+        crate::model::check_finite_state(
+            "reference model and inertia estimate",
+            self.xm.iter().chain(&self.xm_dot).chain(&self.ihat),
+        )?;
         if self.ihat.iter().zip(&core.ihat_min).any(|(i, m)| i < m) {
-            return Err(format!("restored state: inertia estimate {:?} is below its bound {:?}", self.ihat, core.ihat_min));
+            return Err(format!(
+                "restored state: inertia estimate {:?} is below its bound {:?}",
+                self.ihat, core.ihat_min
+            ));
         }
         Ok(())
     }
@@ -87,12 +97,29 @@ impl MracVariables {
     pub fn core(&mut self, gains: ReferenceGains) -> Result<(MracCore, MracState), String> {
         let coordinates = MracCoordinates::from_param("coordinates", self.coordinates)?;
         // I^(0) = ihat0 where given, else the nominal inertia
-        let i0 = self.ihat0.zip_map(&self.inertia, |given, nominal| if given == 0.0 { nominal } else { given });
+        let i0 = self.ihat0.zip_map(
+            &self.inertia,
+            |given, nominal| if given == 0.0 { nominal } else { given },
+        );
         let imin = i0 * self.ihat_min_ratio;
         self.ihat_init = i0;
         self.ihat_min = imin;
-        let core = MracCore { coordinates, lambda: self.lambda, gamma: self.gamma, ihat_min: imin.into(), gains };
-        Ok((core, MracState { xm: [0.0; 3], xm_dot: [0.0; 3], ihat: i0.into(), started: false }))
+        let core = MracCore {
+            coordinates,
+            lambda: self.lambda,
+            gamma: self.gamma,
+            ihat_min: imin.into(),
+            gains,
+        };
+        Ok((
+            core,
+            MracState {
+                xm: [0.0; 3],
+                xm_dot: [0.0; 3],
+                ihat: i0.into(),
+                started: false,
+            },
+        ))
     }
 
     /// Writes the common MRAC outputs.
@@ -118,8 +145,19 @@ crate::param_enum! {
 /// Reference-model gains: fixed (MRAC) or fuzzy-scheduled per axis (adaptive fuzzy).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum ReferenceGains {
-    Fixed { lambda1: f64, lambda2: f64 },
-    Fuzzy { fuzzy: PdFuzzySystem, lambda1_min: f64, lambda1_max: f64, lambda2_min: f64, lambda2_max: f64, e_scale: f64, edot_scale: f64 },
+    Fixed {
+        lambda1: f64,
+        lambda2: f64,
+    },
+    Fuzzy {
+        fuzzy: PdFuzzySystem,
+        lambda1_min: f64,
+        lambda1_max: f64,
+        lambda2_min: f64,
+        lambda2_max: f64,
+        e_scale: f64,
+        edot_scale: f64,
+    },
 }
 
 impl ReferenceGains {
@@ -127,9 +165,20 @@ impl ReferenceGains {
     pub fn axis(&self, e_m: f64, edot_m: f64) -> (f64, f64) {
         match *self {
             ReferenceGains::Fixed { lambda1, lambda2 } => (lambda1, lambda2),
-            ReferenceGains::Fuzzy { fuzzy, lambda1_min, lambda1_max, lambda2_min, lambda2_max, e_scale, edot_scale } => {
+            ReferenceGains::Fuzzy {
+                fuzzy,
+                lambda1_min,
+                lambda1_max,
+                lambda2_min,
+                lambda2_max,
+                e_scale,
+                edot_scale,
+            } => {
                 let (kp, kd) = fuzzy.infer(e_m / e_scale, edot_m / edot_scale);
-                (lambda1_min + (lambda1_max - lambda1_min) * kd, lambda2_min + (lambda2_max - lambda2_min) * kp)
+                (
+                    lambda1_min + (lambda1_max - lambda1_min) * kd,
+                    lambda2_min + (lambda2_max - lambda2_min) * kp,
+                )
             }
         }
     }
@@ -152,7 +201,11 @@ pub fn m_matrix(q: &Quaternion<f64>) -> Matrix3<f64> {
 }
 
 fn short_way(q: Quaternion<f64>) -> Quaternion<f64> {
-    if q.w < 0.0 { -q } else { q }
+    if q.w < 0.0 {
+        -q
+    } else {
+        q
+    }
 }
 
 /// Adaptive state: reference model x_m, ẋ_m and the inertia estimate Î (per axis).
@@ -196,12 +249,24 @@ impl MracCore {
                 let qbar = short_way(inp.q);
                 let qr = short_way(inp.q_ref);
                 let x = qbar.vector().into_owned() * 2.0;
-                Measured { x, xdot: m_matrix(&qbar) * inp.w, r: qr.vector().into_owned() * 2.0, qbar, w: inp.w }
+                Measured {
+                    x,
+                    xdot: m_matrix(&qbar) * inp.w,
+                    r: qr.vector().into_owned() * 2.0,
+                    qbar,
+                    w: inp.w,
+                }
             }
             MracCoordinates::Linear => {
                 let x = Vector3::from(euler321_from_quat(&inp.q));
                 let r = Vector3::from(euler321_from_quat(&inp.q_ref));
-                Measured { x, xdot: inp.w, r, qbar: inp.q, w: inp.w }
+                Measured {
+                    x,
+                    xdot: inp.w,
+                    r,
+                    qbar: inp.q,
+                    w: inp.w,
+                }
             }
         }
     }
@@ -211,7 +276,12 @@ impl MracCore {
         if st.started {
             *st
         } else {
-            MracState { xm: m.x.into(), xm_dot: [0.0; 3], ihat: st.ihat, started: true }
+            MracState {
+                xm: m.x.into(),
+                xm_dot: [0.0; 3],
+                ihat: st.ihat,
+                started: true,
+            }
         }
     }
 
@@ -227,7 +297,14 @@ impl MracCore {
         let lam = self.lambda;
         let v = xm_ddot - xtd * (2.0 * lam) - xt * (lam * lam);
         let s = xtd + xt * lam;
-        Signals { lambda1: l1, lambda2: l2, xm_ddot, xt, s, v }
+        Signals {
+            lambda1: l1,
+            lambda2: l2,
+            xm_ddot,
+            xt,
+            s,
+            v,
+        }
     }
 
     /// Torque for the current inputs and state.
@@ -236,7 +313,10 @@ impl MracCore {
             MracCoordinates::Quaternion => {
                 let q = m.qbar;
                 if q.w < 1e-9 {
-                    return Err(format!("MRAC quaternion coordinates are singular at q_w = {} (180 deg attitude)", q.w));
+                    return Err(format!(
+                        "MRAC quaternion coordinates are singular at q_w = {} (180 deg attitude)",
+                        q.w
+                    ));
                 }
                 let qv = q.vector().into_owned();
                 let m_inv = Matrix3::identity() * q.w - skew(&qv) + qv * qv.transpose() / q.w;
@@ -257,7 +337,11 @@ impl MracCore {
             d[i] = xmd[i];
             d[3 + i] = sig.xm_ddot[i];
             let idot = -self.gamma * sig.v[i] * sig.s[i];
-            d[6 + i] = if y[6 + i] <= self.ihat_min[i] && idot < 0.0 { 0.0 } else { idot };
+            d[6 + i] = if y[6 + i] <= self.ihat_min[i] && idot < 0.0 {
+                0.0
+            } else {
+                idot
+            };
         }
         d
     }
@@ -285,7 +369,12 @@ impl MracCore {
         if !y.iter().all(|v| v.is_finite()) {
             return Err("MRAC state became non-finite (check gamma, lambda and the inputs)".into());
         }
-        Ok(MracState { xm: [y[0], y[1], y[2]], xm_dot: [y[3], y[4], y[5]], ihat: [y[6], y[7], y[8]], started: true })
+        Ok(MracState {
+            xm: [y[0], y[1], y[2]],
+            xm_dot: [y[3], y[4], y[5]],
+            ihat: [y[6], y[7], y[8]],
+            started: true,
+        })
     }
 
     /// Largest internal RK4 step of the adaptive state (project choice).
@@ -307,7 +396,12 @@ pub fn mrac_outputs(core: &MracCore, st: &MracState, inp: &AttitudeControllerPor
     let e = core.effective(st, &m);
     let sig = core.signals(&m, &Vector3::from(e.xm), &Vector3::from(e.xm_dot));
     let torque = core.torque(&m, &sig, &Vector3::from(e.ihat))?;
-    Ok(MracOutputs { torque, state: e, sig, x: m.x })
+    Ok(MracOutputs {
+        torque,
+        state: e,
+        sig,
+        x: m.x,
+    })
 }
 
 /// HTML of the adaptive law shared by both MRAC-type models.
@@ -330,7 +424,12 @@ mod tests {
     use crate::math::attitude::{quat, quat_derivative};
 
     fn inputs(q: Quaternion<f64>, w: Vector3<f64>, q_ref: Quaternion<f64>) -> AttitudeControllerPorts {
-        AttitudeControllerPorts { q, w, q_ref, ..Default::default() }
+        AttitudeControllerPorts {
+            q,
+            w,
+            q_ref,
+            ..Default::default()
+        }
     }
 
     /// With Î = I the quaternion law gives ẍ = v exactly: checked by a central second difference of
@@ -338,11 +437,25 @@ mod tests {
     #[test]
     fn exact_inertia_feedback_linearises() {
         let inertia = Vector3::new(1000.0, 500.0, 700.0);
-        let core = MracCore { coordinates: MracCoordinates::Quaternion, lambda: 2.0, gamma: 0.0, ihat_min: [1.0; 3], gains: ReferenceGains::Fixed { lambda1: 2.0, lambda2: 1.0 } };
+        let core = MracCore {
+            coordinates: MracCoordinates::Quaternion,
+            lambda: 2.0,
+            gamma: 0.0,
+            ihat_min: [1.0; 3],
+            gains: ReferenceGains::Fixed {
+                lambda1: 2.0,
+                lambda2: 1.0,
+            },
+        };
         let q = quat(0.8, 0.3, -0.4, 0.2).normalize();
         let w = Vector3::new(0.05, -0.12, 0.2);
         let q_ref = quat(0.9, -0.2, 0.3, 0.1).normalize();
-        let st = MracState { xm: [0.1, -0.2, 0.05], xm_dot: [0.01, 0.02, -0.03], ihat: inertia.into(), started: true };
+        let st = MracState {
+            xm: [0.1, -0.2, 0.05],
+            xm_dot: [0.01, 0.02, -0.03],
+            ihat: inertia.into(),
+            started: true,
+        };
         let inp = inputs(q, w, q_ref);
         let o = mrac_outputs(&core, &st, &inp).unwrap();
         let f = |q: Quaternion<f64>, w: Vector3<f64>| {
@@ -360,14 +473,34 @@ mod tests {
         };
         let h = 1e-3;
         let xdd = (x_at(h) - q.vector().into_owned() * 4.0 + x_at(-h)) / (h * h);
-        assert!((xdd - o.sig.v).norm() < 1e-6 * o.sig.v.norm().max(1e-3), "{xdd} vs {}", o.sig.v);
+        assert!(
+            (xdd - o.sig.v).norm() < 1e-6 * o.sig.v.norm().max(1e-3),
+            "{xdd} vs {}",
+            o.sig.v
+        );
     }
 
     #[test]
     fn estimate_respects_lower_bound() {
-        let core = MracCore { coordinates: MracCoordinates::Linear, lambda: 2.0, gamma: 1e9, ihat_min: [50.0; 3], gains: ReferenceGains::Fixed { lambda1: 2.0, lambda2: 1.0 } };
-        let inp = inputs(quat(1.0, 0.0, 0.0, 0.0), Vector3::new(0.3, -0.3, 0.2), quat(0.9, 0.3, 0.2, 0.1).normalize());
-        let mut st = MracState { ihat: [500.0; 3], ..Default::default() };
+        let core = MracCore {
+            coordinates: MracCoordinates::Linear,
+            lambda: 2.0,
+            gamma: 1e9,
+            ihat_min: [50.0; 3],
+            gains: ReferenceGains::Fixed {
+                lambda1: 2.0,
+                lambda2: 1.0,
+            },
+        };
+        let inp = inputs(
+            quat(1.0, 0.0, 0.0, 0.0),
+            Vector3::new(0.3, -0.3, 0.2),
+            quat(0.9, 0.3, 0.2, 0.1).normalize(),
+        );
+        let mut st = MracState {
+            ihat: [500.0; 3],
+            ..Default::default()
+        };
         let meas = core.measure(&inp);
         for _ in 0..100 {
             st = core.step(&st, &meas, 0.01).unwrap();
@@ -375,4 +508,3 @@ mod tests {
         }
     }
 }
-

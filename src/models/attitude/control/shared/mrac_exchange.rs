@@ -26,13 +26,24 @@ const IHAT_Z: [&str; 14] = names(&[&Q, &W, &Q_REF, &["state_xm_z", "state_xm_dot
 
 /// The continuous states of an MRAC-type controller under Model Exchange: x_m, ẋ_m, Î.
 pub const MRAC_STATES: [StateDecl; 9] = [
-    StateDecl::new("state_xm_x", "", "Continuous state: reference-model state x_m,x").depends_on(&["state_xm_dot_x"]).starting_from(&Q),
-    StateDecl::new("state_xm_y", "", "Continuous state: reference-model state x_m,y").depends_on(&["state_xm_dot_y"]).starting_from(&Q),
-    StateDecl::new("state_xm_z", "", "Continuous state: reference-model state x_m,z").depends_on(&["state_xm_dot_z"]).starting_from(&Q),
+    StateDecl::new("state_xm_x", "", "Continuous state: reference-model state x_m,x")
+        .depends_on(&["state_xm_dot_x"])
+        .starting_from(&Q),
+    StateDecl::new("state_xm_y", "", "Continuous state: reference-model state x_m,y")
+        .depends_on(&["state_xm_dot_y"])
+        .starting_from(&Q),
+    StateDecl::new("state_xm_z", "", "Continuous state: reference-model state x_m,z")
+        .depends_on(&["state_xm_dot_z"])
+        .starting_from(&Q),
     StateDecl::new("state_xm_dot_x", "1/s", "Continuous state: reference-model rate x_m,x'").depends_on(&XM_DOT_X),
     StateDecl::new("state_xm_dot_y", "1/s", "Continuous state: reference-model rate x_m,y'").depends_on(&XM_DOT_Y),
     StateDecl::new("state_xm_dot_z", "1/s", "Continuous state: reference-model rate x_m,z'").depends_on(&XM_DOT_Z),
-    StateDecl::new("state_ihat_x", "kg.m2", "Continuous state: inertia estimate I^_x (kept at or above ihat_min_x)").depends_on(&IHAT_X),
+    StateDecl::new(
+        "state_ihat_x",
+        "kg.m2",
+        "Continuous state: inertia estimate I^_x (kept at or above ihat_min_x)",
+    )
+    .depends_on(&IHAT_X),
     StateDecl::new("state_ihat_y", "kg.m2", "Continuous state: inertia estimate I^_y").depends_on(&IHAT_Y),
     StateDecl::new("state_ihat_z", "kg.m2", "Continuous state: inertia estimate I^_z").depends_on(&IHAT_Z),
 ];
@@ -44,7 +55,8 @@ pub const MRAC_STATES: [StateDecl; 9] = [
 #[doc(hidden)]
 macro_rules! mrac_model_exchange {
     () => {
-        const STATES: Option<&'static [$crate::model::StateDecl]> = Some(&$crate::models::attitude::control::shared::mrac_exchange::MRAC_STATES);
+        const STATES: Option<&'static [$crate::model::StateDecl]> =
+            Some(&$crate::models::attitude::control::shared::mrac_exchange::MRAC_STATES);
         fn get_states(&self, v: &Self::Vars, x: &mut [f64]) {
             self.0.get_states(&v.ports, x)
         }
@@ -74,7 +86,12 @@ impl Mrac {
 
     pub fn set_states(&mut self, x: &[f64]) {
         let v3 = |i: usize| [x[i], x[i + 1], x[i + 2]];
-        self.st = MracState { xm: v3(0), xm_dot: v3(3), ihat: v3(6), started: true };
+        self.st = MracState {
+            xm: v3(0),
+            xm_dot: v3(3),
+            ihat: v3(6),
+            started: true,
+        };
     }
 
     /// d/dt [x_m, ẋ_m, Î] for the current inputs (Î held at its bound where the law would push it below).

@@ -21,7 +21,9 @@ pub fn check_unit_quaternions(p: &AttitudeControllerPorts) -> Result<(), String>
     for (name, q) in [("q", p.q), ("q_ref", p.q_ref)] {
         let n = q.norm();
         if (n - 1.0).abs() > 1e-3 {
-            return Err(format!("input quaternion {name} has norm {n}, expected 1 (is it connected?)"));
+            return Err(format!(
+                "input quaternion {name} has norm {n}, expected 1 (is it connected?)"
+            ));
         }
     }
     Ok(())

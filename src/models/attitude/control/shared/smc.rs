@@ -67,9 +67,15 @@ impl SmcVariables {
     pub fn law(&self) -> Result<SmcLaw, String> {
         let d = self.inertia;
         let i = Matrix3::new(
-            d.x, self.inertia_xy, self.inertia_xz,
-            self.inertia_xy, d.y, self.inertia_yz,
-            self.inertia_xz, self.inertia_yz, d.z,
+            d.x,
+            self.inertia_xy,
+            self.inertia_xz,
+            self.inertia_xy,
+            d.y,
+            self.inertia_yz,
+            self.inertia_xz,
+            self.inertia_yz,
+            d.z,
         );
         if i.cholesky().is_none() {
             return Err(format!(
@@ -77,7 +83,11 @@ impl SmcVariables {
                 d.x, d.y, d.z, self.inertia_xy, self.inertia_xz, self.inertia_yz
             ));
         }
-        Ok(SmcLaw { inertia: i, lambda: self.lambda, phi: self.boundary_layer })
+        Ok(SmcLaw {
+            inertia: i,
+            lambda: self.lambda,
+            phi: self.boundary_layer,
+        })
     }
 
     /// Writes the diagnostic outputs and returns the torque T = T_eq − K ⊙ sat(s/Φ); fails on a
@@ -85,7 +95,9 @@ impl SmcVariables {
     pub fn finish(&mut self, law: &SmcLaw, sig: &SmcSignals, k: &Vector3<f64>) -> Result<Vector3<f64>, String> {
         let torque = law.torque(sig, k);
         if !torque.iter().all(|t| t.is_finite()) {
-            return Err(format!("sliding-mode torque is not finite ({torque:?}); check the inputs q, w, q_ref, w_ref, h_wheel"));
+            return Err(format!(
+                "sliding-mode torque is not finite ({torque:?}); check the inputs q, w, q_ref, w_ref, h_wheel"
+            ));
         }
         self.q_err = sig.q_ev;
         self.k_gain = *k;
@@ -111,8 +123,14 @@ impl SmcLaw {
         let w_e = p.w - w_ref_b;
         let s = w_e + qv * self.lambda;
         let qv_dot = (w_e * qe.w + qv.cross(&w_e)) * 0.5;
-        let t_eq = p.w.cross(&(self.inertia * p.w + h_wheel)) - self.inertia * (qv_dot * self.lambda + w_e.cross(&w_ref_b));
-        Ok(SmcSignals { q_ev: qv, q_ev_dot: qv_dot, s, t_eq })
+        let t_eq =
+            p.w.cross(&(self.inertia * p.w + h_wheel)) - self.inertia * (qv_dot * self.lambda + w_e.cross(&w_ref_b));
+        Ok(SmcSignals {
+            q_ev: qv,
+            q_ev_dot: qv_dot,
+            s,
+            t_eq,
+        })
     }
 
     /// T = T_eq − K ⊙ sat(s/Φ).
@@ -138,8 +156,19 @@ mod tests {
     use crate::math::attitude::{quat, quat_derivative, quat_from_euler321};
     use nalgebra::Quaternion;
 
-    fn ports(q: Quaternion<f64>, w: Vector3<f64>, q_ref: Quaternion<f64>, w_ref: Vector3<f64>) -> AttitudeControllerPorts {
-        AttitudeControllerPorts { q, w, q_ref, w_ref, ..Default::default() }
+    fn ports(
+        q: Quaternion<f64>,
+        w: Vector3<f64>,
+        q_ref: Quaternion<f64>,
+        w_ref: Vector3<f64>,
+    ) -> AttitudeControllerPorts {
+        AttitudeControllerPorts {
+            q,
+            w,
+            q_ref,
+            w_ref,
+            ..Default::default()
+        }
     }
 
     /// Rigid body with wheels, I ω̇ = T − ω × (Iω + h), h constant, q̇ = ½ q ⊗ ω: under T = T_eq the
@@ -159,8 +188,15 @@ mod tests {
         let dt = 1e-3;
         // state derivative under the equivalent control
         let f = |q: Quaternion<f64>, w: Vector3<f64>, q_ref: Quaternion<f64>| {
-            let t = law.signals(&ports(q.normalize(), w, q_ref.normalize(), w_ref), &h).unwrap().t_eq;
-            (quat_derivative(&q, &w), i_inv * (t - w.cross(&(law.inertia * w + h))), quat_derivative(&q_ref, &w_ref))
+            let t = law
+                .signals(&ports(q.normalize(), w, q_ref.normalize(), w_ref), &h)
+                .unwrap()
+                .t_eq;
+            (
+                quat_derivative(&q, &w),
+                i_inv * (t - w.cross(&(law.inertia * w + h))),
+                quat_derivative(&q_ref, &w_ref),
+            )
         };
         for _ in 0..2000 {
             let (a1, b1, c1) = f(q, w, q_ref);
@@ -171,10 +207,18 @@ mod tests {
             w += (b1 + b2 * 2.0 + b3 * 2.0 + b4) * (dt / 6.0);
             q_ref += (c1 + c2 * 2.0 + c3 * 2.0 + c4) * (dt / 6.0);
         }
-        let s1 = law.signals(&ports(q.normalize(), w, q_ref.normalize(), w_ref), &h).unwrap().s;
-        assert!((s1 - s0).norm() < 1e-9 * s0.norm().max(1.0), "s moved from {s0:?} to {s1:?}");
+        let s1 = law
+            .signals(&ports(q.normalize(), w, q_ref.normalize(), w_ref), &h)
+            .unwrap()
+            .s;
+        assert!(
+            (s1 - s0).norm() < 1e-9 * s0.norm().max(1.0),
+            "s moved from {s0:?} to {s1:?}"
+        );
         // and the finish step writes the diagnostics
-        let sig = law.signals(&ports(q.normalize(), w, q_ref.normalize(), w_ref), &h).unwrap();
+        let sig = law
+            .signals(&ports(q.normalize(), w, q_ref.normalize(), w_ref), &h)
+            .unwrap();
         let t = v.finish(&law, &sig, &Vector3::repeat(0.01)).unwrap();
         assert_eq!(v.s, sig.s);
         assert!((t - law.torque(&sig, &Vector3::repeat(0.01))).norm() == 0.0);
@@ -188,8 +232,12 @@ mod tests {
         let q = quat_from_euler321(0.2, 0.1, -0.3);
         let q_ref = quat(1.0, 0.0, 0.0, 0.0);
         let w = Vector3::new(0.01, 0.0, -0.02);
-        let a = law.signals(&ports(q, w, q_ref, Vector3::zeros()), &Vector3::zeros()).unwrap();
-        let b = law.signals(&ports(-q, w, q_ref, Vector3::zeros()), &Vector3::zeros()).unwrap();
+        let a = law
+            .signals(&ports(q, w, q_ref, Vector3::zeros()), &Vector3::zeros())
+            .unwrap();
+        let b = law
+            .signals(&ports(-q, w, q_ref, Vector3::zeros()), &Vector3::zeros())
+            .unwrap();
         assert!((a.s - b.s).norm() < 1e-15 && (a.q_ev - q.vector() * q.w.signum()).norm() < 1e-15);
         // far outside the boundary layer: T = T_eq − K sign(s)
         let k = Vector3::new(1.0, 2.0, 3.0);
