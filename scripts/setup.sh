@@ -10,6 +10,17 @@ if ! command -v cargo >/dev/null 2>&1; then
     echo "setup: cargo not found. Install the Rust toolchain (https://rustup.rs), then re-run." >&2
     exit 1
 fi
+# The lint gates of scripts/lint.sh need rustfmt and clippy; a rustup toolchain adds them as components.
+for c in rustfmt clippy; do
+    if ! cargo "$c" --version >/dev/null 2>&1; then
+        if command -v rustup >/dev/null 2>&1; then
+            echo "setup: adding the $c component"
+            rustup component add "$c" >/dev/null
+        else
+            echo "setup: cargo $c is missing (install the $c component of your Rust toolchain)" >&2
+        fi
+    fi
+done
 # System tools the tests use: gcc (the hostile C master of tests/test_hardening.py) and valgrind
 # (memcheck). Installed with apt-get where missing and we are root (CI, fresh machines).
 can_apt() { [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; }

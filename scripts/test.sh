@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
-# Runs every test: Rust unit and integration tests, then the pytest suite that drives the built FMUs
+# Runs every test: the lint gates (scripts/lint.sh), Rust unit and integration tests, then the pytest suite that drives the built FMUs
 # through fmpy, the papers' tests in their plug-in folders, the import-layer contract and the wheel test.
 # Sets up the toolchain check and the Python venv first; fails on any failure.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
 scripts/build_fmus.sh
+scripts/lint.sh   # cargo fmt --check, cargo clippy -D warnings, ruff check
 cargo test --release --locked
 .venv/bin/python -m pytest -q   # testpaths (pyproject.toml): tests/ and the papers' own tests under scfmu/

@@ -25,8 +25,10 @@ const fn u(kg: i32, m: i32, s: i32, a: i32, rad: i32) -> BaseUnit {
 
 const DEG: f64 = std::f64::consts::PI / 180.0;
 
-/// (name, base unit, display units with their factor to the base unit)
-pub const UNITS: &[(&str, BaseUnit, &[(&str, f64)])] = &[
+/// One unit: (name, base unit, display units with their factor to the base unit).
+pub type UnitRow = (&'static str, BaseUnit, &'static [(&'static str, f64)]);
+
+pub const UNITS: &[UnitRow] = &[
     ("s", u(0, 0, 1, 0, 0), &[]),
     ("1/s", u(0, 0, -1, 0, 0), &[]),
     ("1/s2", u(0, 0, -2, 0, 0), &[]),
@@ -103,7 +105,7 @@ pub const fn is_defined(name: &str) -> bool {
     false
 }
 
-pub fn lookup(name: &str) -> Option<&'static (&'static str, BaseUnit, &'static [(&'static str, f64)])> {
+pub fn lookup(name: &str) -> Option<&'static UnitRow> {
     UNITS.iter().find(|(n, _, _)| *n == name)
 }
 

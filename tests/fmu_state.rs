@@ -131,7 +131,6 @@ fn corrupted_or_foreign_bytes_are_refused() {
         OK
     );
     assert_eq!(fmi2FreeFMUstate(q.c, &mut good), OK);
-    let mut s = s;
     assert_eq!(fmi2FreeFMUstate(p.c, &mut s), OK);
 }
 

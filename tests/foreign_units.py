@@ -241,7 +241,7 @@ def c3_model_description(model: str) -> str:
             f'  <LogCategories>\n    <Category name="logStatusError"/>\n  </LogCategories>\n'
             f'  <DefaultExperiment startTime="0" stopTime="10" stepSize="0.01"/>\n'
             f'  <ModelVariables>\n' + "".join(f"    {x}\n" for x in variables) + '  </ModelVariables>\n'
-            f'  <ModelStructure>\n' + "".join(f"    {x}\n" for x in structure) + '  </ModelStructure>\n'
+            '  <ModelStructure>\n' + "".join(f"    {x}\n" for x in structure) + '  </ModelStructure>\n'
             '</fmiModelDescription>\n')
 
 

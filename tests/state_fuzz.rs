@@ -154,13 +154,13 @@ fn mutated_states_of_every_fmu_are_refused_or_usable() {
             let mut what = vec![];
             for _ in 0..n {
                 // half of the changes in the first 512 payload bytes (header, parameters, flags)
-                let span = if rng.next() % 2 == 0 {
+                let span = if rng.next().is_multiple_of(2) {
                     payload.len().min(512)
                 } else {
                     payload.len()
                 };
                 let at = payload.start + rng.below(span);
-                if rng.next() % 2 == 0 {
+                if rng.next().is_multiple_of(2) {
                     b[at] ^= 1 << rng.below(8);
                 } else {
                     b[at] = rng.next() as u8;

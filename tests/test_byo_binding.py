@@ -22,7 +22,6 @@ import math
 import subprocess
 import sys
 
-import numpy as np
 import pytest
 
 import foreign_units as fu

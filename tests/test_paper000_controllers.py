@@ -17,15 +17,13 @@ from fmpy.validation import validate_fmu
 from scfmu.engines.reference import CoSimulation
 from scfmu.fmu import Fmu
 from scfmu.fmu import fmu_path
+from quat_oracle import q321, qconj, qmul  # independent helpers shared by the tests
 
 NEW = ["LqrController", "PolePlacementController", "MracController", "FuzzyPdController", "AdaptiveFuzzyController"]
 INERTIA = (1000.0, 500.0, 700.0)
 LARGE = (math.radians(40.0), math.radians(-40.0), math.radians(-60.0))
 SMALL = (math.radians(4.0), math.radians(-4.0), math.radians(-6.0))
 AX = "xyz"
-
-
-from quat_oracle import q321, qconj, qmul  # independent helpers shared by the tests
 
 
 def set_att(ctrl: Fmu, q, w, q_ref):
@@ -249,8 +247,10 @@ def test_fuzzy_pd_matches_skfuzzy_on_grid(defuzz):
                 q_ref = [math.cos(a / 2), math.sin(a / 2), 0.0, 0.0]
                 samples.append(([1.0, 0.0, 0.0, 0.0], [-ed_bar * edot_scale, 0.31, -0.62], q_ref))
         for _ in range(40 if defuzz == 1 else 150):     # random attitudes and rates
-            q = rng.normal(size=4); q /= np.linalg.norm(q)
-            qr = rng.normal(size=4); qr /= np.linalg.norm(qr)
+            q = rng.normal(size=4)
+            q /= np.linalg.norm(q)
+            qr = rng.normal(size=4)
+            qr /= np.linalg.norm(qr)
             samples.append((q, rng.uniform(-0.7, 0.7, size=3), qr))
         worst_k = worst_t = 0.0
         for q, w, qr in samples:

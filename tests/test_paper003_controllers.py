@@ -19,15 +19,13 @@ from scfmu.fmu import Fmu
 from scfmu.fmu import fmu_path
 
 from scfmu.papers.paper003 import commands as paper003
+from quat_oracle import q321, qconj, qmul  # independent helpers shared by the tests
 
 MODELS = ["SlidingModeController", "Type2FuzzySmcController"]
 AX = "xyz"
 INERTIA = np.array([[4.0, 0.05, -0.03], [0.05, 5.0, 0.02], [-0.03, 0.02, 3.5]])
 PLANT003 = paper003.PLANT
 CMD = paper003.COMMAND
-
-
-from quat_oracle import q321, qconj, qmul  # independent helpers shared by the tests
 
 
 def set_inputs(ctrl: Fmu, q, w, q_ref, w_ref=(0.0, 0.0, 0.0), h=(0.0, 0.0, 0.0)):

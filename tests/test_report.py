@@ -12,13 +12,13 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
-
 from scfmu.report import cli as report_cli
 from scfmu.report import docs, render, rules
 from scfmu.report.types import (BY_CONSTRUCTION, CALIBRATED, CHOSEN, CONFIRMED, DEPENDS, INDEPENDENT, NOT_CHECKABLE,
                                 NOT_CONFIRMED, NOT_REPRODUCED, REPRODUCED, SAME_ORDERING, Claim, Figure, NumberRow,
                                 PaperSection, Sensitivity, Table, on_bound)
+
+ROOT = Path(__file__).resolve().parents[1]
 
 # The verdicts of the last full build (`scfmu report --workers 2`), claims and reported numbers: the quick
 # build must reach every one of them (it may run fewer points, never another set-up).

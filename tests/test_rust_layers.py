@@ -6,11 +6,9 @@ are expanded first. A child module may use its parent's items (`instance/me.rs` 
 
 from __future__ import annotations
 
-import os
 import re
 from pathlib import Path
 
-import pytest
 
 ROOT = Path(__file__).resolve().parents[1] / "src" / "fmi"
 BRACES = re.compile(r"\b((?:crate::fmi|super|self)(?:::\w+)*)::\{([^{}]*)\}")  # `use super::{a, b::c}`

@@ -152,8 +152,8 @@ def summary_html(sections: list[PaperSection]) -> str:
 
 def render_html(sections: list[PaperSection], out_dir: Path, meta: dict) -> str:
     mode = "quick (reduced grids, CI)" if meta.get("quick") else "full"
-    head = [f"<!DOCTYPE html><html lang=\"en\"><head><meta charset=\"utf-8\">",
-            f"<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">",
+    head = ["<!DOCTYPE html><html lang=\"en\"><head><meta charset=\"utf-8\">",
+            "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">",
             f"<title>{_e(meta.get('title', 'Reproduction report'))}</title><style>{CSS}</style></head><body>",
             f"<h1>{_e(meta.get('title', 'Reproduction report'))}</h1>",
             f"<p class=\"meta\">Built {_e(meta.get('built', '?'))} · git commit {_e(meta.get('commit', '?'))} · "

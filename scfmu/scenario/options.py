@@ -52,7 +52,7 @@ def scenario_by_name(name: str, **kw) -> Scenario:
     """A registered scenario; an unknown name is a :class:`UsageError` with the closest known names."""
     try:
         return get(name, **kw)
-    except KeyError as e:
+    except KeyError:
         known = [n for n, _ in REGISTRY.scenario_names("*")]
         if name in known:
             raise

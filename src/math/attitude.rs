@@ -4,8 +4,6 @@
 use nalgebra::{Matrix3, Quaternion, Vector3};
 use std::f64::consts::PI;
 
-/// Cross-product matrix [a×], so that [a×] b = a × b.
-
 /// Deviation of |q| from 1 (or of ‖AᵀA − I‖ from 0) that is only the round-off of a normalisation
 /// (8 ulp of 1): a projection event leaves such a state alone, so repeating it changes nothing.
 pub const NORM_ROUNDOFF: f64 = 8.0 * f64::EPSILON;

@@ -58,7 +58,7 @@ pub fn index_at(t: f64, period: f64, scale: f64) -> i64 {
 /// Index of the last grid instant strictly before `t_end` (−1 if none), where an instant within the
 /// tolerance of t_end counts as at t_end (not before it): the samples a step ending at t_end takes.
 pub fn last_before(t_end: f64, period: f64, scale: f64) -> i64 {
-    on_grid(t_end, period, scale).map_or_else(|| (t_end / period).ceil() as i64, |k| k) - 1
+    on_grid(t_end, period, scale).unwrap_or_else(|| (t_end / period).ceil() as i64) - 1
 }
 
 /// The number k ≥ 0 of sample times in a communication step h (|h − k T| within the tolerance of a

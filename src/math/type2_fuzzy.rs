@@ -144,12 +144,12 @@ impl SmcGainFuzzy {
             .map(|&c| interval_gaussian(edot_bar, c, self.sigma_lo, self.sigma_up))
             .collect();
         let (mut y, mut lo, mut up) = ([0.0; 9], [0.0; 9], [0.0; 9]);
-        for i in 0..3 {
-            for j in 0..3 {
+        for (i, (row, e)) in self.table.iter().zip(&me).enumerate() {
+            for (j, (&cell, d)) in row.iter().zip(&md).enumerate() {
                 let r = 3 * i + j;
-                y[r] = self.table[i][j];
-                lo[r] = me[i].0 * md[j].0;
-                up[r] = me[i].1 * md[j].1;
+                y[r] = cell;
+                lo[r] = e.0 * d.0;
+                up[r] = e.1 * d.1;
             }
         }
         (y, lo, up)

@@ -118,6 +118,7 @@ fn run2(
         }
         None => None,
     };
+    #[allow(clippy::arc_with_non_send_sync)] // fmi-rs's simulate() takes the recorder as an Arc; one thread
     let recorder = Arc::new(Recorder::new(Trajectories::new(md.clone(), outs)));
     let settings = SimulationSettings {
         unzipdir: dir.to_path_buf(),
@@ -184,6 +185,7 @@ fn run3(
         }
         None => None,
     };
+    #[allow(clippy::arc_with_non_send_sync)] // fmi-rs's simulate() takes the recorder as an Arc; one thread
     let recorder = Arc::new(Recorder::new(Trajectories::new(md.clone(), outs)));
     let settings = SimulationSettings {
         unzipdir: dir.to_path_buf(),

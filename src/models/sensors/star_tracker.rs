@@ -23,7 +23,7 @@ declare_variables! {
         104 => noise_about: Real = 2.0e-4, Parameter, "rad", "1-sigma error about the boresight (sensor z; default 41 arcsec)", NonNegative;
         105 => latency: Real = 0.1, Parameter, "s", "Latency d: the sample of t_k is delivered at t_k + d", Range(0.0, 1e4);
         106 => mount: Vec3 = [0.0; 3], Parameter, "rad", "Mounting: rotation vector of the sensor axes relative to the body axes (boresight = sensor z)", Range(-4.0, 4.0);
-        109 => sun_exclusion: Real = 0.5235987755982988, Parameter, "rad", "Sun exclusion half-angle about the boresight (0 = none; default 30 deg)", Range(0.0, 3.141592653589793);
+        109 => sun_exclusion: Real = 0.5235987755982988, Parameter, "rad", "Sun exclusion half-angle about the boresight (0 = none; default 30 deg)", Range(0.0, std::f64::consts::PI);
         140 => seed: Integer = 1, Parameter, "", "Seed of the counter-based noise generator";
     }
 }

@@ -22,7 +22,7 @@ declare_variables! {
         103 => noise: Real = 1.745e-3, Parameter, "rad", "1-sigma angular noise about each axis perpendicular to the sun line (default 0.1 deg)", NonNegative;
         110 => bias: Vec3 = [0.0; 3], Parameter, "rad", "Bias: fixed rotation vector applied to the measured direction, body axes", Range(-0.5, 0.5);
         106 => mount: Vec3 = [0.0; 3], Parameter, "rad", "Mounting: rotation vector of the sensor axes relative to the body axes (boresight = sensor z)", Range(-4.0, 4.0);
-        113 => fov: Real = 1.0471975511965976, Parameter, "rad", "Field-of-view half-angle about the boresight (pi = whole sky; default 60 deg)", Range(0.0, 3.141592653589793);
+        113 => fov: Real = 1.0471975511965976, Parameter, "rad", "Field-of-view half-angle about the boresight (pi = whole sky; default 60 deg)", Range(0.0, std::f64::consts::PI);
         140 => seed: Integer = 1, Parameter, "", "Seed of the counter-based noise generator";
         141 => eclipse: Integer = 1, Parameter, "", "1 = no measurement in the Earth's cylindrical shadow, 0 = shadow ignored", Choice(SWITCH);
     }

@@ -176,7 +176,7 @@ mod tests {
             for n in 0..200 {
                 let t = n as f64 * h;
                 let u = |k: i64| (k as f64 * period).powi(2);
-                let (y, ok) = line.at(t, period, delay, |k| u(k), |_| true);
+                let (y, ok) = line.at(t, period, delay, &u, |_| true);
                 let kd = ((t - delay) / period + 1e-9).floor() as i64;
                 let want = if kd < 0 { -1.0 } else { u(kd) };
                 assert_eq!(y, want, "delay {delay}, t = {t}");
@@ -205,7 +205,7 @@ mod tests {
                     k as f64 + 10.0
                 }
             };
-            out.push(line.at(t, period, 0.0, |k| u(k), |s| *s >= 0.0));
+            out.push(line.at(t, period, 0.0, &u, |s| *s >= 0.0));
             line.advance(t, h, period, 0.0, u, |s| *s >= 0.0).unwrap();
         }
         let ys: Vec<f64> = out.iter().map(|(y, _)| *y).collect();

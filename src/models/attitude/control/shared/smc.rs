@@ -248,8 +248,7 @@ mod tests {
 
     #[test]
     fn indefinite_inertia_is_refused() {
-        let mut v = SmcVariables::default();
-        v.inertia_xy = 10.0;
+        let v = SmcVariables { inertia_xy: 10.0, ..Default::default() };
         let e = v.law().unwrap_err();
         assert!(e.contains("inertia_xy"), "{e}");
     }
