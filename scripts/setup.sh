@@ -11,13 +11,13 @@ if ! command -v cargo >/dev/null 2>&1; then
     exit 1
 fi
 # The lint gates of scripts/lint.sh need rustfmt and clippy; a rustup toolchain adds them as components.
-for c in rustfmt clippy; do
-    if ! cargo "$c" --version >/dev/null 2>&1; then
+for c in fmt:rustfmt clippy:clippy; do
+    if ! cargo "${c%%:*}" --version >/dev/null 2>&1; then
         if command -v rustup >/dev/null 2>&1; then
-            echo "setup: adding the $c component"
-            rustup component add "$c" >/dev/null
+            echo "setup: adding the ${c#*:} component"
+            rustup component add "${c#*:}" >/dev/null
         else
-            echo "setup: cargo $c is missing (install the $c component of your Rust toolchain)" >&2
+            echo "setup: cargo ${c%%:*} is missing (install the ${c#*:} component of your Rust toolchain)" >&2
         fi
     fi
 done
