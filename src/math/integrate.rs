@@ -100,6 +100,31 @@ const DP_E: [f64; 7] = [
     -1.0 / 40.0,
 ];
 
+/// The step's error estimate as the RMS over components of e_i / (atol + rtol · max(|x_i|, |x_new,i|)),
+/// with e = step · Σ_j E_j k_j.
+fn error_norm<const N: usize>(
+    k: &[SVector<f64, N>; 7],
+    step: f64,
+    x: &SVector<f64, N>,
+    xs: &SVector<f64, N>,
+    rtol: f64,
+    atol: f64,
+) -> f64 {
+    let mut errv = SVector::<f64, N>::zeros();
+    for (j, kj) in k.iter().enumerate() {
+        if DP_E[j] != 0.0 {
+            errv += kj * (DP_E[j] * step);
+        }
+    }
+    let mut sum = 0.0;
+    for i in 0..N {
+        let sc = atol + rtol * x[i].abs().max(xs[i].abs());
+        let r = errv[i] / sc;
+        sum += r * r;
+    }
+    (sum / N as f64).sqrt()
+}
+
 /// Adaptive Dormand–Prince 5(4) (local extrapolation, FSAL) from t0 to exactly t1.
 /// Error norm: RMS over components of e_i / (atol + rtol · max(|x_i|, |x_new,i|)); a step is
 /// accepted when the norm is ≤ 1; the next step is h · clamp(0.9 · norm^(−1/5), 0.2, 5).
@@ -146,20 +171,7 @@ pub fn dopri5<const N: usize>(
             if s == 6 {
                 // the 7th stage is evaluated at the 5th-order solution (FSAL)
                 k[6] = f(t + step, &xs);
-                // error estimate
-                let mut errv = SVector::<f64, N>::zeros();
-                for (j, kj) in k.iter().enumerate() {
-                    if DP_E[j] != 0.0 {
-                        errv += kj * (DP_E[j] * step);
-                    }
-                }
-                let mut sum = 0.0;
-                for i in 0..N {
-                    let sc = atol + rtol * x[i].abs().max(xs[i].abs());
-                    let r = errv[i] / sc;
-                    sum += r * r;
-                }
-                let norm = (sum / N as f64).sqrt();
+                let norm = error_norm(&k, step, &x, &xs, rtol, atol);
                 if !norm.is_finite() {
                     return Err(format!("adaptive integrator: non-finite error estimate at t = {t}"));
                 }

@@ -248,7 +248,10 @@ mod tests {
 
     #[test]
     fn indefinite_inertia_is_refused() {
-        let v = SmcVariables { inertia_xy: 10.0, ..Default::default() };
+        let v = SmcVariables {
+            inertia_xy: 10.0,
+            ..Default::default()
+        };
         let e = v.law().unwrap_err();
         assert!(e.contains("inertia_xy"), "{e}");
     }
