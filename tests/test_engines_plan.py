@@ -239,7 +239,7 @@ def test_ssp_1_0_and_libcosim_refuse_fmi3_units_with_a_message(tmp_path):
     sc = get("default", stop_time=0.1).with_models({"controller": str(FMUS / "fmi3" / "PdController.fmu")})
     with pytest.raises(ValueError, match="controller: FMI 3.0 units cannot be written to an SSP 1.0 file"):
         write_ssp(sc, tmp_path / "x.ssp")
-    with pytest.raises(ValueError, match=r"libcosim runs FMI 2.0 units only: \['controller'\]"):
+    with pytest.raises(ValueError, match=r"libcosim runs FMI 1.0/2.0 units only: \[.controller.\] are FMI 3.0 \(the libcosim of libcosimpy"):
         run_libcosim(sc)
 
 
