@@ -157,9 +157,26 @@ def test_the_plant_as_model_exchange_under_fixed_step_rk4_chosen_per_instance(en
     assert worst_rel(ref, got) < 1e-6
 
 
-def test_the_native_engine_refuses_model_exchange_units_with_a_message():
-    with pytest.raises(PlanError, match="plant: Model Exchange instances cannot be nested in fmpy's container"):
-        simulate(get("default", stop_time=0.1), "native", model_exchange={"plant"})
+@pytest.mark.parametrize("fmi", [2, 3])
+def test_the_native_engine_and_loop_fmus_refuse_model_exchange_units_with_a_message(fmi, units, tmp_path):
+    """fmpy's container nests Co-Simulation units only and fmpy 0.3.32 ships no Model Exchange to
+    Co-Simulation wrapper: the native engine and the loop-FMU export refuse an ME unit (ours as FMI 2.0 or
+    3.0, and the foreign ME-only body) in one line naming the instance, before anything is built."""
+    from scfmu.export.loops import write_loop_fmu
+    msg = (r"^plant: Model Exchange instances cannot be nested in fmpy's container FMU \(Co-Simulation units only: "
+           r"fmpy \S+ ships no Model Exchange to Co-Simulation wrapper\): run the scenario on the 'compiled', "
+           r"'lean' or 'reference' engine$")
+    fm = {"plant": str(FMUS / "fmi3" / "AttitudePlant.fmu")} if fmi == 3 else None
+    with pytest.raises(PlanError, match=msg):
+        simulate(get("default", stop_time=0.1), "native", fmus=fm, model_exchange={"plant"})
+    me = get("default", stop_time=0.1).with_models(fm or {})
+    me.component("plant").interface = "me"
+    with pytest.raises(PlanError, match=msg):
+        write_loop_fmu(me, tmp_path / "loop.fmu")
+    assert not (tmp_path / "loop.fmu").exists()
+    if fmi == 3:  # the foreign FMI 3.0 ME-only body needs no interface choice: it has no other
+        with pytest.raises(PlanError, match=msg):
+            simulate(_axis_scenario(units, stop=0.1), "native")
 
 
 def _axis_scenario(units, stop=3.0, **params) -> Scenario:

@@ -37,9 +37,9 @@ def run_libcosim(scenario: Scenario) -> dict:
     if plan.model_exchange:
         raise ValueError(f"libcosim runs Co-Simulation units only: {sorted(plan.model_exchange)} are Model Exchange")
     fmi3 = [u.name for u in plan.units if u.fmi == 3]
-    if fmi3:  # libcosimpy 0.0.6's libcosim imports FMI 1.0/2.0 only; an FMI 3.0 unit aborts the process
+    if fmi3:  # libcosimpy 0.0.6: FMI 1.0/2.0 importers only; add_local_slave of an FMI 3.0 unit is a SIGSEGV
         raise ValueError(f"libcosim runs FMI 1.0/2.0 units only: {fmi3} are FMI 3.0 (the libcosim of libcosimpy "
-                         f"{_libcosimpy_version()} has no FMI 3.0 importer and aborts the process on one)")
+                         f"{_libcosimpy_version()} has no FMI 3.0 importer: adding one is a segmentation fault)")
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
     from libcosimpy.CosimObserver import CosimObserver
