@@ -248,6 +248,64 @@ def test_foreign_model_exchange_plant_in_a_campaign(units, tmp_path):
     assert rows2["status"] == ["ok"], rows2["message"]
 
 
+# ----- issue 34: --scheduler campaigns with FMI 3.0 and Model Exchange units --------------------------------
+def _rows(table):
+    return table.to_pylist()
+
+
+def _same_rows(a, b):
+    """Rows equal to the bit (NaN equal to NaN)."""
+    assert len(a) == len(b)
+    for x, y in zip(a, b):
+        assert x.keys() == y.keys()
+        for k in x:
+            nan = isinstance(x[k], float) and np.isnan(x[k])
+            assert (nan and isinstance(y[k], float) and np.isnan(y[k])) or (not nan and x[k] == y[k]), (x["run"], k)
+
+
+def _unit_campaigns():
+    """Two campaigns of run 000-6's loop: the project's FMI 3.0 PdController in place of the FMI 2.0 one (native
+    engine, as `scfmu campaign --engine native`), and the plant as a Model Exchange unit (auto engine: the
+    compiled loop integrates it)."""
+    from scfmu import campaign
+    fmi3 = get("default", stop_time=2.0).with_models({"controller": str(FMUS / "fmi3" / "PdController.fmu")})
+    me = get("default", stop_time=2.0)
+    me.component("plant").interface = "me"
+    sets = campaign.grid({"controller.wn": [0.5, 1.0, 2.0]}) + [{"controller.wn": -1.0}]
+    return {"fmi3": campaign.Campaign(fmi3, sets, seeds=[None], engine="native", timeseries=["alpha_deg"]),
+            "me": campaign.Campaign(me, sets, seeds=[None], timeseries=["alpha_deg"])}
+
+
+def test_scheduler_campaigns_with_fmi3_and_model_exchange_units_match_the_local_run(tmp_path):
+    """The same campaigns on a local run (the package's own LocalCluster) and through `scheduler=` (what
+    `scfmu campaign --scheduler` passes) to a LocalCluster started here: rows and time series bit-identical;
+    the FMI 3.0 controller's rows are those of the FMI 2.0 one (same numbers by construction), and the ME
+    plant's metrics are within 1e-6 of the Co-Simulation plant's (a solver instead of the plant's RK4)."""
+    from dask.distributed import LocalCluster
+    from scfmu import campaign
+    sets = _unit_campaigns()["fmi3"].overrides
+    cs = _rows(campaign.run(campaign.Campaign(get("default", stop_time=2.0), sets, seeds=[None], engine="native"),
+                            tmp_path / "cs", n_workers=1, progress=False))
+    local = {k: _rows(campaign.run(c, tmp_path / f"{k}_local", n_workers=1, progress=False))
+             for k, c in _unit_campaigns().items()}
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=":0",
+                      host="127.0.0.1") as cluster:
+        remote = {k: _rows(campaign.run(c, tmp_path / f"{k}_sched", scheduler=cluster.scheduler_address,
+                                        progress=False)) for k, c in _unit_campaigns().items()}
+    for k in local:
+        assert [r["status"] for r in local[k]] == ["ok", "ok", "ok", "fmu_error"], (k, local[k][-1]["message"])
+        _same_rows(local[k], remote[k])
+        for i in range(3):
+            a = campaign.read_timeseries(tmp_path / f"{k}_local", i)
+            b = campaign.read_timeseries(tmp_path / f"{k}_sched", i)
+            assert a.keys() == b.keys() and all(np.array_equal(a[s], b[s]) for s in a)
+    metrics = [k for k, v in cs[0].items() if isinstance(v, float) and np.isfinite(v) and not k.startswith("p:")]
+    assert "eulerint_deg_s" in metrics and len(metrics) >= 4, metrics  # (settling times are NaN over 2 s)
+    for a, b, m in zip(cs[:3], local["fmi3"][:3], local["me"][:3]):
+        assert all(a[k] == b[k] for k in metrics), [(k, a[k], b[k]) for k in metrics if a[k] != b[k]]
+        assert all(abs(a[k] - m[k]) <= 1e-6 * max(abs(a[k]), 1e-3) for k in metrics), [(k, a[k], m[k]) for k in metrics]
+
+
 def test_ssp_1_0_and_libcosim_refuse_fmi3_units_with_a_message(tmp_path):
     """SSP 1.0 carries FMI 1.0/2.0 FMUs; the libcosim that libcosimpy ships crashes on FMI 3.0 units: both
     refuse them up front, naming the instance."""
