@@ -38,14 +38,17 @@ import shutil
 import tempfile
 import zipfile
 from ctypes import c_int32, c_uint
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+from fmpy import read_model_description
 
 from ..fmu import Fmu, fmu_digest, safe_extract, scalar_type, unpacked
 from ..scenario.model import Scenario
-from ..scenario.plan import Plan, PlanError
+from ..scenario.plan import Plan
 from .calls import SimulationError, raw_calls
+from .cs_face import cs_face, wrapper_library
 from .instances import as_plan
 
 CACHE = Path(os.environ.get("SCFMU_CONTAINER_DIR", Path.home() / ".cache" / "scfmu" / "containers"))
@@ -60,7 +63,8 @@ def _structure(plan: Plan, starts: dict | None) -> tuple:
     files = []
     for u in plan.units:
         st = u.path.stat()
-        files.append((u.name, u.model, str(u.path), st.st_mtime_ns, st.st_size))
+        files.append((u.name, u.model, str(u.path), st.st_mtime_ns, st.st_size, u.interface,
+                      tuple(sorted((k, repr(v)) for k, v in u.solver.items())) if u.interface == "me" else ()))
     return (tuple(files), repr(plan.scenario.step), tuple(plan.links),
             tuple(sorted((k, repr(v)) for k, v in starts.items())) if starts else ())
 
@@ -74,6 +78,10 @@ def container_key(plan: Plan, starts: dict | None = None) -> str:
            "links": plan.links, "step": repr(plan.scenario.step), "layout": LAYOUT}
     if starts:
         key["starts"] = sorted((k, repr(v)) for k, v in starts.items())
+    me = [(u.name, sorted((k, repr(v)) for k, v in u.solver.items())) for u in plan.units if u.interface == "me"]
+    if me:  # Model Exchange units run through their Co-Simulation face (scfmu.engines.cs_face)
+        lib = wrapper_library()
+        key["me"] = [me, None if lib is None else (lib.stat().st_size, lib.stat().st_mtime_ns)]
     h = hashlib.sha256(json.dumps(key, sort_keys=True).encode()).hexdigest()[:20]
     _KEYS[sig] = h
     return h
@@ -98,44 +106,43 @@ def _start_text(vtype: str, value) -> str:
 def build_container(scenario, starts: dict | None = None) -> Path:
     """Path of the container FMU for a plan's (or a scenario's) structure (built once, then cached): the
     one container builder, used by the native engine and the loop-FMU export. Nested units may be
-    FMI 2.0 or FMI 3.0 Co-Simulation FMUs (fmpy's container runtime loads both); ``starts``
+    FMI 2.0 or FMI 3.0 Co-Simulation FMUs (fmpy's container runtime loads both), or Model Exchange units,
+    nested as their Co-Simulation face (:mod:`scfmu.engines.cs_face`); ``starts``
     (``"instance.variable" -> value``, e.g. :func:`scenario_starts`) replaces the nested FMUs' start
     values of those container variables (the container applies them at instantiation)."""
     from fmpy.container_fmu.config import Configuration, Connection
 
     plan = as_plan(scenario)
-    refuse_model_exchange(plan, "nested in fmpy's container FMU")
     starts = dict(starts or {})
     h = container_key(plan, starts)
     path = CACHE / f"loop_{h}.fmu"
     if path.exists():
         return path
-    comps, cvars, container_vars, mappings, cv_of = _container_variables(plan, starts)
+    units = _nested_units(plan)
+    comps, cvars, container_vars, mappings, cv_of = _container_variables(units, starts)
     # one connection per link group of the plan (destination, source, type), in Gauss–Seidel order
     connections = [Connection(comps[g.src], [cvars[g.src][so] for so in g.src_names],
                               comps[g.dst], [cvars[g.dst][di] for di in g.dst_names]) for g in plan.groups]
-    md = _container_description(plan, h, container_vars, cv_of)
+    md = _container_description(plan.scenario, units, h, container_vars, cv_of)
     config = Configuration(parallelDoStep=False, modelDescription=md, components=list(comps.values()),
                            connections=connections, variableMappings=mappings)
     _write_container(config, h, path)
     return path
 
 
-def refuse_model_exchange(plan: Plan, where: str) -> None:
-    """One-line refusal of a plan's Model Exchange instances where only Co-Simulation units can go."""
-    me = sorted(plan.model_exchange)
-    if me:
-        raise PlanError(f"{', '.join(me)}: Model Exchange instances cannot be {where} (Co-Simulation units only: "
-                        f"fmpy {_fmpy_version()} ships no Model Exchange to Co-Simulation wrapper): run the scenario "
-                        f"on the 'compiled', 'lean' or 'reference' engine")
+def _nested_units(plan: Plan) -> list:
+    """The plan's units as the container nests them: a Model Exchange unit as its Co-Simulation face (the
+    unit's FMU with scfmu's wrapper library added, :mod:`scfmu.engines.cs_face`)."""
+    out = []
+    for u in plan.units:
+        if u.interface == "me":
+            face = cs_face(u, CACHE / "faces")
+            u = replace(u, path=face, md=read_model_description(str(face)))
+        out.append(u)
+    return out
 
 
-def _fmpy_version() -> str:
-    import fmpy
-    return fmpy.__version__
-
-
-def _container_variables(plan: Plan, starts: dict):
+def _container_variables(units: list, starts: dict):
     """The container's components and variables: one container variable ``"<instance>.<variable>"`` per
     parameter, calculated parameter, input and output of every instance (``starts`` consumed: an unknown
     name or a start value of another kind of variable is a KeyError). Returns ``(components, nested
@@ -147,7 +154,7 @@ def _container_variables(plan: Plan, starts: dict):
     container_vars = [ModelVariable(type="Real", variability="continuous", causality="independent", name="time")]
     mappings = {}
     cv_of = {}  # (instance, nested variable name) -> container variable
-    for u in plan.units:
+    for u in units:
         comp = CComponent(name=u.name, filename=u.path, modelDescription=u.md)
         comps[u.name] = comp
         cvars[u.name] = {v.name: v for v in u.md.modelVariables}
@@ -187,12 +194,11 @@ def _container_variable(v, vt: str, q: str):
     return cv
 
 
-def _container_description(plan: Plan, h: str, container_vars: list, cv_of: dict):
+def _container_description(scenario: Scenario, units: list, h: str, container_vars: list, cv_of: dict):
     """The container's FMI 2.0 Co-Simulation model description, with its ModelStructure."""
     from fmpy.model_description import CoSimulation, DefaultExperiment, ModelDescription, Unknown
 
-    scenario = plan.scenario
-    mds = {u.name: u.md for u in plan.units}
+    mds = {u.name: u.md for u in units}
     md = ModelDescription(fmiVersion="2.0", modelName=f"scfmu_loop_{h}", instantiationToken="{scfmu-" + h + "}",
                           description=f"closed loop of {[Path(c.model).stem for c in scenario.components]} "
                                       f"(scfmu native path)",
