@@ -253,7 +253,7 @@ def test_foreign_model_exchange_plant_in_a_campaign(units, tmp_path):
         assert np.max(np.abs(r["theta"] - th)) < 1e-8
         finals.append(r["theta"][-1])
     assert len(set(finals)) == 3  # the parameter reached the unit
-    # a coarser log grid (log_every) is the native engine's, which cannot host the unit: the compiled one runs it
+    # a coarser log grid (log_every): the campaign runs the ME unit on the compiled engine
     c2 = campaign.Campaign(sc, [{"plant.inertia": 7.7}], log_every=10)
     rows2 = campaign.run(c2, tmp_path / "c2", n_workers=1, progress=False).to_pydict()
     assert rows2["status"] == ["ok"], rows2["message"]

@@ -20,8 +20,10 @@ from __future__ import annotations
 
 import hashlib
 import os
+import platform
 import sys
 import zipfile
+from importlib import resources
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
@@ -37,6 +39,8 @@ def _platform(fmi: int) -> tuple[str, str]:
         return ("win64" if fmi == 2 else "x86_64-windows"), f"{LIB}.dll"
     if sys.platform == "darwin":
         return ("darwin64" if fmi == 2 else "x86_64-darwin"), f"{LIB}.dylib"
+    if platform.machine().lower() in ("aarch64", "arm64"):  # the project's folder for both versions
+        return "aarch64-linux", f"{LIB}.so"
     return ("linux64" if fmi == 2 else "x86_64-linux"), f"{LIB}.so"
 
 
@@ -44,11 +48,13 @@ def wrapper_library() -> Path | None:
     """The built wrapper library: ``scfmu/engines/me_cs/bin/<folder>/`` (a wheel) or ``target/release/`` (a
     source checkout built with ``cargo build --release``), else None."""
     name = {"win32": f"{LIB}.dll", "darwin": f"lib{LIB}.dylib"}.get(sys.platform, f"lib{LIB}.so")
-    here = Path(__file__).resolve().parent
-    for p in (here / "me_cs" / "bin" / _platform(2)[0] / name, here.parents[1] / "target" / "release" / name):
-        if p.is_file():
-            return p
-    return None
+    pkg = Path(str(resources.files("scfmu")))
+    shipped = pkg / "engines" / "me_cs" / "bin" / _platform(2)[0] / name
+    if shipped.is_file():
+        return shipped
+    root = pkg.parent  # the source checkout holding this package (editable install), if it is one
+    built = root / "target" / "release" / name
+    return built if (root / "Cargo.toml").is_file() and built.is_file() else None
 
 
 def _config(u: Unit) -> str:
@@ -95,6 +101,9 @@ def cs_face(u: Unit, cache: Path) -> Path:
     if path.exists():
         return path
     folder, fname = _platform(u.fmi)
+    with zipfile.ZipFile(u.path) as z:
+        if f"binaries/{folder}/{fname}" in z.namelist():
+            raise PlanError(f"{u.name}: {Path(u.path).name} already carries a library named {fname}")
     cache.mkdir(parents=True, exist_ok=True)
     tmp = cache / f".{path.name}.{os.getpid()}"
     with zipfile.ZipFile(u.path) as zi, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as zo:
@@ -102,8 +111,9 @@ def cs_face(u: Unit, cache: Path) -> Path:
             data = zi.read(info)
             if info.filename == "modelDescription.xml":
                 data = _description(data)
-            elif info.filename in (f"binaries/{folder}/{fname}", f"resources/{LIB}.txt"):
-                continue
+            elif info.filename == f"resources/{LIB}.txt" or (info.filename.startswith("binaries/")
+                                                              and not info.filename.startswith(f"binaries/{folder}/")):
+                continue  # the face runs where its wrapper library was built: this platform only
             zo.writestr(info, data, compress_type=zipfile.ZIP_DEFLATED)
         zo.write(lib, f"binaries/{folder}/{fname}")
         zo.writestr(f"resources/{LIB}.txt", cfg)

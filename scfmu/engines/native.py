@@ -23,6 +23,10 @@ Logging. ``log_every = m`` (default 1) reads the logged variables with one conta
 every m communication steps (one ``fmi2DoStep(t, mΔ)`` in between); ``log_every = 0`` runs the whole
 interval in one ``fmi2DoStep`` call and returns only the initial and final samples.
 
+Model Exchange units. fmpy's container nests Co-Simulation units only: a Model Exchange instance is
+nested as its Co-Simulation face (:mod:`scfmu.engines.cs_face`: the unit's FMU with scfmu's wrapper library,
+which integrates it over each fixed step with the instance's solver, events included).
+
 Containers are cached on disk by a hash of their configuration (FMU GUIDs and file SHA-256, wiring,
 step), in
 ``$SCFMU_CONTAINER_DIR`` or ``~/.cache/scfmu/containers``.

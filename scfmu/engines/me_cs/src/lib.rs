@@ -140,7 +140,12 @@ pub unsafe fn load(location: *const c_char, v3: bool) -> Result<Config, String> 
     let cfg_path = format!("{res}/scfmu_me_cs.txt");
     let text = std::fs::read_to_string(&cfg_path).map_err(|e| format!("{cfg_path}: {e}"))?;
     let cfg = Config::parse(&text).map_err(|e| format!("{cfg_path}: {e}"))?;
-    let folder = match (v3, cfg!(windows), cfg!(target_os = "macos")) {
+    let folder = match (
+        v3 || cfg!(target_arch = "aarch64"),
+        cfg!(windows),
+        cfg!(target_os = "macos"),
+    ) {
+        (true, false, false) if cfg!(target_arch = "aarch64") => "aarch64-linux",
         (false, true, _) => "win64",
         (false, _, true) => "darwin64",
         (false, _, _) => "linux64",
