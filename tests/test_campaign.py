@@ -425,4 +425,3 @@ def test_campaign_metrics_equal_those_of_a_full_log_reference_run(name, t, overr
     for k in cols:
         a, b = row[k], float(want.get(k, np.nan))
         assert np.array(a).view(np.int64) == np.array(b).view(np.int64) or (np.isnan(a) and np.isnan(b)), (k, a, b)
-
