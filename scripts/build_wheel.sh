@@ -86,6 +86,11 @@ for plat in "${platforms[@]}"; do
         echo "build_wheel: $plat: no compiled loop library ($lib): not shipped, campaigns use the \"native\" engine" >&2
         lib=-
     fi
+    # the Co-Simulation face of Model Exchange units (scfmu/engines/cs_face.py): built on this host only
+    if [ "$plat" = linux-x86_64 ] && [ -f target/release/libscfmu_me_cs.so ]; then
+        mkdir -p "$stage/scfmu/engines/me_cs/bin/linux64"
+        cp target/release/libscfmu_me_cs.so "$stage/scfmu/engines/me_cs/bin/linux64/"
+    fi
     tag=$(.venv/bin/python scripts/wheel_platform.py "$plat" "$stage/scfmu/fmus" "$lib")
     .venv/bin/python -m build --wheel --no-isolation --outdir "$stage/dist" "$stage" >"$stage/build.log" 2>&1 ||
         { cat "$stage/build.log" >&2; exit 1; }

@@ -11,8 +11,8 @@
 * ``"auto"`` (the campaigns' default): ``"compiled"`` when available, else ``"native"``.
 
 Every engine executes one :class:`~scfmu.scenario.plan.Plan` (built once by :func:`simulate`): units of FMI
-2.0 or 3.0; Co-Simulation units everywhere, Model Exchange units in the reference, lean and compiled
-engines (fmpy's container, hence the native engine and loop FMUs, hosts Co-Simulation units only).
+2.0 or 3.0, Co-Simulation or Model Exchange, in every engine (fmpy's container, hence the native engine and
+loop FMUs, nests a Model Exchange unit as its Co-Simulation face: :mod:`scfmu.engines.cs_face`).
 
 A run that fails (FMU error status, non-finite logged value) raises ``SimulationError`` with a status
 code and the FMUs' log messages.
@@ -22,8 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..scenario.model import Scenario
-from ..scenario.plan import Plan, PlanError, build_plan
+from ..scenario.model import Scenario  # noqa: F401  (re-exported)
+from ..scenario.plan import Plan, PlanError, build_plan  # noqa: F401  (PlanError re-exported)
 from .calls import SimulationError
 from .instances import as_plan, build_fmus, ports_of  # noqa: F401
 from .lean import LeanMaster

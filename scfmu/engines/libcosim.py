@@ -20,6 +20,14 @@ from .instances import as_plan
 NS = 10**9
 
 
+def _libcosimpy_version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+    try:
+        return version("libcosimpy")
+    except PackageNotFoundError:
+        return "(not installed)"
+
+
 def run_libcosim(scenario: Scenario) -> dict:
     """Runs the scenario (or its plan) to its stop time; returns the final value of every logged key plus
     ``wall_s`` (the simulate_until call only). Co-Simulation units only (libcosim hosts no Model Exchange
@@ -29,8 +37,9 @@ def run_libcosim(scenario: Scenario) -> dict:
     if plan.model_exchange:
         raise ValueError(f"libcosim runs Co-Simulation units only: {sorted(plan.model_exchange)} are Model Exchange")
     fmi3 = [u.name for u in plan.units if u.fmi == 3]
-    if fmi3:  # the libcosim that libcosimpy ships loads FMI 1.0/2.0 (an FMI 3.0 unit crashes the process)
-        raise ValueError(f"libcosim runs FMI 2.0 units only: {fmi3} are FMI 3.0")
+    if fmi3:  # libcosimpy 0.0.6: FMI 1.0/2.0 importers only; add_local_slave of an FMI 3.0 unit is a SIGSEGV
+        raise ValueError(f"libcosim runs FMI 1.0/2.0 units only: {fmi3} are FMI 3.0 (the libcosim of libcosimpy "
+                         f"{_libcosimpy_version()} has no FMI 3.0 importer: adding one is a segmentation fault)")
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
     from libcosimpy.CosimObserver import CosimObserver

@@ -23,6 +23,10 @@ Logging. ``log_every = m`` (default 1) reads the logged variables with one conta
 every m communication steps (one ``fmi2DoStep(t, mΔ)`` in between); ``log_every = 0`` runs the whole
 interval in one ``fmi2DoStep`` call and returns only the initial and final samples.
 
+Model Exchange units. fmpy's container nests Co-Simulation units only: a Model Exchange instance is
+nested as its Co-Simulation face (:mod:`scfmu.engines.cs_face`: the unit's FMU with scfmu's wrapper library,
+which integrates it over each fixed step with the instance's solver, events included).
+
 Containers are cached on disk by a hash of their configuration (FMU GUIDs and file SHA-256, wiring,
 step), in
 ``$SCFMU_CONTAINER_DIR`` or ``~/.cache/scfmu/containers``.
@@ -38,14 +42,17 @@ import shutil
 import tempfile
 import zipfile
 from ctypes import c_int32, c_uint
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+from fmpy import read_model_description
 
 from ..fmu import Fmu, fmu_digest, safe_extract, scalar_type, unpacked
 from ..scenario.model import Scenario
-from ..scenario.plan import Plan, PlanError
+from ..scenario.plan import Plan
 from .calls import SimulationError, raw_calls
+from .cs_face import cs_face, wrapper_library
 from .instances import as_plan
 
 CACHE = Path(os.environ.get("SCFMU_CONTAINER_DIR", Path.home() / ".cache" / "scfmu" / "containers"))
@@ -60,7 +67,8 @@ def _structure(plan: Plan, starts: dict | None) -> tuple:
     files = []
     for u in plan.units:
         st = u.path.stat()
-        files.append((u.name, u.model, str(u.path), st.st_mtime_ns, st.st_size))
+        files.append((u.name, u.model, str(u.path), st.st_mtime_ns, st.st_size, u.interface,
+                      tuple(sorted((k, repr(v)) for k, v in u.solver.items())) if u.interface == "me" else ()))
     return (tuple(files), repr(plan.scenario.step), tuple(plan.links),
             tuple(sorted((k, repr(v)) for k, v in starts.items())) if starts else ())
 
@@ -74,6 +82,10 @@ def container_key(plan: Plan, starts: dict | None = None) -> str:
            "links": plan.links, "step": repr(plan.scenario.step), "layout": LAYOUT}
     if starts:
         key["starts"] = sorted((k, repr(v)) for k, v in starts.items())
+    me = [(u.name, sorted((k, repr(v)) for k, v in u.solver.items())) for u in plan.units if u.interface == "me"]
+    if me:  # Model Exchange units run through their Co-Simulation face (scfmu.engines.cs_face)
+        lib = wrapper_library()
+        key["me"] = [me, None if lib is None else (lib.stat().st_size, lib.stat().st_mtime_ns)]
     h = hashlib.sha256(json.dumps(key, sort_keys=True).encode()).hexdigest()[:20]
     _KEYS[sig] = h
     return h
@@ -98,69 +110,100 @@ def _start_text(vtype: str, value) -> str:
 def build_container(scenario, starts: dict | None = None) -> Path:
     """Path of the container FMU for a plan's (or a scenario's) structure (built once, then cached): the
     one container builder, used by the native engine and the loop-FMU export. Nested units may be
-    FMI 2.0 or FMI 3.0 Co-Simulation FMUs (fmpy's container runtime loads both); ``starts``
+    FMI 2.0 or FMI 3.0 Co-Simulation FMUs (fmpy's container runtime loads both), or Model Exchange units,
+    nested as their Co-Simulation face (:mod:`scfmu.engines.cs_face`); ``starts``
     (``"instance.variable" -> value``, e.g. :func:`scenario_starts`) replaces the nested FMUs' start
     values of those container variables (the container applies them at instantiation)."""
-    from fmpy.container_fmu import write_configuration
-    from fmpy.container_fmu.config import Component as CComponent, Configuration, Connection
-    from fmpy.model_description import (CoSimulation, DefaultExperiment, ModelDescription, ModelVariable, Unknown,
-                                        write_model_description)
+    from fmpy.container_fmu.config import Configuration, Connection
 
     plan = as_plan(scenario)
-    scenario = plan.scenario
-    me = sorted(plan.model_exchange)
-    if me:
-        raise PlanError(f"{', '.join(me)}: Model Exchange instances cannot be nested in fmpy's container FMU "
-                        f"(Co-Simulation units only): run the scenario on the 'compiled', 'lean' or 'reference' engine")
     starts = dict(starts or {})
     h = container_key(plan, starts)
     path = CACHE / f"loop_{h}.fmu"
     if path.exists():
         return path
-    mds = {u.name: u.md for u in plan.units}
-    guid = "{scfmu-" + h + "}"
+    units = _nested_units(plan)
+    comps, cvars, container_vars, mappings, cv_of = _container_variables(units, starts)
+    # one connection per link group of the plan (destination, source, type), in Gauss–Seidel order
+    connections = [Connection(comps[g.src], [cvars[g.src][so] for so in g.src_names],
+                              comps[g.dst], [cvars[g.dst][di] for di in g.dst_names]) for g in plan.groups]
+    md = _container_description(plan.scenario, units, h, container_vars, cv_of)
+    config = Configuration(parallelDoStep=False, modelDescription=md, components=list(comps.values()),
+                           connections=connections, variableMappings=mappings)
+    _write_container(config, h, path)
+    return path
+
+
+def _nested_units(plan: Plan) -> list:
+    """The plan's units as the container nests them: a Model Exchange unit as its Co-Simulation face (the
+    unit's FMU with scfmu's wrapper library added, :mod:`scfmu.engines.cs_face`)."""
+    out = []
+    for u in plan.units:
+        if u.interface == "me":
+            face = cs_face(u, CACHE / "faces")
+            u = replace(u, path=face, md=read_model_description(str(face)))
+        out.append(u)
+    return out
+
+
+def _container_variables(units: list, starts: dict):
+    """The container's components and variables: one container variable ``"<instance>.<variable>"`` per
+    parameter, calculated parameter, input and output of every instance (``starts`` consumed: an unknown
+    name or a start value of another kind of variable is a KeyError). Returns ``(components, nested
+    variables by instance and name, container variables, mappings, container variable by (instance, name))``."""
+    from fmpy.container_fmu.config import Component as CComponent
+    from fmpy.model_description import ModelVariable
+
     comps, cvars = {}, {}
     container_vars = [ModelVariable(type="Real", variability="continuous", causality="independent", name="time")]
     mappings = {}
     cv_of = {}  # (instance, nested variable name) -> container variable
-    for u in plan.units:
-        c = u
-        md = mds[c.name]
-        comp = CComponent(name=c.name, filename=u.path, modelDescription=md)
-        comps[c.name] = comp
-        cvars[c.name] = {v.name: v for v in md.modelVariables}
-        for v in md.modelVariables:
+    for u in units:
+        comp = CComponent(name=u.name, filename=u.path, modelDescription=u.md)
+        comps[u.name] = comp
+        cvars[u.name] = {v.name: v for v in u.md.modelVariables}
+        for v in u.md.modelVariables:
             vt = scalar_type(v)  # FMI 3.0 Float64/Int32/Boolean are the container's Real/Integer/Boolean
             if v.causality not in _KINDS or vt is None:
                 continue
-            if v.causality == "parameter":
-                cv = ModelVariable(type=vt, variability="tunable" if v.variability == "tunable" else "fixed",
-                                   causality="parameter", name=f"{c.name}.{v.name}", start=v.start)
-                cv.initial = "exact"
-            elif v.causality == "calculatedParameter":
-                cv = ModelVariable(type=vt, variability=v.variability, causality="calculatedParameter",
-                                   name=f"{c.name}.{v.name}")
-            elif v.causality == "input":
-                cv = ModelVariable(type=vt, variability=v.variability, causality="input",
-                                   name=f"{c.name}.{v.name}", start=v.start)
-            else:
-                cv = ModelVariable(type=vt, variability=v.variability, causality="output",
-                                   name=f"{c.name}.{v.name}")
-            cv.description = v.description
-            q = f"{c.name}.{v.name}"
+            q = f"{u.name}.{v.name}"
+            cv = _container_variable(v, vt, q)
             if q in starts:
                 if v.causality not in ("parameter", "input"):
                     raise KeyError(f"start value for {q}: not a parameter or input")
                 cv.start = _start_text(vt, starts.pop(q))
             container_vars.append(cv)
             mappings[cv] = [(comp, v)]
-            cv_of[(c.name, v.name)] = cv
+            cv_of[(u.name, v.name)] = cv
     if starts:
         raise KeyError(f"start values for unknown variables {sorted(starts)}")
-    # one connection per link group of the plan (destination, source, type), in Gauss–Seidel order
-    connections = [Connection(comps[g.src], [cvars[g.src][so] for so in g.src_names],
-                              comps[g.dst], [cvars[g.dst][di] for di in g.dst_names]) for g in plan.groups]
-    md = ModelDescription(fmiVersion="2.0", modelName=f"scfmu_loop_{h}", instantiationToken=guid,
+    return comps, cvars, container_vars, mappings, cv_of
+
+
+def _container_variable(v, vt: str, q: str):
+    """The container variable ``q`` of nested variable ``v`` (scalar type ``vt``), same causality."""
+    from fmpy.model_description import ModelVariable
+
+    if v.causality == "parameter":
+        cv = ModelVariable(type=vt, variability="tunable" if v.variability == "tunable" else "fixed",
+                           causality="parameter", name=q, start=v.start)
+        cv.initial = "exact"
+    elif v.causality == "calculatedParameter":
+        cv = ModelVariable(type=vt, variability=v.variability, causality="calculatedParameter", name=q)
+    elif v.causality == "input":
+        cv = ModelVariable(type=vt, variability=v.variability, causality="input", name=q, start=v.start)
+    else:
+        cv = ModelVariable(type=vt, variability=v.variability, causality="output", name=q)
+    cv.description = v.description
+    return cv
+
+
+def _container_description(scenario: Scenario, units: list, h: str, container_vars: list, cv_of: dict):
+    """The container's FMI 2.0 Co-Simulation model description, with its ModelStructure."""
+    from fmpy.model_description import CoSimulation, DefaultExperiment, ModelDescription, Unknown
+
+    mds = {u.name: u.md for u in units}
+    md = ModelDescription(fmiVersion="2.0", modelName=f"scfmu_loop_{h}", instantiationToken="{scfmu-" + h + "}",
                           description=f"closed loop of {[Path(c.model).stem for c in scenario.components]} "
                                       f"(scfmu native path)",
                           generationTool="scfmu.native",
@@ -187,20 +230,28 @@ def build_container(scenario, starts: dict | None = None) -> Path:
                 # a dependency on a nested continuous state (a local of a Model Exchange capable FMU) is
                 # internal to the container: only container variables are listed
                 deps = None if u.dependencies is None else sorted(
-                    (cv_of[(c.name, d.name)] for d in u.dependencies if (c.name, d.name) in cv_of), key=lambda x: order[id(x)])
+                    (cv_of[(c.name, d.name)] for d in u.dependencies if (c.name, d.name) in cv_of),
+                    key=lambda x: order[id(x)])
                 unknowns.append(Unknown(variable=cv, dependencies=deps))
         unknowns.sort(key=lambda u: order[id(u.variable)])
         setattr(md, attr, unknowns)
     for i, v in enumerate(md.modelVariables):
         v.valueReference = i  # "time" is 0; container variable i maps to mappings[i - 1]
-    config = Configuration(parallelDoStep=False, modelDescription=md, components=list(comps.values()),
-                           connections=connections, variableMappings=mappings)
+    return md
+
+
+def _write_container(config, h: str, path: Path) -> None:
+    """Writes the container FMU ``path`` (atomically): model description, ``resources/container.json``,
+    the nested FMUs unpacked under ``resources/<file stem>`` and fmpy's container binaries."""
+    from fmpy.container_fmu import write_configuration
+    from fmpy.model_description import write_model_description
+
     CACHE.mkdir(parents=True, exist_ok=True)
     work = Path(tempfile.mkdtemp(prefix="scfmu_container_"))
     try:
-        for c in comps.values():  # nested FMUs unpacked under resources/<file stem>
+        for c in config.components:  # nested FMUs unpacked under resources/<file stem>
             safe_extract(c.filename, work / "resources" / Path(c.filename).stem)  # archive limits (scfmu.fmu)
-        write_model_description(md, work / "modelDescription.xml")
+        write_model_description(config.modelDescription, work / "modelDescription.xml")
         cfg = work / "resources" / "container.json"
         write_configuration(config, cfg)
         data = json.loads(cfg.read_text())
@@ -225,7 +276,6 @@ def build_container(scenario, starts: dict | None = None) -> Path:
         os.replace(tmp, path)  # atomic: concurrent workers may build the same container
     finally:
         shutil.rmtree(work, ignore_errors=True)
-    return path
 
 
 _POOL: dict[str, list[Fmu]] = {}  # reset container instances ready for the next run, per container file

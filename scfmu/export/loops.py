@@ -1,4 +1,5 @@
-"""One FMI 2.0 co-simulation FMU per closed loop (its units FMI 2.0 or 3.0) (``fmus/loops/<scenario>.fmu``).
+"""One FMI 2.0 co-simulation FMU per closed loop (its units FMI 2.0 or 3.0, Co-Simulation or Model Exchange)
+(``fmus/loops/<scenario>.fmu``).
 
 Each file is the scenario's fmpy container FMU (:func:`scfmu.engines.native.build_container`: the scenario's
 FMUs nested under ``resources/``, wired in the scenario's Gauss–Seidel order, one fixed step of
@@ -28,8 +29,9 @@ from ..scenario.plan import build_plan
 
 
 def write_loop_fmu(scenario: Scenario, path: str | Path) -> Path:
-    """Writes the loop FMU of a scenario (its units may be FMI 2.0 or FMI 3.0 Co-Simulation FMUs; the loop
-    FMU itself is FMI 2.0 Co-Simulation)."""
+    """Writes the loop FMU of a scenario (its units may be FMI 2.0 or FMI 3.0 FMUs, Co-Simulation or Model
+    Exchange: a Model Exchange unit is nested as its Co-Simulation face, :mod:`scfmu.engines.cs_face`; the
+    loop FMU itself is FMI 2.0 Co-Simulation)."""
     plan = build_plan(scenario)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)

@@ -30,7 +30,6 @@ from __future__ import annotations
 
 import json
 import re
-import tempfile
 import zipfile
 from pathlib import Path
 from xml.etree import ElementTree as ET
@@ -126,10 +125,44 @@ def write_ssp(scenario: Scenario, path: str | Path, path_of=None) -> Path:
                          f"for SSP importers; got {[c.name for c in scenario.components]}")
     path_of = path_of or fmu_path
     mds = {c.model: read_model_description(str(path_of(c.model))) for c in scenario.components}
+    refuse_fmi3(scenario, mds)
+    root = ET.Element(_q("ssd", "SystemStructureDescription"),
+                      {"version": "1.0", "name": identifier(file_stem(scenario.name)), "generationTool": "scfmu.ssp",
+                       "description": scenario.description or scenario.name})
+    system = ET.SubElement(root, _q("ssd", "System"), {"name": "loop"})
+    ssv_files = _system(system, scenario, mds)
+    _experiment(root, scenario)
+    ET.indent(root)
+    ssd = ET.tostring(root, encoding="UTF-8", xml_declaration=True)
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(".ssp.tmp")
+    with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as z:
+        z.writestr("SystemStructure.ssd", ssd)
+        for src, data in sorted(ssv_files.items()):
+            z.writestr(src, data)
+        for model in dict.fromkeys(c.model for c in scenario.components):
+            z.write(path_of(model), f"resources/{resource_name(model)}")
+    tmp.replace(path)
+    return path
+
+
+def refuse_fmi3(scenario: Scenario, mds: dict) -> None:
+    """One-line refusal of FMI 3.0 units (``mds``: model -> model description): SSP 1.0 gives the meaning of
+    an FMU component's connectors and parameter bindings for FMI 1.0 and 2.0 variables only (its types are
+    Real/Integer/Boolean/String/Enumeration/Binary, its rules speak of FMI 1.0 and 2.0 causality, variability
+    and initial); FMI 3.0 components and types (Float64, Int32, ...) are SSP 2.0's, and fmpy ships the SSP 1.0
+    schemas and reads SSP 1.0 only."""
     fmi3 = [c.name for c in scenario.components if mds[c.model].fmiVersion.startswith("3")]
-    if fmi3:  # SSP 1.0 components are FMI 1.0/2.0 FMUs (FMI 3.0 comes with SSP 2.0)
-        raise ValueError(f"{', '.join(fmi3)}: FMI 3.0 units cannot be written to an SSP 1.0 file (SSP 1.0 "
-                         f"carries FMI 1.0 and 2.0 FMUs): use the unit's FMI 2.0 FMU, or a loop FMU (scfmu export loop)")
+    if fmi3:
+        raise ValueError(f"{', '.join(fmi3)}: FMI 3.0 units cannot be written to an SSP 1.0 file (SSP 1.0 defines "
+                         f"FMU components for FMI 1.0 and 2.0 only; FMI 3.0 came with SSP 2.0): use the unit's "
+                         f"FMI 2.0 FMU, or a loop FMU (scfmu export loop)")
+
+
+def _system(system, scenario: Scenario, mds: dict) -> dict:
+    """Fills the ``ssd:System``: elements with connectors and parameter bindings, connections and the
+    OMSimulator master annotation. Returns the ``.ssv`` files (archive name -> bytes)."""
     vars_of = {c.name: {v.name: v for v in mds[c.model].modelVariables} for c in scenario.components}
     ports = {c.name: ([v.name for v in mds[c.model].modelVariables if v.causality == "input"],
                       [v.name for v in mds[c.model].modelVariables if v.causality == "output"])
@@ -141,11 +174,6 @@ def write_ssp(scenario: Scenario, path: str | Path, path_of=None) -> Path:
         if var not in ports[inst][0]:
             raise KeyError(f"scenario input {q}: not an input of {inst}")
         fixed.setdefault(inst, []).append((var, value))
-
-    root = ET.Element(_q("ssd", "SystemStructureDescription"),
-                      {"version": "1.0", "name": identifier(file_stem(scenario.name)), "generationTool": "scfmu.ssp",
-                       "description": scenario.description or scenario.name})
-    system = ET.SubElement(root, _q("ssd", "System"), {"name": "loop"})
     elements = ET.SubElement(system, _q("ssd", "Elements"))
     ssv_files = {}
     for c in scenario.components:
@@ -178,6 +206,11 @@ def write_ssp(scenario: Scenario, path: str | Path, path_of=None) -> Path:
     ET.SubElement(ET.SubElement(oms, _q("oms", "SimulationInformation")), _q("oms", "FixedStepMaster"),
                   {"description": "oms-ma", "stepSize": repr(float(scenario.step)), "absoluteTolerance": "0.0001",
                    "relativeTolerance": "0.0001"})
+    return ssv_files
+
+
+def _experiment(root, scenario: Scenario) -> None:
+    """The ``ssd:DefaultExperiment`` with libcosim's step annotation and the package's master settings."""
     exp = ET.SubElement(root, _q("ssd", "DefaultExperiment"),
                         {"startTime": repr(float(scenario.start_time)), "stopTime": repr(float(scenario.stop_time))})
     anns = ET.SubElement(exp, _q("ssd", "Annotations"))
@@ -188,19 +221,6 @@ def write_ssp(scenario: Scenario, path: str | Path, path_of=None) -> Path:
                            {"scheme": "fixed-step Gauss-Seidel in element order", "stepSize": repr(float(scenario.step))})
     master.text = json.dumps({"name": scenario.name, "log": scenario.log, "metrics": scenario.metrics,
                               "seed_params": scenario.seed_params, "inputs": sorted(scenario.inputs)}, sort_keys=True)
-    ET.indent(root)
-    ssd = ET.tostring(root, encoding="UTF-8", xml_declaration=True)
-
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_suffix(".ssp.tmp")
-    with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as z:
-        z.writestr("SystemStructure.ssd", ssd)
-        for src, data in sorted(ssv_files.items()):
-            z.writestr(src, data)
-        for model in dict.fromkeys(c.model for c in scenario.components):
-            z.write(path_of(model), f"resources/{resource_name(model)}")
-    tmp.replace(path)
-    return path
 
 
 def _typed(elem, ns: str):

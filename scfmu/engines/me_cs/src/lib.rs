@@ -1,0 +1,277 @@
+//! A Co-Simulation face for a Model Exchange FMU: this library is copied into the FMU next to the FMU's own
+//! binary and named by an added `<CoSimulation modelIdentifier="scfmu_me_cs">` element
+//! (`scfmu/engines/me_cs.py`), so that a master which nests Co-Simulation units only (fmpy's container FMU:
+//! scfmu's native engine and loop FMUs) can run the unit.
+//!
+//! It exports the FMI 2.0 Co-Simulation functions ([`fmi2`], for an FMI 2.0 Model Exchange unit) and the
+//! FMI 3.0 ones ([`fmi3`], for an FMI 3.0 unit). At instantiation it reads `scfmu_me_cs.txt` from the
+//! unit's resources folder (the Model Exchange model identifier, the numbers of states and event indicators,
+//! the method and its tolerances), opens the unit's own library `binaries/<platform>/<identifier>` and
+//! instantiates it as Model Exchange. Getters, setters and the other common functions are forwarded; a
+//! communication step `doStep(t, h)` integrates the continuous states with the inputs held ([`Solver`]):
+//!
+//! * method `RK4`: the classic Runge–Kutta 4 with a fixed step (the communication step, or `max_step` when
+//!   smaller); any other method: Dormand–Prince 5(4) with local extrapolation and adaptive steps under
+//!   `rtol`/`atol` (the compiled engine's choice for a method it does not have, too);
+//! * after every accepted step `completedIntegratorStep`; a sign change of an event indicator (a state
+//!   event) is located by bisection on re-integrated partial steps to 1e-12 relative in time; at a time
+//!   event (`nextEventTime`), a state event or when the unit asks, the event iteration (`enterEventMode`,
+//!   `newDiscreteStates` / `updateDiscreteStates` until no update is needed), then continuous-time mode again
+//!   with the states re-read.
+//!
+//! One wrapped unit per copy of this library (a copy lives in each wrapped FMU), so the unit's library
+//! handle and its function pointers are process-wide statics of the copy.
+
+#![allow(clippy::missing_safety_doc)]
+
+use std::ffi::{c_char, c_void, CStr, CString};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+
+pub mod fmi2;
+pub mod fmi3;
+mod solver;
+
+pub use solver::Solver;
+
+pub const OK: i32 = 0;
+pub const WARNING: i32 = 1;
+pub const DISCARD: i32 = 2;
+pub const ERROR: i32 = 3;
+
+static LIB: AtomicUsize = AtomicUsize::new(0); // dlopen handle of the unit's own library
+static LIB_PATH: Mutex<Option<String>> = Mutex::new(None);
+
+/// The wrapped unit's settings (`resources/scfmu_me_cs.txt`, `key=value` lines).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Config {
+    pub model_identifier: String,
+    pub states: usize,
+    pub event_indicators: usize,
+    pub rk4: bool,
+    pub rtol: f64,
+    pub atol: f64,
+    pub max_step: f64,
+}
+
+impl Config {
+    pub fn parse(text: &str) -> Result<Config, String> {
+        let mut c = Config {
+            model_identifier: String::new(),
+            states: 0,
+            event_indicators: 0,
+            rk4: false,
+            rtol: 1e-10,
+            atol: 1e-12,
+            max_step: 0.0,
+        };
+        for line in text
+            .lines()
+            .map(str::trim)
+            .filter(|l| !l.is_empty() && !l.starts_with('#'))
+        {
+            let (k, v) = line
+                .split_once('=')
+                .ok_or_else(|| format!("line {line:?}: not key=value"))?;
+            let (k, v) = (k.trim(), v.trim());
+            let num = |v: &str| v.parse::<f64>().map_err(|_| format!("{k} = {v:?}: not a number"));
+            let int = |v: &str| v.parse::<usize>().map_err(|_| format!("{k} = {v:?}: not a count"));
+            match k {
+                "model_identifier" => c.model_identifier = v.to_string(),
+                "states" => c.states = int(v)?,
+                "event_indicators" => c.event_indicators = int(v)?,
+                "method" => c.rk4 = v == "RK4",
+                "rtol" => c.rtol = num(v)?,
+                "atol" => c.atol = num(v)?,
+                "max_step" => c.max_step = num(v)?,
+                _ => return Err(format!("unknown key {k:?}")),
+            }
+        }
+        if c.model_identifier.is_empty() || c.model_identifier.contains(['/', '\\']) {
+            return Err(format!("model_identifier {:?} is not a file name", c.model_identifier));
+        }
+        if !(c.rtol > 0.0 && c.atol > 0.0 && c.max_step >= 0.0 && c.max_step.is_finite()) {
+            return Err("rtol and atol must be > 0, max_step >= 0".into());
+        }
+        Ok(c)
+    }
+}
+
+/// The folder of a resource location: an FMI 2.0 `file:` URI or an FMI 3.0 path (percent escapes decoded).
+pub fn resource_dir(location: &str) -> String {
+    let p = if let Some(rest) = location.strip_prefix("file://") {
+        rest.strip_prefix("localhost").unwrap_or(rest).to_string()
+    } else if let Some(rest) = location.strip_prefix("file:") {
+        rest.to_string()
+    } else {
+        return location.trim_end_matches('/').to_string();
+    };
+    let b = p.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        let hex = |c: u8| (c as char).to_digit(16);
+        if b[i] == b'%' && i + 2 < b.len() {
+            if let (Some(h), Some(l)) = (hex(b[i + 1]), hex(b[i + 2])) {
+                out.push((h * 16 + l) as u8);
+                i += 3;
+                continue;
+            }
+        }
+        out.push(b[i]);
+        i += 1;
+    }
+    let mut s = String::from_utf8_lossy(&out).into_owned();
+    if cfg!(windows) && s.starts_with('/') && s.as_bytes().get(2) == Some(&b':') {
+        s.remove(0);
+    }
+    s.trim_end_matches('/').to_string()
+}
+
+/// Reads the settings and opens the unit's own library (`<resources>/../binaries/<folder>/<identifier>`).
+///
+/// # Safety
+/// `location` is null or a NUL-terminated string.
+pub unsafe fn load(location: *const c_char, v3: bool) -> Result<Config, String> {
+    if location.is_null() {
+        return Err("no resource location".into());
+    }
+    let res = resource_dir(&CStr::from_ptr(location).to_string_lossy());
+    let cfg_path = format!("{res}/scfmu_me_cs.txt");
+    let text = std::fs::read_to_string(&cfg_path).map_err(|e| format!("{cfg_path}: {e}"))?;
+    let cfg = Config::parse(&text).map_err(|e| format!("{cfg_path}: {e}"))?;
+    let folder = match (
+        v3 || cfg!(target_arch = "aarch64"),
+        cfg!(windows),
+        cfg!(target_os = "macos"),
+    ) {
+        (true, false, false) if cfg!(target_arch = "aarch64") => "aarch64-linux",
+        (false, true, _) => "win64",
+        (false, _, true) => "darwin64",
+        (false, _, _) => "linux64",
+        (true, true, _) => "x86_64-windows",
+        (true, _, true) => "x86_64-darwin",
+        (true, _, _) => "x86_64-linux",
+    };
+    let ext = if cfg!(windows) {
+        "dll"
+    } else if cfg!(target_os = "macos") {
+        "dylib"
+    } else {
+        "so"
+    };
+    let lib = format!("{res}/../binaries/{folder}/{}.{ext}", cfg.model_identifier);
+    let mut open = LIB_PATH.lock().unwrap_or_else(|e| e.into_inner());
+    match open.as_deref() {
+        Some(p) if p != lib => return Err(format!("this wrapper already serves {p}, not {lib}")),
+        Some(_) => return Ok(cfg),
+        None => {}
+    }
+    let c = CString::new(lib.clone()).map_err(|_| "library path with a NUL byte".to_string())?;
+    let h = libc::dlopen(c.as_ptr(), libc::RTLD_NOW | libc::RTLD_LOCAL);
+    if h.is_null() {
+        let why = libc::dlerror();
+        let why = if why.is_null() {
+            String::new()
+        } else {
+            CStr::from_ptr(why).to_string_lossy().into()
+        };
+        return Err(format!("cannot open {lib}: {why}"));
+    }
+    LIB.store(h as usize, Ordering::SeqCst);
+    *open = Some(lib);
+    Ok(cfg)
+}
+
+/// The unit's function `name` (NUL-terminated), cached in `cache`; None when the library lacks it.
+pub fn sym(cache: &AtomicUsize, name: &[u8]) -> Option<*const c_void> {
+    let p = cache.load(Ordering::Relaxed);
+    if p != 0 {
+        return Some(p as *const c_void);
+    }
+    let h = LIB.load(Ordering::SeqCst);
+    if h == 0 {
+        return None;
+    }
+    let f = unsafe { libc::dlsym(h as *mut c_void, name.as_ptr() as *const c_char) };
+    if f.is_null() {
+        return None;
+    }
+    cache.store(f as usize, Ordering::Relaxed);
+    Some(f as *const c_void)
+}
+
+/// `me!(fmi2SetTime, unsafe extern "C" fn(...) -> i32)`: the unit's function, or None.
+#[macro_export]
+macro_rules! me {
+    ($name:ident, $ty:ty) => {{
+        static P: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+        $crate::sym(&P, concat!(stringify!($name), "\0").as_bytes())
+            .map(|f| unsafe { std::mem::transmute::<*const std::ffi::c_void, $ty>(f) })
+    }};
+}
+
+/// What the solver needs from a Model Exchange unit (FMI 2.0 or 3.0), statuses as ints.
+pub trait Unit {
+    fn set_time(&mut self, t: f64) -> i32;
+    fn set_states(&mut self, x: &[f64]) -> i32;
+    fn get_states(&mut self, x: &mut [f64]) -> i32;
+    fn derivatives(&mut self, dx: &mut [f64]) -> i32;
+    fn indicators(&mut self, z: &mut [f64]) -> i32;
+    /// `completedIntegratorStep`: (status, enter event mode, terminate).
+    fn completed(&mut self) -> (i32, bool, bool);
+    fn enter_event_mode(&mut self) -> i32;
+    /// One `newDiscreteStates` / `updateDiscreteStates`: (status, more needed, terminate, next event time).
+    fn update(&mut self) -> (i32, bool, bool, Option<f64>);
+    fn enter_continuous_mode(&mut self) -> i32;
+}
+
+/// A wrapper instance (both versions): the unit's instance and the solver.
+pub struct Instance {
+    pub magic: u64,
+    pub inner: *mut c_void,
+    pub solver: Solver,
+    pub start_time: f64,
+    pub terminated: bool,
+}
+
+pub const MAGIC: u64 = 0x5343_464d_554d_4543; // "SCFMUMEC"
+
+/// The instance behind a pointer handed out by this library, or None.
+pub unsafe fn instance<'a>(p: *mut c_void) -> Option<&'a mut Instance> {
+    let w = p as *mut Instance;
+    if w.is_null() || (*w).magic != MAGIC {
+        None
+    } else {
+        Some(&mut *w)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn config_parses_and_refuses_bad_values() {
+        let c = Config::parse("model_identifier=AttitudePlant\nmethod=RK4\nmax_step=0.005\nstates=13\n").unwrap();
+        assert_eq!(
+            (c.model_identifier.as_str(), c.rk4, c.max_step, c.states),
+            ("AttitudePlant", true, 0.005, 13)
+        );
+        assert_eq!((c.rtol, c.atol, c.event_indicators), (1e-10, 1e-12, 0));
+        assert!(!Config::parse("model_identifier=A\nmethod=DOP853").unwrap().rk4);
+        assert!(Config::parse("model_identifier=../x").is_err());
+        assert!(Config::parse("model_identifier=A\nrtol=0").is_err());
+        assert!(Config::parse("model_identifier=A\nmax_step=-1").is_err());
+        assert!(Config::parse("model_identifier=A\nspeed=1").is_err());
+        assert!(Config::parse("states=1").is_err());
+    }
+
+    #[test]
+    fn resource_locations_of_both_versions() {
+        assert_eq!(resource_dir("file:///tmp/a%20b/resources/"), "/tmp/a b/resources");
+        assert_eq!(resource_dir("file:/tmp/x/resources"), "/tmp/x/resources");
+        assert_eq!(resource_dir("file://localhost/tmp/x/resources"), "/tmp/x/resources");
+        assert_eq!(resource_dir("/tmp/x/resources/"), "/tmp/x/resources");
+    }
+}
