@@ -7,4 +7,4 @@ cd "$(dirname "$0")/.."
 scripts/setup.sh
 scripts/build_fmus.sh
 cargo test --release --locked
-.venv/bin/python -m pytest -q   # testpaths (pyproject.toml): tests/ and the papers' own tests under scfmu/
+.venv/bin/python -m pytest -q   # testpaths (pyproject.toml): tests/, the papers' own tests under scfmu/, the family tests under src/models/
