@@ -212,8 +212,8 @@ def test_nonlinear_controller_loop_on_aarch64_agrees_with_x86_64(work):
             assert ulps(va, vb) <= 4 or abs(va - vb) < 1e-300, f"step {k} {name}: x86-64 {va!r} aarch64 {vb!r}"
 
 
-# The bad-input sections of the two hostile masters, with the arguments tests/test_hardening.py and
-# tests/test_fmi3_hardening.py use (fewer fuzz iterations: the emulated CPU is ~10x slower).
+# The bad-input sections of the two hostile masters, with the arguments tests/test_hardening.py
+# uses (fewer fuzz iterations: the emulated CPU is ~10x slower).
 HOSTILE_FMI2 = [("hang",), ("extreme",), ("fuzz", "1000", "20261123"), ("me", "2000", "300"), ("cycles", "50")]
 HOSTILE_FMI3 = [("abuse",), ("me",), ("mixed",)]
 

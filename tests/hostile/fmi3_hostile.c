@@ -1,6 +1,6 @@
 /* A hostile FMI 3.0 master in C: loads an FMU binary with dlopen and drives its fmi3* functions the way a
  * careless or malicious tool would. Each mode prints one summary line "ok ..." and exits 0, or prints what
- * went wrong and exits 1. Run under valgrind / a timeout by tests/test_fmi3_hardening.py.
+ * went wrong and exits 1. Run under valgrind / a timeout by tests/test_hardening.py.
  *
  *   fmi3_hostile LIB TOKEN cycles N   instantiate/init/step/state/serialize/deserialize/free N times:
  *                                     every cycle gives the same bits
