@@ -17,7 +17,7 @@ from fmpy import extract, read_model_description, simulate_fmu
 from fmpy.fmi3 import FMU3Model, FMU3Slave, fmi3Boolean, fmi3Float64, fmi3Int32
 from fmpy.validation import validate_fmu
 
-from test_fmi3_bad_input import ERROR, OK, TIME_VR, f64, status, vrs  # the raw-call helpers
+from test_fmi_bad_input import ERROR, OK, TIME_VR, f64, status, vrs  # the raw-call helpers
 from test_model_exchange import PLANT_CASES, dedup_last
 
 ROOT = Path(__file__).resolve().parents[1]
