@@ -1,5 +1,6 @@
-"""The FMU binary against a hostile C master, for every FMI version: tests/hostile/fmi_hostile.c (FMI 2.0)
-and tests/hostile/fmi3_hostile.c (FMI 3.0), compiled here with gcc and loaded with dlopen like any C master.
+"""The FMU binary against a hostile C master, for every FMI version: tests/hostile/fmi_hostile.c (FMI 2.0
+modes, and with `-3` the FMI 3.0 modes), compiled here with gcc, loading the binary with dlopen like any C
+master.
 
 FMI 2.0: bounded call time, validated FMU states, race-free state registry under 8 threads, nothing leaked
 per instance or per load (valgrind memcheck), no infinite value with fmi2OK; Co-Simulation and Model
@@ -23,10 +24,10 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 IN_CI = os.environ.get("CI") == "true"
-# per version: the master's source and gcc flags, the FMU folder, the binary folder, the token attribute
+# per version: the master's version switch, the FMU folder, the binary folder, the token attribute
 VERSIONS = {
-    2: ("fmi_hostile.c", ["-pthread"], ROOT / "fmus", "binaries/linux64", "guid"),
-    3: ("fmi3_hostile.c", [], ROOT / "fmus" / "fmi3", "binaries/x86_64-linux", "instantiationToken"),
+    2: ([], ROOT / "fmus", "binaries/linux64", "guid"),
+    3: (["-3"], ROOT / "fmus" / "fmi3", "binaries/x86_64-linux", "instantiationToken"),
 }
 # FMI 2.0 counts definite and indirect leaks as errors; FMI 3.0 measures them per instance (the library keeps
 # what it keeps per load; the per-load leak checks are the FMI 2.0 reload modes)
@@ -37,26 +38,23 @@ VALGRIND = {2: ["--leak-check=full", "--show-leak-kinds=definite,indirect",
 
 @pytest.fixture(scope="module")
 def masters(tmp_path_factory):
-    """FMI version -> compiled master program."""
+    """The compiled master program."""
     if shutil.which("gcc") is None:
-        pytest.fail("gcc is needed to build the hostile masters (scripts/setup.sh installs them)")
-    d = tmp_path_factory.mktemp("hostile")
-    progs = {}
-    for v, (src, flags, *_) in VERSIONS.items():
-        progs[v] = d / src[:-2]
-        subprocess.run(["gcc", "-O1", "-g", "-Wall", "-Werror", *flags, "-o", str(progs[v]),
-                        str(ROOT / "tests" / "hostile" / src), "-ldl", "-lm"], check=True)
-    return progs
+        pytest.fail("gcc is needed to build the hostile master (scripts/setup.sh installs it)")
+    prog = tmp_path_factory.mktemp("hostile") / "fmi_hostile"
+    subprocess.run(["gcc", "-O1", "-g", "-Wall", "-Werror", "-pthread", "-o", str(prog),
+                    str(ROOT / "tests" / "hostile" / "fmi_hostile.c"), "-ldl", "-lm"], check=True)
+    return prog
 
 
 def unit(masters, version: int, model: str = "AttitudePlant"):
     """(program, library, GUID or instantiation token, version) of `model` packaged for `version`."""
-    _, _, fmus, binaries, attr = VERSIONS[version]
-    lib = masters[version].parent / f"{model}.fmi{version}.so"
+    _, fmus, binaries, attr = VERSIONS[version]
+    lib = masters.parent / f"{model}.fmi{version}.so"
     with zipfile.ZipFile(fmus / f"{model}.fmu") as z:
         lib.write_bytes(z.read(f"{binaries}/{model}.so"))
         token = re.search(attr + r'="([^"]+)"', z.read("modelDescription.xml").decode()).group(1)
-    return masters[version], lib, token, version
+    return masters, lib, token, version
 
 
 @pytest.fixture(scope="module")
@@ -77,7 +75,7 @@ def law(masters):
 
 def run(target, *args, timeout=120, valgrind=False):
     prog, lib, token, version = target
-    cmd = [str(prog), str(lib), token, *map(str, args)]
+    cmd = [str(prog), *VERSIONS[version][0], str(lib), token, *map(str, args)]
     if valgrind:
         if shutil.which("valgrind") is None:
             if IN_CI:
