@@ -133,7 +133,7 @@ def choose_folder(base: Path, ident: dict, chosen: bool) -> tuple[Path, str | No
     return p, f"note: {base} holds another run; this one is written to {p}"
 
 
-def main(argv=None) -> int:
+def _parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="scfmu run", description=__doc__ + "\n" + options.__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     options.add_arguments(ap)
@@ -145,52 +145,12 @@ def main(argv=None) -> int:
     ap.add_argument("--no-plot", action="store_true")
     ap.add_argument("--log-every", type=int, default=1, metavar="N",
                     help="native engine: log every N-th communication step (for long runs; metrics on that grid)")
-    args = ap.parse_args(argv)
-    sc = options.build(args, notice=lambda t: print(t, file=sys.stderr))
-    bounded_int("--log-every", args.log_every, 1, 10 ** 9)
-    if args.log_every != 1 and args.engine not in (None, "native"):
-        raise UsageError(f"--log-every {args.log_every}: allowed only with --engine native (the {args.engine} "
-                         f"engine logs every step)")
-    problems = timing_problems(sc.start_time, sc.stop_time, sc.step, log_every=args.log_every,
-                               log_hint=args.engine in (None, "native"))
-    if problems:
-        raise UsageError(problems[0])
-    try:
-        require(sc, warn=lambda t: print(f"warning: {t}", file=sys.stderr))
-    except IncompatibleUnit as e:
-        print(f"scfmu run: {e.one_line()}", file=sys.stderr)
-        return 2
-    unbound = options.binding_report(sc, "scfmu run", args.strict, lambda t: print(t, file=sys.stderr))
-    try:
-        plan = build_plan(sc)
-    except (PlanError, KeyError, ValueError) as e:
-        print(f"scfmu run: {e}", file=sys.stderr)
-        return 2
-    if args.engine is None:
-        args.engine = "native"
-        if plan.model_exchange:  # fmpy's container (native) hosts Co-Simulation units only
-            from .engines.compiled import available
-            args.engine = "compiled" if available() else "lean"
-    if args.log_every != 1 and args.engine != "native":
-        raise UsageError(f"--log-every {args.log_every}: allowed only with --engine native (the {args.engine} "
-                         f"engine logs every step)")
+    return ap
+
+
+def _write(sc, r, args, out: Path, ident: dict, unbound: list) -> None:
+    """Prints the run's summary and metrics and writes the CSV, run.json, the manifest and the plot."""
     stem = file_stem(sc.name)
-    ident = run_identity(sc, args.engine)
-    out, notice = choose_folder(Path(args.out) if args.out else Path("out") / run_folder_name(sc), ident,
-                                chosen=args.out is not None)
-    if notice:
-        print(notice, file=sys.stderr)
-    try:
-        r = simulate(plan, args.engine, **({"log_every": args.log_every} if args.log_every != 1 else {}))
-    except PlanError as e:
-        print(f"scfmu run: {e}", file=sys.stderr)
-        return 2
-    except SimulationError as e:
-        print(f"scfmu run: the run failed ({e.status}): {e}", file=sys.stderr)
-        return 1
-    except FmuError as e:
-        print(f"scfmu run: the run failed: {e}", file=sys.stderr)
-        return 1
     out.mkdir(parents=True, exist_ok=True)
     m, mu = r.metrics, r.metric_units
     print(f"{sc.name}: {sc.description or ''}".rstrip(": "))
@@ -219,4 +179,53 @@ def main(argv=None) -> int:
         plot(r, png, title, r.units)
         written.append(png)
     print("wrote " + " and ".join(str(p) for p in written))
+
+
+def main(argv=None) -> int:
+    args = _parser().parse_args(argv)
+    sc = options.build(args, notice=lambda t: print(t, file=sys.stderr))
+    bounded_int("--log-every", args.log_every, 1, 10 ** 9)
+    if args.log_every != 1 and args.engine not in (None, "native"):
+        raise UsageError(f"--log-every {args.log_every}: allowed only with --engine native (the {args.engine} "
+                         f"engine logs every step)")
+    problems = timing_problems(sc.start_time, sc.stop_time, sc.step, log_every=args.log_every,
+                               log_hint=args.engine in (None, "native"))
+    if problems:
+        raise UsageError(problems[0])
+    try:
+        require(sc, warn=lambda t: print(f"warning: {t}", file=sys.stderr))
+    except IncompatibleUnit as e:
+        print(f"scfmu run: {e.one_line()}", file=sys.stderr)
+        return 2
+    unbound = options.binding_report(sc, "scfmu run", args.strict, lambda t: print(t, file=sys.stderr))
+    try:
+        plan = build_plan(sc)
+    except (PlanError, KeyError, ValueError) as e:
+        print(f"scfmu run: {e}", file=sys.stderr)
+        return 2
+    if args.engine is None:
+        args.engine = "native"
+        if plan.model_exchange:  # fmpy's container (native) hosts Co-Simulation units only
+            from .engines.compiled import available
+            args.engine = "compiled" if available() else "lean"
+    if args.log_every != 1 and args.engine != "native":
+        raise UsageError(f"--log-every {args.log_every}: allowed only with --engine native (the {args.engine} "
+                         f"engine logs every step)")
+    ident = run_identity(sc, args.engine)
+    out, notice = choose_folder(Path(args.out) if args.out else Path("out") / run_folder_name(sc), ident,
+                                chosen=args.out is not None)
+    if notice:
+        print(notice, file=sys.stderr)
+    try:
+        r = simulate(plan, args.engine, **({"log_every": args.log_every} if args.log_every != 1 else {}))
+    except PlanError as e:
+        print(f"scfmu run: {e}", file=sys.stderr)
+        return 2
+    except SimulationError as e:
+        print(f"scfmu run: the run failed ({e.status}): {e}", file=sys.stderr)
+        return 1
+    except FmuError as e:
+        print(f"scfmu run: the run failed: {e}", file=sys.stderr)
+        return 1
+    _write(sc, r, args, out, ident, unbound)
     return 0

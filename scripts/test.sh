@@ -8,4 +8,4 @@ scripts/setup.sh
 scripts/build_fmus.sh
 scripts/lint.sh   # cargo fmt --check, cargo clippy -D warnings, ruff check
 cargo test --release --locked
-.venv/bin/python -m pytest -q   # testpaths (pyproject.toml): tests/ and the papers' own tests under scfmu/
+.venv/bin/python -m pytest -q   # testpaths (pyproject.toml): tests/, the papers' own tests under scfmu/, the family tests under src/models/

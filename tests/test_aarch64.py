@@ -9,7 +9,7 @@ once with aarch64-linux-gnu-gcc (run under qemu), give the same results on both 
   rates, torques and wheel momentum bit for bit at every step; the Euler angles (atan2/asin of each
   platform's C library) within 1 ulp; with nonlinear controllers (exp/tanh of the C library) every output
   within 4 ulp;
-- the hostile masters' bad-input sections (tests/hostile/fmi_hostile.c and fmi3_hostile.c: hang-prone
+- the hostile masters' bad-input sections (tests/hostile/fmi_hostile.c, both versions: hang-prone
   calls, extreme parameters, mutated FMU states, every Model Exchange entry point abused, FMI 3.0 abuse):
   the same report line, character for character (counts of refused calls, accepted mutations, events and
   the printed w_x to 17 digits).
@@ -36,7 +36,6 @@ ROOT = Path(__file__).resolve().parents[1]
 FMUS = ROOT / "fmus"
 LOADER = ROOT / "tests" / "loader" / "fmi_loop.c"
 HOSTILE2 = ROOT / "tests" / "hostile" / "fmi_hostile.c"
-HOSTILE3 = ROOT / "tests" / "hostile" / "fmi3_hostile.c"
 CROSS_GCC = "aarch64-linux-gnu-gcc"
 CROSS_NM = "aarch64-linux-gnu-nm"
 CROSS_READELF = "aarch64-linux-gnu-readelf"
@@ -100,8 +99,7 @@ def work(tmp_path_factory, fmus_with_aarch64):
     under their own file names (the library finds its model by its file name): x86/<Model>.so and
     arm/<Model>.so (FMI 2.0), x86_3/AttitudePlant.so and arm_3/AttitudePlant.so (FMI 3.0); and the GUIDs."""
     d = tmp_path_factory.mktemp("aarch64")
-    for src, name, extra in ((LOADER, "fmi_loop", ["-ldl"]), (HOSTILE2, "fmi_hostile", ["-pthread", "-ldl", "-lm"]),
-                             (HOSTILE3, "fmi3_hostile", ["-ldl", "-lm"])):
+    for src, name, extra in ((LOADER, "fmi_loop", ["-ldl"]), (HOSTILE2, "fmi_hostile", ["-pthread", "-ldl", "-lm"])):
         for cc, suffix in (("gcc", ""), (CROSS_GCC, ".arm")):
             subprocess.run([cc, "-O1", "-Wall", "-Werror", "-o", str(d / (name + suffix)), str(src), *extra], check=True)
         assert elf_machine((d / f"{name}.arm").read_bytes())[1] == EM_AARCH64
@@ -212,8 +210,8 @@ def test_nonlinear_controller_loop_on_aarch64_agrees_with_x86_64(work):
             assert ulps(va, vb) <= 4 or abs(va - vb) < 1e-300, f"step {k} {name}: x86-64 {va!r} aarch64 {vb!r}"
 
 
-# The bad-input sections of the two hostile masters, with the arguments tests/test_hardening.py and
-# tests/test_fmi3_hardening.py use (fewer fuzz iterations: the emulated CPU is ~10x slower).
+# The bad-input sections of the two hostile masters, with the arguments tests/test_hardening.py
+# uses (fewer fuzz iterations: the emulated CPU is ~10x slower).
 HOSTILE_FMI2 = [("hang",), ("extreme",), ("fuzz", "1000", "20261123"), ("me", "2000", "300"), ("cycles", "50")]
 HOSTILE_FMI3 = [("abuse",), ("me",), ("mixed",)]
 
@@ -232,8 +230,8 @@ def test_hostile_fmi2_master_reports_the_same_on_aarch64(work, args):
 @pytest.mark.parametrize("args", HOSTILE_FMI3, ids=lambda a: " ".join(a))
 def test_hostile_fmi3_master_reports_the_same_on_aarch64(work, args):
     d, info = work
-    native = run_native(d, "x86_3", "fmi3_hostile", "./AttitudePlant.so", info["token3"], *args)
-    arm = run_arm(d, "arm_3", "fmi3_hostile", "./AttitudePlant.so", info["token3"], *args)
+    native = run_native(d, "x86_3", "fmi_hostile", "-3", "./AttitudePlant.so", info["token3"], *args)
+    arm = run_arm(d, "arm_3", "fmi_hostile", "-3", "./AttitudePlant.so", info["token3"], *args)
     assert native.returncode == 0 and native.stdout.startswith("ok"), native.stdout + native.stderr[-2000:]
     assert arm.returncode == 0 and arm.stdout.startswith("ok"), arm.stdout + arm.stderr[-2000:]
     assert arm.stdout == native.stdout

@@ -4,8 +4,8 @@ finite, an FMU state serialized and restored into the other instance, terminate,
 load) under memcheck with definite and indirect leaks counted as errors. Time-bounded: in CI every FMU file
 once (its Model Exchange interface where it has one, which runs more entry points and the derivatives,
 else Co-Simulation), 20 steps; with SCFMU_LONG=1 every interface of every FMU, 200 steps. The leak checks per
-library load and the hostile call sequences under valgrind are in tests/test_hardening.py and
-tests/test_fmi3_hardening.py."""
+library load and the hostile call sequences under valgrind are in tests/test_hardening.py
+(both FMI versions)."""
 
 from __future__ import annotations
 

@@ -1,6 +1,7 @@
 """FMI 3.0 Co-Simulation FMUs (fmus/fmi3/<Model>.fmu): every one validates in fmpy, matches the committed
 modelDescription/fmi3/, simulates in fmpy's own FMI 3.0 master with results bit-identical to the FMI 2.0
-FMU of the same model (Co-Simulation; Model Exchange is tests/test_fmi3_model_exchange.py), AttitudePlant follows the closed form under a constant torque, and a closed loop
+FMU of the same model (Co-Simulation; Model Exchange is tests/test_model_exchange.py), AttitudePlant follows
+the closed form under a constant torque, and a closed loop
 stepped over FMI 3.0 equals the same loop over FMI 2.0 bit for bit."""
 
 from __future__ import annotations

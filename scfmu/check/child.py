@@ -37,7 +37,8 @@ def main() -> int:
     opts = job["options"]
     _limits(opts)
     from .fmi import Trace
-    from .gauntlet import CHECKS, Fail, NotApplicable
+    from .gauntlet import CHECKS
+    from .verdict import Fail, NotApplicable
     from .unit import Unit
     out = sys.stdout.fileno()
     trace = Trace(out)

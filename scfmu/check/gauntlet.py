@@ -3,93 +3,20 @@
 Each check takes a :class:`~scfmu.check.unit.Unit` and the options and returns a result dict
 (status "pass" | "fail" | "n/a", kind, detail, reproducer, metrics). A failure raises :class:`Fail`; the
 reproducer is the call list of the scenario that failed (the current :class:`~scfmu.check.fmi.Trace`).
-A crash or a hang is seen by the parent, which has the same call list from the child's output."""
+A crash or a hang is seen by the parent, which has the same call list from the child's output. The
+verdicts and shared steps are in scfmu.check.verdict, the misuse checks (bad arguments, random call
+sequences) in scfmu.check.misuse."""
 
 from __future__ import annotations
 
-import math
 import random
-import struct
 import threading
 
 from .fmi import OK, WARNING, Lib
+from .misuse import bad_arguments, random_sequences
 from .unit import Unit, s_name
-
-NOT_OK = "a status other than OK/Warning"
-
-
-class Fail(Exception):
-    def __init__(self, kind: str, detail: str):
-        super().__init__(detail)
-        self.kind, self.detail = kind, detail
-
-
-class NotApplicable(Exception):
-    pass
-
-
-def _rss() -> int:
-    """Resident set size of this process in bytes (Linux /proc; elsewhere the peak from getrusage)."""
-    try:
-        with open("/proc/self/statm") as f:
-            import os
-            return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
-    except OSError:
-        import resource
-        return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
-
-
-def _need(u: Unit, h, what: str):
-    if h is None:
-        raise Fail("error_status", f"{what}: instantiation returned NULL")
-    return h
-
-
-def _expect_refused(u: Unit, s: int, what: str, kind: str = "wrong_status"):
-    if s in (OK, WARNING):
-        raise Fail(kind, f"{what} returned {s_name(u.v, s)}; the standard prescribes an error status")
-
-
-def _expect_ok(u: Unit, s: int, what: str):
-    if s > WARNING:
-        msg = u.messages[-1][1] if u.messages else "no log message"
-        raise Fail("error_status", f"{what} returned {s_name(u.v, s)} ({msg})")
-
-
-def _check_status_valid(u: Unit, s: int, what: str):
-    if not 0 <= s <= (5 if u.v == 2 else 4):
-        raise Fail("invalid_status", f"{what} returned the invalid status value {s}")
-
-
-def _steps(u: Unit, h, t: float, n: int, inputs=None) -> tuple[float, list]:
-    """n steps of u.dt with the outputs checked after each; returns (time, outputs after each step)."""
-    outs = []
-    for k in range(n):
-        if inputs is not None:
-            _expect_ok(u, u.set(h, u.inputs, inputs(k)), "setting the inputs")
-        s = u.step(h, t, u.dt)
-        _check_status_valid(u, s, "a step")
-        _expect_ok(u, s, f"the step from t = {t!r}")
-        t += u.dt
-        s, vals, problem = u.outputs_ok(h)
-        _expect_ok(u, s, "reading the outputs")
-        if problem:
-            raise Fail("nonfinite", problem)
-        outs.append(vals)
-    return t, outs
-
-
-def _bits(rows) -> bytes:
-    return b"".join(struct.pack(f"<{len(r)}d", *[float(x) for x in r]) for r in rows)
-
-
-def _inputs_fn(u: Unit, seed: int):
-    """The input sequence of the nominal, FMU-state and thread runs: the inputs' start values (an operating
-    point the modelDescription promises; perturbing them could break a unit's input contract, e.g. a unit
-    quaternion). `seed` is kept for the signature: the sequence is the same for every seed."""
-    base = u.nominal_inputs()
-    return lambda k: base
-
+from .verdict import (Fail, NotApplicable, _bits, _check_status_valid, _expect_ok, _expect_refused, _inputs_fn,
+                      _need, _rss, _steps)
 
 # ============================================================================================ checks
 def nominal_run(u: Unit, o: dict) -> dict:
@@ -242,277 +169,52 @@ def state_machine(u: Unit, o: dict) -> dict:
             "metrics": {"forbidden_calls": n_calls}}
 
 
-def bad_arguments(u: Unit, o: dict) -> dict:
-    """NULL pointers, a wrong GUID/token, unknown value references, NaN/Inf inputs, zero, negative and
-    non-finite steps: refused (or, for values the unit accepts, no non-finite output with OK); never a crash."""
-    from ctypes import c_double, c_uint32
-    p, v = u.p, u.v
-    notes = []
-    u.trace.start("bad arguments: wrong GUID / instantiation token")
-    h = u.new(token="{00000000-0000-0000-0000-000000000000}")
-    if h is not None:
-        u.free(h)
-        raise Fail("wrong_status", "instantiation with a wrong GUID/instantiationToken returned an instance")
-    u.trace.start("bad arguments: NULL GUID / instantiation token")
-    h = u.new(null_token=True)
-    if h is not None:
-        u.free(h)
-        raise Fail("wrong_status", "instantiation with a NULL GUID/instantiationToken returned an instance")
-    if v == 2:
-        u.trace.start("bad arguments: NULL callback functions")
-        h = u.new(null_callbacks=True)
-        if h is not None:
-            u.free(h)
-            notes.append("NULL callbacks accepted")
-    u.trace.start("bad arguments: NULL instance")
-    calls = [(f"{p}EnterInitializationMode(NULL)", lambda: u.enter_init(None)),
-             (f"{p}ExitInitializationMode(NULL)", lambda: u.exit_init(None)),
-             (f"{p}Terminate(NULL)", lambda: u.terminate(None)),
-             (f"{p}Reset(NULL)", lambda: u.reset(None))]
-    if u.outputs:
-        calls.append(("reading the outputs of NULL", lambda: u.get(None, u.outputs[:1])[0]))
-    if u.real_inputs:
-        calls.append(("setting an input of NULL", lambda: u.set(None, u.real_inputs[:1], [0.0])))
-    if not u.me:
-        calls.append(("a step of NULL", lambda: u.step(None, 0.0, u.dt)))
-    for what, f in calls:
-        _expect_refused(u, f(), what)
-    u.lib.call(f"{p}FreeInstance", None)
-
-    u.trace.start("bad arguments: NULL arrays and unknown value references")
-    h = _need(u, u.new(), "instantiate")
-    _expect_ok(u, u.start(h), "initialization")
-    getter = "fmi2GetReal" if v == 2 else "fmi3GetFloat64"
-    setter = "fmi2SetReal" if v == 2 else "fmi3SetFloat64"
-    ext = [] if v == 2 else [1]
-    real_out = [x for x in u.outputs if x["type"] in ("Real", "Float64")]
-    if real_out:
-        vr1 = (c_uint32 * 1)(real_out[0]["vr"])
-        val = (c_double * 1)()
-        hn = u.lib.handle_name(h)
-        sh = [] if v == 2 else ["1"]
-        _expect_refused(u, u.lib.call(getter, h, None, 1, val, *ext, shown=[hn, "NULL", "1", "values", *sh]),
-                        f"{getter} with a NULL value-reference array")
-        _expect_refused(u, u.lib.call(getter, h, vr1, 1, None, *ext, shown=[hn, f"{{{real_out[0]['vr']}}}", "1",
-                                                                              "NULL", *sh]),
-                        f"{getter} with a NULL value array")
-    used = set(u.spec["all_vrs"])
-    unknown = max(used, default=0) + 1000
-    while unknown in used:
-        unknown += 1
-    vr = (c_uint32 * 1)(unknown)
-    val = (c_double * 1)(0.0)
-    hn = u.lib.handle_name(h)
-    sh = [] if v == 2 else ["1"]
-    s = u.lib.call(getter, h, vr, 1, val, *ext, shown=[hn, f"{{{unknown}}}", "1", "values", *sh])
-    _expect_refused(u, s, f"{getter} of the unknown value reference {unknown}")
-    u.free(h)
-    h = _need(u, u.new(), "instantiate")
-    _expect_ok(u, u.start(h), "initialization")
-    hn = u.lib.handle_name(h)
-    s = u.lib.call(setter, h, vr, 1, val, *ext, shown=[hn, f"{{{unknown}}}", "1", "{0.0}", *sh])
-    _expect_refused(u, s, f"{setter} of the unknown value reference {unknown}")
-    u.free(h)
-
-    # non-finite inputs: refused, or no non-finite output returned with OK afterwards
-    accepted = []
-    for var in u.real_inputs:
-        for bad in (math.nan, math.inf, -math.inf):
-            u.trace.start(f"bad arguments: input {var['name']} = {bad}")
-            h = _need(u, u.new(), "instantiate")
-            _expect_ok(u, u.start(h), "initialization")
-            s = u.set(h, [var], [bad])
-            if s <= WARNING:
-                s = u.step(h, u.start_time, u.dt)
-                if s <= WARNING:
-                    s2, _, problem = u.outputs_ok(h)
-                    if problem:
-                        u.free(h)
-                        raise Fail("nonfinite", f"input {var['name']} = {bad} accepted, then {problem}")
-                    accepted.append(var["name"])
-            u.free(h)
-    # bad steps
-    bad_steps = [(0.0, None), (-u.dt, "negative"), (math.nan, "NaN"), (math.inf, "infinite"), (-math.inf, "negative")]
-    zero_ok = None
-    for dt, must in bad_steps:
-        u.trace.start(f"bad arguments: step size {dt}")
-        h = _need(u, u.new(), "instantiate")
-        _expect_ok(u, u.start(h), "initialization")
-        if u.me:
-            s = u.lib.call(f"{p}SetTime", h, u.start_time + dt if math.isfinite(dt) else dt)
-            label = f"{p}SetTime to start time + {dt}"
-            must = "NaN" if math.isnan(dt) else None  # time may be set back in Model Exchange
-        else:
-            s = u.step(h, u.start_time, dt)
-            label = f"a step of size {dt}"
-        _check_status_valid(u, s, label)
-        if must and s <= WARNING:
-            if must == "infinite":
-                _, _, problem = u.outputs_ok(h)
-                if problem:
-                    raise Fail("nonfinite", f"{label} accepted, then {problem}")
-            else:
-                raise Fail("wrong_status", f"{label} returned {s_name(v, s)}; a {must} step must be refused")
-        if dt == 0.0:
-            zero_ok = s <= WARNING
-        u.free(h)
-    if not u.me:
-        u.trace.start("bad arguments: NaN communication point")
-        h = _need(u, u.new(), "instantiate")
-        _expect_ok(u, u.start(h), "initialization")
-        s = u.step(h, math.nan, u.dt)
+def _corrupted_states(u: Unit, o: dict, data: bytes, t: float) -> tuple[int, int, int]:
+    """Corrupted serialized states (empty, truncated, garbage, NULL, random byte changes) deserialized and
+    set into fresh instances: refused, or usable with finite outputs; returns (cases, refused, usable)."""
+    rng = random.Random(o["seed"] * 31 + 7)
+    refused = usable = 0
+    cases = [("empty", b""), ("truncated", data[: len(data) // 2]), ("one byte short", data[:-1]),
+             ("garbage", bytes(rng.randrange(256) for _ in range(len(data)))), ("NULL", None)]
+    for i in range(o["mutations"]):
+        b = bytearray(data)
+        for _ in range(rng.choice([1, 1, 2, 4, 16])):
+            pos = rng.randrange(len(b))
+            b[pos] = rng.randrange(256)
+        cases.append((f"mutation {i}", bytes(b)))
+    h3 = _need(u, u.new(), "instantiate")
+    _expect_ok(u, u.start(h3), "initialization")
+    for label, bad in cases:
+        u.trace.start(f"FMU state: deserialize a corrupted state ({label})")
+        s, st3 = u.deserialize(h3, bad, label=label)
+        _check_status_valid(u, s, "deserialize")
+        if s > WARNING or not st3:
+            if label in ("empty", "NULL") and s <= WARNING:
+                raise Fail("wrong_status", f"deserializing a {label} state returned {s_name(u.v, s)}")
+            refused += 1
+            if s > WARNING:
+                u.reset(h3)
+                u.free(h3)
+                h3 = _need(u, u.new(), "instantiate")
+                _expect_ok(u, u.start(h3), "initialization")
+            continue
+        s = u.set_state(h3, st3)
         if s <= WARNING:
-            raise Fail("wrong_status", f"a step from t = NaN returned {s_name(v, s)}")
-        u.free(h)
-    detail = (f"wrong and NULL GUID refused, NULL instance and arrays refused, unknown value reference {unknown} "
-              f"refused, non-finite inputs {'accepted by ' + ', '.join(sorted(set(accepted))[:3]) + ' without a non-finite output' if accepted else 'refused'}, "
-              f"negative/NaN steps refused, zero step {'accepted' if zero_ok else 'refused'}")
-    if notes:
-        detail += "; " + "; ".join(notes)
-    return {"detail": detail, "metrics": {"nonfinite_inputs_accepted": len(accepted)}}
-
-
-# ----------------------------------------------------------------------------------- random sequences
-# the modelled states
-INST, INIT, READY, TERM = "instantiated", "initialization", "ready", "terminated"
-ACTIONS = ("set", "get", "step", "step", "step", "bad_step", "enter_init", "exit_init", "terminate", "reset",
-           "state", "free_new", "extreme")
-
-
-# the calls a well-behaved master makes in each state (three quarters of the calls; the rest are any call)
-LEGAL = {INST: ("enter_init", "set", "state"), INIT: ("set", "get", "exit_init", "exit_init"),
-         READY: ("set", "get", "step", "step", "step", "step", "state", "extreme", "terminate"),
-         TERM: ("get", "reset", "free_new")}
-
-
-def random_sequences(u: Unit, o: dict) -> dict:
-    """`sequences` seeded random call sequences of `length` calls from the unit's state machine (legal calls,
-    forbidden calls, extreme values, bad steps, FMU states), re-initialised after every error so that
-    sequences reach deep states. Fails on a forbidden call accepted, a non-finite output returned with OK, an
-    invalid status or (seen by the parent) a crash or hang. Reports the share of calls that succeeded."""
-    rng = random.Random(o["seed"] * 7919 + 11)
-    n_seq, length = o["sequences"], o["length"]
-    total = ok = reinit = 0
-    can_state = u.spec["can_get_set_state"]
-    for k in range(n_seq):
-        u.trace.start(f"random sequence {k} (seed {o['seed']})")
-        h = _need(u, u.new(), "instantiate")
-        st, t = INST, u.start_time
-        saved = None
-        for _ in range(length):
-            a = rng.choice(ACTIONS) if rng.random() < 0.25 else rng.choice(LEGAL[st] if st in LEGAL else ACTIONS)
-            forbidden = False
-            s = OK
-            if a == "set":
-                if not u.inputs:
-                    continue
-                base = u.nominal_inputs()
-                scale = rng.choice([0.0, 0.0, 1e-3, 0.1])  # mostly the start values, sometimes perturbed
-                vals = [b + rng.gauss(0, scale * (1 + abs(b))) if var["type"] in ("Real", "Float64") else b
-                        for var, b in zip(u.inputs, base)]
-                vals = [min(max(x, var["min"]), var["max"]) if var["type"] in ("Real", "Float64") and
-                        var.get("min") is not None and var.get("max") is not None else x
-                        for var, x in zip(u.inputs, vals)]
-                forbidden = st == TERM
-                s = u.set(h, u.inputs, vals)
-            elif a == "extreme":
-                if not u.real_inputs:
-                    continue
-                var = rng.choice(u.real_inputs)
-                x = rng.choice([math.nan, math.inf, -math.inf, 1e300, -1e300, 5e-324])
-                forbidden = st == TERM
-                s = u.set(h, [var], [x])
-            elif a == "get":
-                if not u.outputs or st == INST:
-                    continue
-                s, _, problem = u.outputs_ok(h)
-                if problem:
-                    raise Fail("nonfinite", f"random sequence {k}: {problem}")
-            elif a in ("step", "bad_step"):
-                dt = u.dt * rng.choice([1, 1, 1, 0.5, 2, 10]) if a == "step" else \
-                    rng.choice([0.0, -u.dt, math.nan, 1e9 * u.dt])
-                if u.me and st == READY:
-                    s = u.me_step(h, t, dt) if math.isfinite(dt) and dt > 0 else \
-                        u.lib.call(f"{u.p}SetTime", h, t + dt if not math.isnan(dt) else dt)
-                    if s <= WARNING and math.isnan(dt):
-                        forbidden = True
-                else:
-                    forbidden = st != READY or (a == "bad_step" and (math.isnan(dt) or dt < 0))
-                    s = u.step(h, t, dt)
-                if s <= WARNING and st == READY and math.isfinite(dt) and dt > 0:
-                    t += dt
-            elif a == "enter_init":
-                forbidden = st != INST
-                s = u.enter_init(h, t) if st == INST or rng.random() < 0.5 else \
-                    u.lib.call(f"{u.p}EnterInitializationMode", h) if u.v == 2 else u.enter_init(h, t)
-                if s <= WARNING:
-                    st = INIT
-            elif a == "exit_init":
-                forbidden = st != INIT
-                s = u.exit_init(h)
-                if s <= WARNING and st == INIT:
-                    st = READY
-                    if u.me:
-                        s = max(s, u.event_iteration(h))
-                        if s <= WARNING:
-                            s = max(s, u.lib.call(f"{u.p}EnterContinuousTimeMode", h))
-            elif a == "terminate":
-                forbidden = st == INST
-                s = u.terminate(h)
-                if s <= WARNING and st != INST:
-                    st = TERM
-            elif a == "reset":
-                s = u.reset(h)
-                if s <= WARNING:
-                    st, t = INST, u.start_time
-            elif a == "state":
-                if not can_state:
-                    continue
-                if saved is None or rng.random() < 0.5:
-                    if saved is not None:
-                        u.free_state(h, saved)
-                    s, saved = u.get_state(h)
-                    if s > WARNING:
-                        saved = None
-                else:
-                    s = u.set_state(h, saved)
-                    if s <= WARNING:
-                        st = "unknown"  # the restored state's mode is not modelled: re-initialise
-            elif a == "free_new":
-                if saved is not None:
-                    u.free_state(h, saved)
-                    saved = None
-                u.free(h)
-                h = _need(u, u.new(), "instantiate")
-                st, t = INST, u.start_time
-                continue
-            total += 1
-            _check_status_valid(u, s, a)
-            if forbidden and s <= WARNING and st != "unknown":
-                last = u.trace.lines[-1] if u.trace.lines else a
-                raise Fail("wrong_status", f"random sequence {k}: {last.split(' -> ')[0]} is forbidden in state "
-                                           f"'{st}' but returned {s_name(u.v, s)}")
+            u.x.pop(h3, None)
+            s = u.step(h3, t, u.dt)
             if s <= WARNING:
-                ok += 1
-            if s > WARNING or st == "unknown":
-                reinit += 1
-                if saved is not None:
-                    u.free_state(h, saved)
-                    saved = None
-                s = u.reset(h)
-                if s > WARNING:
-                    u.free(h)
-                    h = _need(u, u.new(), "instantiate")
-                s = u.start(h)
-                st, t = (READY, u.start_time) if s <= WARNING else (INST, u.start_time)
-        if saved is not None:
-            u.free_state(h, saved)
-        u.free(h)
-    share = ok / total if total else 0.0
-    return {"detail": f"{n_seq} sequences x {length} calls (seed {o['seed']}): {ok} of {total} calls succeeded "
-                      f"({100 * share:.1f} %), {reinit} re-initialisations after errors",
-            "metrics": {"sequences": n_seq, "calls": total, "succeeded": ok, "share_succeeded": share,
-                        "reinitialisations": reinit}}
+                _, _, problem = u.outputs_ok(h3)
+                if problem:
+                    raise Fail("nonfinite", f"a corrupted state ({label}) was accepted, then {problem}")
+            usable += 1
+        else:
+            refused += 1
+        u.free_state(h3, st3)
+        u.free(h3)
+        h3 = _need(u, u.new(), "instantiate")
+        _expect_ok(u, u.start(h3), "initialization")
+    u.free(h3)
+    return len(cases), refused, usable
 
 
 def fmu_state(u: Unit, o: dict) -> dict:
@@ -557,52 +259,10 @@ def fmu_state(u: Unit, o: dict) -> dict:
             raise Fail("nondeterministic", "a second instance restored from the serialized state steps differently")
         u.free_state(h2, st2)
         u.free(h2)
-        # corrupted states
-        rng = random.Random(o["seed"] * 31 + 7)
-        refused = usable = 0
-        cases = [("empty", b""), ("truncated", data[: len(data) // 2]), ("one byte short", data[:-1]),
-                 ("garbage", bytes(rng.randrange(256) for _ in range(len(data)))), ("NULL", None)]
-        for i in range(o["mutations"]):
-            b = bytearray(data)
-            for _ in range(rng.choice([1, 1, 2, 4, 16])):
-                pos = rng.randrange(len(b))
-                b[pos] = rng.randrange(256)
-            cases.append((f"mutation {i}", bytes(b)))
-        h3 = _need(u, u.new(), "instantiate")
-        _expect_ok(u, u.start(h3), "initialization")
-        for label, bad in cases:
-            u.trace.start(f"FMU state: deserialize a corrupted state ({label})")
-            s, st3 = u.deserialize(h3, bad, label=label)
-            _check_status_valid(u, s, "deserialize")
-            if s > WARNING or not st3:
-                if label in ("empty", "NULL") and s <= WARNING:
-                    raise Fail("wrong_status", f"deserializing a {label} state returned {s_name(u.v, s)}")
-                refused += 1
-                if s > WARNING:
-                    u.reset(h3)
-                    u.free(h3)
-                    h3 = _need(u, u.new(), "instantiate")
-                    _expect_ok(u, u.start(h3), "initialization")
-                continue
-            s = u.set_state(h3, st3)
-            if s <= WARNING:
-                u.x.pop(h3, None)
-                s = u.step(h3, t, u.dt)
-                if s <= WARNING:
-                    _, _, problem = u.outputs_ok(h3)
-                    if problem:
-                        raise Fail("nonfinite", f"a corrupted state ({label}) was accepted, then {problem}")
-                usable += 1
-            else:
-                refused += 1
-            u.free_state(h3, st3)
-            u.free(h3)
-            h3 = _need(u, u.new(), "instantiate")
-            _expect_ok(u, u.start(h3), "initialization")
-        u.free(h3)
+        n_cases, refused, usable = _corrupted_states(u, o, data, t)
         detail += (f"; serialized ({len(data)} bytes) and restored in a second instance bit-identical; "
-                   f"{len(cases)} corrupted states: {refused} refused, {usable} usable with finite outputs")
-        metrics.update(serialized_bytes=len(data), corrupted=len(cases), refused=refused, usable=usable)
+                   f"{n_cases} corrupted states: {refused} refused, {usable} usable with finite outputs")
+        metrics.update(serialized_bytes=len(data), corrupted=n_cases, refused=refused, usable=usable)
     u.trace.start("FMU state: set a NULL state")
     _expect_refused(u, u.set_state(h, None), "setting a NULL FMU state")
     u.free_state(h, st)

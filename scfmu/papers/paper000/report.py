@@ -376,11 +376,10 @@ RULE_TEXT = {
 }
 
 
-def build(ctx: Context) -> PaperSection:
-    t0 = time.time()
-    base, ts = run_base(ctx)
-    figs = [fig_ranking(ctx, base), fig_effort(ctx, base), fig_robust(ctx, ts)]
-    sws = sweeps(ctx.quick)
+def _sweeps(ctx: Context, base: dict, sws: list) -> tuple[dict, dict, list, dict]:
+    """Every one-reading sweep: its runs, figure, and per claim the verdict at each value (with the table
+    where the reading moves the verdict) and whether the value moves the paper's own numbers away. Returns
+    (per_claim, away_of, needed effort ratios, rows of each sweep)."""
     per_claim: dict[str, list[tuple[dict, list[bool], Sensitivity]]] = {c: [] for c in RULES}
     away_of: dict[str, list[tuple[str, list, list[bool], list[bool]]]] = {c: [] for c in RULES}
     needed = [(c6_needed_ratio(base), "the defaults")]
@@ -416,6 +415,12 @@ def build(ctx: Context) -> PaperSection:
             per_claim[c].append((sw, h, s))
             away_of[c].append((sw["param"], list(sw["values"]), list(h), away))
 
+    return per_claim, away_of, needed, all_rows
+
+
+def _joint(ctx: Context, base: dict, sws: list, all_rows: dict, per_claim: dict, away_of: dict, needed: list):
+    """The fuzzy PD's T_r and the adaptive-fuzzy λ-range scale evaluated together, from the same runs;
+    appends to per_claim, away_of and needed, returns the figure."""
     swa, swb = (next(sw for sw in sws if sw["param"] == n) for n in JOINT)
     ra, rb = all_rows[swa["param"]], all_rows[swb["param"]]
     jh = {c: evaluate_joint(base, swa, ra, swb, rb, c) for c in ("C000-4", "C000-5", "C000-6", "C000-7")}
@@ -444,65 +449,64 @@ def build(ctx: Context) -> PaperSection:
                                           f"s: {len(swb['values'])} values in [{swb['values'][0]:.3g}, "
                                           f"{swb['values'][-1]:.3g}]"],
                                          (swa["default"], swb["default"]), joint_where(swa, swb, h), jfig)))
-    figs.append(jfig)
+    return jfig
 
-    claims = []
-    for c, rule in RULES.items():
-        ok, why = rule(base)
-        extra, sens = "", [s for _, _, s in per_claim[c]]
-        swept = [x for _, h, _ in per_claim[c] for x in h]
-        if c in ("C000-5", "C000-6"):  # the effort metric is a reading too
-            ok_sq, why_sq = rule(base, "effort_sq")
-            swept.append(ok_sq)
-            extra = f" With effort = ∫‖τ‖² dt instead: {'holds' if ok_sq else 'fails'} ({why_sq})."
-            sens.append(Sensitivity("effort metric", ["effort_abs", "effort_sq"], "effort_abs",
-                                    "both" if ok and ok_sq else "effort_abs" if ok else "effort_sq" if ok_sq else
-                                    "neither"))
-        if c == "C000-6":
-            r_min, where = min(needed, key=lambda t: t[0])
-            extra += (" The EULERINT parts of the rule hold nowhere tried, so no effort threshold would help."
-                      if math.isinf(r_min) else
-                      f" Smallest effort ratio (max of fuzzy and adaptive fuzzy over PD) among the points where the "
-                      f"EULERINT parts hold: {r_min:.2f} at {where}; the claim would need 'not much more' to allow "
-                      f"that ratio.")
-        if c == "C000-7":
-            ok2, why2 = rule(base, ("L",))
-            swept.append(ok2)
-            extra = f" On command L (R1 not mirror-symmetric): {'holds' if ok2 else 'fails'} ({why2})."
-            sens.append(Sensitivity("robustness command (L2 or L)", ["L2", "L"], "L2",
-                                    "both" if ok and ok2 else "L2" if ok else "L" if ok2 else "neither"))
-        # every reading checked: (holds, moves the paper's own numbers away); the extra readings above (effort
-        # metric, command) change no reported EULERINT
-        readings = {f"{name} = {v_}": (bool(h_), bool(a_)) for name, vals, hs, aw in away_of[c]
-                    for v_, h_, a_ in zip(vals, hs, aw)}
-        extra_n = len(swept) - sum(len(hs) for _, _, hs, _ in away_of[c])
-        for k_, x in enumerate(swept[len(swept) - extra_n:]):
-            readings[f"other reading {k_}"] = (bool(x), False)
-        v, _support, away_names = rules.combine_faithful(ok, readings)
-        away_params = sorted({name for name, vals, hs, aw in away_of[c] if any(h_ and a_ for h_, a_ in zip(hs, aw))})
-        if away_params and not ok:
-            extra += (" Readings under which it holds only by moving the paper's own Table 3 numbers further away "
-                      f"(not counted as support): {', '.join(away_params)} ({len(away_names)} points).")
-        # a reading flips the verdict when some value changes the rule's outcome; one that does so only at values
-        # moving the paper's own numbers away is listed apart (combine_faithful leaves it out of the verdict)
-        fl = [(s.parameter, any(x != ok and not a for x, a in zip(h, aw)), any(x != ok for x in h))
-              for (sw, h, s), (_, _, _, aw) in zip(per_claim[c], away_of[c])]
-        flips, flips_away = [p for p, f, _ in fl if f], [p for p, f, any_ in fl if any_ and not f]
-        if c in ("C000-5", "C000-6") and (rule(base, "effort_sq")[0] != ok):
-            flips.append("effort metric")
-        if c == "C000-7" and rule(base, ("L",))[0] != ok:
-            flips.append("robustness command (L2 or L)")
-        evidence = (f"Rule: {RULE_TEXT[c]} At the defaults it {'holds' if ok else 'fails'}: {why}.{extra} "
-                    + (f"The verdict flips with: {', '.join(flips)}." if flips else "No counted reading changes it.")
-                    + (f" It flips only at values that move the paper's own Table 3 numbers further away (listed, "
-                       f"not counted): {', '.join(flips_away)}." if flips_away else ""))
-        claims.append(Claim(c, STATEMENTS[c], v, evidence, figures=[], sensitivity=sens, sensitive_to=flips + [
-            f"{p} (flips it only while moving the paper's numbers away; not counted)" for p in flips_away]))
-    claims[0].figures = [figs[0]]
-    claims[3].figures = [figs[0]]
-    claims[4].figures = [figs[1]]
-    claims[5].figures = [figs[1]]
-    claims[6].figures = [figs[2]]
+
+def _claim(c: str, rule, base: dict, per_claim: dict, away_of: dict, needed: list) -> Claim:
+    """The verdict of claim `c` with its evidence, sensitivities and the readings that flip it."""
+    ok, why = rule(base)
+    extra, sens = "", [s for _, _, s in per_claim[c]]
+    swept = [x for _, h, _ in per_claim[c] for x in h]
+    if c in ("C000-5", "C000-6"):  # the effort metric is a reading too
+        ok_sq, why_sq = rule(base, "effort_sq")
+        swept.append(ok_sq)
+        extra = f" With effort = ∫‖τ‖² dt instead: {'holds' if ok_sq else 'fails'} ({why_sq})."
+        sens.append(Sensitivity("effort metric", ["effort_abs", "effort_sq"], "effort_abs",
+                                "both" if ok and ok_sq else "effort_abs" if ok else "effort_sq" if ok_sq else
+                                "neither"))
+    if c == "C000-6":
+        r_min, where = min(needed, key=lambda t: t[0])
+        extra += (" The EULERINT parts of the rule hold nowhere tried, so no effort threshold would help."
+                  if math.isinf(r_min) else
+                  f" Smallest effort ratio (max of fuzzy and adaptive fuzzy over PD) among the points where the "
+                  f"EULERINT parts hold: {r_min:.2f} at {where}; the claim would need 'not much more' to allow "
+                  f"that ratio.")
+    if c == "C000-7":
+        ok2, why2 = rule(base, ("L",))
+        swept.append(ok2)
+        extra = f" On command L (R1 not mirror-symmetric): {'holds' if ok2 else 'fails'} ({why2})."
+        sens.append(Sensitivity("robustness command (L2 or L)", ["L2", "L"], "L2",
+                                "both" if ok and ok2 else "L2" if ok else "L" if ok2 else "neither"))
+    # every reading checked: (holds, moves the paper's own numbers away); the extra readings above (effort
+    # metric, command) change no reported EULERINT
+    readings = {f"{name} = {v_}": (bool(h_), bool(a_)) for name, vals, hs, aw in away_of[c]
+                for v_, h_, a_ in zip(vals, hs, aw)}
+    extra_n = len(swept) - sum(len(hs) for _, _, hs, _ in away_of[c])
+    for k_, x in enumerate(swept[len(swept) - extra_n:]):
+        readings[f"other reading {k_}"] = (bool(x), False)
+    v, _support, away_names = rules.combine_faithful(ok, readings)
+    away_params = sorted({name for name, vals, hs, aw in away_of[c] if any(h_ and a_ for h_, a_ in zip(hs, aw))})
+    if away_params and not ok:
+        extra += (" Readings under which it holds only by moving the paper's own Table 3 numbers further away "
+                  f"(not counted as support): {', '.join(away_params)} ({len(away_names)} points).")
+    # a reading flips the verdict when some value changes the rule's outcome; one that does so only at values
+    # moving the paper's own numbers away is listed apart (combine_faithful leaves it out of the verdict)
+    fl = [(s.parameter, any(x != ok and not a for x, a in zip(h, aw)), any(x != ok for x in h))
+          for (sw, h, s), (_, _, _, aw) in zip(per_claim[c], away_of[c])]
+    flips, flips_away = [p for p, f, _ in fl if f], [p for p, f, any_ in fl if any_ and not f]
+    if c in ("C000-5", "C000-6") and (rule(base, "effort_sq")[0] != ok):
+        flips.append("effort metric")
+    if c == "C000-7" and rule(base, ("L",))[0] != ok:
+        flips.append("robustness command (L2 or L)")
+    evidence = (f"Rule: {RULE_TEXT[c]} At the defaults it {'holds' if ok else 'fails'}: {why}.{extra} "
+                + (f"The verdict flips with: {', '.join(flips)}." if flips else "No counted reading changes it.")
+                + (f" It flips only at values that move the paper's own Table 3 numbers further away (listed, "
+                   f"not counted): {', '.join(flips_away)}." if flips_away else ""))
+    return Claim(c, STATEMENTS[c], v, evidence, figures=[], sensitivity=sens, sensitive_to=flips + [
+        f"{p} (flips it only while moving the paper's numbers away; not counted)" for p in flips_away])
+
+
+def _setup_and_notes(ctx: Context, base: dict, sws: list) -> tuple[str, str]:
     n_sweep = sum(len(sw["values"]) * len(sw["runs"]) for sw in sws)
     setup = (f"AttitudeCommand → controller → AttitudePlant → AttitudeMetrics, every controller swapped by FMU name; "
              f"{len(base)} runs of the paper 000 table (000-1 … 000-11 and the robustness runs R1, R2) plus "
@@ -522,11 +526,10 @@ def build(ctx: Context) -> PaperSection:
         + ("Quick mode: 2–3 points per sweep (the regions are coarse; the verdicts are those of the full grids "
            "except where a region falls between the quick points)." if ctx.quick else
            "Full mode: 13–26 points per sweep."))
-    nums = N.eulerint_rows(base, calibrated={"fuzzy"})
-    eff_rows, eff_table, eff_text = N.effort_rows(base, ts)
-    nums += eff_rows
-    claims[4].evidence += f" Paper's effort numbers: {eff_text}"
-    claims[4].tables.append(eff_table)
+    return setup, notes
+
+
+def _calibrations(eff_text: str) -> str:
     calibrations = (
         f"Calibration: the fuzzy PD's reference settling time T_r = {scenarios.T_R_CALIBRATED:g} s is fitted to the "
         f"fuzzy controller's Table 3 EULERINT (127.8 deg·s). The paper defines T_r as the model's settling time "
@@ -537,6 +540,31 @@ def build(ctx: Context) -> PaperSection:
         f"AttitudePlant.kinematics = 4; other set-ups in the row's note); PD, DCM, quaternion and MRAC on (roll, pitch, yaw) = "
         f"(40, −40, −60) deg, fuzzy, adaptive fuzzy and the robustness runs on (40, 40, 60) deg (the figures' "
         f"commands). Effort: {eff_text}")
+    return calibrations
+
+
+def build(ctx: Context) -> PaperSection:
+    t0 = time.time()
+    base, ts = run_base(ctx)
+    figs = [fig_ranking(ctx, base), fig_effort(ctx, base), fig_robust(ctx, ts)]
+    sws = sweeps(ctx.quick)
+    per_claim, away_of, needed, all_rows = _sweeps(ctx, base, sws)
+    jfig = _joint(ctx, base, sws, all_rows, per_claim, away_of, needed)
+    figs.append(jfig)
+
+    claims = [_claim(c, rule, base, per_claim, away_of, needed) for c, rule in RULES.items()]
+    claims[0].figures = [figs[0]]
+    claims[3].figures = [figs[0]]
+    claims[4].figures = [figs[1]]
+    claims[5].figures = [figs[1]]
+    claims[6].figures = [figs[2]]
+    setup, notes = _setup_and_notes(ctx, base, sws)
+    nums = N.eulerint_rows(base, calibrated={"fuzzy"})
+    eff_rows, eff_table, eff_text = N.effort_rows(base, ts)
+    nums += eff_rows
+    claims[4].evidence += f" Paper's effort numbers: {eff_text}"
+    claims[4].tables.append(eff_table)
+    calibrations = _calibrations(eff_text)
     mt = N.metrics_table(base)
     return PaperSection("000", TITLE, setup, claims, figures=figs, tables=[mt], notes=notes, doc_tables={"runs": mt},
                         runtime_s=time.time() - t0, numbers=nums, calibrations=calibrations)

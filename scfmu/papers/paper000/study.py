@@ -126,6 +126,56 @@ def table_line(row: dict) -> str:
     return " ".join(fmt.format(v) for (_, fmt, _), v in zip(COLUMNS, vals))
 
 
+def _print_table(rows: list, skipped: list, args) -> None:
+    """The study's table on stdout, the skipped runs, and the L vs L2 mirror-symmetry check."""
+    print(f"Paper 000 study: Δ = {args.dt} s, t_end = {args.t_end} s, plant RK4 0.01 s, inertia diag(1000, 500, 700), "
+          f"no torque limit; controllers at default parameters unless noted")
+    print("EULERINT [deg·s], eff_abs = ∫Σ|τ| [N·m·s], eff_sq = ∫‖τ‖² [N²·m²·s], ts = 2 % settling time [s] "
+          "(nan = not settled by t_end), OS = overshoot [%] per 321 angle")
+    print("R1 = 10 N·m constant disturbance on each axis; R2-s = plant inertia_scale s on every axis")
+    header = " ".join(f"{name:>{w}s}" if not fmt.startswith("{:<") else f"{name:<{w}s}" for name, fmt, w in COLUMNS)
+    print(header)
+    print("-" * len(header))
+    for row in rows:
+        print(table_line(row))
+    for s in skipped:
+        print(f"skipped: {s}")
+    # L2 = (40, 40, 60) deg is the mirror image of L = (40, -40, -60) deg under the 180 deg rotation
+    # about x (q -> (q_w, q_x, -q_y, -q_z)), a symmetry of the diagonal-inertia plant and of every law
+    # here; without a disturbance the metrics of L and L2 must agree (R1's +10 N m breaks the symmetry).
+    by_id = {row["run"]: row for row in rows}
+    diffs = []
+    for rid, row in by_id.items():
+        if row["command"] == "L" and not rid.startswith("R1"):
+            twin = by_id.get(rid[:-1] + "L2") if rid.endswith("L") else None
+            if twin:
+                diffs.append(abs(row["eulerint_deg_s"] - twin["eulerint_deg_s"]) / row["eulerint_deg_s"])
+    if diffs:
+        print(f"L vs L2 (no disturbance, {len(diffs)} pairs): max relative EULERINT difference {max(diffs):.2e} "
+              f"(mirror symmetry)")
+
+
+def _write_summary(out: Path, rows: list, results: dict, plots: bool) -> None:
+    """summary.csv and, with `plots`, the comparison figures."""
+    with open(out / "summary.csv", "w", newline="") as f:
+        if rows:
+            w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+            w.writeheader()
+            w.writerows(rows)
+    if plots:
+        for cmd in ("L", "L2"):
+            items = [(f"{row['run']} {row['label']}", results[row["run"]]) for row in rows
+                     if row["command"] == cmd and row["run"].startswith("000-")]
+            if items:
+                plot_comparison(out / f"compare_000_{cmd}.png", f"Paper 000 controllers, command {cmd}", items)
+        for prefix, title in (("R1", "R1: 10 N·m disturbance"), ("R2-1.2", "R2: inertia ×1.2"), ("R2-0.8", "R2: inertia ×0.8")):
+            for cmd in ("L", "L2"):
+                items = [(row["label"], results[row["run"]]) for row in rows
+                         if row["run"].startswith(prefix) and row["command"] == cmd]
+                if items:
+                    plot_comparison(out / f"compare_{prefix}_{cmd}.png", f"{title}, command {cmd}", items)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", default="out/paper000")
@@ -161,50 +211,10 @@ def main(argv=None) -> int:
         if not args.no_plots:
             plot_run(out / f"{run.run_id}.png", run, r, row)
 
-    print(f"Paper 000 study: Δ = {args.dt} s, t_end = {args.t_end} s, plant RK4 0.01 s, inertia diag(1000, 500, 700), "
-          f"no torque limit; controllers at default parameters unless noted")
-    print("EULERINT [deg·s], eff_abs = ∫Σ|τ| [N·m·s], eff_sq = ∫‖τ‖² [N²·m²·s], ts = 2 % settling time [s] "
-          "(nan = not settled by t_end), OS = overshoot [%] per 321 angle")
-    print("R1 = 10 N·m constant disturbance on each axis; R2-s = plant inertia_scale s on every axis")
-    header = " ".join(f"{name:>{w}s}" if not fmt.startswith("{:<") else f"{name:<{w}s}" for name, fmt, w in COLUMNS)
-    print(header)
-    print("-" * len(header))
-    for row in rows:
-        print(table_line(row))
-    for s in skipped:
-        print(f"skipped: {s}")
-    # L2 = (40, 40, 60) deg is the mirror image of L = (40, -40, -60) deg under the 180 deg rotation
-    # about x (q -> (q_w, q_x, -q_y, -q_z)), a symmetry of the diagonal-inertia plant and of every law
-    # here; without a disturbance the metrics of L and L2 must agree (R1's +10 N m breaks the symmetry).
-    by_id = {row["run"]: row for row in rows}
-    diffs = []
-    for rid, row in by_id.items():
-        if row["command"] == "L" and not rid.startswith("R1"):
-            twin = by_id.get(rid[:-1] + "L2") if rid.endswith("L") else None
-            if twin:
-                diffs.append(abs(row["eulerint_deg_s"] - twin["eulerint_deg_s"]) / row["eulerint_deg_s"])
-    if diffs:
-        print(f"L vs L2 (no disturbance, {len(diffs)} pairs): max relative EULERINT difference {max(diffs):.2e} "
-              f"(mirror symmetry)")
+    _print_table(rows, skipped, args)
     print(f"({len(rows)} runs in {time.time() - t0:.1f} s)")
 
-    with open(out / "summary.csv", "w", newline="") as f:
-        if rows:
-            w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
-            w.writeheader()
-            w.writerows(rows)
-    if not args.no_plots:
-        for cmd in ("L", "L2"):
-            items = [(f"{row['run']} {row['label']}", results[row["run"]]) for row in rows
-                     if row["command"] == cmd and row["run"].startswith("000-")]
-            if items:
-                plot_comparison(out / f"compare_000_{cmd}.png", f"Paper 000 controllers, command {cmd}", items)
-        for prefix, title in (("R1", "R1: 10 N·m disturbance"), ("R2-1.2", "R2: inertia ×1.2"), ("R2-0.8", "R2: inertia ×0.8")):
-            for cmd in ("L", "L2"):
-                items = [(row["label"], results[row["run"]]) for row in rows
-                         if row["run"].startswith(prefix) and row["command"] == cmd]
-                if items:
-                    plot_comparison(out / f"compare_{prefix}_{cmd}.png", f"{title}, command {cmd}", items)
+    _write_summary(out, rows, results, not args.no_plots)
     print(f"wrote {out}/summary.csv, one CSV per run" + ("" if args.no_plots else " and PNG figures"))
     return 0
 

@@ -173,33 +173,9 @@ def effort_ratio_rows(by_step: dict, reported: dict) -> list:
 
 
 # ----- the section ----------------------------------------------------------------------------------
-def build(ctx) -> PaperSection:
-    t0 = time.time()
-    pl = plan(ctx.quick)
+def _claim_horizon(ctx, pl: dict, rs: list, t_runs: list) -> Claim:
+    """C001-1: the horizon sweep (settling and effort against T2) and the two readings of the abstracts."""
     t_end = pl["t_end"]
-    sets, index = [], {}
-
-    def add(key, ov):
-        k = tuple(sorted(ov.items()))
-        if k not in index:
-            index[k] = len(sets)
-            sets.append(ov)
-        return index[k]
-
-    case_runs = {(n, d): add((n, d), _ov(*CASES[n], d)) for d in (0.0, DIST_PAPER, DIST_ALT) for n in CASES}
-    t_runs = [add(("T", t), _ov(t, 5.0, DIST_PAPER)) for t in pl["T2"]]
-    c_runs = [add(("c", c), _ov(25.0, c, DIST_PAPER)) for c in pl["c"]]
-    sc = scenarios.paper001("a", 0.0, stop_time=t_end)
-    camp = campaign.Campaign(sc, sets, timeseries=[f"pos_{a}" for a in "xyz"] + ["force_z", "dist_est_z"],
-                             ts_every=10)
-    name = "paper001" + ("_quick" if ctx.quick else "")
-    rs = common.rows(ctx.campaign(camp, name))
-    bad = common.failed(rs)
-    if bad:
-        raise RuntimeError("paper 001 runs failed:\n" + "\n".join(bad))
-    ts = lambda i: campaign.read_timeseries(ctx.runs_dir(name), i)  # noqa: E731
-
-    # ---- C001-1: horizon --------------------------------------------------------------------------
     tr = [rs[i] for i in t_runs]
     settle_T = [r["settling_s"] for r in tr]
     eff_T = {m: [r[m] for r in tr] for m in EFFORTS}
@@ -218,7 +194,7 @@ def build(ctx) -> PaperSection:
                      "the metric moves its way at every step of the sweep)",
                      ["effort metric", "reading A: effort falls as T2 grows", "reading B: effort rises with T2"],
                      [[EFFORTS[m], *rd[m]] for m in EFFORTS])
-    c1 = Claim(
+    return Claim(
         "C001-1", "A shorter prediction horizon gives a shorter settling time and a larger control effort "
                   "(reading A, body and English abstract); the Persian abstract says the effort rises with the "
                   "horizon (reading B).",
@@ -230,25 +206,18 @@ def build(ctx) -> PaperSection:
         f"{len(EFFORTS)} effort metrics, reading B for {sum(h[f'B:{m}'] for m in EFFORTS)}. Rule: confirmed when "
         f"settling rises at every step and reading A holds for every effort metric; depends on a reading when it "
         f"holds for some metrics only; otherwise not confirmed. The paper does not define its effort metric.",
-        tables=[tab_T, tab_read], figures=[Figure(rel_T, f"Settling time and three effort metrics against the "
-                                                         f"prediction horizon T2 (c = 5 1/s, 0.01 N per axis).")],
+        tables=[tab_T, tab_read], figures=[Figure(rel_T, "Settling time and three effort metrics against the "
+                                                         "prediction horizon T2 (c = 5 1/s, 0.01 N per axis).")],
         sensitive_to=["effort metric (paper 001 gives none)", "reading of the abstracts (A vs B)"],
         sensitivity=[Sensitivity("effort metric, reading A (effort falls with T2)", list(EFFORTS), "effort_abs",
                                  rules.holds_at(list(EFFORTS), [h[f"A:{m}"] for m in EFFORTS])),
                      Sensitivity("effort metric, reading B (effort rises with T2)", list(EFFORTS), "effort_abs",
                                  rules.holds_at(list(EFFORTS), [h[f"B:{m}"] for m in EFFORTS]))])
 
-    # ---- C001-2: observer gain ---------------------------------------------------------------------
-    cr = [rs[i] for i in c_runs]
-    settle_c = [r["settling_s"] for r in cr]
-    eff_c = {m: [r[m] for r in cr] for m in EFFORTS}
-    # the paper's own number: a six-fold L (25 → 150) raises the effort more than 50 times
-    far_paper = REPORTED["bound"] / (REPORTED["c_hi"] / REPORTED["c_lo"])
-    o = observer_rule(pl["c"], settle_c, eff_c, far=far_paper)
-    c_star = settled_at(pl["c"], settle_c)
-    o_strict = observer_rule(pl["c"], settle_c, eff_c, far=FAR_MORE[0])   # "more than six-fold" only
-    verdict2 = o["verdict"]
-    # the paper's pair c = 25 → 150 at T2 = 25 s under each sample-step reading, force logged at every step
+
+def _clock_pair(ctx, t_end: float) -> tuple[dict, list]:
+    """The paper's pair c = 25 → 150 at T2 = 25 s under each reading of the controller's sample step, the
+    force logged at every step: (per reading: ratios, support, settling; the table rows)."""
     clock, clock_rows = {}, []
     for label, dt in SAMPLE_STEPS.items():
         sc_k = scenarios.paper001("a", 0.0, stop_time=t_end, step=dt)
@@ -264,6 +233,23 @@ def build(ctx) -> PaperSection:
         clock[label] = {"ratios": ratios, "support": support, "settling": (rk[0]["settling_s"], rk[1]["settling_s"])}
         clock_rows.append([label, rk[0]["settling_s"], rk[1]["settling_s"], *ratios.values(),
                            ", ".join(support) or "none"])
+    return clock, clock_rows
+
+
+def _claim_observer(ctx, pl: dict, rs: list, c_runs: list) -> tuple[Claim, list]:
+    """C001-2: the observer-gain sweep and the paper's effort ratio; returns the claim and the paper's
+    numbers beside ours."""
+    t_end = pl["t_end"]
+    cr = [rs[i] for i in c_runs]
+    settle_c = [r["settling_s"] for r in cr]
+    eff_c = {m: [r[m] for r in cr] for m in EFFORTS}
+    # the paper's own number: a six-fold L (25 → 150) raises the effort more than 50 times
+    far_paper = REPORTED["bound"] / (REPORTED["c_hi"] / REPORTED["c_lo"])
+    o = observer_rule(pl["c"], settle_c, eff_c, far=far_paper)
+    c_star = settled_at(pl["c"], settle_c)
+    o_strict = observer_rule(pl["c"], settle_c, eff_c, far=FAR_MORE[0])   # "more than six-fold" only
+    verdict2 = o["verdict"]
+    clock, clock_rows = _clock_pair(ctx, t_end)
     ratios_all = clock[DEFAULT_SAMPLE]["ratios"]
     nums = effort_ratio_rows({k: d["ratios"] for k, d in clock.items()}, REPORTED)
     tab_clock = Table(f"The paper's pair c = {REPORTED['c_lo']:g} → {REPORTED['c_hi']:g} 1/s (T2 = {REPORTED['T2']:g} s, "
@@ -318,8 +304,11 @@ def build(ctx) -> PaperSection:
                                  table=tab_c),
                      Sensitivity("effort metric", list(EFFORTS), "effort_abs",
                                  rules.holds_at(list(EFFORTS), [o[f'holds:{m}'] for m in EFFORTS]))])
+    return c2, nums
 
-    # ---- C001-3: disturbance rejection -------------------------------------------------------------
+
+def _claim_disturbance(ctx, rs: list, ts, case_runs: dict) -> Claim:
+    """C001-3: each case without and with the disturbance under its two readings (0.01 N, 1 N per axis)."""
     ref_min = min(abs(x) for x in REF)
     dev_rows, holds = [], {DIST_PAPER: [], DIST_ALT: []}
     p_d, rel_d = common.figure(ctx, "001_disturbance_effect.png")
@@ -350,7 +339,7 @@ def build(ctx) -> PaperSection:
                   "without and with it, final observer estimate (x axis)",
                   ["case", "dist (N)", "max deviation (m)", "settling, no dist (s)", "settling, dist (s)",
                    "final dist_est_x (N)", "no noticeable change"], dev_rows)
-    c3 = Claim(
+    return Claim(
         "C001-3", "Applying the disturbance causes no noticeable change of the response (the observer rejects it).",
         rules.combine(nominal_ok, {"1 N": alt_ok}),
         f"Each case run without disturbance, with {DIST_PAPER} N per axis (our reading of the paper's disturbance) and "
@@ -366,7 +355,9 @@ def build(ctx) -> PaperSection:
         sensitivity=[Sensitivity("disturbance per axis (N)", [DIST_PAPER, DIST_ALT], DIST_PAPER,
                                  rules.holds_at([f"{DIST_PAPER:g} N", f"{DIST_ALT:g} N"], [nominal_ok, alt_ok]))])
 
-    # ---- C001-4: tracking ----------------------------------------------------------------------------
+
+def _claim_tracking(ctx, rs: list, ts, case_runs: dict, t_end: float) -> Claim:
+    """C001-4: every case run tracks the commanded relative position."""
     track_rows, track_ok = [], []
     for (n, d), i in case_runs.items():
         r = rs[i]
@@ -376,7 +367,7 @@ def build(ctx) -> PaperSection:
                            r["final_error"], "yes" if ok else "no"])
     p_t, rel_t = common.figure(ctx, "001_cases.png")
     formation.plot_compare(p_t, {n: ts(case_runs[(n, DIST_PAPER)]) for n in CASES}, DIST_PAPER)
-    c4 = Claim(
+    return Claim(
         "C001-4", "The closed loop tracks the commanded relative position.",
         rules.verdict(all(track_ok)),
         f"All 12 case runs (cases a–d × disturbance 0, {DIST_PAPER}, {DIST_ALT:g} N): rule: every axis inside its 2 % "
@@ -386,8 +377,40 @@ def build(ctx) -> PaperSection:
         f"observer predict).",
         tables=[Table("Tracking per run", ["case", "dist (N)", "settling (s)", "max overshoot (%)",
                                            "final ‖error‖ (m)", "tracks"], track_rows)],
-        figures=[Figure(rel_t, f"z position, F_z and the observer estimate for the four cases (0.01 N per axis); "
-                               f"dashed: reference (50, 40, 60) m and the applied disturbance.")])
+        figures=[Figure(rel_t, "z position, F_z and the observer estimate for the four cases (0.01 N per axis); "
+                               "dashed: reference (50, 40, 60) m and the applied disturbance.")])
+
+
+def build(ctx) -> PaperSection:
+    t0 = time.time()
+    pl = plan(ctx.quick)
+    t_end = pl["t_end"]
+    sets, index = [], {}
+
+    def add(key, ov):
+        k = tuple(sorted(ov.items()))
+        if k not in index:
+            index[k] = len(sets)
+            sets.append(ov)
+        return index[k]
+
+    case_runs = {(n, d): add((n, d), _ov(*CASES[n], d)) for d in (0.0, DIST_PAPER, DIST_ALT) for n in CASES}
+    t_runs = [add(("T", t), _ov(t, 5.0, DIST_PAPER)) for t in pl["T2"]]
+    c_runs = [add(("c", c), _ov(25.0, c, DIST_PAPER)) for c in pl["c"]]
+    sc = scenarios.paper001("a", 0.0, stop_time=t_end)
+    camp = campaign.Campaign(sc, sets, timeseries=[f"pos_{a}" for a in "xyz"] + ["force_z", "dist_est_z"],
+                             ts_every=10)
+    name = "paper001" + ("_quick" if ctx.quick else "")
+    rs = common.rows(ctx.campaign(camp, name))
+    bad = common.failed(rs)
+    if bad:
+        raise RuntimeError("paper 001 runs failed:\n" + "\n".join(bad))
+    ts = lambda i: campaign.read_timeseries(ctx.runs_dir(name), i)  # noqa: E731
+
+    c1 = _claim_horizon(ctx, pl, rs, t_runs)
+    c2, nums = _claim_observer(ctx, pl, rs, c_runs)
+    c3 = _claim_disturbance(ctx, rs, ts, case_runs)
+    c4 = _claim_tracking(ctx, rs, ts, case_runs, t_end)
 
     return PaperSection(
         paper="001", title="A Nonlinear Predictive PID Controller Design for Spacecraft Formation Flying Control",

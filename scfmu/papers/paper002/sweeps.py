@@ -68,37 +68,9 @@ def _job(args):
     return run_case(c, gains, sc, record=record)
 
 
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--workers", type=int, default=min(2, os.cpu_count() or 1))
-    ap.add_argument("--quick", action="store_true", help="CI: t_end 12 s, first and last point of each sweep")
-    ap.add_argument("--digits", action="store_true", help="also run 002-7 (damaged-digit candidates)")
-    ap.add_argument("--gains", type=Path, default=GAINS_FILE)
-    ap.add_argument("--out", type=Path, default=Path("out") / "paper002")
-    a = ap.parse_args(argv)
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from tqdm import tqdm
-
-    out = a.out
-    out.mkdir(parents=True, exist_ok=True)
-    gains = load_gains(a.gains)
-    missing = [c for c in NAMES if c not in gains]
-    if missing:
-        print(f"no tuned gains for {missing} in {a.gains}: run `scfmu paper 002 tune` first", file=sys.stderr)
-        return 2
-    base = Scenario(t_end=12.0) if a.quick else Scenario()
-    t0 = time.perf_counter()
-    plan = sweeps(a.quick, a.digits)
-    jobs = [(c, gains[c], base, True) for c in NAMES]
-    for run, (_, pts) in plan.items():
-        jobs += [(c, gains[c], sc, False) for _, sc in pts for c in NAMES]
-    with ProcessPoolExecutor(a.workers) as pool:
-        results = list(tqdm(pool.map(_job, jobs), total=len(jobs), desc="paper 002 runs"))
-    nominal = dict(zip(NAMES, results[: len(NAMES)]))
-    rest = iter(results[len(NAMES):])
-
+def _nominal(out: Path, nominal: dict, base: Scenario, plt) -> list:
+    """002-1 / 002-2: the nominal time series and phase planes (CSV + PNG) and the nominal metrics
+    (002-1_nominal_metrics.csv); returns the metric rows."""
     # 002-1 / 002-2: time series and phase planes
     sig = {"time": nominal[NAMES[0]]["t"]}
     for c in NAMES:
@@ -138,7 +110,6 @@ def main(argv=None) -> int:
     fig.savefig(out / "002-2_phase_plane.png", dpi=120)
     plt.close(fig)
 
-    summary = []
     nom_rows = []
     for c in NAMES:
         m = step_metrics(nominal[c]["t"], nominal[c]["theta"], base)
@@ -148,53 +119,56 @@ def main(argv=None) -> int:
         w.writerow(["controller", "mae_deg", "overshoot_pct", "settling_2pct_s", "max_abs_error_after_10s_deg"])
         w.writerows(nom_rows)
 
-    for run, (xname, pts) in plan.items():
-        rows = []
-        for x, _ in pts:
-            mae = [next(rest)["mae_deg"] for _ in NAMES]
-            rows.append([x, *mae])
-            summary.append([run, xname, f"J={x[0]:g} K={x[1]:g}" if run == "002-7" else x, *mae])
-        with open(out / f"{run}.csv", "w", newline="") as f:
-            w = csv.writer(f)
-            if run == "002-7":
-                w.writerow(["inertia_kg_m2", "wheel_gain", *[f"mae_deg_{c}" for c in NAMES]])
-                w.writerows([[x[0], x[1], *m] for x, *m in rows])
-            else:
-                w.writerow([xname, *[f"mae_deg_{c}" for c in NAMES]])
-                w.writerows(rows)
-        arr = np.array([r[1:] for r in rows], float)
-        if run == "002-7":  # one panel per wheel gain K, MAE vs J
-            ks = sorted({x[1] for x, *_ in rows})
-            fig, axs = plt.subplots(1, len(ks), figsize=(4.2 * len(ks), 4.2), squeeze=False)
-            for ax, k in zip(axs[0], ks):
-                sel = [i for i, r in enumerate(rows) if r[0][1] == k]
-                js = [rows[i][0][0] for i in sel]
-                for i, c in enumerate(NAMES):
-                    ax.plot(js, arr[sel, i], marker="o", ls="-" if c.startswith("FO") else "--", label=c)
-                ax.set_xlabel("inertia J (kg m²)")
-                ax.set_ylabel("MAE (deg)")
-                ax.set_title(f"002-7: wheel gain K = {k:g}")
-                ax.legend()
-                ax.grid(alpha=0.3)
-            fig.suptitle(f"002-7: damaged-digit candidates, gains tuned at J = 7.7, K = 1 (MAE over [0, {base.t_end:g}) s)")
-            fig.tight_layout()
-            fig.savefig(out / f"{run}.png", dpi=120)
-            plt.close(fig)
-            continue
-        fig, ax = plt.subplots(figsize=(6.5, 4.2))
-        xs = np.array([r[0] for r in rows], float)
-        for i, c in enumerate(NAMES):
-            ax.plot(xs, arr[:, i], marker="o", ls="-" if c.startswith("FO") else "--", label=c)
-        ax.set_xlabel({"inertia_scale": "inertia scale J_true/J (-)", "wheel_time_constant_s": "wheel time constant T (s)",
-                       "disturbance_factor": "disturbance factor (-)", "theta_ref_deg": "θ_ref (deg)"}[xname])
-        ax.set_ylabel("MAE (deg)")
-        ax.set_title(f"{run}: MAE over [0, {base.t_end:g}) s")
-        ax.legend()
-        ax.grid(alpha=0.3)
+    return nom_rows
+
+
+def _sweep(out: Path, run: str, xname: str, rows: list, base: Scenario, plt) -> None:
+    """One sweep's CSV and figure (002-7: one panel per wheel gain, MAE vs inertia)."""
+    with open(out / f"{run}.csv", "w", newline="") as f:
+        w = csv.writer(f)
+        if run == "002-7":
+            w.writerow(["inertia_kg_m2", "wheel_gain", *[f"mae_deg_{c}" for c in NAMES]])
+            w.writerows([[x[0], x[1], *m] for x, *m in rows])
+        else:
+            w.writerow([xname, *[f"mae_deg_{c}" for c in NAMES]])
+            w.writerows(rows)
+    arr = np.array([r[1:] for r in rows], float)
+    if run == "002-7":  # one panel per wheel gain K, MAE vs J
+        ks = sorted({x[1] for x, *_ in rows})
+        fig, axs = plt.subplots(1, len(ks), figsize=(4.2 * len(ks), 4.2), squeeze=False)
+        for ax, k in zip(axs[0], ks):
+            sel = [i for i, r in enumerate(rows) if r[0][1] == k]
+            js = [rows[i][0][0] for i in sel]
+            for i, c in enumerate(NAMES):
+                ax.plot(js, arr[sel, i], marker="o", ls="-" if c.startswith("FO") else "--", label=c)
+            ax.set_xlabel("inertia J (kg m²)")
+            ax.set_ylabel("MAE (deg)")
+            ax.set_title(f"002-7: wheel gain K = {k:g}")
+            ax.legend()
+            ax.grid(alpha=0.3)
+        fig.suptitle(f"002-7: damaged-digit candidates, gains tuned at J = 7.7, K = 1 (MAE over [0, {base.t_end:g}) s)")
         fig.tight_layout()
         fig.savefig(out / f"{run}.png", dpi=120)
         plt.close(fig)
+        return
+    fig, ax = plt.subplots(figsize=(6.5, 4.2))
+    xs = np.array([r[0] for r in rows], float)
+    for i, c in enumerate(NAMES):
+        ax.plot(xs, arr[:, i], marker="o", ls="-" if c.startswith("FO") else "--", label=c)
+    ax.set_xlabel({"inertia_scale": "inertia scale J_true/J (-)", "wheel_time_constant_s": "wheel time constant T (s)",
+                   "disturbance_factor": "disturbance factor (-)", "theta_ref_deg": "θ_ref (deg)"}[xname])
+    ax.set_ylabel("MAE (deg)")
+    ax.set_title(f"{run}: MAE over [0, {base.t_end:g}) s")
+    ax.legend()
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(out / f"{run}.png", dpi=120)
+    plt.close(fig)
 
+
+
+def _summary(out: Path, nom_rows: list, summary: list, base: Scenario) -> None:
+    """summary.csv and the printed table."""
     with open(out / "summary.csv", "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["run", "swept", "value", *[f"mae_deg_{c}" for c in NAMES]])
@@ -207,6 +181,49 @@ def main(argv=None) -> int:
     for r in summary:
         best = NAMES[int(np.argmin(r[3:]))]
         print(f"{r[0]:6s} {r[1]:22s} {r[2]!s:>9.9s} " + " ".join(f"{v:9.5f}" for v in r[3:]) + f"   {best}")
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--workers", type=int, default=min(2, os.cpu_count() or 1))
+    ap.add_argument("--quick", action="store_true", help="CI: t_end 12 s, first and last point of each sweep")
+    ap.add_argument("--digits", action="store_true", help="also run 002-7 (damaged-digit candidates)")
+    ap.add_argument("--gains", type=Path, default=GAINS_FILE)
+    ap.add_argument("--out", type=Path, default=Path("out") / "paper002")
+    a = ap.parse_args(argv)
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from tqdm import tqdm
+
+    out = a.out
+    out.mkdir(parents=True, exist_ok=True)
+    gains = load_gains(a.gains)
+    missing = [c for c in NAMES if c not in gains]
+    if missing:
+        print(f"no tuned gains for {missing} in {a.gains}: run `scfmu paper 002 tune` first", file=sys.stderr)
+        return 2
+    base = Scenario(t_end=12.0) if a.quick else Scenario()
+    t0 = time.perf_counter()
+    plan = sweeps(a.quick, a.digits)
+    jobs = [(c, gains[c], base, True) for c in NAMES]
+    for run, (_, pts) in plan.items():
+        jobs += [(c, gains[c], sc, False) for _, sc in pts for c in NAMES]
+    with ProcessPoolExecutor(a.workers) as pool:
+        results = list(tqdm(pool.map(_job, jobs), total=len(jobs), desc="paper 002 runs"))
+    nominal = dict(zip(NAMES, results[: len(NAMES)]))
+    rest = iter(results[len(NAMES):])
+
+    summary = []
+    nom_rows = _nominal(out, nominal, base, plt)
+    for run, (xname, pts) in plan.items():
+        rows = []
+        for x, _ in pts:
+            mae = [next(rest)["mae_deg"] for _ in NAMES]
+            rows.append([x, *mae])
+            summary.append([run, xname, f"J={x[0]:g} K={x[1]:g}" if run == "002-7" else x, *mae])
+        _sweep(out, run, xname, rows, base, plt)
+    _summary(out, nom_rows, summary, base)
     print(f"{len(jobs)} runs in {time.perf_counter() - t0:.1f} s ({a.workers} workers) -> {out}")
     return 0
 

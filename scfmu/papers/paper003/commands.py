@@ -70,7 +70,8 @@ class Case:
 def simulate_reference(case: Case) -> tuple[dict, dict | None]:
     """The loop written out with the reference master (``scfmu.CoSimulation``, names matched each step),
     independent of the scenario declaration and the campaign engine: the yardstick the engine is tested
-    against (tests/test_paper003_controllers.py). Returns the metrics dict (and the signals if asked)."""
+    against (src/models/attitude/tests/test_paper003_controllers.py). Returns the metrics dict (and the
+    signals if asked)."""
     cmd = Fmu("AttitudeCommand", {"ref_euler321_roll": COMMAND[0], "ref_euler321_pitch": COMMAND[1],
                                   "ref_euler321_yaw": COMMAND[2]})
     ctrl = Fmu(case.controller, case.ctrl_params)

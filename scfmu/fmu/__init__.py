@@ -12,19 +12,8 @@ Where the FMUs are is decided here and nowhere else (:func:`fmu_dir`), first mat
 A component's model may also be a path to any ``.fmu`` file (:func:`fmu_path`).
 
 Every FMU this package unpacks (ours, a user's, one shipped to a Dask worker, the units nested in a loop
-FMU) goes through :func:`safe_extract`, which inspects the whole archive before it writes anything and
-refuses (:class:`ArchiveError`):
-
-* more than ``max_files`` entries (default 10,000; ``SCFMU_FMU_MAX_FILES``);
-* more than ``max_bytes`` uncompressed in total (default 1 GiB; ``SCFMU_FMU_MAX_BYTES``);
-* an entry larger than 1 MiB that is more than ``max_ratio`` times its compressed size (default 200;
-  ``SCFMU_FMU_MAX_RATIO``; our own FMUs compress at most about 16:1, a zip bomb about 1000:1);
-* symbolic links and other special files, encrypted entries, and paths that would leave the extraction
-  folder: absolute paths, drive letters (``C:``), backslashes, ``..`` components, NUL bytes.
-
-While writing it counts the bytes again (an entry that inflates past its declared size stops there), and on
-any failure it removes the folder it created. :func:`inspect_archive` runs the same checks without
-extracting (the pre-flight check uses it before reading a unit's model description).
+FMU) goes through :func:`safe_extract`, which inspects the whole archive before it writes anything (the
+limits: scfmu.fmu.archive). The Model Exchange integration of :class:`Fmu` is in scfmu.fmu.model_exchange.
 """
 
 from __future__ import annotations
@@ -32,20 +21,18 @@ from __future__ import annotations
 import functools
 import os
 import shutil
-import stat
-import tempfile
-import zipfile
-from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 
 from fmpy import read_model_description
 from fmpy.fmi1 import FMICallException
-from ctypes import POINTER, c_double
-
-import numpy as np
 from fmpy.fmi2 import FMU2Model, FMU2Slave, defaultCallbacks, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
 from fmpy.fmi3 import FMU3Model, FMU3Slave
+
+from .archive import ArchiveError, ArchiveLimits, archive_limits, inspect_archive, safe_extract, set_archive_limits
+from .model_exchange import ModelExchange
+
+__all__ = ["ArchiveError", "ArchiveLimits", "archive_limits", "inspect_archive", "safe_extract", "set_archive_limits"]
 
 _FMU_DIR_OVERRIDE: Path | None = None
 INT32 = (-(2 ** 31), 2 ** 31 - 1)  # the range of an FMI 2.0 Integer (fmi2Integer is a C int)
@@ -125,172 +112,6 @@ def fmu_path(model: str) -> Path:
         raise UnknownModel(f"{p} not found: build the FMUs (scripts/build_fmus.sh in a checkout), set "
                            f"SCFMU_FMU_DIR or pass --fmus DIR")
     return p
-
-
-# ----- archive limits ----------------------------------------------------------------------------------
-class ArchiveError(ValueError):
-    """An FMU (or SSP) archive refused by :func:`inspect_archive`/:func:`safe_extract`; the message names
-    the file, the entry and the limit."""
-
-
-@dataclass(frozen=True)
-class ArchiveLimits:
-    """Limits of one extraction (see the module docstring). ``ratio_floor``: entries up to this size
-    [bytes] are not held to ``max_ratio`` (small files of repeated text compress well and cost nothing)."""
-    max_bytes: int = 1 << 30
-    max_files: int = 10_000
-    max_ratio: float = 200.0
-    ratio_floor: int = 1 << 20
-
-    ENV = {"max_bytes": "SCFMU_FMU_MAX_BYTES", "max_files": "SCFMU_FMU_MAX_FILES", "max_ratio": "SCFMU_FMU_MAX_RATIO"}
-
-    @classmethod
-    def from_env(cls) -> "ArchiveLimits":
-        """The defaults, each replaced by its environment variable when set (a positive number)."""
-        kw = {}
-        for field_, var in cls.ENV.items():
-            text = os.environ.get(var)
-            if text is None or not text.strip():
-                continue
-            try:
-                v = float(text) if field_ == "max_ratio" else int(text)
-            except ValueError:
-                v = None
-            if v is None or not v > 0 or v != v or v == float("inf"):
-                raise ArchiveError(f"{var} = {text!r}: expected a positive "
-                                   f"{'number' if field_ == 'max_ratio' else 'integer'}")
-            kw[field_] = v
-        return cls(**kw)
-
-    def to_dict(self) -> dict:
-        return {"max_bytes": self.max_bytes, "max_files": self.max_files, "max_ratio": self.max_ratio,
-                "ratio_floor": self.ratio_floor}
-
-
-_LIMITS_OVERRIDE: ArchiveLimits | None = None
-
-
-def set_archive_limits(limits: ArchiveLimits | dict | None) -> None:
-    """Uses ``limits`` for every extraction of this process (a campaign's workers get the client's);
-    None restores the environment's/defaults."""
-    global _LIMITS_OVERRIDE
-    _LIMITS_OVERRIDE = ArchiveLimits(**limits) if isinstance(limits, dict) else limits
-
-
-def archive_limits() -> ArchiveLimits:
-    """The limits in force: :func:`set_archive_limits`, else the environment variables, else the defaults."""
-    return _LIMITS_OVERRIDE if _LIMITS_OVERRIDE is not None else ArchiveLimits.from_env()
-
-
-def _entry_problem(name: str) -> str | None:
-    """Why an entry name is not a safe relative path (None when it is)."""
-    if "\0" in name:
-        return "a NUL byte in the name"
-    if "\\" in name:
-        return "a backslash in the path (entries use forward slashes)"
-    if name.startswith("/"):
-        return "an absolute path"
-    if len(name) >= 2 and name[1] == ":" and name[0].isalpha():
-        return "a drive letter"
-    if ":" in name.split("/")[0]:
-        return "a device or drive prefix"
-    if any(part == ".." for part in name.split("/")):
-        return "a '..' component (outside the extraction folder)"
-    return None
-
-
-def inspect_archive(path: str | Path, limits: ArchiveLimits | None = None) -> list[zipfile.ZipInfo]:
-    """The entries of a zip archive after every check of :func:`safe_extract` (nothing is written);
-    raises :class:`ArchiveError` naming the file, the entry and the limit."""
-    limits = limits or archive_limits()
-    path = Path(path)
-    if path.is_dir():
-        raise ArchiveError(f"{path} is a directory, not an FMU file (give the .fmu archive)")
-    try:
-        size = path.stat().st_size
-    except OSError as e:
-        raise ArchiveError(f"{path}: {e.strerror or e}") from None
-    if size > limits.max_bytes:  # before its directory (which could list millions of entries) is read
-        raise ArchiveError(f"{path}: {size} bytes; the limit is {limits.max_bytes} bytes (SCFMU_FMU_MAX_BYTES)")
-    try:
-        with zipfile.ZipFile(path) as z:
-            infos = z.infolist()
-    except zipfile.BadZipFile as e:
-        raise ArchiveError(f"{path}: not a zip archive ({e})") from None
-    except OSError as e:
-        raise ArchiveError(f"{path}: {e.strerror or e}") from None
-    if len(infos) > limits.max_files:
-        raise ArchiveError(f"{path}: {len(infos)} entries; at most {limits.max_files} are extracted "
-                           f"(SCFMU_FMU_MAX_FILES)")
-    total = 0
-    for i in infos:
-        why = _entry_problem(i.filename)
-        if why:
-            raise ArchiveError(f"{path}: entry {i.filename!r} refused: {why}")
-        mode = i.external_attr >> 16
-        if stat.S_ISLNK(mode):
-            raise ArchiveError(f"{path}: entry {i.filename!r} refused: a symbolic link")
-        if stat.S_IFMT(mode) not in (0, stat.S_IFREG, stat.S_IFDIR):
-            raise ArchiveError(f"{path}: entry {i.filename!r} refused: a special file (mode {oct(mode)})")
-        if i.flag_bits & 0x1:
-            raise ArchiveError(f"{path}: entry {i.filename!r} refused: encrypted")
-        total += i.file_size
-        if total > limits.max_bytes:
-            raise ArchiveError(f"{path}: more than {limits.max_bytes} bytes uncompressed (at entry {i.filename!r}); "
-                               f"the limit is {limits.max_bytes} bytes (SCFMU_FMU_MAX_BYTES)")
-        if i.file_size > limits.ratio_floor and i.file_size > limits.max_ratio * max(i.compress_size, 1):
-            raise ArchiveError(f"{path}: entry {i.filename!r} inflates {i.compress_size} bytes to {i.file_size} "
-                               f"(ratio {i.file_size / max(i.compress_size, 1):.0f}); at most {limits.max_ratio:g} "
-                               f"is allowed (SCFMU_FMU_MAX_RATIO): a zip bomb?")
-    return infos
-
-
-def safe_extract(path: str | Path, dest: str | Path | None = None, limits: ArchiveLimits | None = None) -> str:
-    """Extracts a zip archive (an FMU or SSP) into ``dest`` (a new temporary folder by default; created when
-    absent) after :func:`inspect_archive`; returns the folder. On any failure the folder is removed (when this
-    call created it) and :class:`ArchiveError` is raised."""
-    limits = limits or archive_limits()
-    infos = inspect_archive(path, limits)
-    if dest is None:
-        root = Path(tempfile.mkdtemp(prefix="scfmu_fmu_"))
-        created = root
-    else:
-        root = Path(dest)
-        created = None if root.exists() else root
-        root.mkdir(parents=True, exist_ok=True)
-    base = root.resolve()
-    written = 0
-    try:
-        with zipfile.ZipFile(path) as z:
-            for i in infos:
-                target = (base / i.filename).resolve()
-                if target != base and base not in target.parents:  # a second line of defence
-                    raise ArchiveError(f"{path}: entry {i.filename!r} refused: outside the extraction folder")
-                if i.is_dir():
-                    target.mkdir(parents=True, exist_ok=True)
-                    continue
-                target.parent.mkdir(parents=True, exist_ok=True)
-                n = 0
-                with z.open(i) as src, open(target, "wb") as out:
-                    while True:
-                        block = src.read(1 << 20)
-                        if not block:
-                            break
-                        n += len(block)
-                        written += len(block)
-                        if n > i.file_size or written > limits.max_bytes:
-                            raise ArchiveError(f"{path}: entry {i.filename!r} inflates past its declared size "
-                                               f"({i.file_size} bytes)")
-                        out.write(block)
-    except BaseException as e:
-        if created is not None:
-            shutil.rmtree(created, ignore_errors=True)
-        if isinstance(e, ArchiveError):
-            raise
-        if isinstance(e, (zipfile.BadZipFile, OSError, EOFError, RuntimeError, ValueError)):
-            raise ArchiveError(f"{path}: extraction failed: {e}") from None
-        raise
-    return str(root)
 
 
 def model_description(path: str | Path):
@@ -383,7 +204,7 @@ def scalar_type(v) -> str | None:
     return t if t in ("Real", "Integer", "Boolean") else None
 
 
-class Fmu:
+class Fmu(ModelExchange):
     """One instantiated FMU (FMI 2.0 or 3.0) with name-based access. With `initialize=True` (default) it is
     set up, given `params` in initialization mode, and ready to step at `start_time`. Every logger message
     is kept in `messages` as (status, category, text).
@@ -513,137 +334,6 @@ class Fmu:
             if self.interface == "me":
                 self._event_iteration()
                 self.slave.enterContinuousTimeMode()
-
-    # ----- Model Exchange ------------------------------------------------------------------
-    def _event_iteration(self) -> None:
-        while True:
-            if self.fmi == 2:
-                needed, terminate, _, _, defined, t_next = self.slave.newDiscreteStates()
-            else:
-                needed, terminate, _, _, defined, t_next = self.slave.updateDiscreteStates()
-            if terminate:
-                raise RuntimeError(f"{self.model}: the unit asked to terminate at t = {self.time}")
-            if not needed:
-                break
-        self.next_event = t_next if defined else None
-
-    def _states(self) -> np.ndarray:
-        x = np.zeros(self.nx)
-        if self.nx:
-            self.slave.getContinuousStates(x.ctypes.data_as(POINTER(c_double)), self.nx)
-        return x
-
-    def _rhs(self, t: float, x: np.ndarray) -> np.ndarray:
-        x = np.ascontiguousarray(x, dtype=float)
-        self.slave.setTime(t)
-        self.slave.setContinuousStates(x.ctypes.data_as(POINTER(c_double)), self.nx)
-        dx = np.zeros(self.nx)
-        if self.fmi == 2:
-            self.slave.getDerivatives(dx.ctypes.data_as(POINTER(c_double)), self.nx)
-        else:
-            self.slave.getContinuousStateDerivatives(dx.ctypes.data_as(POINTER(c_double)), self.nx)
-        return dx
-
-    def _indicators(self) -> np.ndarray:
-        z = np.zeros(self.nz)
-        if self.nz:
-            self.slave.getEventIndicators(z.ctypes.data_as(POINTER(c_double)), self.nz)
-        return z
-
-    def _state_events(self):
-        """solve_ivp event functions, one per event indicator: a sign change stops the integration."""
-        def ev(i):
-            def f(t, x):
-                self._rhs(t, x)
-                return self._indicators()[i]
-            f.terminal = True
-            return f
-        return [ev(i) for i in range(self.nz)]
-
-    def _rk4(self, t: float, x: np.ndarray, h: float, k1: np.ndarray) -> np.ndarray:
-        k2 = self._rhs(t + 0.5 * h, x + 0.5 * h * k1)
-        k3 = self._rhs(t + 0.5 * h, x + 0.5 * h * k2)
-        k4 = self._rhs(t + h, x + h * k3)
-        return x + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
-
-    def _rk4_interval(self, t: float, t_stop: float, dt: float, eps: float) -> tuple[float, bool]:
-        """Fixed-step RK4 from t towards t_stop; stops early at a state event or when the unit asks for an
-        event after ``completedIntegratorStep``. Returns (time reached, event to handle)."""
-        h_fix = min(self.me_max_step, dt) if self.me_max_step > 0 else dt
-        x = self._states()
-        z = self._indicators() if self.nz else None
-        while t < t_stop - eps:
-            h = min(h_fix, t_stop - t)
-            if t + h > t_stop - eps:
-                h = t_stop - t
-            k1 = self._rhs(t, x)
-            xn = self._rk4(t, x, h, k1)
-            tn = t_stop if abs(t + h - t_stop) <= eps else t + h
-            self._rhs(tn, xn)
-            crossed = False
-            if self.nz:
-                zn = self._indicators()
-                crossed = bool(np.any((z > 0) != (zn > 0)))
-                if crossed:  # bisection on the step size
-                    lo, hi, x_hi = 0.0, 1.0, xn
-                    while (hi - lo) * h > eps:
-                        mid = 0.5 * (lo + hi)
-                        xm = self._rk4(t, x, mid * h, k1)
-                        self._rhs(t + mid * h, xm)
-                        if np.any((z > 0) != (self._indicators() > 0)):
-                            hi, x_hi = mid, xm
-                        else:
-                            lo = mid
-                    tn, xn = t + hi * h, x_hi
-                    self._rhs(tn, xn)
-                else:
-                    z = zn
-            t, x = tn, xn
-            enter, terminate = self.slave.completedIntegratorStep()
-            if terminate:
-                raise RuntimeError(f"{self.model}: the unit asked to terminate at t = {t}")
-            if crossed or enter:
-                return t, True
-        return t, False
-
-    def _me_step(self, t: float, dt: float) -> None:
-        t_end = t + dt
-        eps = 1e-12 * max(1.0, abs(t_end))
-        events = self._state_events() if self.nz else None
-        while t < t_end - eps:
-            t_stop = t_end if self.next_event is None or self.next_event >= t_end - eps else self.next_event
-            state_event = False
-            if self.me_method == "RK4" and self.nx:
-                t_stop, event = self._rk4_interval(t, t_stop, dt, eps)
-                at_event = self.next_event is not None and abs(t_stop - self.next_event) <= eps
-                if event or at_event:
-                    self.time = t_stop
-                    self.slave.enterEventMode()
-                    self._event_iteration()
-                    self.slave.enterContinuousTimeMode()
-                t = t_stop
-                continue
-            if self.nx:
-                from scipy.integrate import solve_ivp  # imported here: SciPy costs ~1 s at start-up
-                sol = solve_ivp(self._rhs, (t, t_stop), self._states(), method=self.me_method,
-                                rtol=self.me_rtol, atol=self.me_atol, events=events)
-                if not sol.success:
-                    raise RuntimeError(f"{self.model}: solve_ivp failed from t = {t} to {t_stop}: {sol.message}")
-                if sol.status == 1:  # an event indicator changed sign: stop there
-                    state_event, t_stop = True, float(sol.t[-1])
-                self._rhs(t_stop, sol.y[:, -1])  # leaves the unit at (t_stop, x(t_stop))
-            else:
-                self.slave.setTime(t_stop)
-            enter, terminate = self.slave.completedIntegratorStep()
-            if terminate:
-                raise RuntimeError(f"{self.model}: the unit asked to terminate at t = {t_stop}")
-            at_event = self.next_event is not None and abs(t_stop - self.next_event) <= eps
-            if enter or at_event or state_event:
-                self.time = t_stop
-                self.slave.enterEventMode()
-                self._event_iteration()
-                self.slave.enterContinuousTimeMode()
-            t = t_stop
 
     # ----- name-based access -------------------------------------------------------------
     def var(self, name: str):
