@@ -324,7 +324,7 @@ def build(ctx) -> PaperSection:
     c2 = Claim("C002-2", "In the phase plane the fractional controllers give a smaller pointing error; PD is preferable "
                          "to PID.",
                rules.combine(ph["holds"], dict(zip(dlabels, d2))),
-               f"Nominal MAE (deg): " + ", ".join(f"{c} {maes[c]:.5g}" for c in NAMES) + f". Fractional lower than its "
+               "Nominal MAE (deg): " + ", ".join(f"{c} {maes[c]:.5g}" for c in NAMES) + f". Fractional lower than its "
                f"integer counterpart by more than {MARGIN:.1%}: FOPD vs PD {'yes' if ph['fo_better'][0] else 'no'}, FOPID "
                f"vs PID {'yes' if ph['fo_better'][1] else 'no'}; PD not worse than PID: "
                f"{'yes' if ph['pd_not_worse'] else 'no'}. Rule: both fractional wins and PD not worse than PID. Verdict "

@@ -10,7 +10,6 @@ the requirement, and the requirement tolerances themselves (computed from the te
 
 from __future__ import annotations
 
-import json
 import math
 import time
 
@@ -19,7 +18,6 @@ import numpy as np
 from ... import campaign
 from . import scenarios
 from . import model as P
-from .data import data_file
 from ...scenario.model import log_of
 from ...report import common, rules
 from ...report.types import Claim, Figure, PaperSection, Sensitivity, Table
