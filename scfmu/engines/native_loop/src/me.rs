@@ -236,6 +236,18 @@ impl Solver {
         Ok(w)
     }
 
+    /// The continuous states only (the unit's time is already the right one).
+    unsafe fn set_states_only(&self, f: &Fmu, x: &[f64]) -> Result<i32, Fail> {
+        if self.nx == 0 {
+            return Ok(0);
+        }
+        ok(transmute::<*const c_void, Vector>(f.fns[F_SET_STATES])(
+            f.comp,
+            x.as_ptr() as *mut f64,
+            self.nx,
+        ))
+    }
+
     unsafe fn set(&self, f: &Fmu, t: f64, x: &[f64]) -> Result<i32, Fail> {
         let mut w = ok(transmute::<*const c_void, SetTime>(f.fns[F_SET_TIME])(f.comp, t))?;
         if self.nx > 0 {
@@ -391,20 +403,21 @@ impl Solver {
         }
     }
 
-    /// One communication step of the unit from `t` to `t + dt` (module docstring).
+    /// One communication step of the unit from `t` to `t_end` (module docstring). The loop gives the next
+    /// communication point t_(k+1) = t0 + (k+1)·dt itself, not t_k + dt (which can differ from it in the last
+    /// bit): the unit then ends exactly where the next step starts, and nothing is read or set again there.
     ///
     /// # Safety
     /// `f` must be a Model Exchange instance in continuous-time mode with the function table of its version.
-    pub unsafe fn step(&mut self, f: &mut Fmu, t: f64, dt: f64) -> Result<i32, Fail> {
-        let t_end = t + dt;
+    pub unsafe fn step(&mut self, f: &mut Fmu, t: f64, t_end: f64) -> Result<i32, Fail> {
+        let dt = t_end - t;
         let eps = 1e-12 * t_end.abs().max(1.0);
         let mut t = t;
         let here = self.at == Some(t); // left at (t, x) by the previous step: nothing to read or set
         let mut w = if here { 0 } else { self.read_states(f)? };
         if self.nz > 0 {
-            let x = self.x.clone();
             if !here {
-                w = w.max(self.set(f, t, &x)?);
+                w = w.max(self.set(f, t, &self.x)?);
                 self.at = Some(t);
             }
             let mut z = std::mem::take(&mut self.z);
@@ -428,8 +441,7 @@ impl Solver {
             let r = if self.at == Some(t) {
                 self.derivatives_here(f, &mut k0)
             } else {
-                let x = self.x.clone();
-                self.rhs(f, t, &x, &mut k0)
+                self.rhs(f, t, &self.x, &mut k0)
             };
             self.k[0] = k0;
             w = w.max(r?);
@@ -463,8 +475,7 @@ impl Solver {
                         let r = if self.at == Some(t) {
                             self.derivatives_here(f, &mut k0)
                         } else {
-                            let x = self.x.clone();
-                            self.rhs(f, t, &x, &mut k0)
+                            self.rhs(f, t, &self.x, &mut k0)
                         };
                         self.k[0] = k0;
                         w = w.max(r?);
@@ -473,17 +484,11 @@ impl Solver {
                     w = w.max(self.rk4_step(f, t, h)?);
                     self.accepted += 1;
                     let mut t_new = if (t + h - t_stop).abs() <= eps { t_stop } else { t + h };
-                    let xn = self.x_new.clone();
                     if t_new == t + h {
                         // the unit's time is already t + h (the last stage): only the states are set
-                        let st = transmute::<*const c_void, Vector>(f.fns[F_SET_STATES])(
-                            f.comp,
-                            xn.as_ptr() as *mut f64,
-                            self.nx,
-                        );
-                        w = w.max(ok(st)?);
+                        w = w.max(self.set_states_only(f, &self.x_new)?);
                     } else {
-                        w = w.max(self.set(f, t_new, &xn)?);
+                        w = w.max(self.set(f, t_new, &self.x_new)?);
                     }
                     let mut crossed = false;
                     if self.nz > 0 {
@@ -567,10 +572,11 @@ impl Solver {
                         }
                         self.x_new[i] = acc;
                     }
-                    let xn = std::mem::take(&mut self.x_new);
+                    // FSAL stage f(t + h, x_new): the unit's time is already t + h (stage 6, C[5] = 1)
                     let mut k6 = std::mem::take(&mut self.k[6]);
-                    let r = self.rhs(f, t + h, &xn, &mut k6);
-                    self.x_new = xn;
+                    let r = self
+                        .set_states_only(f, &self.x_new)
+                        .and_then(|a| self.derivatives_here(f, &mut k6).map(|b| a.max(b)));
                     self.k[6] = k6;
                     w = w.max(r?);
                     for i in 0..self.nx {
@@ -639,6 +645,9 @@ impl Solver {
                     w = w.max(self.set(f, t_new, &xn)?);
                 }
                 std::mem::swap(&mut self.x, &mut self.x_new);
+                if !crossed && t_new == t + h {
+                    self.at = Some(t_new); // the last stage left the unit at (t + h, x_new): nothing to set again
+                }
                 t = t_new;
                 if !crossed {
                     self.k.swap(0, 6); // FSAL: k[6] is f(t, x) at the new point
@@ -658,8 +667,7 @@ impl Solver {
                 w = w.max(self.event(f)?);
                 self.at = None; // the event iteration may have changed the states (read again)
                 if self.nz > 0 {
-                    let x = self.x.clone();
-                    w = w.max(self.set(f, t, &x)?);
+                    w = w.max(self.set(f, t, &self.x)?);
                     self.at = Some(t);
                     let mut z = std::mem::take(&mut self.z);
                     w = w.max(self.indicators(f, &mut z)?);
@@ -669,8 +677,7 @@ impl Solver {
         }
         // leave the unit exactly at (t_end, x(t_end)) for the outputs read at the next communication point
         if self.at != Some(t_end) {
-            let x = self.x.clone();
-            w = w.max(self.set(f, t_end, &x)?);
+            w = w.max(self.set(f, t_end, &self.x)?);
             self.at = Some(t_end);
         }
         Ok(w)
