@@ -228,12 +228,22 @@ def campaign_throughput(n_runs: int):
     return res
 
 
+RUN_COST_TARGET = 1.5  # issue 34: a campaign run costs at most 1.5x the native stepping of the same run
+UNIT_COST_TARGET = 1.2  # issue 34: an ME / FMI 3.0 unit costs at most 1.2x the FMI 2.0 CS unit it replaces
+
+
+def _verdict(ratio: float, target: float) -> str:
+    return f"{ratio:.2f}× ({'≤' if ratio <= target else '>'} {target}×: {'met' if ratio <= target else 'NOT met'})"
+
+
 def campaign_cost(n_runs: int, repeat: int):
     """Side by side in this process: the native stepping of run 000-6 with no Python call per step
     (log_every=0), and one campaign run of it (``campaign.run_one``, what a worker does per run: scenario
     from the spec, overrides, instances from the pool, logging of the metric set's signals, metrics, row)
     on the compiled engine (the campaigns' default "auto" when its library is available) and on the
-    native engine; each the minimum over interleaved repetitions."""
+    native engine. Interleaved run by run (native stepping, compiled loop alone, campaign run on each
+    engine, then the next run), so that both sides of a ratio see the same machine load; each figure is
+    the minimum over ``repeat`` repetitions of the total over the ``n_runs`` runs. Returns the ratios."""
     from scfmu import campaign
     from scfmu.engines import compiled
     sc = scenarios.get("default")
@@ -249,6 +259,9 @@ def campaign_cost(n_runs: int, repeat: int):
     def best(a, b):
         return min(a[0], b[0]), min(a[1], b[1])
 
+    def add(a, b):
+        return a[0] + b[0], a[1] + b[1]
+
     def timed(f):
         w, c = time.perf_counter(), time.process_time()
         f()
@@ -263,19 +276,24 @@ def campaign_cost(n_runs: int, repeat: int):
         with CompiledLoop(sc) as m:
             return timed(m.run)
 
-    def runs(e):
-        for s in specs[e]:
-            row, _ = campaign.run_one(s)
-            assert row["status"] == "ok", row["message"]
+    def one(s):
+        row, _ = campaign.run_one(s)
+        assert row["status"] == "ok", row["message"]
 
     for _ in range(repeat):
-        step = best(step, native_step())
-        if compiled.available():
-            stepc = best(stepc, compiled_alone())
+        tot_step, tot_stepc, tot_run = (0.0, 0.0), (0.0, 0.0), dict.fromkeys(engines, (0.0, 0.0))
+        for i in range(n_runs):
+            tot_step = add(tot_step, native_step())
+            if compiled.available():
+                tot_stepc = add(tot_stepc, compiled_alone())
+            for e in engines:
+                tot_run[e] = add(tot_run[e], timed(lambda: one(specs[e][i])))
+        step = best(step, (tot_step[0] / n_runs, tot_step[1] / n_runs))
+        stepc = best(stepc, (tot_stepc[0] / n_runs, tot_stepc[1] / n_runs))
         for e in engines:
-            w, c = timed(lambda: runs(e))
-            run[e] = best(run[e], (w / n_runs, c / n_runs))
-    print(f"\n| run 000-6 (3,000 steps), one process | wall ms per run | CPU ms per run | wall µs per step |")
+            run[e] = best(run[e], (tot_run[e][0] / n_runs, tot_run[e][1] / n_runs))
+    print(f"\n| run 000-6 (3,000 steps), one process, mean of {n_runs} interleaved runs (min over {repeat}) "
+          "| wall ms per run | CPU ms per run | wall µs per step |")
     print("|---|---:|---:|---:|")
     print(f"| native stepping, log_every=0 | {step[0] * 1e3:.2f} | {step[1] * 1e3:.2f} | {step[0] / sc.n_steps * 1e6:.2f} |")
     if compiled.available():
@@ -284,59 +302,91 @@ def campaign_cost(n_runs: int, repeat: int):
     for e in engines:
         print(f"| campaign run on the {e} engine (run_one, 1 worker's work) | {run[e][0] * 1e3:.2f} "
               f"({1 / run[e][0]:.1f} runs/s) | {run[e][1] * 1e3:.2f} | {run[e][0] / sc.n_steps * 1e6:.2f} |")
+    ratios = {}
     for e in engines:
-        print(f"| ratio campaign run ({e}) / native stepping | {run[e][0] / step[0]:.2f}× (wall) | "
-              f"{run[e][1] / step[1]:.2f}× (CPU) | |")
-    return step, run
+        ratios[e] = (run[e][0] / step[0], run[e][1] / step[1])
+        print(f"| ratio campaign run ({e}) / native stepping | {_verdict(ratios[e][0], RUN_COST_TARGET)} (wall) | "
+              f"{_verdict(ratios[e][1], RUN_COST_TARGET)} (CPU) | |")
+    return ratios
+
+
+def _unit_variants(base):
+    """(label, plan, target label or None) of the unit-cost table: each Model Exchange or FMI 3.0 variant is
+    compared with the FMI 2.0 Co-Simulation run that uses the same integration method (like with like)."""
+    from scfmu.scenario.plan import build_plan
+    f = ROOT / "fmus"
+    out = []
+    for label, ver, me, solver, plant, ref in [
+            ("FMI 2.0 CS, plant RK4 at the communication step (reference)", "", False, None, {}, None),
+            ("FMI 3.0 CS", "fmi3", False, None, {}, "FMI 2.0 CS, plant RK4 at the communication step (reference)"),
+            ("FMI 2.0 plant ME, RK4 at the communication step", "", True, {"method": "RK4"}, {},
+             "FMI 2.0 CS, plant RK4 at the communication step (reference)"),
+            ("FMI 3.0 plant ME, RK4 at the communication step", "fmi3", True, {"method": "RK4"}, {},
+             "FMI 2.0 CS, plant RK4 at the communication step (reference)"),
+            ("FMI 2.0 CS, plant DP5(4) inside, tol 1e-8", "", False, None, {"integrator": 2}, None),
+            ("FMI 2.0 plant ME, DP5(4) rtol = atol = 1e-8", "", True, {"rtol": 1e-8, "atol": 1e-8}, {},
+             "FMI 2.0 CS, plant DP5(4) inside, tol 1e-8"),
+            ("FMI 3.0 plant ME, DP5(4) rtol = atol = 1e-8", "fmi3", True, {"rtol": 1e-8, "atol": 1e-8}, {},
+             "FMI 2.0 CS, plant DP5(4) inside, tol 1e-8"),
+            ("FMI 2.0 plant ME, DP5(4) rtol 1e-10 (default)", "", True, {}, {}, None),
+            ("accurate solution: FMI 2.0 CS, plant RK4 at step/20", "", False, None,
+             {"max_internal_step": 0.0005}, None)]:
+        d = f / ver if ver else f
+        sc = base.with_models({"controller": str(d / "PdController.fmu"), "plant": str(d / "AttitudePlant.fmu")})
+        if plant:
+            sc = sc.with_overrides({f"plant.{k}": v for k, v in plant.items()})
+        if solver:
+            sc.component("plant").solver = dict(solver)
+        out.append((label, build_plan(sc, model_exchange={"plant"} if me else frozenset()), ref))
+    return out
 
 
 def unit_cost(repeat: int):
     """Side by side in this process, the compiled loop's run 000-6 (3,000 steps, every signal logged) with
     the FMI 2.0 Co-Simulation PdController and AttitudePlant, with their FMI 3.0 Co-Simulation FMUs, and
-    with the plant as a Model Exchange unit (FMI 2.0 and 3.0) under the loop's Dormand–Prince 5(4)
-    (rtol 1e-10) and under its fixed-step RK4 (the communication step, as the Co-Simulation plant's own
-    integrator); each the minimum over interleaved repetitions, wall and CPU time, and the largest
-    deviation of any logged signal from the FMI 2.0 Co-Simulation run (relative to the signal's range)."""
+    with the plant as a Model Exchange unit (FMI 2.0 and 3.0) under the loop's fixed-step RK4 (against the
+    CS plant's own RK4 at the same step) and under its Dormand–Prince 5(4) (against the CS plant's own
+    DP5(4) at the same tolerance); each the minimum over interleaved repetitions, wall and CPU time; the
+    largest deviation of any logged signal from the FMI 2.0 CS run with the same method, and from an
+    accurate solution (the CS plant's RK4 at a twentieth of the step), relative to the signal's range.
+    Returns {label: CPU ratio} of the variants with a target."""
     import numpy as np
     from scfmu.engines.compiled import CompiledLoop, available
-    from scfmu.scenario.plan import build_plan
     if not available():
         print("compiled loop library not available: cargo build --release")
-        return
-    f = ROOT / "fmus"
-    base = scenarios.get("default")
-    variants = {}
-    for label, ver, me, method in [("FMI 2.0 CS (reference)", "", False, None), ("FMI 3.0 CS", "fmi3", False, None),
-                                   ("FMI 2.0 plant ME, DP5(4) rtol 1e-10", "", True, "DOP853"),
-                                   ("FMI 3.0 plant ME, DP5(4) rtol 1e-10", "fmi3", True, "DOP853"),
-                                   ("FMI 2.0 plant ME, RK4 fixed step", "", True, "RK4"),
-                                   ("FMI 3.0 plant ME, RK4 fixed step", "fmi3", True, "RK4")]:
-        d = f / ver if ver else f
-        sc = base.with_models({"controller": str(d / "PdController.fmu"), "plant": str(d / "AttitudePlant.fmu")})
-        if method:
-            sc.component("plant").solver = {"method": method}
-        variants[label] = build_plan(sc, model_exchange={"plant"} if me else frozenset())
+        return {}
+    variants = _unit_variants(scenarios.get("default"))
     results = {}
-    for label, plan in variants.items():
+    for label, plan, _ in variants:
         with CompiledLoop(plan) as m:
             results[label] = m.run()
-    ref = results["FMI 2.0 CS (reference)"]
-    dev = {k: max(float(np.max(np.abs(ref[s] - r[s])) / max(1e-300, np.max(np.abs(ref[s])))) for s in ref if s != "time")
-           for k, r in results.items()}
-    best = {k: [float("inf"), float("inf")] for k in variants}
+
+    def dev(a, b):
+        return max(float(np.max(np.abs(a[s] - b[s])) / max(1e-300, np.max(np.abs(a[s])))) for s in a if s != "time")
+
+    acc = results[variants[-1][0]]
+    best = {label: [float("inf"), float("inf")] for label, _, _ in variants[:-1]}
     for _ in range(repeat):
-        for label, plan in variants.items():
+        for label, plan, _ in variants[:-1]:
             with CompiledLoop(plan) as m:
                 w, c = time.perf_counter(), time.process_time()
                 m.run()
                 w, c = time.perf_counter() - w, time.process_time() - c
             best[label] = [min(best[label][0], w), min(best[label][1], c)]
-    w0, c0 = best["FMI 2.0 CS (reference)"]
     print("\n| run 000-6 in the compiled loop (3,000 steps, 22 signals logged) | wall ms | CPU ms | "
-          "ratio (wall) | ratio (CPU) | max deviation |")
-    print("|---|---:|---:|---:|---:|---:|")
-    for label, (w, c) in best.items():
-        print(f"| {label} | {w * 1e3:.2f} | {c * 1e3:.2f} | {w / w0:.2f}× | {c / c0:.2f}× | {dev[label]:.1e} |")
+          "ratio to its CS run (wall) | ratio to its CS run (CPU) | deviation from its CS run | error (accurate solution) |")
+    print("|---|---:|---:|---:|---:|---:|---:|")
+    ratios = {}
+    for label, _, ref in variants[:-1]:
+        w, c = best[label]
+        if ref:
+            rw, rc = w / best[ref][0], c / best[ref][1]
+            ratios[label] = rc
+            cells = f"{rw:.2f}× | {_verdict(rc, UNIT_COST_TARGET)} | {dev(results[ref], results[label]):.1e}"
+        else:
+            cells = "— | — | —"
+        print(f"| {label} | {w * 1e3:.2f} | {c * 1e3:.2f} | {cells} | {dev(acc, results[label]):.1e} |")
+    return ratios
 
 
 def main() -> int:
@@ -347,6 +397,8 @@ def main() -> int:
     ap.add_argument("--no-loops", action="store_true", help="only the campaign throughput")
     ap.add_argument("--run-cost", action="store_true",
                     help="campaign run cost against native stepping, side by side in this process")
+    ap.add_argument("--check", action="store_true",
+                    help="with --run-cost: exit 1 when a target of issue 34 is not met")
     args = ap.parse_args()
     load = os.getloadavg()[0]
     print(f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, {os.cpu_count()} cores, load average {load:.1f}, "
@@ -354,8 +406,16 @@ def main() -> int:
     if not args.no_loops:
         loops(args.repeat)
     if args.run_cost:
-        campaign_cost(args.runs, args.repeat)
-        unit_cost(args.repeat)
+        run_ratios = campaign_cost(args.runs, args.repeat)
+        unit_ratios = unit_cost(args.repeat)
+        missed = [f"campaign run ({e}, {'wall' if k == 0 else 'CPU'}) {r[k]:.2f}× > {RUN_COST_TARGET}×"
+                  for e, r in run_ratios.items() if e == "compiled" for k in (0, 1) if r[k] > RUN_COST_TARGET]
+        missed += [f"{lb}: {r:.2f}× > {UNIT_COST_TARGET}× (CPU)" for lb, r in unit_ratios.items() if r > UNIT_COST_TARGET]
+        print("\ntargets (issue 34): campaign run on the default engine ≤ 1.5× native stepping (wall and CPU); "
+              "ME / FMI 3.0 units ≤ 1.2× the CS run with the same method (CPU): "
+              + ("all met" if not missed else "NOT met: " + "; ".join(missed)))
+        if args.check and missed:
+            return 1
     if args.campaign:
         campaign_throughput(args.runs)
     return 0

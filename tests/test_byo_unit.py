@@ -215,7 +215,7 @@ def test_foreign_fmu_is_shipped_to_a_worker_without_the_file(tmp_path, my_pd):
     for comp in moved["scenario"]["components"]:
         if comp["model"] == str(my_pd):
             comp["model"] = str(gone)
-    campaign.FMU_CACHE = tmp_path / "cache"
+    campaign.runs.FMU_CACHE = tmp_path / "cache"
     a, _ = campaign.run_one(spec)
     b, _ = campaign.run_one(moved, blobs=blobs)
     assert a["status"] == b["status"] == "ok"

@@ -399,17 +399,17 @@ def test_campaign_metrics_equal_those_of_a_full_log_reference_run(name, t, overr
     base = short(name, t)
     spec = campaign.Campaign(base, [overrides], seeds=[seed]).runs()[0]
     seen = []
-    real_simulate = campaign.simulate
+    real_simulate = campaign.runs.simulate
 
     def spy(sc, *a, **kw):  # a campaign run hands simulate its plan (the scenario resolved once)
         seen.append(dict(getattr(sc, "scenario", sc).log))
         return real_simulate(sc, *a, **kw)
 
-    campaign.simulate = spy
+    campaign.runs.simulate = spy
     try:
         row, ts = campaign.run_one(spec)
     finally:
-        campaign.simulate = real_simulate
+        campaign.runs.simulate = real_simulate
     assert row["status"] == "ok", row["message"]
     assert ts is None
     need = run_metrics.logs_needed(base.metrics)

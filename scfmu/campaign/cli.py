@@ -151,7 +151,9 @@ def build(args) -> campaign.Campaign:
                              isolate=True if args.isolate else None, timeout=args.timeout)
 
 
-def main(argv=None) -> int:
+def _parser() -> argparse.ArgumentParser:
+    """The command line of ``scfmu campaign``: the scenario options, the parameter sets, seeds, engine, Dask
+    and output options."""
     ap = argparse.ArgumentParser(prog="scfmu campaign", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     options.add_arguments(ap)
     ap.add_argument("--grid", action="append", default=[], metavar="INST.VAR=V1,V2,...", help="grid axis (repeatable)")
@@ -180,7 +182,45 @@ def main(argv=None) -> int:
     ap.add_argument("--metric", default="eulerint_deg_s", help="metric of the figures")
     ap.add_argument("--plot-vs", action="append", default=[], metavar="INST.VAR", help="metric-vs-parameter figure")
     ap.add_argument("--no-plots", action="store_true")
-    args = ap.parse_args(argv)
+    return ap
+
+
+def _summary(table, out: Path) -> tuple[list, list]:
+    """Prints the status counts, the failed runs and the main metrics' ranges; returns (rows, ok rows)."""
+    rows = table.to_pylist()
+    ok = [r for r in rows if r["status"] == "ok"]
+    counts: dict[str, int] = {}
+    for r in rows:
+        counts[r["status"]] = counts.get(r["status"], 0) + 1
+    print(f"{len(ok)} of {len(rows)} runs ok ({', '.join(f'{k}: {v}' for k, v in sorted(counts.items()))}); "
+          f"results {out / 'results.parquet'}, manifest {out / 'manifest.json'}")
+    for r in rows:
+        if r["status"] != "ok":
+            print(f"  run {r['run']}: {r['status']}: {r['message'][:160]}")
+    import numpy as np
+    for m in ("eulerint_deg_s", "ise", "settling_s", "effort_abs", "final_error"):
+        v = np.array([r[m] for r in ok], dtype=float)
+        v = v[np.isfinite(v)]
+        if v.size:
+            print(f"  {m:16s} min {v.min():12.6g}  median {np.median(v):12.6g}  max {v.max():12.6g}  ({v.size} runs)")
+    return rows, ok
+
+
+def _figures(c, table, out: Path, args) -> None:
+    """The metric histogram, the metric-vs-parameter figures and the time-series envelopes."""
+    figs = [campaign_plots.hist(table, args.metric, out / f"hist_{args.metric}.png")]
+    for p in args.plot_vs:
+        figs.append(campaign_plots.metric_vs_param(table, p, args.metric,
+                                                   out / f"{args.metric}_vs_{p.replace('.', '_')}.png"))
+    if c.timeseries is not None:
+        keys = c.timeseries or [k for k in c.scenario.log]
+        for k in keys[:3]:
+            figs.append(campaign_plots.envelope(out, k, out / f"envelope_{k}.png"))
+    print("figures: " + ", ".join(str(f) for f in figs))
+
+
+def main(argv=None) -> int:
+    args = _parser().parse_args(argv)
 
     c = build(args)
     try:
@@ -210,32 +250,9 @@ def main(argv=None) -> int:
         if "holds another campaign" in str(e) or "other FMU builds" in str(e):
             raise UsageError(f"{e} (--overwrite replaces it)") from None
         raise
-    rows = table.to_pylist()
-    ok = [r for r in rows if r["status"] == "ok"]
-    counts: dict[str, int] = {}
-    for r in rows:
-        counts[r["status"]] = counts.get(r["status"], 0) + 1
-    print(f"{len(ok)} of {len(rows)} runs ok ({', '.join(f'{k}: {v}' for k, v in sorted(counts.items()))}); "
-          f"results {out / 'results.parquet'}, manifest {out / 'manifest.json'}")
-    for r in rows:
-        if r["status"] != "ok":
-            print(f"  run {r['run']}: {r['status']}: {r['message'][:160]}")
-    import numpy as np
-    for m in ("eulerint_deg_s", "ise", "settling_s", "effort_abs", "final_error"):
-        v = np.array([r[m] for r in ok], dtype=float)
-        v = v[np.isfinite(v)]
-        if v.size:
-            print(f"  {m:16s} min {v.min():12.6g}  median {np.median(v):12.6g}  max {v.max():12.6g}  ({v.size} runs)")
+    rows, ok = _summary(table, out)
     if not args.no_plots and ok:
-        figs = [campaign_plots.hist(table, args.metric, out / f"hist_{args.metric}.png")]
-        for p in args.plot_vs:
-            figs.append(campaign_plots.metric_vs_param(table, p, args.metric,
-                                                       out / f"{args.metric}_vs_{p.replace('.', '_')}.png"))
-        if c.timeseries is not None:
-            keys = c.timeseries or [k for k in c.scenario.log]
-            for k in keys[:3]:
-                figs.append(campaign_plots.envelope(out, k, out / f"envelope_{k}.png"))
-        print("figures: " + ", ".join(str(f) for f in figs))
+        _figures(c, table, out, args)
     if len(ok) < len(rows):
         print(f"scfmu campaign: {len(rows) - len(ok)} of {len(rows)} runs failed", file=sys.stderr)
         return 1

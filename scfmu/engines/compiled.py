@@ -260,6 +260,19 @@ class CompiledLoop(LeanMaster):
         self._ok = True
         return self._result()
 
+    def _result(self) -> dict[str, np.ndarray]:
+        """``LeanMaster._result`` in one copy: the row-major output block transposed once, each logged signal
+        a contiguous row of that copy (the same values as a copy per column, at a third of the cost)."""
+        sc = self.scenario
+        cols = np.ascontiguousarray(self._out.T)
+        out = {"time": sc.start_time + np.arange(self.n + 1) * sc.step}
+        i = 0
+        for keys in self._log_keys:
+            for key in keys:
+                out[key] = cols[i]
+                i += 1
+        return {k: out[k] for k in ["time", *sc.log]}
+
     def _fail(self, t: float, what: str | None = None):
         msgs = fmu_messages(self.fmus)
         raise SimulationError("fmu_error", "; ".join(msgs) or what or f"an FMI call failed at t = {t}", t)

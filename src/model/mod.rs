@@ -444,7 +444,9 @@ pub trait Model: Clone + Serialize + DeserializeOwned + Send + 'static {
     /// Replaces the continuous state vector (finite values, length checked by the layer).
     fn set_states(&mut self, _x: &[f64]) {}
     /// ẋ at time t for the current inputs and states (length `STATES.len()`); the right-hand side
-    /// valid at the instant t (after an event at t, the new one).
+    /// valid at the instant t (after an event at t, the new one). It reads the inputs, parameters and
+    /// state only, never a value `outputs` computes: the FMI layer does not update the outputs before
+    /// evaluating it.
     fn derivatives(&self, _v: &Self::Vars, _t: f64, _dx: &mut [f64]) -> ModelResult {
         Ok(())
     }

@@ -84,7 +84,7 @@ impl Instance {
 
     pub fn get_continuous_states(&mut self, x: &mut [f64]) -> CallResult {
         self.check_len("x[]", x.len())?;
-        self.ensure_outputs()?;
+        self.ensure_initialized()?;
         self.model.get_states(x).map_err(Fail::error)
     }
 
@@ -94,8 +94,12 @@ impl Instance {
         Ok(())
     }
 
+    /// ẋ at the current time, inputs and states. The outputs are not computed here: a model's
+    /// right-hand side reads only its inputs, parameters and state (`Model::derivatives` gets the
+    /// variables read-only), and a solver evaluates ẋ several times per step where the outputs are read
+    /// once per communication point (computing them at every evaluation doubled a plant's cost).
     fn derivatives_into(&mut self, dx: &mut [f64]) -> CallResult {
-        self.ensure_outputs()?;
+        self.ensure_initialized()?;
         self.model
             .derivatives(self.run.time, dx)
             .map_err(|e| Fail::error(format!("derivatives at t = {}: {e}", self.run.time)))?;

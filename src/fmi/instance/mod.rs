@@ -385,14 +385,21 @@ impl Instance {
         Ok(())
     }
 
-    /// Brings outputs up to date with the inputs most recently set. During initialization the
-    /// parameters are (re)applied first so that initial outputs reflect them.
-    pub fn ensure_outputs(&mut self) -> CallResult {
+    /// During initialization, (re)applies parameters set since the last initialization (what reads the
+    /// state or the derivatives needs; the outputs are left to be computed when they are read).
+    pub fn ensure_initialized(&mut self) -> CallResult {
         if self.run.fsm == FsmState::InitializationMode && self.run.params_dirty {
             self.model.initialize(&self.run.exp).map_err(Fail::error)?;
             self.run.params_dirty = false;
             self.run.outputs_dirty = true;
         }
+        Ok(())
+    }
+
+    /// Brings outputs up to date with the inputs most recently set. During initialization the
+    /// parameters are (re)applied first so that initial outputs reflect them.
+    pub fn ensure_outputs(&mut self) -> CallResult {
+        self.ensure_initialized()?;
         if self.run.outputs_dirty && self.run.fsm != FsmState::Instantiated {
             self.model.update_outputs(self.run.time).map_err(Fail::error)?;
             self.run.outputs_dirty = false;

@@ -1,0 +1,292 @@
+//! The Dormand–Prince 5(4) pair for a Model Exchange unit (see the parent module): adaptive steps with
+//! local extrapolation, first-same-as-last stage, the fourth-order continuous extension for state events
+//! (the method of SciPy's `RK45`, written here from the published coefficients).
+
+use super::Solver;
+use crate::{Fail, Fmu, PHASE_SOLVER};
+
+// Dormand–Prince 5(4): nodes, stage coefficients, 5th-order weights, error weights, dense output.
+const C: [f64; 6] = [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0];
+const A: [[f64; 5]; 6] = [
+    [0.0, 0.0, 0.0, 0.0, 0.0],
+    [1.0 / 5.0, 0.0, 0.0, 0.0, 0.0],
+    [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0],
+    [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0],
+    [
+        19372.0 / 6561.0,
+        -25360.0 / 2187.0,
+        64448.0 / 6561.0,
+        -212.0 / 729.0,
+        0.0,
+    ],
+    [
+        9017.0 / 3168.0,
+        -355.0 / 33.0,
+        46732.0 / 5247.0,
+        49.0 / 176.0,
+        -5103.0 / 18656.0,
+    ],
+];
+const B: [f64; 6] = [
+    35.0 / 384.0,
+    0.0,
+    500.0 / 1113.0,
+    125.0 / 192.0,
+    -2187.0 / 6784.0,
+    11.0 / 84.0,
+];
+const E: [f64; 7] = [
+    -71.0 / 57600.0,
+    0.0,
+    71.0 / 16695.0,
+    -71.0 / 1920.0,
+    17253.0 / 339200.0,
+    -22.0 / 525.0,
+    1.0 / 40.0,
+];
+const P: [[f64; 4]; 7] = [
+    [
+        1.0,
+        -8048581381.0 / 2820520608.0,
+        8663915743.0 / 2820520608.0,
+        -12715105075.0 / 11282082432.0,
+    ],
+    [0.0, 0.0, 0.0, 0.0],
+    [
+        0.0,
+        131558114200.0 / 32700410799.0,
+        -68118460800.0 / 10900136933.0,
+        87487479700.0 / 32700410799.0,
+    ],
+    [
+        0.0,
+        -1754552775.0 / 470086768.0,
+        14199869525.0 / 1410260304.0,
+        -10690763975.0 / 1880347072.0,
+    ],
+    [
+        0.0,
+        127303824393.0 / 49829197408.0,
+        -318862633887.0 / 49829197408.0,
+        701980252875.0 / 199316789632.0,
+    ],
+    [
+        0.0,
+        -282668133.0 / 205662961.0,
+        2019193451.0 / 616988883.0,
+        -1453857185.0 / 822651844.0,
+    ],
+    [
+        0.0,
+        40617522.0 / 29380423.0,
+        -110615467.0 / 29380423.0,
+        69997945.0 / 29380423.0,
+    ],
+];
+const SAFETY: f64 = 0.9;
+const MIN_FACTOR: f64 = 0.2;
+const MAX_FACTOR: f64 = 10.0;
+
+impl Solver {
+    /// Starting step size (Hairer, Nørsett & Wanner's heuristic, as in SciPy).
+    pub(super) unsafe fn initial_step(&mut self, f: &Fmu, t: f64, span: f64) -> Result<f64, Fail> {
+        let n = self.nx;
+        let scale: Vec<f64> = self.x.iter().map(|v| self.atol + v.abs() * self.rtol).collect();
+        let rms = |v: &[f64]| (v.iter().zip(&scale).map(|(a, s)| (a / s) * (a / s)).sum::<f64>() / n as f64).sqrt();
+        let d0 = rms(&self.x);
+        let d1 = rms(&self.k[0]);
+        let h0 = if d0 < 1e-5 || d1 < 1e-5 { 1e-6 } else { 0.01 * d0 / d1 };
+        let h0 = h0.min(span);
+        for i in 0..n {
+            self.y[i] = self.x[i] + h0 * self.k[0][i];
+        }
+        let mut f1 = vec![0.0; n];
+        let y = self.y.clone();
+        self.rhs(f, t + h0, &y, &mut f1)?;
+        let diff: Vec<f64> = f1.iter().zip(&self.k[0]).map(|(a, b)| a - b).collect();
+        let d2 = rms(&diff) / h0;
+        let h1 = if d1 <= 1e-15 && d2 <= 1e-15 {
+            (h0 * 1e-3).max(1e-6)
+        } else {
+            (0.01 / d1.max(d2)).powf(1.0 / 5.0)
+        };
+        Ok((100.0 * h0).min(h1).min(span))
+    }
+
+    /// The continuous extension at t0 + θ·h into `xi`.
+    fn dense(&mut self, h: f64, theta: f64) {
+        let pw = [theta, theta * theta, theta.powi(3), theta.powi(4)];
+        for i in 0..self.nx {
+            let mut s = 0.0;
+            for (j, kj) in self.k.iter().enumerate() {
+                let q = P[j][0] * pw[0] + P[j][1] * pw[1] + P[j][2] * pw[2] + P[j][3] * pw[3];
+                s += kj[i] * q;
+            }
+            self.xi[i] = self.x[i] + h * s;
+        }
+    }
+
+    /// One accepted Dormand–Prince 5(4) step from (t, x) (k1 = f(t, x) in `k[0]`) towards `t_stop`; a state
+    /// event found in it ends the step there. (new time, status, enter event mode).
+    pub(super) unsafe fn dp_advance(
+        &mut self,
+        f: &Fmu,
+        t: f64,
+        t_stop: f64,
+        eps: f64,
+    ) -> Result<(f64, i32, bool), Fail> {
+        self.at = None;
+        let (h, mut w) = self.dp_attempts(f, t, t_stop, eps)?;
+        self.accepted += 1;
+        // ----- state events: a sign change of an indicator over [t, t + h]
+        let mut t_new = if (t + h - t_stop).abs() <= eps { t_stop } else { t + h };
+        let mut crossed = false;
+        if self.nz > 0 {
+            // the unit is at (t + h, x_new) after the last stage
+            let mut zn = std::mem::take(&mut self.z_new);
+            w = w.max(self.indicators(f, &mut zn)?);
+            self.z_new = zn;
+            crossed = self.z.iter().zip(&self.z_new).any(|(a, b)| (*a > 0.0) != (*b > 0.0));
+        }
+        if crossed {
+            let (hi, st) = self.dp_locate(f, t, h, eps)?;
+            w = w.max(st);
+            self.dense(h, hi);
+            std::mem::swap(&mut self.x_new, &mut self.xi);
+            t_new = t + hi * h;
+            w = w.max(self.set(f, t_new, &self.x_new)?);
+        }
+        std::mem::swap(&mut self.x, &mut self.x_new);
+        if !crossed && t_new == t + h {
+            self.at = Some(t_new); // the last stage left the unit at (t + h, x_new): nothing to set again
+        }
+        if !crossed {
+            self.k.swap(0, 6); // FSAL: k[6] is f(t, x) at the new point
+            if self.nz > 0 {
+                std::mem::swap(&mut self.z, &mut self.z_new);
+            }
+        }
+        let (enter, st) = self.completed(f)?;
+        Ok((t_new, w.max(st), crossed || enter))
+    }
+
+    /// Dormand–Prince 5(4) attempts from (t, x) until one meets the tolerance: the stages in `k`, the new
+    /// point in `x_new`, the next step size proposal in `self.h`. (accepted step size, status).
+    unsafe fn dp_attempts(&mut self, f: &Fmu, t: f64, t_stop: f64, eps: f64) -> Result<(f64, i32), Fail> {
+        let mut w = 0;
+        let mut h = self.h.min(t_stop - t);
+        if t + h > t_stop - eps {
+            h = t_stop - t;
+        }
+        let truncated = h < self.h;
+        let h_min = 10.0 * f64::EPSILON * t.abs().max(1.0);
+        let mut rejected_now = false;
+        // stages 2..6 and the new point (FSAL: stage 7 = f(t + h, x_new))
+        loop {
+            if h < h_min.min(t_stop - t) {
+                return Err((3, PHASE_SOLVER));
+            }
+            w = w.max(self.dp_stages(f, t, h)?);
+            for i in 0..self.nx {
+                let mut acc = 0.0;
+                for j in 0..7 {
+                    acc += E[j] * self.k[j][i];
+                }
+                self.y[i] = h * acc; // the error estimate
+            }
+            let en = self.norm(&self.y, &self.x, &self.x_new);
+            if en <= 1.0 {
+                let mut fac = if en == 0.0 {
+                    MAX_FACTOR
+                } else {
+                    (SAFETY * en.powf(-0.2)).min(MAX_FACTOR)
+                };
+                if rejected_now {
+                    fac = fac.min(1.0);
+                }
+                self.h = if truncated && !rejected_now {
+                    self.h.max(h * fac)
+                } else {
+                    h * fac
+                };
+                return Ok((h, w));
+            }
+            self.rejected += 1;
+            rejected_now = true;
+            h *= (SAFETY * en.powf(-0.2)).max(MIN_FACTOR);
+        }
+    }
+
+    /// Stages 2..7 of a Dormand–Prince step of size h from (t, x): `k[1..7]`, the 5th-order point `x_new`.
+    unsafe fn dp_stages(&mut self, f: &Fmu, t: f64, h: f64) -> Result<i32, Fail> {
+        let mut w = 0;
+        for s in 1..6 {
+            for i in 0..self.nx {
+                let mut acc = self.x[i];
+                for j in 0..s {
+                    acc += h * A[s][j] * self.k[j][i];
+                }
+                self.y[i] = acc;
+            }
+            let y = std::mem::take(&mut self.y);
+            let mut ks = std::mem::take(&mut self.k[s]);
+            let r = self.rhs(f, t + C[s] * h, &y, &mut ks);
+            self.y = y;
+            self.k[s] = ks;
+            w = w.max(r?);
+        }
+        for i in 0..self.nx {
+            let mut acc = self.x[i];
+            for j in 0..6 {
+                acc += h * B[j] * self.k[j][i];
+            }
+            self.x_new[i] = acc;
+        }
+        // FSAL stage f(t + h, x_new): the unit's time is already t + h (stage 6, C[5] = 1)
+        let mut k6 = std::mem::take(&mut self.k[6]);
+        let r = self
+            .set_states_only(f, &self.x_new)
+            .and_then(|a| self.derivatives_here(f, &mut k6).map(|b| a.max(b)));
+        self.k[6] = k6;
+        Ok(w.max(r?))
+    }
+
+    /// A sign change of an indicator over the accepted step [t, t + h]: bisection on the continuous
+    /// extension to `eps`. (θ past the crossing, status).
+    unsafe fn dp_locate(&mut self, f: &Fmu, t: f64, h: f64, eps: f64) -> Result<(f64, i32), Fail> {
+        let mut w = 0;
+        let (mut lo, mut hi) = (0.0f64, 1.0f64);
+        for _ in 0..200 {
+            if (hi - lo) * h <= eps {
+                break;
+            }
+            let mid = 0.5 * (lo + hi);
+            self.dense(h, mid);
+            let xi = std::mem::take(&mut self.xi);
+            w = w.max(self.set(f, t + mid * h, &xi)?);
+            self.xi = xi;
+            let mut zi = std::mem::take(&mut self.zi);
+            w = w.max(self.indicators(f, &mut zi)?);
+            self.zi = zi;
+            if self.z.iter().zip(&self.zi).any(|(a, b)| (*a > 0.0) != (*b > 0.0)) {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        Ok((hi, w))
+    }
+
+    fn norm(&self, err: &[f64], a: &[f64], b: &[f64]) -> f64 {
+        if self.nx == 0 {
+            return 0.0;
+        }
+        let mut s = 0.0;
+        for i in 0..self.nx {
+            let sc = self.atol + self.rtol * a[i].abs().max(b[i].abs());
+            let e = err[i] / sc;
+            s += e * e;
+        }
+        (s / self.nx as f64).sqrt()
+    }
+}
