@@ -45,8 +45,6 @@ import time
 from ctypes import c_double, c_long, c_size_t, c_void_p
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-
 from scfmu import scenario as scenarios
 from scfmu.papers.paper000 import scenarios as p000_scenarios
 from scfmu.engines.lean import LeanMaster
@@ -55,6 +53,8 @@ from scfmu.engines.native import NativeLoop
 from scfmu.scenario.model import Component, Scenario, log_of
 from scfmu.engines.libcosim import run_libcosim
 from scfmu.engines import reference_master
+
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def two_fmu_scenario(stop_time=30.0) -> Scenario:
