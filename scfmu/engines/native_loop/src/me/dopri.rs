@@ -189,8 +189,8 @@ impl Solver {
             w = w.max(self.dp_stages(f, t, h)?);
             for i in 0..self.nx {
                 let mut acc = 0.0;
-                for j in 0..7 {
-                    acc += E[j] * self.k[j][i];
+                for (e, kj) in E.iter().zip(&self.k) {
+                    acc += e * kj[i];
                 }
                 self.y[i] = h * acc; // the error estimate
             }
@@ -223,8 +223,8 @@ impl Solver {
         for s in 1..6 {
             for i in 0..self.nx {
                 let mut acc = self.x[i];
-                for j in 0..s {
-                    acc += h * A[s][j] * self.k[j][i];
+                for (a, kj) in A[s].iter().zip(&self.k).take(s) {
+                    acc += h * a * kj[i];
                 }
                 self.y[i] = acc;
             }
@@ -237,8 +237,8 @@ impl Solver {
         }
         for i in 0..self.nx {
             let mut acc = self.x[i];
-            for j in 0..6 {
-                acc += h * B[j] * self.k[j][i];
+            for (b, kj) in B.iter().zip(&self.k).take(6) {
+                acc += h * b * kj[i];
             }
             self.x_new[i] = acc;
         }

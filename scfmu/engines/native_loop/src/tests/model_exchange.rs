@@ -88,7 +88,7 @@ unsafe extern "C" fn me_update(c: *mut c_void, ei: *mut Info2) -> i32 {
         m.a = m.a2;
         m.time_events.push(m.t);
     }
-    if m.x <= m.level && m.crossings.len() < 1 {
+    if m.x <= m.level && m.crossings.is_empty() {
         m.crossings.push(m.t);
         m.x *= 0.5;
         ei.val = 1;
@@ -270,14 +270,11 @@ fn toy_me(params: &[f64; 5]) {
             0.25 * (-(1.0 - ln2)).exp() * (-3.0 * (t - 1.0)).exp()
         }
     };
-    for k in 0..=n {
+    assert!(out.len() > n, "{} outputs for {} points", out.len(), n + 1);
+    for (k, &yk) in out.iter().enumerate().take(n + 1) {
         let tk = k as f64 * dt;
         let e = exact(tk);
-        assert!(
-            (out[k] - e).abs() <= 1e-8 * e.abs().max(1e-3),
-            "t = {tk}: {} vs {e}",
-            out[k]
-        );
+        assert!((yk - e).abs() <= 1e-8 * e.abs().max(1e-3), "t = {tk}: {yk} vs {e}");
     }
     assert!(m.completed >= n);
 }
