@@ -27,6 +27,8 @@ use std::mem::transmute;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 pub mod me;
+mod setup;
+use setup::Setup;
 
 /// Version of the calling convention of [`scfmu_loop_run`] (Python checks it before use).
 pub const ABI_VERSION: u32 = 2;
@@ -305,143 +307,41 @@ struct Args {
     max_ok: i32,
 }
 
-const CS_SLOTS: [usize; 3] = [F_GET_REAL, F_SET_REAL, F_DO_STEP];
-const ME_SLOTS: [usize; 11] = [
-    F_GET_REAL,
-    F_SET_REAL,
-    F_SET_TIME,
-    F_SET_STATES,
-    F_GET_STATES,
-    F_GET_DERIVATIVES,
-    F_GET_INDICATORS,
-    F_COMPLETED_STEP,
-    F_ENTER_EVENT_MODE,
-    F_UPDATE_DISCRETE,
-    F_ENTER_CONT_MODE,
-];
+impl Fmu {
+    /// Gets one log group's values into its columns of `row` (Integer and Boolean as f64).
+    unsafe fn log(&mut self, g: &LogGroup, log_vr: &[u32], row: *mut f64) -> i32 {
+        let vr = log_vr.as_ptr().add(g.col);
+        if g.ty == T_REAL {
+            return self.reals(false, vr, g.n, row.add(g.col));
+        }
+        let mut tmp = std::mem::take(&mut self.tmp);
+        tmp.resize(g.n, 0);
+        let st = if g.ty == T_INT {
+            self.ints(false, vr, g.n, tmp.as_mut_ptr())
+        } else {
+            self.bools(false, vr, g.n, tmp.as_mut_ptr())
+        };
+        for (i, v) in tmp.iter().enumerate() {
+            *row.add(g.col + i) = *v as f64;
+        }
+        self.tmp = tmp;
+        st
+    }
+}
 
 unsafe fn run(a: &Args, where_: &mut [i64; 3]) -> i32 {
-    // ----- validation: nothing is called before every argument has been checked
-    let n_fmus = a.n_fmus;
-    let (Some(n_info), Some(n_fns), Some(n_me)) = (
-        n_fmus.checked_mul(INFO_FIELDS),
-        n_fmus.checked_mul(FN_SLOTS),
-        n_fmus.checked_mul(ME_FIELDS),
-    ) else {
-        return ERR_SIZE;
+    let Setup {
+        mut fmus,
+        mut solvers,
+        plan,
+        groups,
+        vrs,
+        log_vr,
+        rows,
+    } = match setup::setup(a) {
+        Ok(s) => s,
+        Err(code) => return code,
     };
-    let (Some(comps), Some(info), Some(fns)) = (slice(a.comps, n_fmus), slice(a.info, n_info), slice(a.fns, n_fns))
-    else {
-        return ERR_NULL;
-    };
-    let Some(n_op_fields) = a.n_ops.checked_mul(OP_FIELDS) else {
-        return ERR_SIZE;
-    };
-    let (Some(ops), Some(vrs), Some(log_fmu), Some(log_vr), Some(log_type)) = (
-        slice(a.ops, n_op_fields),
-        slice(a.vrs, a.n_vrs),
-        slice(a.log_fmu, a.n_log),
-        slice(a.log_vr, a.n_log),
-        slice(a.log_type, a.n_log),
-    ) else {
-        return ERR_NULL;
-    };
-    let any_me = (0..n_fmus).any(|i| info[i * INFO_FIELDS + 1] == 1);
-    let me_params = if any_me {
-        match slice(a.me_params, n_me) {
-            Some(p) => p,
-            None => return ERR_NULL,
-        }
-    } else {
-        &[]
-    };
-    let mut fmus = Vec::with_capacity(n_fmus);
-    let mut solvers: Vec<Option<me::Solver>> = Vec::with_capacity(n_fmus);
-    for i in 0..n_fmus {
-        let inf = &info[i * INFO_FIELDS..(i + 1) * INFO_FIELDS];
-        let (version, interface, nx, nz) = (inf[0], inf[1], inf[2], inf[3]);
-        if comps[i].is_null() {
-            return ERR_NULL;
-        }
-        if !(version == 2 || version == 3) || interface > 1 {
-            return ERR_SIZE;
-        }
-        let mut table = [std::ptr::null(); FN_SLOTS];
-        table.copy_from_slice(&fns[i * FN_SLOTS..(i + 1) * FN_SLOTS]);
-        let needed: &[usize] = if interface == 1 { &ME_SLOTS } else { &CS_SLOTS };
-        if needed.iter().any(|&s| table[s].is_null()) {
-            return ERR_NULL;
-        }
-        fmus.push(Fmu {
-            comp: comps[i],
-            v3: version == 3,
-            fns: table,
-            scratch: Vec::new(),
-            tmp: Vec::new(),
-        });
-        solvers.push(if interface == 1 {
-            let p = &me_params[i * ME_FIELDS..(i + 1) * ME_FIELDS];
-            if !(p[0] > 0.0 && p[1] > 0.0) || !(p[3] == 0.0 || p[3] == 1.0) || !(p[4] >= 0.0) {
-                return ERR_SIZE;
-            }
-            let mut s = me::Solver::new(nx, nz, p[0], p[1], if p[2].is_nan() { None } else { Some(p[2]) });
-            if p[3] == 1.0 {
-                s.fixed_rk4(p[4]);
-            }
-            Some(s)
-        } else {
-            None
-        });
-    }
-    let mut plan = Vec::with_capacity(a.n_ops);
-    for o in ops.chunks_exact(OP_FIELDS) {
-        let op = Op {
-            kind: o[0],
-            fmu: o[1],
-            vr: o[2],
-            n: o[3],
-            buf: o[4],
-        };
-        let n_buf = if op.kind <= K_SET_REAL {
-            a.n_real_buf
-        } else {
-            a.n_int_buf
-        };
-        let vr_ok = op.vr.checked_add(op.n).is_some_and(|e| e <= a.n_vrs);
-        let buf_ok = op.buf.checked_add(op.n).is_some_and(|e| e <= n_buf);
-        if op.kind > K_SET_BOOL || op.fmu >= n_fmus || !vr_ok || !buf_ok {
-            return ERR_SIZE;
-        }
-        let slot = [F_GET_REAL, F_SET_REAL, F_GET_INT, F_SET_INT, F_GET_BOOL, F_SET_BOOL][op.kind];
-        if fmus[op.fmu].fns[slot].is_null() {
-            return ERR_NULL;
-        }
-        plan.push(op);
-    }
-    let Some(rows) = a.n_steps.checked_add(1) else {
-        return ERR_SIZE;
-    };
-    if rows.checked_mul(a.n_log) != Some(a.out_len) || (a.out_len > 0 && a.out.is_null()) {
-        return if a.out.is_null() && a.out_len > 0 {
-            ERR_NULL
-        } else {
-            ERR_SIZE
-        };
-    }
-    let mut groups: Vec<LogGroup> = Vec::new();
-    for (col, (&f, &ty)) in log_fmu.iter().zip(log_type.iter()).enumerate() {
-        if f >= n_fmus || ty > T_BOOL {
-            return ERR_SIZE;
-        }
-        let slot = [F_GET_REAL, F_GET_INT, F_GET_BOOL][ty];
-        if fmus[f].fns[slot].is_null() {
-            return ERR_NULL;
-        }
-        match groups.last_mut() {
-            Some(g) if g.fmu == f && g.ty == ty => g.n += 1,
-            _ => groups.push(LogGroup { fmu: f, ty, col, n: 1 }),
-        }
-    }
     let mut rbuf = vec![0.0f64; a.n_real_buf];
     let mut ibuf = vec![0i32; a.n_int_buf];
     let (rp, ip) = (rbuf.as_mut_ptr(), ibuf.as_mut_ptr());
@@ -476,24 +376,7 @@ unsafe fn run(a: &Args, where_: &mut [i64; 3]) -> i32 {
         }
         let row = a.out.add(k * n_log);
         for g in &groups {
-            let f = &mut fmus[g.fmu];
-            let vr = log_vr.as_ptr().add(g.col);
-            let st = if g.ty == T_REAL {
-                f.reals(false, vr, g.n, row.add(g.col))
-            } else {
-                let mut tmp = std::mem::take(&mut f.tmp);
-                tmp.resize(g.n, 0);
-                let st = if g.ty == T_INT {
-                    f.ints(false, vr, g.n, tmp.as_mut_ptr())
-                } else {
-                    f.bools(false, vr, g.n, tmp.as_mut_ptr())
-                };
-                for (i, v) in tmp.iter().enumerate() {
-                    *row.add(g.col + i) = *v as f64;
-                }
-                f.tmp = tmp;
-                st
-            };
+            let st = fmus[g.fmu].log(g, log_vr, row);
             check!(st, k, PHASE_LOG, g.fmu);
         }
         if k < a.n_steps {
