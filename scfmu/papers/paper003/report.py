@@ -19,6 +19,9 @@ setting, not confirmed when it holds nowhere, "depends on a reading" otherwise. 
 by :func:`claim1` and :func:`claim2` on a summary table ``{(controller, case): {"ise", "isf", "sse"}}``
 (controller "SMC" or "T2FSMC", case "N" … "U"; sse = mean over the three Euler angles of the
 steady-state error in deg; for U the Monte Carlo means).
+
+The running (campaigns of controller settings, their summaries), the swept readings and the figures are in
+``report_runs.py``; this file holds the claims, their rules and ``build`` (one helper per part of the section).
 """
 
 from __future__ import annotations
@@ -30,17 +33,10 @@ import numpy as np
 
 from . import model as p3
 from ...report import common, rules
-from ...campaign import Campaign, read_timeseries
+from ...campaign import read_timeseries
 from ...report.types import CONFIRMED, DEPENDS, NOT_CONFIRMED, Claim, Figure, PaperSection, Sensitivity, Table
-
-CASES = ("N", "C", "S", "W", "U")
-DET = ("N", "C", "S", "W")
-CTRL = ("SMC", "T2FSMC")
-LABEL = {"SMC": "GA-SMC", "T2FSMC": "T2F-SMC"}
-CASE_NAME = {"N": "003-N nominal", "C": "003-C constant", "S": "003-S sinusoidal", "W": "003-W white noise",
-             "U": "003-U inertia ±20 %"}
-MAGNITUDE_KEYS = {"C": "dist_const_", "S": "dist_sin_amp_", "W": "dist_noise_std_"}
-DIST_DEFAULT = 5e-4
+from .report_runs import (CASE_NAME, CASES, CTRL, DET, LABEL, _fmt, _plot_overview, _plot_sweep,
+                          _settings_campaign, _summarise, _sweeps)
 
 
 # ----- the claims as functions of a summary table ----------------------------------------------------
@@ -107,154 +103,10 @@ def holds_where(values: list, holds: list[bool], default) -> str:
     return f"holds at {', '.join(yes)}; fails at {', '.join(no)}"
 
 
-# ----- running ------------------------------------------------------------------------------------------
-def _dist_overrides(case: str, scale: float) -> dict:
-    d = dict(p3.DISTURBANCES[case])
-    if case in MAGNITUDE_KEYS:
-        for k in d:
-            if k.startswith(MAGNITUDE_KEYS[case]):
-                d[k] = d[k] * scale
-    return p3.prefixed("plant", d)
-
-
-def _settings_campaign(controller: str, settings: list[tuple], t_end: float, n_mc: int, cases=DET,
-                       log_every: int = 1, timeseries=None, ts_every: int = 1):
-    """One campaign for a list of settings (label, controller overrides, disturbance scale): each setting
-    runs ``cases`` and the first n_mc 003-U seeds. Returns (Campaign, index [(setting, case, seed)])."""
-    sc = p3.scenario(controller, "N", stop_time=t_end)
-    ov, index = [], []
-    for si, (_, cov, ds) in enumerate(settings):
-        cpre = p3.prefixed("controller", cov)
-        for case in cases:
-            ov.append({**cpre, **_dist_overrides(case, ds)})
-            index.append((si, case, None))
-        for s, u in zip(range(1, n_mc + 1), p3.mc_overrides(range(1, n_mc + 1))):
-            ov.append({**cpre, **u})
-            index.append((si, "U", s))
-    return Campaign(sc, ov, [None], engine="native", log_every=log_every, timeseries=timeseries,
-                    ts_every=ts_every), index
-
-
-def _summarise(rows: list[dict], index: list[tuple], n_settings: int) -> list[dict]:
-    """Per setting: {case: {"ise", "isf", "sse", ... "n", "failed"}} (U: Monte Carlo means)."""
-    out = [dict() for _ in range(n_settings)]
-    groups: dict = {}
-    for r, (si, case, _) in zip(rows, index):
-        groups.setdefault((si, case), []).append(r)
-    for (si, case), rs in groups.items():
-        ok = [r for r in rs if r["status"] == "ok"]
-        d = {"n": len(ok), "failed": len(rs) - len(ok)}
-        if not ok:
-            d.update(ise=math.nan, isf=math.nan, sse=math.nan)
-        else:
-            for k in ("ise", "isf", "cost", *[f"sse_{a}_deg" for a in p3.ANGLES]):
-                d[k] = float(np.mean([r[k] for r in ok]))
-            d["sse"] = float(np.mean([d[f"sse_{a}_deg"] for a in p3.ANGLES]))
-            if case == "U" and len(ok) > 1:
-                d["ise_std"] = float(np.std([r["ise"] for r in ok], ddof=1))
-                d["isf_std"] = float(np.std([r["isf"] for r in ok], ddof=1))
-        out[si][case] = d
-    return out
-
-
-def _fmt(v):
-    return f"{v:g}" if isinstance(v, float) else str(v)
-
-
-# ----- figures ----------------------------------------------------------------------------------------
-def _plot_overview(summary: dict, path) -> None:
-    plt = common.plt()
-    fig, ax = plt.subplots(1, 3, figsize=(14, 4))
-    x = np.arange(len(CASES))
-    for j, (key, ylabel) in enumerate((("ise", "ISE (rad² s)"), ("isf", "ISF (N² m² s)"),
-                                       ("sse", "steady-state error, mean of 3 angles (deg)"))):
-        for i, c in enumerate(CTRL):
-            ax[j].bar(x + (i - 0.5) * 0.38, [summary[(c, k)][key] for k in CASES], 0.38, label=LABEL[c])
-        ax[j].set_xticks(x, [f"003-{k}" for k in CASES])
-        ax[j].set_ylabel(ylabel)
-        ax[j].set_xlabel("scenario (003-U: mean of the Monte Carlo runs)")
-        ax[j].grid(True, axis="y", alpha=0.3)
-        ax[j].legend(loc="lower left", framealpha=0.9)
-        if key == "sse":
-            ax[j].set_yscale("log")
-    fig.suptitle("Paper 003: GA-SMC vs T2F-SMC per scenario (lower is better)")
-    common.save(fig, path)
-
-
-def _plot_sweep(name: str, unit: str, values: list, summaries: list[dict], path) -> None:
-    """Ratio T2F-SMC / GA-SMC of ISE, ISF and steady-state error per case against the swept value."""
-    plt = common.plt()
-    fig, ax = plt.subplots(1, 3, figsize=(14, 4))
-    numeric = all(isinstance(v, (int, float)) for v in values)
-    xs = values if numeric else list(range(len(values)))
-    for j, key in enumerate(("ise", "isf", "sse")):
-        for case, mk in zip(CASES, "osd^v"):
-            ys = [s[("T2FSMC", case)][key] / s[("SMC", case)][key] if (("SMC", case) in s and
-                  s[("SMC", case)][key] > 0) else math.nan for s in summaries]
-            ax[j].plot(xs, ys, marker=mk, label=f"003-{case}")
-        ax[j].axhline(1.0, color="k", lw=0.8)
-        ax[j].set_yscale("log")
-        from matplotlib.ticker import FuncFormatter
-        plain = FuncFormatter(lambda y, _: f"{y:g}")
-        ax[j].yaxis.set_major_formatter(plain)
-        ax[j].yaxis.set_minor_formatter(plain)
-        ax[j].set_xlabel(f"{name}{f' ({unit})' if unit else ''}")
-        ax[j].set_ylabel(f"{key.upper() if key != 'sse' else 'steady-state error'} ratio T2F-SMC / GA-SMC (-)")
-        if numeric and min(values) > 0 and max(values) / min(values) > 20:
-            ax[j].set_xscale("log")
-        if not numeric:
-            ax[j].set_xticks(xs, [str(v) for v in values])
-        elif all(isinstance(v, int) for v in values):
-            ax[j].set_xticks(xs)
-        ax[j].grid(True, alpha=0.3)
-        ax[j].legend(fontsize=7)
-    fig.suptitle(f"Sensitivity to {name}: below 1 = T2F-SMC lower")
-    common.save(fig, path)
-
-
 # ----- the section ------------------------------------------------------------------------------------
-def _sweeps(tuned: dict, quick: bool) -> list[dict]:
-    """The swept project-choice readings: name, unit, values, default, and for each value the controller
-    overrides of each controller and the disturbance scale."""
-    t2 = tuned["T2FSMC"]
-    kappa0 = float(t2.get("kappa", 0.5))
-    es0, eds0 = float(t2.get("e_scale", 0.05)), float(t2.get("edot_scale", 0.01))
-    phi0 = 0.005
-    kappas = [0.1, kappa0, 0.9] if quick else sorted({0.1, 0.3, round(kappa0, 4), 0.7, 0.9})
-    if round(kappa0, 4) in kappas:
-        kappas = [kappa0 if v == round(kappa0, 4) else v for v in kappas]
-    sigmas = [(0.3, 0.5), (0.1, 0.9)] if quick else [(0.3, 0.5), (0.45, 0.5), (0.2, 0.6), (0.1, 0.9)]
-    scales = [0.5, 1.0, 2.0] if quick else [0.25, 0.5, 1.0, 2.0, 4.0]
-    dists = [1e-4, 5e-4, 5e-3] if quick else [1e-4, 2e-4, 5e-4, 1e-3, 2e-3, 5e-3]
-    phis = [0.002, 0.005, 0.02] if quick else [0.001, 0.002, 0.005, 0.01, 0.02]
-    return [
-        {"name": "Type2FuzzySmcController.kappa", "unit": "-", "values": kappas, "default": kappa0,
-         "ctrl": lambda v: ({}, {"kappa": v}), "dist": lambda v: 1.0},
-        {"name": "Type2FuzzySmcController.(sigma_lo, sigma_up)", "unit": "-", "values": sigmas, "default": (0.3, 0.5),
-         "ctrl": lambda v: ({}, {"sigma_lo": v[0], "sigma_up": v[1]}), "dist": lambda v: 1.0},
-        {"name": "Type2FuzzySmcController.table_transpose", "unit": "", "values": [0, 1], "default": 0,
-         "ctrl": lambda v: ({}, {"table_transpose": v}), "dist": lambda v: 1.0},
-        {"name": "Type2FuzzySmcController e_scale and edot_scale × factor", "unit": "× tuned", "values": scales,
-         "default": 1.0, "ctrl": lambda v: ({}, {"e_scale": es0 * v, "edot_scale": eds0 * v}),
-         "dist": lambda v: 1.0},
-        {"name": "disturbance magnitude of 003-C, -S, -W", "unit": "N m", "values": dists, "default": DIST_DEFAULT,
-         "ctrl": lambda v: ({}, {}), "dist": lambda v: v / DIST_DEFAULT, "cases": ("C", "S", "W"), "mc": False},
-        {"name": "boundary layer Φ (both controllers)", "unit": "rad/s", "values": phis, "default": phi0,
-         "ctrl": lambda v: ({"boundary_layer": v}, {"boundary_layer": v}), "dist": lambda v: 1.0},
-    ]
-
-
-def build(ctx) -> PaperSection:
-    t_start = time.time()
-    quick = bool(ctx.quick)
-    t_end = p3.T_END   # quick mode runs fewer cases, never a shorter horizon ("steady state" must mean the same)
-    n_mc = 8 if quick else 100
-    n_mc_sweep = 4 if quick else 20
-    tuned = p3.tuned_params()
-    figs = ctx.figures_dir
-    rel = lambda name: f"figures/{name}"
-
-    # ---- main runs: N, C, S, W with time series, and the 003-U Monte Carlo -------------------------------
+def _main_runs(ctx, t_end: float, n_mc: int, n_mc_sweep: int) -> tuple[dict, dict, dict, dict]:
+    """The main runs: N, C, S, W with time series and the 003-U Monte Carlo, per controller. Returns
+    (summary, sweep_base, ts, mc_rows); sweep_base has the 003-U means of the first n_mc_sweep seeds."""
     main, mc_rows = {}, {}
     ts = {}
     for c in CTRL:
@@ -274,21 +126,35 @@ def build(ctx) -> PaperSection:
     summary = {k: v for k, v in main.items() if k[1] != "U_sweep"}
     sweep_base = {**{k: v for k, v in main.items() if k[1] in DET},
                   **{(c, "U"): main[(c, "U_sweep")] for c in CTRL}}
+    return summary, sweep_base, ts, mc_rows
 
+
+def _main_figures(ctx, summary: dict, ts: dict, mc_rows: dict, t_end: float, n_mc: int) -> tuple[list, Figure]:
+    """The scenario figures (one per deterministic case, the 003-U Monte Carlo) and the overview figure."""
+    figs = ctx.figures_dir
     figures = []
     for case in DET:
         if all((c, case) in ts for c in CTRL):
             p3.plot_scenario({LABEL[c]: ts[(c, case)] for c in CTRL}, f"003-{case}", figs / f"003_{case}.png")
-            figures.append(Figure(rel(f"003_{case}.png"), f"{CASE_NAME[case]}: Euler angles, applied torques, wheel "
-                                  f"momentum and external torque, GA-SMC (solid) and T2F-SMC (dashed), {t_end:g} s."))
+            figures.append(Figure(_rel(f"003_{case}.png"), f"{CASE_NAME[case]}: Euler angles, applied torques, "
+                                  f"wheel momentum and external torque, GA-SMC (solid) and T2F-SMC (dashed), "
+                                  f"{t_end:g} s."))
     p3.plot_monte_carlo({LABEL[c]: mc_rows[c] for c in CTRL}, figs / "003_U.png")
-    figures.append(Figure(rel("003_U.png"), f"003-U: ISE and ISF over {n_mc} runs with inertia scaled uniformly in "
-                                            f"[0.8, 1.2] per axis (seeds 1…{n_mc}), and the GA cost J."))
+    figures.append(Figure(_rel("003_U.png"), f"003-U: ISE and ISF over {n_mc} runs with inertia scaled uniformly in "
+                                             f"[0.8, 1.2] per axis (seeds 1…{n_mc}), and the GA cost J."))
     _plot_overview(summary, figs / "003_overview.png")
-    overview = Figure(rel("003_overview.png"), "ISE, ISF and steady-state error of both controllers in every "
-                                               "scenario (003-U: Monte Carlo mean).")
+    overview = Figure(_rel("003_overview.png"), "ISE, ISF and steady-state error of both controllers in every "
+                                                "scenario (003-U: Monte Carlo mean).")
+    return figures, overview
 
-    # ---- tables ---------------------------------------------------------------------------------------
+
+def _rel(name: str) -> str:
+    return f"figures/{name}"
+
+
+def _result_tables(summary: dict, ts: dict, n_mc: int) -> tuple[Table, Table, Table, Table]:
+    """(results per scenario and controller, its deterministic part for the docs, the 003-U Monte Carlo
+    table, the applied-torque extremes)."""
     res_rows = []
     for case in CASES:
         for c in CTRL:
@@ -314,40 +180,65 @@ def build(ctx) -> PaperSection:
                                                                 for a in p3.AX for f in (np.max, np.min)])
     t_torque = Table("Applied torque extremes per axis (N m), from the logged series (every 10th sample).",
                      ["scenario", "controller", "max x", "min x", "max y", "min y", "max z", "min z"], torque_rows)
+    return t_results, doc_results, mc_tab, t_torque
 
-    # ---- sensitivity sweeps -----------------------------------------------------------------------------
-    c1_default, c1_per = claim1(summary)
-    c2_body, c2_abs, c2_w = claim2(summary)
-    c1_sweep_base, _ = claim1(sweep_base)
-    sens1, sens2, sweep_holds1, sweep_holds2_body, sweep_holds2_abs = [], [], [], [], []
-    flips1, flips2 = [], []  # (parameter, holds per value): a parameter whose values flip a claim
-    ise_half, sse_half, ise_isf_both = [], [], []  # swept settings where a part of a claim holds
-    for k, sw in enumerate(_sweeps(tuned, quick)):
-        values = sw["values"]
-        cases = sw.get("cases", DET)
-        with_mc = sw.get("mc", True)
-        summaries = []
-        todo = {c: [] for c in CTRL}  # settings to run per controller (the default reuses the main runs)
-        for v in values:
-            covs = sw["ctrl"](v)
-            for c, cov in zip(CTRL, covs):
-                if v != sw["default"] and (cov or sw["dist"](v) != 1.0):
-                    todo[c].append((v, cov, sw["dist"](v)))
-        ran = {}
+
+def _sweep_summaries(ctx, k: int, sw: dict, sweep_base: dict, t_end: float, n_mc_sweep: int) -> list[dict]:
+    """Runs one swept reading (the default reuses the main runs) and returns one summary per value."""
+    values = sw["values"]
+    cases = sw.get("cases", DET)
+    with_mc = sw.get("mc", True)
+    summaries = []
+    todo = {c: [] for c in CTRL}  # settings to run per controller (the default reuses the main runs)
+    for v in values:
+        covs = sw["ctrl"](v)
+        for c, cov in zip(CTRL, covs):
+            if v != sw["default"] and (cov or sw["dist"](v) != 1.0):
+                todo[c].append((v, cov, sw["dist"](v)))
+    ran = {}
+    for c in CTRL:
+        if not todo[c]:
+            continue
+        camp, index = _settings_campaign(c, todo[c], t_end, n_mc_sweep if with_mc else 0, cases=cases,
+                                         log_every=10)
+        rows = p3.rows(ctx.campaign(camp, f"paper003/sweep{k}_{c}"))
+        for (v, _, _), s in zip(todo[c], _summarise(rows, index, len(todo[c]))):
+            ran[(c, repr(v))] = s
+    for v in values:
+        s = dict(sweep_base)
         for c in CTRL:
-            if not todo[c]:
-                continue
-            camp, index = _settings_campaign(c, todo[c], t_end, n_mc_sweep if with_mc else 0, cases=cases,
-                                             log_every=10)
-            rows = p3.rows(ctx.campaign(camp, f"paper003/sweep{k}_{c}"))
-            for (v, _, _), s in zip(todo[c], _summarise(rows, index, len(todo[c]))):
-                ran[(c, repr(v))] = s
-        for v in values:
-            s = dict(sweep_base)
-            for c in CTRL:
-                for case, d in ran.get((c, repr(v)), {}).items():
-                    s[(c, case)] = d
-            summaries.append(s)
+            for case, d in ran.get((c, repr(v)), {}).items():
+                s[(c, case)] = d
+        summaries.append(s)
+    return summaries
+
+
+def _sweep_table(sw: dict, summaries: list[dict], h1: list, h2: list) -> Table:
+    """Per swept value: where T2F-SMC is lower on ISE and on steady-state error, the lower ISF, the claims."""
+    trows = []
+    for v, s, a, (b, ab) in zip(sw["values"], summaries, h1, h2):
+        _, per = claim1(s)
+        w = isf_winners(s)
+        trows.append([_fmt(v) + (" (default)" if v == sw["default"] else ""),
+                      " ".join(f"{cs}{'+' if per[cs][0] else '-'}" for cs in per),
+                      " ".join(f"{cs}{'+' if per[cs][1] else '-'}" for cs in per),
+                      "yes" if a else "no",
+                      " ".join(f"{cs}:{LABEL.get(w[cs], w[cs])}" for cs in w),
+                      "yes" if b else "no", "yes" if ab else "no"])
+    return Table(f"{sw['name']}: '+' = T2F-SMC lower on ISE / on steady-state error in that scenario; lower ISF per "
+                 f"scenario; whether each claim holds.",
+                 ["value", "ISE (T2F lower)", "sse (T2F lower)", "C003-1 holds", "lower ISF",
+                  "C003-2 body holds", "C003-2 abstract holds"], trows, digits=4)
+
+
+def _sensitivity(ctx, tuned: dict, sweep_base: dict, t_end: float, n_mc_sweep: int) -> dict:
+    """Every swept reading, run and judged: the Sensitivity entries of both claims, the claims' results
+    in the non-default settings, the flips per reading, and the settings where a half of a claim holds."""
+    acc = {key: [] for key in ("sens1", "sens2", "holds1", "holds2_body", "holds2_abs", "flips1", "flips2",
+                               "ise_half", "sse_half", "ise_isf_both")}
+    for k, sw in enumerate(_sweeps(tuned, bool(ctx.quick))):
+        values = sw["values"]
+        summaries = _sweep_summaries(ctx, k, sw, sweep_base, t_end, n_mc_sweep)
         h1 = [claim1(s)[0] for s in summaries]
         for v, sm in zip(values, summaries):
             if v == sw["default"]:
@@ -355,45 +246,38 @@ def build(ctx) -> PaperSection:
             per = claim1(sm)[1]
             label = f"{sw['name']} = {_fmt(v)}"
             if all(i for i, _ in per.values()):
-                ise_half.append(label)
+                acc["ise_half"].append(label)
             if all(x for _, x in per.values()):
-                sse_half.append(label)
+                acc["sse_half"].append(label)
             if all(i for i, _ in per.values()) and claim2(sm)[1]:
-                ise_isf_both.append(label)
+                acc["ise_isf_both"].append(label)
         h2 = [claim2(s)[:2] for s in summaries]
         fname = f"003_sweep_{k}.png"
-        _plot_sweep(sw["name"], sw["unit"], values, summaries, figs / fname)
-        fig = Figure(rel(fname), f"Sensitivity of paper 003 to {sw['name']}: T2F-SMC / GA-SMC ratios of ISE, ISF and "
-                                 f"steady-state error per scenario (003-U: first {n_mc_sweep} seeds).")
-        trows = []
-        for v, s, a, (b, ab) in zip(values, summaries, h1, h2):
-            _, per = claim1(s)
-            w = isf_winners(s)
-            trows.append([_fmt(v) + (" (default)" if v == sw["default"] else ""),
-                          " ".join(f"{cs}{'+' if per[cs][0] else '-'}" for cs in per),
-                          " ".join(f"{cs}{'+' if per[cs][1] else '-'}" for cs in per),
-                          "yes" if a else "no",
-                          " ".join(f"{cs}:{LABEL.get(w[cs], w[cs])}" for cs in w),
-                          "yes" if b else "no", "yes" if ab else "no"])
-        tab = Table(f"{sw['name']}: '+' = T2F-SMC lower on ISE / on steady-state error in that scenario; lower ISF per "
-                    f"scenario; whether each claim holds.",
-                    ["value", "ISE (T2F lower)", "sse (T2F lower)", "C003-1 holds", "lower ISF",
-                     "C003-2 body holds", "C003-2 abstract holds"], trows, digits=4)
+        _plot_sweep(sw["name"], sw["unit"], values, summaries, ctx.figures_dir / fname)
+        fig = Figure(_rel(fname), f"Sensitivity of paper 003 to {sw['name']}: T2F-SMC / GA-SMC ratios of ISE, ISF "
+                                  f"and steady-state error per scenario (003-U: first {n_mc_sweep} seeds).")
+        tab = _sweep_table(sw, summaries, h1, h2)
         dflt = sw["default"]
-        sens1.append(Sensitivity(sw["name"], values, dflt, holds_where(values, h1, dflt), fig, tab))
-        sens2.append(Sensitivity(sw["name"], values, dflt,
-                                 f"body reading: {holds_where(values, [b for b, _ in h2], dflt)}; abstract reading: "
-                                 f"{holds_where(values, [a for _, a in h2], dflt)}", fig, tab))
-        flips1.append((sw["name"], h1))
-        flips2.append((sw["name"], [tuple(x) for x in h2]))  # either reading flipping counts
-        sweep_holds1 += [h for v, h in zip(values, h1) if v != dflt]
-        sweep_holds2_body += [b for v, (b, _) in zip(values, h2) if v != dflt]
-        sweep_holds2_abs += [a for v, (_, a) in zip(values, h2) if v != dflt]
+        acc["sens1"].append(Sensitivity(sw["name"], values, dflt, holds_where(values, h1, dflt), fig, tab))
+        acc["sens2"].append(Sensitivity(sw["name"], values, dflt,
+                                        f"body reading: {holds_where(values, [b for b, _ in h2], dflt)}; abstract "
+                                        f"reading: {holds_where(values, [a for _, a in h2], dflt)}", fig, tab))
+        acc["flips1"].append((sw["name"], h1))
+        acc["flips2"].append((sw["name"], [tuple(x) for x in h2]))  # either reading flipping counts
+        acc["holds1"] += [h for v, h in zip(values, h1) if v != dflt]
+        acc["holds2_body"] += [b for v, (b, _) in zip(values, h2) if v != dflt]
+        acc["holds2_abs"] += [a for v, (_, a) in zip(values, h2) if v != dflt]
+    return acc
 
-    # ---- claims -------------------------------------------------------------------------------------------
+
+def _claim_1(summary: dict, sweep_base: dict, acc: dict, tables: list, overview: Figure, t_end: float,
+             n_mc: int, n_mc_sweep: int) -> Claim:
+    """C003-1: T2F-SMC lower on ISE and steady-state error in every scenario."""
+    c1_default, c1_per = claim1(summary)
+    c1_sweep_base, _ = claim1(sweep_base)
+    sweep_holds1, ise_half, sse_half = acc["holds1"], acc["ise_half"], acc["sse_half"]
     v1 = verdict(c1_default, sweep_holds1)
     n_sw = len(sweep_holds1)
-    lst = lambda xs: "; ".join(xs) if xs else "none"
     fails_ise = [f"003-{c}" for c, (i, _) in c1_per.items() if not i]
     fails_sse = [f"003-{c}" for c, (_, s) in c1_per.items() if not s]
     ev1 = (f"Both controllers ran the five scenarios with the committed GA values ({t_end:g} s; 003-U {n_mc} runs). "
@@ -405,14 +289,24 @@ def build(ctx) -> PaperSection:
            f"Across {len(sweep_holds1)} swept settings of the project-choice readings it holds in "
            f"{sum(sweep_holds1)}. Taken apart, the ISE half holds in {len(ise_half)} of {n_sw} swept settings (fails in "
            f"{n_sw - len(ise_half)}) and the steady-state half in {len(sse_half)} of {n_sw}"
-           + (f" ({lst(sse_half)})" if sse_half else "") + "." + ("" if c1_sweep_base == c1_default else
-                                     f" (On the first {n_mc_sweep} 003-U seeds used by the sweeps the default "
-                                     f"{'holds' if c1_sweep_base else 'does not hold'}.)"))
-    claim_1 = Claim("C003-1", "The type-2 fuzzy SMC has the smaller steady-state error and the smaller ISE in every "
-                              "scenario (nominal, constant, sinusoidal and white-noise disturbance, inertia uncertainty).",
-                    v1, ev1, tables=[t_results, mc_tab], figures=[overview],
-                    sensitive_to=examined(flips1),
-                    sensitivity=sens1)
+           + (f" ({_lst(sse_half)})" if sse_half else "") + "." + ("" if c1_sweep_base == c1_default else
+                                      f" (On the first {n_mc_sweep} 003-U seeds used by the sweeps the default "
+                                      f"{'holds' if c1_sweep_base else 'does not hold'}.)"))
+    return Claim("C003-1", "The type-2 fuzzy SMC has the smaller steady-state error and the smaller ISE in every "
+                           "scenario (nominal, constant, sinusoidal and white-noise disturbance, inertia uncertainty).",
+                 v1, ev1, tables=tables, figures=[overview],
+                 sensitive_to=examined(acc["flips1"]),
+                 sensitivity=acc["sens1"])
+
+
+def _lst(xs: list) -> str:
+    return "; ".join(xs) if xs else "none"
+
+
+def _claim_2(summary: dict, acc: dict, overview: Figure) -> Claim:
+    """C003-2: which controller has the lower ISF per scenario, in the body's and the abstract's reading."""
+    c2_body, c2_abs, c2_w = claim2(summary)
+    sweep_holds2_body, sweep_holds2_abs = acc["holds2_body"], acc["holds2_abs"]
     v2 = verdict(c2_body, sweep_holds2_body)
     win_txt = ", ".join(f"003-{c}: {LABEL.get(w, w)}" for c, w in c2_w.items())
     ev2 = (f"Lower ISF per scenario in our runs: {win_txt}. The paper's body says GA-SMC is lower in 003-N, C, S and "
@@ -421,19 +315,22 @@ def build(ctx) -> PaperSection:
            f"(T2F-SMC better in all situations, i.e. lower ISF everywhere) {'holds' if c2_abs else 'does not hold'} "
            f"with today's readings and in {sum(sweep_holds2_abs)} of {len(sweep_holds2_abs)} swept settings. "
            f"The verdict is on the body's statement. Settings where T2F-SMC is lower on both ISE and ISF in every "
-           f"scenario (the abstract's 'better', leaving the steady-state error aside): {lst(ise_isf_both)}. The ISF "
-           f"differences are small (a few per cent at most, see the table), so which controller has the lower ISF "
-           f"moves with most readings.")
+           f"scenario (the abstract's 'better', leaving the steady-state error aside): {_lst(acc['ise_isf_both'])}. "
+           f"The ISF differences are small (a few per cent at most, see the table), so which controller has the "
+           f"lower ISF moves with most readings.")
     isf_tab = Table("ISF (N² m² s) per scenario and the lower one (003-U: Monte Carlo mean).",
                     ["scenario", "GA-SMC", "T2F-SMC", "lower", "body says", "abstract says"],
                     [[f"003-{c}", summary[("SMC", c)]["isf"], summary[("T2FSMC", c)]["isf"], LABEL.get(w, w),
                       LABEL[ISF_BODY[c]], "T2F-SMC"] for c, w in c2_w.items()], digits=5)
-    claim_2 = Claim("C003-2", "On ISF, GA-SMC is better in the nominal, constant- and sinusoidal-disturbance scenarios; "
-                              "the type-2 fuzzy SMC is better with uncertainty and with white noise (the body's "
-                              "statement). The abstract instead says the type-2 fuzzy SMC is better in all situations.",
-                    v2, ev2, tables=[isf_tab], figures=[overview],
-                    sensitive_to=examined(flips2),
-                    sensitivity=sens2)
+    return Claim("C003-2", "On ISF, GA-SMC is better in the nominal, constant- and sinusoidal-disturbance scenarios; "
+                           "the type-2 fuzzy SMC is better with uncertainty and with white noise (the body's "
+                           "statement). The abstract instead says the type-2 fuzzy SMC is better in all situations.",
+                 v2, ev2, tables=[isf_tab], figures=[overview],
+                 sensitive_to=examined(acc["flips2"]),
+                 sensitivity=acc["sens2"])
+
+
+def _setup_and_notes(tuned: dict, t_end: float, n_mc: int, n_mc_sweep: int, quick: bool) -> tuple[str, str]:
     setup = (f"AttitudePlant with the paper 003 inertia, three reaction wheels with magnetorquer dumping and gravity "
              f"gradient on a 700 km / 98° orbit; command roll 20°, pitch −15°, yaw 0° from rest; Δ = 0.01 s, "
              f"{t_end:g} s. SlidingModeController (k = {tuned['SMC'].get('k_switch', 0.005):.4g} N m) and "
@@ -448,6 +345,23 @@ def build(ctx) -> PaperSection:
              "the mean |wrapped error| over the last 10 % of the logged samples (every sample in the main runs, every "
              "10th in the sweeps)." + (" Quick mode: the same runs and horizon, 8 Monte Carlo runs, 4 per swept "
                                        "setting, fewer sweep values." if quick else ""))
+    return setup, notes
+
+
+def build(ctx) -> PaperSection:
+    t_start = time.time()
+    quick = bool(ctx.quick)
+    t_end = p3.T_END   # quick mode runs fewer cases, never a shorter horizon ("steady state" must mean the same)
+    n_mc = 8 if quick else 100
+    n_mc_sweep = 4 if quick else 20
+    tuned = p3.tuned_params()
+    summary, sweep_base, ts, mc_rows = _main_runs(ctx, t_end, n_mc, n_mc_sweep)
+    figures, overview = _main_figures(ctx, summary, ts, mc_rows, t_end, n_mc)
+    t_results, doc_results, mc_tab, t_torque = _result_tables(summary, ts, n_mc)
+    acc = _sensitivity(ctx, tuned, sweep_base, t_end, n_mc_sweep)
+    claim_1 = _claim_1(summary, sweep_base, acc, [t_results, mc_tab], overview, t_end, n_mc, n_mc_sweep)
+    claim_2 = _claim_2(summary, acc, overview)
+    setup, notes = _setup_and_notes(tuned, t_end, n_mc, n_mc_sweep, quick)
     return PaperSection("003", "Sliding mode (GA-tuned) vs sliding mode with an interval type-2 fuzzy gain, LEO "
                                "satellite with reaction wheels and magnetorquers (title lost)",
                         setup, [claim_1, claim_2], figures=figures, tables=[t_torque], notes=notes,
