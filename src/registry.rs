@@ -47,7 +47,7 @@ pub const FAMILIES: &[Family] = &[
     },
     Family {
         slug: "estimation",
-        title: "Attitude estimation and determination",
+        title: "Attitude estimation and determination: MEKF, TRIAD, QUEST and the B-dot detumbling law",
         overview: include_str!("models/estimation/README.md"),
         fmus: estimation::FMUS,
     },
