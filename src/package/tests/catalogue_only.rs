@@ -35,5 +35,8 @@ fn the_packager_reads_only_the_catalogue_and_the_unit_table() {
         }
         assert!(!code.contains("Box::leak"), "{}: leaks", path.display());
     }
-    assert!(seen >= 6, "only {seen} paths into the runtime crate: is the scan looking at the packager?");
+    assert!(
+        seen >= 6,
+        "only {seen} paths into the runtime crate: is the scan looking at the packager?"
+    );
 }
