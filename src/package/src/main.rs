@@ -167,16 +167,7 @@ fn run() -> Result<(), String> {
         });
     }
 
-    if let Some(x) = &xml {
-        write_model_descriptions(&cat, x)
-            .map_err(|e| format!("cannot write model descriptions to {}: {e}", x.display()))?;
-        write_model_descriptions3(&cat, &x.join("fmi3"))
-            .map_err(|e| format!("cannot write FMI 3.0 model descriptions to {}/fmi3: {e}", x.display()))?;
-    }
-    if let Some(d) = &docs {
-        spacecraft_fmus_package::docs::write_pages(d, &cat)
-            .map_err(|e| format!("cannot write docs/models and docs/references.md: {e}"))?;
-    }
+    write_generated(&cat, xml.as_deref(), docs.as_deref())?;
     let out = args.out.clone().unwrap_or_else(|| {
         if is_project {
             root.join("fmus")
@@ -193,6 +184,21 @@ fn run() -> Result<(), String> {
         );
         let p3 = write_fmu3(&cat, m, &binaries, &out.join("fmi3")).map_err(|e| format!("{} (FMI 3.0): {e}", m.name))?;
         println!("wrote {} (FMI 3.0)", p3.display());
+    }
+    Ok(())
+}
+
+/// Writes the XML folder (FMI 2.0 and, in `fmi3/`, FMI 3.0) and, for the project, the generated pages.
+fn write_generated(cat: &Catalogue, xml: Option<&Path>, docs: Option<&Path>) -> Result<(), String> {
+    if let Some(x) = xml {
+        write_model_descriptions(cat, x)
+            .map_err(|e| format!("cannot write model descriptions to {}: {e}", x.display()))?;
+        write_model_descriptions3(cat, &x.join("fmi3"))
+            .map_err(|e| format!("cannot write FMI 3.0 model descriptions to {}/fmi3: {e}", x.display()))?;
+    }
+    if let Some(d) = docs {
+        spacecraft_fmus_package::docs::write_pages(d, cat)
+            .map_err(|e| format!("cannot write docs/models and docs/references.md: {e}"))?;
     }
     Ok(())
 }
