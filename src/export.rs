@@ -57,282 +57,168 @@
 //! ```
 //!
 //! The packaging tool (`src/package`, binary `fmu-package`) builds such a crate, reads the
-//! declarations back from the built library ([`catalogue`], exported by `export_fmus!` as the C symbol
-//! `spacecraft_fmus_catalogue`), writes `modelDescription.xml` and `documentation/index.html` from
-//! them and zips one `.fmu` per model. The runtime renders no XML and links no packaging code.
+//! declarations back from the built library (the [`Catalogue`] of `crate::catalogue`, exported by
+//! `export_fmus!` as the C symbol `spacecraft_fmus_catalogue`), writes `modelDescription.xml` and
+//! `documentation/index.html` from it alone and zips one `.fmu` per model. The runtime renders no XML
+//! and links no packaging code.
+//!
+//! Texts cite publications by a bracketed key (`"... after [Smith-2020] Eq. 4"`); the library declares
+//! them as a `&[Reference]` passed to `export_fmus!` (`references: MY_PAPERS; MyModel`), and the
+//! packaging tool expands each cited key in the model's documentation and refuses an undeclared one.
 
+pub use crate::catalogue::{
+    read_catalogue, BoundDescription, Catalogue, FamilyDescription, FeedthroughDescription, LayerInfo,
+    ModelDescription, PackageInfo, Reference, ReferenceDescription, StateDescription, VariableDescription,
+    CATALOGUE_FORMAT, RUNTIME_VERSION,
+};
 pub use crate::math;
 pub use crate::model::{
     check, check_derived, check_finite_state, Bound, Causality, Experiment, Feedthrough, Fmu, Model, ModelEntry,
     ModelInfo, ModelResult, ParamEnum, Start, StateDecl, VarDecl, VarKind, Variability, Variables, DERIVATIVE_VR_BASE,
     RESERVED_VR_START, STATE_VR_BASE, SWITCH,
 };
-pub use crate::models::attitude::control::shared::{check_unit_quaternions, AttitudeControllerPorts};
+pub use crate::models::ports::{check_unit_quaternions, AttitudeControllerPorts};
 pub use crate::{declare_variables, export_fmus, param_enum};
 pub use nalgebra::{Quaternion, Vector3};
 pub use serde::{Deserialize, Serialize};
 
-/// Version of the catalogue's byte layout; the packaging tool refuses any other.
-pub const CATALOGUE_FORMAT: u32 = 3;
-
-/// Version of this crate, recorded in every catalogue (and part of every GUID).
-pub const RUNTIME_VERSION: &str = env!("CARGO_PKG_VERSION");
-
-/// What a shared library built with [`export_fmus!`](crate::export_fmus) declares: every model's
-/// header and variables, and the GUID the library will accept. Owned data, so that the packaging tool
-/// can read it from the bytes a library exports.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Catalogue {
-    pub format: u32,
-    pub runtime_version: String,
-    /// The Cargo package that built the library: its name, version, authors and license go into every
-    /// model description (`author`, `version`, `license`).
-    pub package: PackageInfo,
-    pub models: Vec<ModelDescription>,
+/// A family of models: a page `docs/models/<slug>.md` with a title, a Markdown overview and the
+/// models in page order (the project's families are `crate::registry::FAMILIES`; a model crate may
+/// declare its own and pass them to `export_fmus!`).
+pub struct Family {
+    pub slug: &'static str,
+    pub title: &'static str,
+    /// Markdown overview (the project's: the family folder's README.md).
+    pub overview: &'static str,
+    pub fmus: &'static [ModelEntry],
 }
 
-/// Metadata of the package that exports the models (captured by `export_fmus!` from the exporting
-/// crate's Cargo.toml).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct PackageInfo {
-    pub name: String,
-    pub version: String,
-    /// Cargo's `authors`, joined by ':' as Cargo passes them.
-    pub authors: String,
-    pub license: String,
+/// What a library exports besides its models: its families and its bibliography (both may be empty).
+#[derive(Clone, Copy)]
+pub struct Extras {
+    pub families: &'static [Family],
+    pub references: &'static [Reference],
 }
 
-/// One model of a [`Catalogue`]: [`ModelInfo`] and the [`VarDecl`] table as owned data, plus the GUID.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct ModelDescription {
-    pub name: String,
-    pub description: String,
-    pub source: String,
-    pub equations_html: String,
-    pub feedthrough: FeedthroughDescription,
-    pub default_stop_time: f64,
-    pub default_step: f64,
-    pub variable_step: bool,
-    pub guid: String,
-    pub variables: Vec<VariableDescription>,
-    /// Model Exchange: the continuous states; `None` = Co-Simulation only.
-    pub states: Option<Vec<StateDescription>>,
+impl Extras {
+    pub const NONE: Extras = Extras {
+        families: &[],
+        references: &[],
+    };
 }
 
-/// A [`StateDecl`] as owned data.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct StateDescription {
-    pub name: String,
-    pub unit: String,
-    pub description: String,
-    pub depends: Option<Vec<String>>,
-    pub starts_from: Vec<String>,
-}
-
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub enum FeedthroughDescription {
-    None,
-    AllInputs,
-    Some(Vec<(String, Vec<String>)>),
-}
-
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct VariableDescription {
-    pub vr: u32,
-    pub name: String,
-    pub kind: VarKind,
-    pub causality: Causality,
-    pub variability: Variability,
-    pub unit: String,
-    pub description: String,
-    pub start: Start,
-    pub bound: BoundDescription,
-}
-
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub enum BoundDescription {
-    Any,
-    Positive,
-    NonNegative,
-    Limit,
-    Range(f64, f64),
-    Choice(Vec<i32>),
-}
-
-impl ModelDescription {
-    /// The description of a model entry (what the library exports).
-    pub fn of(e: &ModelEntry) -> Self {
-        let i = e.info;
-        ModelDescription {
-            name: i.name.into(),
-            description: i.description.into(),
-            source: i.source.into(),
-            equations_html: i.equations_html.into(),
-            feedthrough: match i.feedthrough {
-                Feedthrough::None => FeedthroughDescription::None,
-                Feedthrough::AllInputs => FeedthroughDescription::AllInputs,
-                Feedthrough::Some(l) => FeedthroughDescription::Some(
-                    l.iter()
-                        .map(|(o, ins)| (o.to_string(), ins.iter().map(|s| s.to_string()).collect()))
-                        .collect(),
-                ),
-            },
-            default_stop_time: i.default_stop_time,
-            default_step: i.default_step,
-            variable_step: i.variable_step,
-            guid: crate::model::guid::guid(e).as_str().into(),
-            variables: e
-                .decls
-                .iter()
-                .map(|d| VariableDescription {
-                    vr: d.vr,
-                    name: d.name.into(),
-                    kind: d.kind,
-                    causality: d.causality,
-                    variability: d.variability,
-                    unit: d.unit.into(),
-                    description: d.description.into(),
-                    start: d.start,
-                    bound: match d.bound {
-                        Bound::Any => BoundDescription::Any,
-                        Bound::Positive => BoundDescription::Positive,
-                        Bound::NonNegative => BoundDescription::NonNegative,
-                        Bound::Limit => BoundDescription::Limit,
-                        Bound::Range(a, b) => BoundDescription::Range(a, b),
-                        Bound::Choice(c) => BoundDescription::Choice(c.to_vec()),
-                    },
-                })
-                .collect(),
-            states: e.states.map(|l| {
+/// The description of a model entry, as the library exports it.
+pub fn describe(e: &ModelEntry) -> ModelDescription {
+    let i = e.info;
+    ModelDescription {
+        name: i.name.into(),
+        description: i.description.into(),
+        source: i.source.into(),
+        equations_html: i.equations_html.into(),
+        feedthrough: match i.feedthrough {
+            Feedthrough::None => FeedthroughDescription::None,
+            Feedthrough::AllInputs => FeedthroughDescription::AllInputs,
+            Feedthrough::Some(l) => FeedthroughDescription::Some(
                 l.iter()
-                    .map(|x| StateDescription {
-                        name: x.name.into(),
-                        unit: x.unit.into(),
-                        description: x.description.into(),
-                        depends: x.depends.map(|d| d.iter().map(|n| n.to_string()).collect()),
-                        starts_from: x.starts_from.iter().map(|n| n.to_string()).collect(),
-                    })
-                    .collect()
-            }),
-        }
-    }
-
-    /// A description-only [`ModelEntry`] with the same header and declarations, for tools that render
-    /// them (the packaging tool). Its strings are leaked: a tool reads a handful of models once per
-    /// process. Its `create` cannot build a model (the code lives in the library the catalogue came from).
-    pub fn into_entry(self) -> ModelEntry {
-        fn leak(s: String) -> &'static str {
-            Box::leak(s.into_boxed_str())
-        }
-        fn no_model() -> Box<dyn crate::model::DynModel> {
-            panic!("a ModelEntry read from a catalogue describes a model; its code is in the library")
-        }
-        let feedthrough = match self.feedthrough {
-            FeedthroughDescription::None => Feedthrough::None,
-            FeedthroughDescription::AllInputs => Feedthrough::AllInputs,
-            FeedthroughDescription::Some(l) => Feedthrough::Some(Box::leak(
-                l.into_iter()
-                    .map(|(o, ins)| {
-                        (
-                            leak(o),
-                            &*Box::leak(ins.into_iter().map(leak).collect::<Vec<_>>().into_boxed_slice()),
-                        )
-                    })
-                    .collect::<Vec<_>>()
-                    .into_boxed_slice(),
-            )),
-        };
-        let info = Box::leak(Box::new(ModelInfo {
-            name: leak(self.name),
-            description: leak(self.description),
-            source: leak(self.source),
-            equations_html: leak(self.equations_html),
-            feedthrough,
-            default_stop_time: self.default_stop_time,
-            default_step: self.default_step,
-            variable_step: self.variable_step,
-        }));
-        let decls: Vec<VarDecl> = self
-            .variables
-            .into_iter()
-            .map(|v| VarDecl {
-                vr: v.vr,
-                name: leak(v.name),
-                kind: v.kind,
-                causality: v.causality,
-                variability: v.variability,
-                unit: leak(v.unit),
-                description: leak(v.description),
-                start: v.start,
-                bound: match v.bound {
-                    BoundDescription::Any => Bound::Any,
-                    BoundDescription::Positive => Bound::Positive,
-                    BoundDescription::NonNegative => Bound::NonNegative,
-                    BoundDescription::Limit => Bound::Limit,
-                    BoundDescription::Range(a, b) => Bound::Range(a, b),
-                    BoundDescription::Choice(c) => Bound::Choice(Box::leak(c.into_boxed_slice())),
-                },
-            })
-            .collect();
-        let states: Option<&'static [StateDecl]> = self.states.map(|l| {
-            let decl = |x: StateDescription| {
-                let starts: &'static [&'static str] = Box::leak(
-                    x.starts_from
-                        .into_iter()
-                        .map(leak)
-                        .collect::<Vec<_>>()
-                        .into_boxed_slice(),
-                );
-                let s = StateDecl::new(leak(x.name), leak(x.unit), leak(x.description)).starting_from(starts);
-                match x.depends {
-                    Some(d) => s.depends_on(Box::leak(
-                        d.into_iter().map(leak).collect::<Vec<_>>().into_boxed_slice(),
-                    )),
-                    None => s,
-                }
-            };
-            &*Box::leak(l.into_iter().map(decl).collect::<Vec<_>>().into_boxed_slice())
-        });
-        ModelEntry {
-            info,
-            decls: Box::leak(decls.into_boxed_slice()),
-            states,
-            create: no_model,
-        }
+                    .map(|(o, ins)| (o.to_string(), ins.iter().map(|s| s.to_string()).collect()))
+                    .collect(),
+            ),
+        },
+        default_stop_time: i.default_stop_time,
+        default_step: i.default_step,
+        variable_step: i.variable_step,
+        guid: crate::model::guid::guid(e).as_str().into(),
+        variables: e.decls.iter().map(describe_variable).collect(),
+        states: e.states.map(|l| {
+            l.iter()
+                .map(|x| StateDescription {
+                    name: x.name.into(),
+                    unit: x.unit.into(),
+                    description: x.description.into(),
+                    depends: x.depends.map(|d| d.iter().map(|n| n.to_string()).collect()),
+                    starts_from: x.starts_from.iter().map(|n| n.to_string()).collect(),
+                })
+                .collect()
+        }),
     }
 }
 
-/// The catalogue of a list of models exported by `package`.
-pub fn catalogue(models: &[ModelEntry], package: PackageInfo) -> Catalogue {
+fn describe_variable(d: &VarDecl) -> VariableDescription {
+    VariableDescription {
+        vr: d.vr,
+        name: d.name.into(),
+        kind: d.kind,
+        causality: d.causality,
+        variability: d.variability,
+        unit: d.unit.into(),
+        description: d.description.into(),
+        start: d.start,
+        bound: match d.bound {
+            Bound::Any => BoundDescription::Any,
+            Bound::Positive => BoundDescription::Positive,
+            Bound::NonNegative => BoundDescription::NonNegative,
+            Bound::Limit => BoundDescription::Limit,
+            Bound::Range(a, b) => BoundDescription::Range(a, b),
+            Bound::Choice(c) => BoundDescription::Choice(c.to_vec()),
+        },
+    }
+}
+
+/// What this crate's FMI layer reserves and offers (the same in every library built on it).
+pub fn layer_info() -> LayerInfo {
+    LayerInfo {
+        log_categories: crate::fmi::LOG_CATEGORIES
+            .iter()
+            .map(|(n, d)| (n.to_string(), d.to_string()))
+            .collect(),
+        time_vr: crate::fmi::fmi3::TIME_VR,
+        state_vr_base: STATE_VR_BASE,
+        derivative_vr_base: DERIVATIVE_VR_BASE,
+        reserved_vr_start: RESERVED_VR_START,
+    }
+}
+
+/// The catalogue of a list of models exported by `package`, with its families and bibliography.
+pub fn catalogue(models: &[ModelEntry], package: PackageInfo, extras: Extras) -> Catalogue {
     Catalogue {
         format: CATALOGUE_FORMAT,
         runtime_version: RUNTIME_VERSION.into(),
         package,
-        models: models.iter().map(ModelDescription::of).collect(),
+        layer: layer_info(),
+        families: extras
+            .families
+            .iter()
+            .map(|f| FamilyDescription {
+                slug: f.slug.into(),
+                title: f.title.into(),
+                overview: f.overview.into(),
+                models: f.fmus.iter().map(|e| e.info.name.into()).collect(),
+            })
+            .collect(),
+        references: extras.references.iter().map(ReferenceDescription::of).collect(),
+        models: models.iter().map(describe).collect(),
     }
 }
 
-/// The catalogue as bytes: the magic `SCFMUCAT`, then the postcard encoding of [`Catalogue`].
-pub fn catalogue_bytes(models: &[ModelEntry], package: PackageInfo) -> Vec<u8> {
-    let mut out = CATALOGUE_MAGIC.to_vec();
-    out.extend(postcard::to_stdvec(&catalogue(models, package)).expect("a catalogue always serializes"));
-    out
+/// The catalogue as bytes (`crate::catalogue::catalogue_to_bytes`), what `spacecraft_fmus_catalogue` returns.
+pub fn catalogue_bytes(models: &[ModelEntry], package: PackageInfo, extras: Extras) -> Vec<u8> {
+    crate::catalogue::catalogue_to_bytes(&catalogue(models, package, extras))
 }
 
-const CATALOGUE_MAGIC: &[u8; 8] = b"SCFMUCAT";
-
-/// Reads [`catalogue_bytes`] back; the message says what is wrong (not a catalogue, another format).
-pub fn read_catalogue(bytes: &[u8]) -> Result<Catalogue, String> {
-    let body = bytes
-        .strip_prefix(CATALOGUE_MAGIC)
-        .ok_or("not a spacecraft_fmus catalogue (no SCFMUCAT header)")?;
-    // the format number is the first field: read it alone first, so a newer layout is named, not garbled
-    let (format, _) =
-        postcard::take_from_bytes::<u32>(body).map_err(|e| format!("catalogue header unreadable: {e}"))?;
-    if format != CATALOGUE_FORMAT {
-        return Err(format!("catalogue format {format}, this tool reads format {CATALOGUE_FORMAT} (rebuild the library and the tool from the same spacecraft_fmus)"));
-    }
-    postcard::from_bytes(body).map_err(|e| format!("catalogue unreadable: {e}"))
+/// The project's own catalogue (every registered model, its families and bibliography), as
+/// `src/cdylib` exports it: for tests and tools that render the project's pages without loading
+/// the library.
+pub fn project_catalogue() -> Catalogue {
+    catalogue(
+        crate::registry::ALL,
+        PackageInfo {
+            name: "spacecraft_fmus_cdylib".into(),
+            version: "0.1.0".into(),
+            authors: "spacecraft_fmus contributors".into(),
+            license: "BSD-2-Clause".into(),
+        },
+        crate::registry::EXTRAS,
+    )
 }
 
 /// Generates the FMI 2.0 and FMI 3.0 Co-Simulation entry points of a shared library for the given models, plus
@@ -340,8 +226,11 @@ pub fn read_catalogue(bytes: &[u8]) -> Result<Catalogue, String> {
 /// `cdylib` crate:
 ///
 /// ```ignore
-/// spacecraft_fmus::export_fmus!(MyController, MyPlant);          // model types
-/// spacecraft_fmus::export_fmus!(list: spacecraft_fmus::registry::ALL);  // a const &[ModelEntry]
+/// spacecraft_fmus::export_fmus!(MyController, MyPlant);               // model types
+/// spacecraft_fmus::export_fmus!(references: MY_PAPERS; MyController);   // ... citing a &[Reference]
+/// spacecraft_fmus::export_fmus!(list: MODELS);                          // a const &[ModelEntry]
+/// spacecraft_fmus::export_fmus!(list: MODELS, references: MY_PAPERS);
+/// spacecraft_fmus::export_fmus!(list: MODELS, families: FAMILIES, references: MY_PAPERS);
 /// ```
 ///
 /// One library may hold several models: each FMU carries the same binary under its own name
@@ -350,9 +239,11 @@ pub fn read_catalogue(bytes: &[u8]) -> Result<Catalogue, String> {
 /// status and logging, panics caught, validated FMU states).
 #[macro_export]
 macro_rules! export_fmus {
-    (list: $list:expr) => {
+    (list: $list:expr, families: $families:expr, references: $references:expr $(,)?) => {
         const _: () = {
             static MODELS: &[$crate::model::ModelEntry] = $list;
+            static EXTRAS: $crate::export::Extras =
+                $crate::export::Extras { families: $families, references: $references };
 
             /// The declarations of this library's models, for the packaging tool: `*size` bytes at the
             /// returned address, valid while the library is loaded.
@@ -365,7 +256,7 @@ macro_rules! export_fmus {
                         version: env!("CARGO_PKG_VERSION").into(),
                         authors: env!("CARGO_PKG_AUTHORS").into(),
                         license: env!("CARGO_PKG_LICENSE").into(),
-                    })
+                    }, EXTRAS)
                 })) {
                     Ok(bytes) => {
                         if !size.is_null() {
@@ -382,8 +273,17 @@ macro_rules! export_fmus {
             $crate::__export_fmi3!(MODELS);
         };
     };
+    (list: $list:expr, references: $references:expr $(,)?) => {
+        $crate::export_fmus!(list: $list, families: &[], references: $references);
+    };
+    (list: $list:expr $(,)?) => {
+        $crate::export_fmus!(list: $list, families: &[], references: &[]);
+    };
+    (references: $references:expr; $($Model:ty),+ $(,)?) => {
+        $crate::export_fmus!(list: &[$($crate::model::ModelEntry::of::<$Model>()),+], families: &[], references: $references);
+    };
     ($($Model:ty),+ $(,)?) => {
-        $crate::export_fmus!(list: &[$($crate::model::ModelEntry::of::<$Model>()),+]);
+        $crate::export_fmus!(list: &[$($crate::model::ModelEntry::of::<$Model>()),+], families: &[], references: &[]);
     };
 }
 
@@ -392,36 +292,40 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_catalogue_round_trips_and_gives_back_the_declarations_and_guids() {
+    fn the_catalogue_round_trips_and_carries_what_the_packager_needs() {
         let pkg = PackageInfo {
             name: "p".into(),
             version: "1.2.3".into(),
             authors: "A:B".into(),
             license: "MIT".into(),
         };
-        let bytes = catalogue_bytes(crate::registry::ALL, pkg.clone());
+        let bytes = catalogue_bytes(crate::registry::ALL, pkg.clone(), crate::registry::EXTRAS);
         let cat = read_catalogue(&bytes).unwrap();
         assert_eq!(cat.models.len(), crate::registry::COUNT);
         assert_eq!(cat.runtime_version, RUNTIME_VERSION);
         assert_eq!(cat.package, pkg);
-        for (m, e) in cat.models.into_iter().zip(crate::registry::ALL) {
-            let guid = m.guid.clone();
-            let back = m.into_entry();
-            assert_eq!(crate::model::guid::compute_fresh(&back), guid, "{}", e.info.name);
-            assert_eq!(guid, crate::model::guid::guid(e).as_str());
-            assert_eq!(back.decls.len(), e.decls.len());
-            for (a, b) in back.decls.iter().zip(e.decls) {
+        assert_eq!(cat.layer.time_vr, crate::fmi::fmi3::TIME_VR);
+        assert_eq!(cat.layer.log_categories.len(), crate::fmi::LOG_CATEGORIES.len());
+        assert_eq!(cat.families.len(), crate::registry::FAMILIES.len());
+        assert_eq!(cat.references.len(), crate::models::references::ALL.len());
+        for (m, e) in cat.models.iter().zip(crate::registry::ALL) {
+            // the packaging tool's GUID (from the owned copy) is the runtime's (from the declarations)
+            assert_eq!(crate::catalogue::guid_of(m), m.guid, "{}", e.info.name);
+            assert_eq!(m.guid, crate::model::guid::guid(e).as_str());
+            assert_eq!(m.variables.len(), e.decls.len());
+            for (a, b) in m.variables.iter().zip(e.decls) {
                 assert_eq!(
-                    (a.vr, a.name, a.unit, a.bound, a.start),
-                    (b.vr, b.name, b.unit, b.bound, b.start)
+                    (a.vr, a.name.as_str(), a.unit.as_str(), a.start),
+                    (b.vr, b.name, b.unit, b.start)
                 );
+                assert_eq!(a.bound.min_max(), b.bound.min_max());
+                assert_eq!((a.initial(), a.has_start()), (b.initial(), b.has_start()));
             }
+            assert_eq!(m.texts(), e.texts());
         }
-        assert!(read_catalogue(b"nonsense")
-            .unwrap_err()
-            .contains("not a spacecraft_fmus catalogue"));
-        let mut other = CATALOGUE_MAGIC.to_vec();
-        other.extend(postcard::to_stdvec(&7u32).unwrap());
-        assert!(read_catalogue(&other).unwrap_err().contains("catalogue format 7"));
+        // one changed character gives another GUID
+        let mut other = cat.models[0].clone();
+        other.variables[0].description.push('.');
+        assert_ne!(crate::catalogue::guid_of(&other), cat.models[0].guid);
     }
 }

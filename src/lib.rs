@@ -6,6 +6,8 @@
 //!   packaging tool reads back. Start there (docs/export.md walks through a model of your own).
 //! - `fmi`: the FMI 2.0 and 3.0 C functions (Co-Simulation and Model Exchange), state machine, logging and
 //!   FMU state, written once, one folder per version over one C boundary; exported by `export_fmus!` in the crate that builds the shared library, never by this one (an rlib).
+//! - `catalogue`: the declaration vocabulary (variables, model header, states, references) and the
+//!   owned catalogue a library exports, the packaging tool's only input.
 //! - `model`: what a model is (declared variables + init/outputs/step), the declaration macro, GUIDs.
 //! - `models`: the project's FMUs, one folder per family; `registry` lists them.
 //! - `math`: shared math (attitude conventions, integrators, ...), unit-tested on its own.
@@ -16,6 +18,7 @@
 //! `fmu-package`: modelDescription.xml, documentation, `.fmu` archives and the generated model pages;
 //! the only code that links an XML writer and `zip`).
 
+pub mod catalogue;
 pub mod export;
 pub mod fmi;
 pub mod math;

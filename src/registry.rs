@@ -1,19 +1,14 @@
 //! Every FMU this crate builds, listed once: each family folder declares its FMUs with `fmus!`, and
-//! this list concatenates the families. Packaging, the GUID table, the C ABI's model lookup and the
-//! tests all iterate over [`ALL`].
+//! this list concatenates the families. The C ABI's model lookup and the tests iterate over [`ALL`];
+//! `src/cdylib` exports it with [`EXTRAS`], and the packaging tool sees it only through that catalogue.
 
+use crate::export::Extras;
+pub use crate::export::Family;
 use crate::model::{concat, total_len, ModelEntry};
 use crate::models::{attitude, estimation, formation, sensors, single_axis};
 
-/// A family of FMUs (one folder under `src/models/`) and its documentation page `docs/models/<slug>.md`.
-pub struct Family {
-    pub slug: &'static str,
-    pub title: &'static str,
-    /// Markdown overview: the family folder's README.md.
-    pub overview: &'static str,
-    pub fmus: &'static [ModelEntry],
-}
-
+/// The families, each a folder under `src/models/` and a page `docs/models/<slug>.md` (title and overview
+/// go into the catalogue the library exports).
 pub const FAMILIES: &[Family] = &[
     Family {
         slug: "attitude",
@@ -70,6 +65,12 @@ pub const ALL: &[ModelEntry] = &LIST;
 
 /// Number of registered FMUs.
 pub const COUNT: usize = LIST.len();
+
+/// What `src/cdylib` exports besides the models: the families and the project's bibliography.
+pub const EXTRAS: Extras = Extras {
+    families: FAMILIES,
+    references: crate::models::references::ALL,
+};
 
 pub fn find(name: &str) -> Option<&'static ModelEntry> {
     ALL.iter().find(|e| e.info.name == name)

@@ -3,4 +3,8 @@
 //! `export_fmus!` line — here the whole registry. Every `.fmu` in `fmus/` carries this library under its
 //! own name, and `fmi2Instantiate` picks the model by that name and checks the GUID.
 
-spacecraft_fmus::export_fmus!(list: spacecraft_fmus::registry::ALL);
+spacecraft_fmus::export_fmus!(
+    list: spacecraft_fmus::registry::ALL,
+    families: spacecraft_fmus::registry::FAMILIES,
+    references: spacecraft_fmus::models::references::ALL,
+);

@@ -1,94 +1,53 @@
-//! The GUID of a model: a name-based UUID (v5) of its declarations — name, flags, default
-//! experiment, feed-through, every variable with its unit definition and bounds — and the package
-//! version. It changes exactly when the interface (or the release) changes. Both the runtime
-//! (`fmi2Instantiate`, FMU-state payloads) and the packaging tool (through the catalogue a binary
-//! exports, `crate::export`) use it; nothing here renders XML.
+//! The GUID of a registered model, for the runtime (`fmi2Instantiate`, FMU-state payloads): the
+//! fingerprint of `crate::catalogue::fingerprint` over the static declarations (the packaging tool
+//! computes the same from a catalogue's owned copy). Nothing here renders XML.
 
-use std::fmt::Write;
+use super::{Feedthrough, ModelEntry};
+use crate::catalogue::fingerprint::{fingerprint, guid_bytes, Header, StateRow, VarRow, GUID_LEN};
 
-use super::{Feedthrough, ModelEntry, Start};
-
-/// Namespace of the project's name-based GUIDs (a fixed random UUID).
-const GUID_NAMESPACE: uuid::Uuid = uuid::Uuid::from_u128(0x6f1d_2b7e_3c4a_4e55_9a61_0d2f_8c3b_71a4);
-
-/// Length of "{xxxxxxxx-xxxx-xxxx-xxxx-xxxxxxxxxxxx}".
-const GUID_LEN: usize = 38;
-
-/// The canonical text the GUID is computed from.
-fn fingerprint(entry: &ModelEntry) -> String {
+/// The fingerprint rows of a registry entry (borrowed: no copy of a string).
+fn compute(entry: &ModelEntry) -> [u8; GUID_LEN] {
     let info = entry.info;
-    let mut s = String::new();
-    let _ = writeln!(s, "spacecraft_fmus {}", env!("CARGO_PKG_VERSION"));
-    let _ = writeln!(
-        s,
-        "{}|{}|{}|{:?}|{:?}|{:?}",
-        info.name,
-        info.description,
-        info.variable_step,
-        info.default_stop_time,
-        info.default_step,
-        info.feedthrough_text()
-    );
-    for d in entry.decls {
-        let start = match d.start {
-            Start::Real(x) => format!("{x:?}"),
-            Start::Integer(x) => x.to_string(),
-            Start::Boolean(x) => x.to_string(),
-        };
-        let unit = crate::units::lookup(d.unit)
-            .map(|(_, b, disp)| format!("{b:?}{disp:?}"))
-            .unwrap_or_default();
-        let _ = writeln!(
-            s,
-            "{}|{}|{:?}|{:?}|{:?}|{}|{}|{}|{:?}|{}",
-            d.vr,
-            d.name,
-            d.kind,
-            d.causality,
-            d.variability,
-            d.unit,
-            unit,
-            d.description,
-            d.bound.min_max(),
-            start
-        );
-    }
-    // Model Exchange models only, so that a Co-Simulation-only model keeps its GUID.
-    if let Some(states) = entry.states {
-        let _ = writeln!(s, "model exchange: {} states", states.len());
-        for x in states {
-            let _ = writeln!(
-                s,
-                "state|{}|{}|{}|{:?}|{:?}",
-                x.name, x.unit, x.description, x.depends, x.starts_from
-            );
-        }
-    }
-    s
-}
-
-impl super::ModelInfo {
-    fn feedthrough_text(&self) -> String {
-        match self.feedthrough {
+    let header = Header {
+        name: info.name,
+        description: info.description,
+        variable_step: info.variable_step,
+        default_stop_time: info.default_stop_time,
+        default_step: info.default_step,
+        feedthrough: match info.feedthrough {
             Feedthrough::None => "none".into(),
             Feedthrough::AllInputs => "all".into(),
             Feedthrough::Some(list) => format!("{list:?}"),
-        }
-    }
+        },
+    };
+    let vars = entry.decls.iter().map(|d| VarRow {
+        vr: d.vr,
+        name: d.name,
+        kind: d.kind,
+        causality: d.causality,
+        variability: d.variability,
+        unit: d.unit,
+        description: d.description,
+        min_max: d.bound.min_max(),
+        start: d.start,
+    });
+    let states = entry.states.map(|l| {
+        l.iter()
+            .map(|x| StateRow {
+                name: x.name,
+                unit: x.unit,
+                description: x.description,
+                depends: x.depends.map(|d| d.to_vec()),
+                starts_from: x.starts_from.to_vec(),
+            })
+            .collect()
+    });
+    guid_bytes(&fingerprint(header, vars, states))
 }
 
-/// The GUID computed afresh (uncached), e.g. to check one read from a catalogue.
+/// The GUID computed afresh (uncached).
 pub fn compute_fresh(entry: &ModelEntry) -> String {
     String::from_utf8(compute(entry).to_vec()).expect("hyphenated UUID is ASCII")
-}
-
-fn compute(entry: &ModelEntry) -> [u8; GUID_LEN] {
-    let uuid = uuid::Uuid::new_v5(&GUID_NAMESPACE, fingerprint(entry).as_bytes());
-    let mut out = [0u8; GUID_LEN];
-    out[0] = b'{';
-    uuid.hyphenated().encode_lower(&mut out[1..GUID_LEN - 1]);
-    out[GUID_LEN - 1] = b'}';
-    out
 }
 
 /// A GUID as text, "{xxxxxxxx-xxxx-xxxx-xxxx-xxxxxxxxxxxx}", held inline (no heap).

@@ -1,11 +1,15 @@
 //! What a model is. A model declares its variables once (`declare_variables!`, one row per port or
 //! parameter, vectors and quaternions as one row) and implements [`Model`]: build its internal state
-//! from the parameters, compute outputs, advance a step. The FMI layer (`crate::fmi`) and the
-//! packaging tool (`src/package`, through the catalogue of `crate::export`) see models only through this module, so a model
-//! never touches C types or XML.
+//! from the parameters, compute outputs, advance a step. The FMI layer (`crate::fmi`) sees models only
+//! through this module, so a model never touches C types or XML.
+//!
+//! The declaration vocabulary (`VarDecl`, `ModelInfo`, `Feedthrough`, `StateDecl`, bounds, …) lives in
+//! `crate::catalogue` and is re-exported here; this module keeps what runs: the variable block
+//! ([`Variables`]), the [`Model`] contract, the registry entry [`ModelEntry`] (which can build a model)
+//! and the [`Experiment`] a master sets up. The packaging tool sees none of it, only the owned catalogue
+//! a built library exports (`crate::export`).
 
 mod declare;
-mod exchange;
 pub mod guid;
 mod instance;
 pub mod leaves;
@@ -13,225 +17,15 @@ mod param;
 #[cfg(test)]
 mod restore_tests;
 
+pub use crate::catalogue::decl::{
+    initial_of, Bound, Causality, Feedthrough, Initial, ModelInfo, Reference, Start, StateDecl, VarDecl, VarKind,
+    Variability, DERIVATIVE_VR_BASE, RESERVED_VR_START, STATE_VR_BASE, SWITCH,
+};
 pub use declare::{concat, field_problem, no_duplicate_names, no_duplicate_vrs, same_str, total_len};
-pub use exchange::{StateDecl, DERIVATIVE_VR_BASE, RESERVED_VR_START, STATE_VR_BASE};
 pub use instance::{DynModel, Fmu};
 pub use param::ParamEnum;
 
 use serde::{de::DeserializeOwned, Serialize};
-
-/// FMI 2.0 causality of a variable.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub enum Causality {
-    Parameter,
-    CalculatedParameter,
-    Input,
-    Output,
-    Local,
-}
-
-/// FMI 2.0 variability of a variable.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub enum Variability {
-    Constant,
-    Fixed,
-    Tunable,
-    Discrete,
-    Continuous,
-}
-
-impl Variability {
-    /// The variability a declaration gets: parameters are fixed (read at fmi2ExitInitializationMode),
-    /// Real ports continuous, Integer/Boolean ports discrete (FMI 2.0 allows continuous only for Real).
-    pub const fn derived(causality: Causality, kind: VarKind) -> Self {
-        match (causality, kind) {
-            (Causality::Parameter | Causality::CalculatedParameter, _) => Variability::Fixed,
-            (_, VarKind::Real) => Variability::Continuous,
-            _ => Variability::Discrete,
-        }
-    }
-}
-
-/// FMI 2.0 `initial` attribute.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Initial {
-    Exact,
-    Approx,
-    Calculated,
-}
-
-/// Base type of a variable.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub enum VarKind {
-    Real,
-    Integer,
-    Boolean,
-}
-
-/// A start value of the declared kind.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub enum Start {
-    Real(f64),
-    Integer(i32),
-    Boolean(bool),
-}
-
-/// Admissible values of a parameter, checked by the FMI layer before the model is initialized (so a
-/// model's `initialize` only derives values) and written to the modelDescription as `min`/`max`.
-/// Every Real is finite anyway: non-finite values are refused when they are set.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Bound {
-    /// Any finite value.
-    Any,
-    /// > 0.
-    Positive,
-    /// ≥ 0.
-    NonNegative,
-    /// ≥ 0, where 1e30 (or more) encodes "no limit".
-    Limit,
-    /// In [lo, hi].
-    Range(f64, f64),
-    /// One of the listed integer codes (an enumeration or a 0/1 switch).
-    Choice(&'static [i32]),
-}
-
-/// The codes of a 0/1 switch.
-pub const SWITCH: &[i32] = &[0, 1];
-
-impl Bound {
-    /// Checks a Real value; the message names the parameter.
-    pub fn check_real(self, name: &str, v: f64) -> Result<(), String> {
-        let ok = v.is_finite()
-            && match self {
-                Bound::Any | Bound::Choice(_) => true,
-                Bound::Positive => v > 0.0,
-                Bound::NonNegative | Bound::Limit => v >= 0.0,
-                Bound::Range(lo, hi) => v >= lo && v <= hi,
-            };
-        if ok {
-            return Ok(());
-        }
-        Err(match self {
-            Bound::Any | Bound::Choice(_) => format!("parameter {name} = {v} is not finite"),
-            Bound::Positive => format!("parameter {name} = {v} must be > 0"),
-            Bound::NonNegative => format!("parameter {name} = {v} must be >= 0"),
-            Bound::Limit => format!("parameter {name} = {v} must be >= 0 (1e30 = no limit)"),
-            Bound::Range(lo, hi) => format!("parameter {name} = {v} must lie in [{lo}, {hi}]"),
-        })
-    }
-
-    /// Checks an Integer value.
-    pub fn check_integer(self, name: &str, v: i32) -> Result<(), String> {
-        match self {
-            Bound::Choice(codes) if !codes.contains(&v) => {
-                Err(format!("parameter {name} = {v} is not one of {codes:?}"))
-            }
-            Bound::Range(lo, hi) if !((v as f64) >= lo && (v as f64) <= hi) => {
-                Err(format!("parameter {name} = {v} must lie in [{lo}, {hi}]"))
-            }
-            Bound::Positive if v <= 0 => Err(format!("parameter {name} = {v} must be > 0")),
-            Bound::NonNegative | Bound::Limit if v < 0 => Err(format!("parameter {name} = {v} must be >= 0")),
-            _ => Ok(()),
-        }
-    }
-
-    /// Whether a start value of the declared kind satisfies the bound (const: checked at compile time
-    /// for every parameter by `declare_variables!`).
-    pub const fn admits(self, start: Start) -> bool {
-        match start {
-            Start::Boolean(_) => true,
-            Start::Real(v) => {
-                v.is_finite()
-                    && match self {
-                        Bound::Any | Bound::Choice(_) => true,
-                        Bound::Positive => v > 0.0,
-                        Bound::NonNegative | Bound::Limit => v >= 0.0,
-                        Bound::Range(lo, hi) => v >= lo && v <= hi,
-                    }
-            }
-            Start::Integer(v) => match self {
-                Bound::Choice(codes) => {
-                    let mut i = 0;
-                    while i < codes.len() {
-                        if codes[i] == v {
-                            return true;
-                        }
-                        i += 1;
-                    }
-                    false
-                }
-                Bound::Range(lo, hi) => (v as f64) >= lo && (v as f64) <= hi,
-                Bound::Positive => v > 0,
-                Bound::NonNegative | Bound::Limit => v >= 0,
-                Bound::Any => true,
-            },
-        }
-    }
-
-    /// (min, max) for the modelDescription, where the bound has them. `Positive` has no inclusive
-    /// minimum in FMI terms and writes none.
-    pub fn min_max(self) -> (Option<f64>, Option<f64>) {
-        match self {
-            Bound::Any | Bound::Positive => (None, None),
-            Bound::NonNegative | Bound::Limit => (Some(0.0), None),
-            Bound::Range(lo, hi) => (Some(lo), Some(hi)),
-            Bound::Choice(codes) => (
-                codes.iter().min().map(|&c| c as f64),
-                codes.iter().max().map(|&c| c as f64),
-            ),
-        }
-    }
-}
-
-/// One declared variable: everything the C ABI, the XML and the HTML documentation need.
-#[derive(Clone, Copy, Debug)]
-pub struct VarDecl {
-    pub vr: u32,
-    pub name: &'static str,
-    pub kind: VarKind,
-    pub causality: Causality,
-    pub variability: Variability,
-    /// Unit name from `crate::units` ("" = dimensionless, no unit attribute).
-    pub unit: &'static str,
-    pub description: &'static str,
-    pub start: Start,
-    pub bound: Bound,
-}
-
-impl VarDecl {
-    /// Filler for const arrays under construction.
-    pub const PLACEHOLDER: VarDecl = VarDecl {
-        vr: u32::MAX,
-        name: "",
-        kind: VarKind::Real,
-        causality: Causality::Local,
-        variability: Variability::Continuous,
-        unit: "",
-        description: "",
-        start: Start::Real(0.0),
-        bound: Bound::Any,
-    };
-
-    /// `initial` follows from causality and variability (FMI 2.0 table of section 2.2.7):
-    /// parameters and constants are exact, outputs/locals/calculated parameters are calculated,
-    /// inputs carry no `initial` attribute (they still have a start value).
-    pub const fn initial(&self) -> Option<Initial> {
-        match self.causality {
-            Causality::Parameter => Some(Initial::Exact),
-            Causality::Input => None,
-            Causality::CalculatedParameter | Causality::Output => Some(Initial::Calculated),
-            Causality::Local => match self.variability {
-                Variability::Constant => Some(Initial::Exact),
-                _ => Some(Initial::Calculated),
-            },
-        }
-    }
-
-    /// Whether the XML carries a `start` attribute (not allowed for `initial="calculated"`).
-    pub const fn has_start(&self) -> bool {
-        !matches!(self.initial(), Some(Initial::Calculated))
-    }
-}
 
 /// A value read from or written to a variable.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -302,51 +96,6 @@ pub trait Variables: Clone + Default + Serialize + DeserializeOwned + Send + 'st
         }
         Ok(())
     }
-}
-
-/// Which outputs depend directly (algebraically) on which inputs; written to ModelStructure so that
-/// masters can order the calls and detect (the absence of) algebraic loops.
-#[derive(Clone, Copy, Debug)]
-pub enum Feedthrough {
-    /// Outputs depend on the internal state only (plants, sources).
-    None,
-    /// Every output depends on every input (controllers).
-    AllInputs,
-    /// Listed outputs depend on the listed inputs; the other outputs on none.
-    Some(&'static [(&'static str, &'static [&'static str])]),
-}
-
-/// Static description of a model: what goes into the XML header, the documentation and the flags.
-/// Start from [`ModelInfo::DEFAULT`] and override what differs.
-#[derive(Clone, Copy, Debug)]
-pub struct ModelInfo {
-    /// modelIdentifier = FMU file name.
-    pub name: &'static str,
-    /// One-line purpose.
-    pub description: &'static str,
-    /// Where the model comes from (paper title and equations).
-    pub source: &'static str,
-    /// HTML fragment with the equations, for documentation/index.html.
-    pub equations_html: &'static str,
-    pub feedthrough: Feedthrough,
-    /// DefaultExperiment: stop time and preferred communication step.
-    pub default_stop_time: f64,
-    pub default_step: f64,
-    /// `canHandleVariableCommunicationStepSize`.
-    pub variable_step: bool,
-}
-
-impl ModelInfo {
-    pub const DEFAULT: ModelInfo = ModelInfo {
-        name: "",
-        description: "",
-        source: "",
-        equations_html: "",
-        feedthrough: Feedthrough::None,
-        default_stop_time: 30.0,
-        default_step: 0.01,
-        variable_step: true,
-    };
 }
 
 /// Range of relative tolerances the adaptive integrators honour (fmi2SetupExperiment clamps into it

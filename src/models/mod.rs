@@ -1,7 +1,8 @@
 //! The FMU models, one folder per family. Each family's `mod.rs` lists its FMUs with `fmus!` (that list
-//! is the family's part of `crate::registry`); what several models of a family share (port blocks,
-//! laws) lives in non-FMU modules beside them (e.g. `attitude/control/shared/`), general math in
-//! `crate::math`.
+//! is the family's part of `crate::registry`); what several models of a family share (laws, variable
+//! blocks) lives in non-FMU modules beside them (e.g. `attitude/control/shared/`), general math in
+//! `crate::math`. Port blocks that every unit of a kind embeds are public, in [`ports`]; the
+//! publications the models cite (by `[key]` in their texts) are listed in [`references`].
 //!
 //! Value references (the same parameter has the same value reference across a family; checked over the
 //! registry by `tests/model_description.rs`):
@@ -38,5 +39,7 @@
 pub mod attitude;
 pub mod estimation;
 pub mod formation;
+pub mod ports;
+pub mod references;
 pub mod sensors;
 pub mod single_axis;

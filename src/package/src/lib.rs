@@ -7,16 +7,28 @@
 //! The same library also exports the FMI 3.0 functions: [`write_fmu3`] writes the FMI 3.0 archive
 //! (`fmus/fmi3/<Model>.fmu`, `binaries/<platform tuple>/<Model>.<ext>`, FMI 3.0 model description).
 //!
+//! The only input is the library's catalogue (`spacecraft_fmus::catalogue`): declarations, GUIDs,
+//! package, the FMI layer's log categories and reserved value references, families and bibliography.
+//! This crate never uses the runtime's registry or FMI layer (its unit tests build the project's
+//! catalogue in-process with `spacecraft_fmus::export::project_catalogue`, as `src/cdylib` exports it).
+//!
+//! Files: [`checks`] (what the type system cannot check), [`structure`] (dependency lists), [`xml`]
+//! (XML helpers and the elements both versions share), [`fmi2`] and [`fmi3`] (the two model
+//! descriptions), [`html`] (documentation/index.html), [`docs`] (the Markdown model pages),
+//! [`platforms`] and [`build`] (binaries), `load` (reading a library's catalogue).
+//!
 //! This crate, not the runtime, links the XML writer and `zip`.
 
 pub mod build;
-pub mod description;
-pub mod description3;
+pub mod checks;
 pub mod docs;
+pub mod fmi2;
+pub mod fmi3;
+pub mod html;
 mod load;
 pub mod platforms;
-pub mod references;
 pub mod structure;
+pub mod xml;
 
 use std::fs;
 use std::io::Write;
@@ -25,64 +37,35 @@ use std::path::Path;
 use zip::write::SimpleFileOptions;
 use zip::{CompressionMethod, DateTime, ZipWriter};
 
-use crate::description::{check_declarations, documentation_html, model_description};
-use crate::description3::model_description3;
-use spacecraft_fmus::export::{read_catalogue, PackageInfo, RUNTIME_VERSION};
-use spacecraft_fmus::model::guid::compute_fresh;
-use spacecraft_fmus::model::ModelEntry;
+pub use crate::checks::check_catalogue;
+pub use crate::fmi2::model_description;
+pub use crate::fmi3::model_description3;
+pub use crate::html::documentation_html;
+use spacecraft_fmus::catalogue::{guid_of, read_catalogue, Catalogue, ModelDescription, RUNTIME_VERSION};
 
-/// A model to package: its declarations, the GUID its binary accepts and the package exporting it.
-#[derive(Clone, Copy)]
-pub struct Unit {
-    pub entry: ModelEntry,
-    pub guid: &'static str,
-    pub package: &'static PackageInfo,
-}
-
-impl Unit {
-    /// A model of this process's registry (the project's own models, for pages and tests).
-    pub fn registered(entry: &ModelEntry) -> Unit {
-        static PROJECT: std::sync::OnceLock<PackageInfo> = std::sync::OnceLock::new();
-        Unit {
-            entry: *entry,
-            guid: Box::leak(spacecraft_fmus::model::guid::guid(entry).as_str().into()),
-            package: PROJECT.get_or_init(description::project_package),
-        }
-    }
-
-    pub fn name(&self) -> &'static str {
-        self.entry.info.name
-    }
-}
-
-/// The models a built shared library declares, read from its catalogue and checked: the declarations
-/// must be consistent ([`check_declarations`]) and each GUID must be the one this tool computes from the
-/// same declarations (otherwise the library was built with another version of `spacecraft_fmus`).
-pub fn units_of_library(lib: &Path) -> Result<Vec<Unit>, String> {
+/// The catalogue a built shared library declares, checked: the declarations must be consistent
+/// ([`check_catalogue`]), the names unique, and each GUID the one this tool computes from the same
+/// declarations (otherwise the library was built with another version of `spacecraft_fmus`).
+pub fn read_library(lib: &Path) -> Result<Catalogue, String> {
     let bytes = load::catalogue_bytes(lib)?;
     let cat = read_catalogue(&bytes).map_err(|e| format!("{}: {e}", lib.display()))?;
     if cat.models.is_empty() {
         return Err(format!("{}: the library declares no model", lib.display()));
     }
-    let package: &'static PackageInfo = Box::leak(Box::new(cat.package));
-    let mut units = Vec::new();
-    for m in cat.models {
-        let guid: &'static str = Box::leak(m.guid.clone().into_boxed_str());
-        let entry = m.into_entry();
-        check_declarations(&entry)?;
-        let fresh = compute_fresh(&entry);
-        if fresh != guid {
+    check_catalogue(&cat)?;
+    for (i, m) in cat.models.iter().enumerate() {
+        let fresh = guid_of(m);
+        if fresh != m.guid {
             return Err(format!(
-                "{}: the library was built with spacecraft_fmus {} and this tool is {RUNTIME_VERSION} (GUID {guid} vs {fresh}); build both from the same spacecraft_fmus",
-                entry.info.name, cat.runtime_version
+                "{}: the library was built with spacecraft_fmus {} and this tool is {RUNTIME_VERSION} (GUID {} vs {fresh}); build both from the same spacecraft_fmus",
+                m.name, cat.runtime_version, m.guid
             ));
         }
-        if units.iter().any(|u: &Unit| u.name() == entry.info.name) {
-            return Err(format!("the library declares two models named {}", entry.info.name));
+        if cat.models[..i].iter().any(|o| o.name == m.name) {
+            return Err(format!("the library declares two models named {}", m.name));
         }
-        units.push(Unit { entry, guid, package });
     }
-    Ok(units)
+    Ok(cat)
 }
 
 /// Platform folder of the binary inside the FMU.
@@ -111,50 +94,47 @@ pub fn platform_lib_ext(platform: &str) -> Option<&'static str> {
 }
 
 /// A model-description writer: FMI 2.0 ([`model_description`]) or FMI 3.0 ([`model_description3`]).
-type Render = fn(&ModelEntry, &str, &PackageInfo) -> String;
+type Render = fn(&Catalogue, &ModelDescription) -> String;
 
-fn write_rendered(units: &[Unit], dir: &Path, render: Render) -> std::io::Result<Vec<String>> {
+fn write_rendered(cat: &Catalogue, dir: &Path, render: Render) -> std::io::Result<Vec<String>> {
     fs::create_dir_all(dir)?;
     let mut written = vec![];
-    for u in units {
-        let p = dir.join(format!("{}.xml", u.name()));
-        fs::write(&p, render(&u.entry, u.guid, u.package))?;
+    for m in &cat.models {
+        let p = dir.join(format!("{}.xml", m.name));
+        fs::write(&p, render(cat, m))?;
         written.push(p.display().to_string());
     }
     Ok(written)
 }
 
-fn stale_rendered(units: &[Unit], dir: &Path, render: Render, prefix: &str) -> Vec<String> {
-    units
+fn stale_rendered(cat: &Catalogue, dir: &Path, render: Render, prefix: &str) -> Vec<String> {
+    cat.models
         .iter()
-        .filter(|u| {
-            fs::read_to_string(dir.join(format!("{}.xml", u.name())))
-                .ok()
-                .as_deref()
-                != Some(render(&u.entry, u.guid, u.package).as_str())
+        .filter(|m| {
+            fs::read_to_string(dir.join(format!("{}.xml", m.name))).ok().as_deref() != Some(render(cat, m).as_str())
         })
-        .map(|u| format!("{prefix}{}", u.name()))
+        .map(|m| format!("{prefix}{}", m.name))
         .collect()
 }
 
-/// Writes `<dir>/<Model>.xml` for every unit; returns the paths written.
-pub fn write_model_descriptions(units: &[Unit], dir: &Path) -> std::io::Result<Vec<String>> {
-    write_rendered(units, dir, model_description)
+/// Writes `<dir>/<Model>.xml` for every model; returns the paths written.
+pub fn write_model_descriptions(cat: &Catalogue, dir: &Path) -> std::io::Result<Vec<String>> {
+    write_rendered(cat, dir, model_description)
 }
 
-/// Names of the units whose committed `<dir>/<Model>.xml` differs from the generated one.
-pub fn stale_model_descriptions(units: &[Unit], dir: &Path) -> Vec<String> {
-    stale_rendered(units, dir, model_description, "")
+/// Names of the models whose committed `<dir>/<Model>.xml` differs from the generated one.
+pub fn stale_model_descriptions(cat: &Catalogue, dir: &Path) -> Vec<String> {
+    stale_rendered(cat, dir, model_description, "")
 }
 
-/// Writes `<dir>/<Model>.xml` (FMI 3.0) for every unit; returns the paths written.
-pub fn write_model_descriptions3(units: &[Unit], dir: &Path) -> std::io::Result<Vec<String>> {
-    write_rendered(units, dir, model_description3)
+/// Writes `<dir>/<Model>.xml` (FMI 3.0) for every model; returns the paths written.
+pub fn write_model_descriptions3(cat: &Catalogue, dir: &Path) -> std::io::Result<Vec<String>> {
+    write_rendered(cat, dir, model_description3)
 }
 
-/// Names of the units whose committed FMI 3.0 `<dir>/<Model>.xml` differs from the generated one.
-pub fn stale_model_descriptions3(units: &[Unit], dir: &Path) -> Vec<String> {
-    stale_rendered(units, dir, model_description3, "fmi3/")
+/// Names of the models whose committed FMI 3.0 `<dir>/<Model>.xml` differs from the generated one.
+pub fn stale_model_descriptions3(cat: &Catalogue, dir: &Path) -> Vec<String> {
+    stale_rendered(cat, dir, model_description3, "fmi3/")
 }
 
 /// FMI 3.0 platform tuple of a build ([`platforms::tuple`]). A `darwin64` build is told apart by its
@@ -187,26 +167,31 @@ impl<'a> Binary<'a> {
 /// Writes one `.fmu` archive (deterministic: fixed timestamps, fixed order) holding the model
 /// description, one binary per entry of `binaries` (in the given order; the macOS builds joined into
 /// one universal `darwin64` file, [`platforms::fmi2_binaries`]) and the documentation.
-pub fn write_fmu(unit: &Unit, binaries: &[Binary], out_dir: &Path) -> std::io::Result<std::path::PathBuf> {
-    let name = unit.entry.info.name;
+pub fn write_fmu(
+    cat: &Catalogue,
+    m: &ModelDescription,
+    binaries: &[Binary],
+    out_dir: &Path,
+) -> std::io::Result<std::path::PathBuf> {
+    let name = &m.name;
     let builds: Vec<(&str, &[u8])> = binaries.iter().map(|b| (b.platform, b.bytes)).collect();
     let folders = platforms::fmi2_binaries(&builds).map_err(std::io::Error::other)?;
     let files: Vec<(String, &[u8])> = folders
         .iter()
         .map(|(dir, ext, bytes)| (format!("binaries/{dir}/{name}.{ext}"), bytes.as_ref()))
         .collect();
-    write_archive(
-        unit,
-        &model_description(&unit.entry, unit.guid, unit.package),
-        &files,
-        out_dir,
-    )
+    write_archive(cat, m, &model_description(cat, m), &files, out_dir)
 }
 
 /// Writes one FMI 3.0 `.fmu` archive: the FMI 3.0 model description, the same binaries under FMI 3.0
 /// platform tuples (`binaries/x86_64-linux/<Model>.so`, ...) and the documentation. Deterministic.
-pub fn write_fmu3(unit: &Unit, binaries: &[Binary], out_dir: &Path) -> std::io::Result<std::path::PathBuf> {
-    let name = unit.entry.info.name;
+pub fn write_fmu3(
+    cat: &Catalogue,
+    m: &ModelDescription,
+    binaries: &[Binary],
+    out_dir: &Path,
+) -> std::io::Result<std::path::PathBuf> {
+    let name = &m.name;
     let files = binaries
         .iter()
         .map(|b| {
@@ -216,28 +201,23 @@ pub fn write_fmu3(unit: &Unit, binaries: &[Binary], out_dir: &Path) -> std::io::
             Ok((format!("binaries/{tuple}/{name}.{}", b.ext), b.bytes))
         })
         .collect::<std::io::Result<Vec<_>>>()?;
-    write_archive(
-        unit,
-        &model_description3(&unit.entry, unit.guid, unit.package),
-        &files,
-        out_dir,
-    )
+    write_archive(cat, m, &model_description3(cat, m), &files, out_dir)
 }
 
 /// The archive both FMI versions share: `modelDescription.xml`, the binaries at their paths, then
 /// `documentation/index.html`, with fixed timestamps and order.
 fn write_archive(
-    unit: &Unit,
+    cat: &Catalogue,
+    m: &ModelDescription,
     description: &str,
     binaries: &[(String, &[u8])],
     out_dir: &Path,
 ) -> std::io::Result<std::path::PathBuf> {
-    let entry = &unit.entry;
     if binaries.is_empty() {
         return Err(std::io::Error::other("no binary to package"));
     }
     fs::create_dir_all(out_dir)?;
-    let path = out_dir.join(format!("{}.fmu", entry.info.name));
+    let path = out_dir.join(format!("{}.fmu", m.name));
     let mut zip = ZipWriter::new(fs::File::create(&path)?);
     let opts = SimpleFileOptions::default()
         .compression_method(CompressionMethod::Deflated)
@@ -254,23 +234,27 @@ fn write_archive(
     add(
         &mut zip,
         "documentation/index.html",
-        documentation_html(entry, unit.guid).as_bytes(),
+        documentation_html(cat, m).as_bytes(),
         0o644,
     )?;
     zip.finish().map_err(std::io::Error::other)?;
     Ok(path)
 }
 
+/// The project's catalogue for the unit tests (what `src/cdylib` exports, built in this process).
+#[cfg(test)]
+pub(crate) mod tests_support {
+    pub fn project() -> spacecraft_fmus::catalogue::Catalogue {
+        spacecraft_fmus::export::project_catalogue()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    #[test]
-    fn one_archive_holds_every_platform_binary_and_one_model_description() {
-        let unit = Unit::registered(&spacecraft_fmus::registry::ALL[0]);
-        let entry = &unit.entry;
-        let dir = std::env::temp_dir().join(format!("scfmu-package-test-{}", std::process::id()));
-        let bins = [
+    fn two_platforms() -> [Binary<'static>; 2] {
+        [
             Binary {
                 platform: "linux64",
                 ext: "so",
@@ -281,13 +265,21 @@ mod tests {
                 ext: "dll",
                 bytes: b"MZ...",
             },
-        ];
-        let path = write_fmu(&unit, &bins, &dir).unwrap();
+        ]
+    }
+
+    #[test]
+    fn one_archive_holds_every_platform_binary_and_one_model_description() {
+        let cat = tests_support::project();
+        let m = &cat.models[0];
+        let dir = std::env::temp_dir().join(format!("scfmu-package-test-{}", std::process::id()));
+        let bins = two_platforms();
+        let path = write_fmu(&cat, m, &bins, &dir).unwrap();
         let mut zip = zip::ZipArchive::new(fs::File::open(&path).unwrap()).unwrap();
         let names: Vec<String> = (0..zip.len())
             .map(|i| zip.by_index(i).unwrap().name().unwrap().to_string())
             .collect();
-        let n = entry.info.name;
+        let n = &m.name;
         assert_eq!(
             names,
             vec![
@@ -300,11 +292,19 @@ mod tests {
         let mut dll = vec![];
         std::io::Read::read_to_end(&mut zip.by_name(&format!("binaries/win64/{n}.dll")).unwrap(), &mut dll).unwrap();
         assert_eq!(dll, b"MZ...");
-        assert!(write_fmu(&unit, &[], &dir).is_err());
+        assert!(write_fmu(&cat, m, &[], &dir).is_err());
         fs::remove_dir_all(&dir).ok();
         assert_eq!(platform_lib_ext("win64"), Some("dll"));
-        // FMI 3.0: the same binaries under platform tuples
-        let path3 = write_fmu3(&unit, &bins, &dir.join("fmi3")).unwrap();
+    }
+
+    #[test]
+    fn the_fmi3_archive_holds_the_same_binaries_under_platform_tuples() {
+        let cat = tests_support::project();
+        let m = &cat.models[0];
+        let n = &m.name;
+        let dir = std::env::temp_dir().join(format!("scfmu-package-test3-{}", std::process::id()));
+        let bins = two_platforms();
+        let path3 = write_fmu3(&cat, m, &bins, &dir.join("fmi3")).unwrap();
         let mut zip3 = zip::ZipArchive::new(fs::File::open(&path3).unwrap()).unwrap();
         let names3: Vec<String> = (0..zip3.len())
             .map(|i| zip3.by_index(i).unwrap().name().unwrap().to_string())

@@ -23,9 +23,10 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+use spacecraft_fmus::catalogue::Catalogue;
 use spacecraft_fmus_package::build::{cargo_build, win64_available, win64_build};
 use spacecraft_fmus_package::{
-    platform_lib_ext, stale_model_descriptions, stale_model_descriptions3, units_of_library, write_fmu, write_fmu3,
+    platform_lib_ext, read_library, stale_model_descriptions, stale_model_descriptions3, write_fmu, write_fmu3,
     write_model_descriptions, write_model_descriptions3, Binary, PLATFORM,
 };
 
@@ -141,7 +142,7 @@ fn run() -> Result<(), String> {
         (None, Some(m)) => cargo_build(m, args.locked)?,
         (None, None) => unreachable!("a crate or a library is always given"),
     };
-    let units = units_of_library(&lib)?;
+    let cat = read_library(&lib)?;
     let xml = args
         .xml
         .clone()
@@ -149,26 +150,83 @@ fn run() -> Result<(), String> {
     let docs = is_project.then(|| root.join("docs"));
 
     if args.check {
-        let mut stale = vec![];
-        if let Some(x) = &xml {
-            stale.extend(stale_model_descriptions(&units, x));
-            stale.extend(stale_model_descriptions3(&units, &x.join("fmi3")));
-        }
-        if let Some(d) = &docs {
-            stale.extend(spacecraft_fmus_package::docs::stale_pages(d));
-        }
-        if stale.is_empty() {
-            println!(
-                "model descriptions{} are up to date ({} models)",
-                if docs.is_some() { " and docs/" } else { "" },
-                units.len()
-            );
-            return Ok(());
-        }
-        return Err(format!("stale generated files: {}", stale.join(", ")));
+        return check(&cat, xml.as_deref(), docs.as_deref());
     }
 
     let host = std::fs::read(&lib).map_err(|e| format!("cannot read {} ({e})", lib.display()))?;
+    let extra = other_platforms(&args, manifest.as_deref(), &lib)?;
+    let mut binaries = vec![Binary::host(&host)];
+    for (platform, bytes) in &extra {
+        if binaries.iter().any(|b| b.platform == platform) {
+            return Err(format!("two binaries for {platform}"));
+        }
+        binaries.push(Binary {
+            platform,
+            ext: platform_lib_ext(platform).unwrap_or("so"),
+            bytes,
+        });
+    }
+
+    write_generated(&cat, xml.as_deref(), docs.as_deref())?;
+    let out = args.out.clone().unwrap_or_else(|| {
+        if is_project {
+            root.join("fmus")
+        } else {
+            krate.clone().unwrap_or_default().join("fmus")
+        }
+    });
+    for m in &cat.models {
+        let p = write_fmu(&cat, m, &binaries, &out).map_err(|e| format!("{}: {e}", m.name))?;
+        println!(
+            "wrote {} ({})",
+            p.display(),
+            binaries.iter().map(|b| b.platform).collect::<Vec<_>>().join(" + ")
+        );
+        let p3 = write_fmu3(&cat, m, &binaries, &out.join("fmi3")).map_err(|e| format!("{} (FMI 3.0): {e}", m.name))?;
+        println!("wrote {} (FMI 3.0)", p3.display());
+    }
+    Ok(())
+}
+
+/// Writes the XML folder (FMI 2.0 and, in `fmi3/`, FMI 3.0) and, for the project, the generated pages.
+fn write_generated(cat: &Catalogue, xml: Option<&Path>, docs: Option<&Path>) -> Result<(), String> {
+    if let Some(x) = xml {
+        write_model_descriptions(cat, x)
+            .map_err(|e| format!("cannot write model descriptions to {}: {e}", x.display()))?;
+        write_model_descriptions3(cat, &x.join("fmi3"))
+            .map_err(|e| format!("cannot write FMI 3.0 model descriptions to {}/fmi3: {e}", x.display()))?;
+    }
+    if let Some(d) = docs {
+        spacecraft_fmus_package::docs::write_pages(d, cat)
+            .map_err(|e| format!("cannot write docs/models and docs/references.md: {e}"))?;
+    }
+    Ok(())
+}
+
+/// `--check`: whether the XML folder and (for the project) the generated pages are what the catalogue gives.
+fn check(cat: &Catalogue, xml: Option<&Path>, docs: Option<&Path>) -> Result<(), String> {
+    let mut stale = vec![];
+    if let Some(x) = xml {
+        stale.extend(stale_model_descriptions(cat, x));
+        stale.extend(stale_model_descriptions3(cat, &x.join("fmi3")));
+    }
+    if let Some(d) = docs {
+        stale.extend(spacecraft_fmus_package::docs::stale_pages(d, cat));
+    }
+    if stale.is_empty() {
+        println!(
+            "model descriptions{} are up to date ({} models)",
+            if docs.is_some() { " and docs/" } else { "" },
+            cat.models.len()
+        );
+        return Ok(());
+    }
+    Err(format!("stale generated files: {}", stale.join(", ")))
+}
+
+/// The builds of the other platforms: `--add-lib` files, and the Windows cross build where asked for
+/// or available.
+fn other_platforms(args: &Args, manifest: Option<&Path>, lib: &Path) -> Result<Vec<(String, Vec<u8>)>, String> {
     let mut extra: Vec<(String, Vec<u8>)> = vec![];
     for (platform, path) in &args.extra {
         let bytes =
@@ -177,9 +235,9 @@ fn run() -> Result<(), String> {
     }
     let no_win64 = args.win64 == "no" || std::env::var("SCFMU_NO_WIN64").as_deref() == Ok("1");
     if !no_win64 && !extra.iter().any(|(p, _)| p == "win64") {
-        match (&manifest, win64_available()) {
+        match (manifest, win64_available()) {
             (Some(m), Ok(())) => {
-                let dll = win64_build(m, &lib)?;
+                let dll = win64_build(m, lib)?;
                 extra.push((
                     "win64".into(),
                     std::fs::read(&dll).map_err(|e| format!("cannot read {} ({e})", dll.display()))?,
@@ -195,44 +253,5 @@ fn run() -> Result<(), String> {
             (None, Ok(())) => {}
         }
     }
-    let mut binaries = vec![Binary::host(&host)];
-    for (platform, bytes) in &extra {
-        if binaries.iter().any(|b| b.platform == platform) {
-            return Err(format!("two binaries for {platform}"));
-        }
-        binaries.push(Binary {
-            platform,
-            ext: platform_lib_ext(platform).unwrap_or("so"),
-            bytes,
-        });
-    }
-
-    if let Some(x) = &xml {
-        write_model_descriptions(&units, x)
-            .map_err(|e| format!("cannot write model descriptions to {}: {e}", x.display()))?;
-        write_model_descriptions3(&units, &x.join("fmi3"))
-            .map_err(|e| format!("cannot write FMI 3.0 model descriptions to {}/fmi3: {e}", x.display()))?;
-    }
-    if let Some(d) = &docs {
-        spacecraft_fmus_package::docs::write_pages(d)
-            .map_err(|e| format!("cannot write docs/models and docs/references.md: {e}"))?;
-    }
-    let out = args.out.clone().unwrap_or_else(|| {
-        if is_project {
-            root.join("fmus")
-        } else {
-            krate.clone().unwrap_or_default().join("fmus")
-        }
-    });
-    for u in &units {
-        let p = write_fmu(u, &binaries, &out).map_err(|e| format!("{}: {e}", u.name()))?;
-        println!(
-            "wrote {} ({})",
-            p.display(),
-            binaries.iter().map(|b| b.platform).collect::<Vec<_>>().join(" + ")
-        );
-        let p3 = write_fmu3(u, &binaries, &out.join("fmi3")).map_err(|e| format!("{} (FMI 3.0): {e}", u.name()))?;
-        println!("wrote {} (FMI 3.0)", p3.display());
-    }
-    Ok(())
+    Ok(extra)
 }

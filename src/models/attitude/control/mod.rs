@@ -1,5 +1,5 @@
 //! Three-axis attitude controllers. Every controller embeds the common port block
-//! (`shared::AttitudeControllerPorts`: `q_*`, `w_*`, `q_ref_*`, `w_ref_*` → `torque_cmd_*`), so they
+//! (`crate::models::ports::AttitudeControllerPorts`: `q_*`, `w_*`, `q_ref_*`, `w_ref_*` → `torque_cmd_*`), so they
 //! swap as black boxes; what several controllers share lives in `shared/` (not FMUs).
 //!
 //! A new controller: one file here, and one line in the list below.

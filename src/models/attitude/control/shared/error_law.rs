@@ -2,8 +2,8 @@
 
 use nalgebra::Vector3;
 
-use super::ports::{check_unit_quaternions, AttitudeControllerPorts};
 use crate::math::attitude::{attitude_matrix, error_quaternion, euler321_from_quat, wrap_pi};
+use crate::models::ports::{check_unit_quaternions, AttitudeControllerPorts};
 
 crate::param_enum! {
     /// Error signal (`error_law` parameter), ≈ commanded minus actual angle per axis.

@@ -5,12 +5,12 @@
 use nalgebra::{Matrix3, Quaternion, SVector, Vector3};
 use serde::{Deserialize, Serialize};
 
-use super::ports::{check_unit_quaternions, AttitudeControllerPorts};
 use crate::declare_variables;
 use crate::math::attitude::{euler321_from_quat, skew};
 use crate::math::fuzzy::PdFuzzySystem;
 use crate::math::integrate::rk4;
 use crate::model::ParamEnum;
+use crate::models::ports::{check_unit_quaternions, AttitudeControllerPorts};
 
 declare_variables! {
     /// Ports and parameters every MRAC-type controller has, besides the common controller ports:

@@ -5,8 +5,8 @@
 use nalgebra::SVector;
 
 use super::mrac::{Mrac, MracState};
-use super::ports::{check_unit_quaternions, AttitudeControllerPorts};
 use crate::model::StateDecl;
+use crate::models::ports::{check_unit_quaternions, AttitudeControllerPorts};
 
 const Q: [&str; 4] = ["q_w", "q_x", "q_y", "q_z"];
 const W: [&str; 3] = ["w_x", "w_y", "w_z"];

@@ -16,9 +16,9 @@
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
-use super::ports::{check_unit_quaternions, AttitudeControllerPorts};
 use crate::declare_variables;
 use crate::math::attitude::attitude_matrix;
+use crate::models::ports::{check_unit_quaternions, AttitudeControllerPorts};
 
 declare_variables! {
     /// Inputs, diagnostic outputs and parameters of every sliding-mode attitude controller besides the

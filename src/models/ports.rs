@@ -1,5 +1,10 @@
-//! The port block every three-axis attitude controller embeds (`ports: AttitudeControllerPorts;`), so
-//! controllers swap as black boxes on `AttitudePlant` and `AttitudeCommand`.
+//! Shared port blocks: the ports every unit of a kind has, declared once and embedded by name in each
+//! unit's declaration (`ports: AttitudeControllerPorts;`), so that units of a kind swap as black boxes.
+//! Public (re-exported by `crate::export`): a model crate's controller embeds the same block and then
+//! plugs into the project's `AttitudePlant` and `AttitudeCommand` like the project's own controllers.
+//!
+//! - [`AttitudeControllerPorts`]: three-axis attitude controllers (measured and commanded attitude and
+//!   rate in, torque command out), with [`check_unit_quaternions`].
 
 use crate::declare_variables;
 

@@ -1,22 +1,12 @@
-//! The publications the models come from, cited in descriptions and documentation by a bracketed key
-//! (`[Navabi-2019] Eq. 37`). The FMU documentation and the generated docs expand every key they use
-//! into the full reference, so a user never meets an internal paper number.
+//! The publications the project's models come from, cited in descriptions and documentation by a
+//! bracketed key (`[Navabi-2019] Eq. 37`). The list goes into the catalogue the library exports; the
+//! packaging tool expands every key a page uses into the full reference (so a user never meets an
+//! internal paper number) and refuses a key that is not listed here.
 
-/// One publication.
-#[derive(Clone, Copy, Debug)]
-pub struct Reference {
-    /// Citation key, written in text as `[key]`.
-    pub key: &'static str,
-    pub authors: &'static str,
-    pub title: &'static str,
-    /// Journal, year and language notes, as far as known ("" = not recorded; likewise `authors`).
-    pub venue: &'static str,
-    /// A description standing in for the title when the title is not recorded ("" otherwise).
-    pub subject: &'static str,
-    /// What this library takes from it.
-    pub used_for: &'static str,
-}
+use crate::catalogue::Reference;
 
+/// The project's bibliography, in the order `docs/references.md` lists it (`src/cdylib` passes it to
+/// `export_fmus!`). A new publication: one entry here, cited as `[key]` in a model's texts.
 pub const ALL: &[Reference] = &[
     Reference {
         key: "Navabi-2019",
@@ -113,84 +103,31 @@ pub const ALL: &[Reference] = &[
     },
 ];
 
-/// The references whose `[key]` occurs in any of `texts`, in the order of [`ALL`].
-pub fn cited_in<'a>(texts: impl IntoIterator<Item = &'a str> + Clone) -> Vec<&'static Reference> {
-    ALL.iter()
-        .filter(|r| {
-            let tag = format!("[{}]", r.key);
-            texts.clone().into_iter().any(|t| t.contains(&tag))
-        })
-        .collect()
-}
-
-/// Every `[key]`-shaped tag in `text` (letters, digits and '-' only), for checking that each is known.
-pub fn tags_in(text: &str) -> Vec<&str> {
-    let mut out = Vec::new();
-    let mut rest = text;
-    while let Some(i) = rest.find('[') {
-        let after = &rest[i + 1..];
-        match after.find(']') {
-            Some(j)
-                if j > 0
-                    && after[..j].chars().all(|c| c.is_ascii_alphanumeric() || c == '-')
-                    && after[..j].chars().any(|c| c.is_ascii_alphabetic())
-                    && after[..j].contains('-') =>
-            {
-                out.push(&after[..j]);
-                rest = &after[j + 1..];
-            }
-            _ => rest = after,
-        }
-    }
-    out
-}
-
-/// "authors, “title”, venue." in plain text; unknown authors or venue (empty) are said to be unknown.
-pub fn citation(r: &Reference) -> String {
-    let title = if r.title.is_empty() {
-        format!("A work on {} (title not recorded)", r.subject)
-    } else {
-        format!("\u{201c}{}\u{201d}", r.title)
-    };
-    match (r.authors.is_empty(), r.venue.is_empty()) {
-        (false, false) => format!("{}, {title}, {}.", r.authors, r.venue),
-        (false, true) => format!("{}, {title} (venue not recorded).", r.authors),
-        (true, false) => format!("{title}, {} (authors not recorded).", r.venue),
-        (true, true) => format!("{title} (authors and venue not recorded)."),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::catalogue::cited_keys;
 
     #[test]
-    fn keys_are_unique_and_found() {
+    fn keys_are_unique_and_well_formed() {
         for (i, a) in ALL.iter().enumerate() {
             assert!(ALL[i + 1..].iter().all(|b| b.key != a.key));
+            assert_eq!(cited_keys(&format!("[{}]", a.key)), [a.key]);
         }
-        let t = "as in [Navabi-2019] Eq. 5 and [Moradi-FTC]; not a key: [0, 1] or [x]";
-        let keys: Vec<_> = cited_in([t]).iter().map(|r| r.key).collect();
-        assert_eq!(keys, ["Navabi-2019", "Moradi-FTC"]);
-        assert_eq!(tags_in(t), ["Navabi-2019", "Moradi-FTC"]);
     }
 
     #[test]
     fn every_model_cites_only_known_references_and_at_least_one() {
-        for e in spacecraft_fmus::registry::ALL {
-            let texts = e.texts();
-            let mut cited = 0;
-            for t in &texts {
-                for tag in tags_in(t) {
-                    assert!(
-                        ALL.iter().any(|r| r.key == tag),
-                        "{}: unknown reference [{tag}]",
-                        e.info.name
-                    );
-                    cited += 1;
-                }
+        for e in crate::registry::ALL {
+            let keys: Vec<&str> = e.texts().iter().flat_map(|t| cited_keys(t)).collect();
+            for k in &keys {
+                assert!(
+                    ALL.iter().any(|r| r.key == *k),
+                    "{}: unknown reference [{k}]",
+                    e.info.name
+                );
             }
-            assert!(cited > 0, "{}: cites no reference", e.info.name);
+            assert!(!keys.is_empty(), "{}: cites no reference", e.info.name);
         }
     }
 }

@@ -1,0 +1,150 @@
+//! `documentation/index.html` of a model, and the texts the Markdown model pages ([`crate::docs`])
+//! share with it: the interfaces sentence, the variable sections, admissible values and the expansion
+//! of cited `[key]`s into full references from the catalogue's bibliography.
+
+use std::fmt::Write as _;
+
+use spacecraft_fmus::catalogue::{
+    BoundDescription, Catalogue, Causality, ModelDescription, ReferenceDescription, VariableDescription,
+};
+
+use crate::xml::{start_str, variability_str, GENERATION_TOOL};
+
+/// The variable tables of a model's documentation (HTML page and Markdown model pages), in order.
+pub(crate) const VARIABLE_SECTIONS: [(&str, Causality); 5] = [
+    ("Parameters", Causality::Parameter),
+    ("Inputs", Causality::Input),
+    ("Outputs", Causality::Output),
+    ("Calculated parameters", Causality::CalculatedParameter),
+    ("Local variables", Causality::Local),
+];
+
+pub(crate) fn bound_text(b: &BoundDescription) -> String {
+    match b {
+        BoundDescription::Any => String::new(),
+        BoundDescription::Positive => "> 0".into(),
+        BoundDescription::NonNegative => ">= 0".into(),
+        BoundDescription::Limit => ">= 0 (1e30 = no limit)".into(),
+        BoundDescription::Range(lo, hi) => format!("[{lo}, {hi}]"),
+        BoundDescription::Choice(codes) => format!("one of {codes:?}"),
+    }
+}
+
+pub(crate) fn html_escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// The start value as the tables show it (none where the description writes none).
+pub(crate) fn start_text(d: &VariableDescription) -> String {
+    if d.has_start() {
+        start_str(d.start)
+    } else {
+        String::new()
+    }
+}
+
+/// The references of the catalogue whose `[key]` occurs in any of `texts`, in bibliography order.
+pub fn cited_in<'c>(cat: &'c Catalogue, texts: &[&str]) -> Vec<&'c ReferenceDescription> {
+    cat.references
+        .iter()
+        .filter(|r| {
+            let tag = format!("[{}]", r.key);
+            texts.iter().any(|t| t.contains(&tag))
+        })
+        .collect()
+}
+
+/// "authors, “title”, venue." in plain text; unknown authors or venue (empty) are said to be unknown.
+pub fn citation(r: &ReferenceDescription) -> String {
+    let title = if r.title.is_empty() {
+        format!("A work on {} (title not recorded)", r.subject)
+    } else {
+        format!("\u{201c}{}\u{201d}", r.title)
+    };
+    match (r.authors.is_empty(), r.venue.is_empty()) {
+        (false, false) => format!("{}, {title}, {}.", r.authors, r.venue),
+        (false, true) => format!("{}, {title} (venue not recorded).", r.authors),
+        (true, false) => format!("{title}, {} (authors not recorded).", r.venue),
+        (true, true) => format!("{title} (authors and venue not recorded)."),
+    }
+}
+
+/// Which FMI interfaces a model offers, in one sentence (model pages and documentation/index.html).
+pub fn interfaces_text(m: &ModelDescription) -> String {
+    match &m.states {
+        Some(states) if states.is_empty() => {
+            "FMI 2.0 and FMI 3.0 Model Exchange (a static law: no continuous state) and Co-Simulation.".into()
+        }
+        Some(states) => format!(
+            "FMI 2.0 and FMI 3.0 Model Exchange ({} continuous states: {}) and Co-Simulation.",
+            states.len(),
+            states.iter().map(|x| x.name.as_str()).collect::<Vec<_>>().join(", ")
+        ),
+        None if !m.variable_step => "FMI 2.0 and FMI 3.0 Co-Simulation only: a sampled law (its behaviour is defined at its sample times, not as a continuous right-hand side).".into(),
+        None => "FMI 2.0 and FMI 3.0 Co-Simulation only: its internal state evolves in discrete steps (not as a continuous right-hand side).".into(),
+    }
+}
+
+const STYLE: &str = "<style>body{font-family:sans-serif;max-width:60em;margin:2em auto;line-height:1.4}table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:2px 6px;text-align:left;vertical-align:top}pre{background:#f4f4f4;padding:0.5em;overflow-x:auto}code{background:#f4f4f4}</style>\n";
+
+const CONVENTIONS: &str = concat!(
+    "\n<h2>Conventions</h2>\n<ul><li>SI units on every port; degrees only where the name ends in <code>_deg</code>.</li>",
+    "<li>Quaternions are scalar-first Hamilton quaternions (q_w, q_x, q_y, q_z) of the body frame relative to the reference frame; A(q) maps reference components into body components.</li>",
+    "<li>Parameters are read at fmi2ExitInitializationMode; invalid values give fmi2Error with a log message.</li>",
+    "<li>\"No limit\" is encoded as 1e30.</li></ul>\n",
+);
+
+/// documentation/index.html: purpose, source, equations, conventions, variable tables, references.
+pub fn documentation_html(cat: &Catalogue, m: &ModelDescription) -> String {
+    let mut h = String::new();
+    h.push_str("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n");
+    let _ = writeln!(h, "<title>{}</title>", m.name);
+    h.push_str(STYLE);
+    h.push_str("</head>\n<body>\n");
+    let _ = writeln!(h, "<h1>{}</h1>\n<p>{}</p>", m.name, html_escape(&m.description));
+    let _ = writeln!(h, "<p><b>Source:</b> {}</p>", html_escape(&m.source));
+    let _ = writeln!(
+        h,
+        "<p><b>GUID:</b> <code>{}</code> &middot; <b>Generated by:</b> {}</p>",
+        m.guid, GENERATION_TOOL
+    );
+    let _ = writeln!(h, "<p><b>Interfaces:</b> {}</p>", html_escape(&interfaces_text(m)));
+    h.push_str("<h2>Equations</h2>\n");
+    h.push_str(&m.equations_html);
+    h.push_str(CONVENTIONS);
+    for (title, caus) in VARIABLE_SECTIONS {
+        let rows: Vec<&VariableDescription> = m.variables.iter().filter(|d| d.causality == caus).collect();
+        if rows.is_empty() {
+            continue;
+        }
+        let _ = writeln!(h, "<h2>{title}</h2>\n<table>\n<tr><th>name</th><th>vr</th><th>type</th><th>variability</th><th>start</th><th>unit</th><th>admissible</th><th>meaning</th></tr>");
+        for d in rows {
+            let _ = writeln!(
+                h,
+                "<tr><td><code>{}</code></td><td>{}</td><td>{:?}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                d.name,
+                d.vr,
+                d.kind,
+                variability_str(d.variability),
+                start_text(d),
+                html_escape(&d.unit),
+                html_escape(&bound_text(&d.bound)),
+                html_escape(&d.description)
+            );
+        }
+        h.push_str("</table>\n");
+    }
+    let cited = cited_in(cat, &m.texts());
+    if !cited.is_empty() {
+        h.push_str("<h2>References</h2>\n<ul>\n");
+        for r in cited {
+            let _ = writeln!(h, "<li><b>[{}]</b> {}</li>", r.key, html_escape(&citation(r)));
+        }
+        h.push_str("</ul>\n");
+    }
+    h.push_str("</body>\n</html>\n");
+    h
+}
