@@ -27,7 +27,7 @@ fn fingerprint(entry: &ModelEntry) -> String {
         info.variable_step,
         info.default_stop_time,
         info.default_step,
-        info.feedthrough_text()
+        feedthrough_text(entry)
     );
     for d in entry.decls {
         let start = match d.start {
@@ -67,13 +67,13 @@ fn fingerprint(entry: &ModelEntry) -> String {
     s
 }
 
-impl super::ModelInfo {
-    fn feedthrough_text(&self) -> String {
-        match self.feedthrough {
-            Feedthrough::None => "none".into(),
-            Feedthrough::AllInputs => "all".into(),
-            Feedthrough::Some(list) => format!("{list:?}"),
-        }
+/// The feed-through list with FMI scalar names (a vector stem expanded, so the GUID does not depend on
+/// how the list was written).
+fn feedthrough_text(entry: &ModelEntry) -> String {
+    match entry.info.feedthrough {
+        Feedthrough::None => "none".into(),
+        Feedthrough::AllInputs => "all".into(),
+        Feedthrough::Some(_) => format!("{:?}", super::feedthrough::scalar_list(entry).unwrap_or_default()),
     }
 }
 

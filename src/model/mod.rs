@@ -6,6 +6,7 @@
 
 mod declare;
 mod exchange;
+pub mod feedthrough;
 pub mod guid;
 mod instance;
 pub mod leaves;
@@ -476,6 +477,7 @@ pub struct ModelEntry {
 
 impl ModelEntry {
     pub const fn of<M: Model>() -> Self {
+        let () = feedthrough::Checked::<M>::FEEDTHROUGH; // a compile error naming a mistyped feed-through name
         ModelEntry {
             info: &M::INFO,
             decls: M::Vars::DECLS,

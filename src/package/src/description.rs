@@ -155,15 +155,16 @@ pub fn check_declarations(entry: &ModelEntry) -> Result<(), String> {
         for d in x.starts_from {
             if input_index(entry, d).is_none() {
                 return Err(format!(
-                    "{name}: the start of continuous state {} is taken from {d}, which is not an input",
-                    x.name
+                    "{name}: the start of continuous state {} is taken from {d}, which is not an input (inputs: {})",
+                    x.name,
+                    crate::names::of_causality(entry, Causality::Input)
                 ));
             }
         }
         for d in x.depends.unwrap_or(&[]) {
             let input = entry.decl(d).is_some_and(|v| v.causality == Causality::Input);
             if !input && !states.iter().any(|y| y.name == *d) {
-                return Err(format!("{name}: the derivative of continuous state {} depends on {d}, which is neither an input nor a continuous state", x.name));
+                return Err(format!("{name}: the derivative of continuous state {} depends on {d}, which is neither an input nor a continuous state (valid: {})", x.name, crate::names::inputs_and_states(entry)));
             }
         }
     }
@@ -177,12 +178,22 @@ pub fn check_declarations(entry: &ModelEntry) -> Result<(), String> {
         for (o, ins) in list {
             match entry.decl(o) {
                 Some(d) if d.causality == Causality::Output => {}
-                _ => return Err(format!("{name}: feedthrough output {o} is not an output")),
+                _ => {
+                    let valid = crate::names::of_causality(entry, Causality::Output);
+                    return Err(format!(
+                        "{name}: feedthrough output {o} is not an output (outputs: {valid})"
+                    ));
+                }
             }
             for i in *ins {
                 match entry.decl(i) {
                     Some(d) if d.causality == Causality::Input => {}
-                    _ => return Err(format!("{name}: feedthrough input {i} is not an input")),
+                    _ => {
+                        let valid = crate::names::of_causality(entry, Causality::Input);
+                        return Err(format!(
+                            "{name}: feedthrough input {i} is not an input (inputs: {valid})"
+                        ));
+                    }
                 }
             }
         }

@@ -14,6 +14,7 @@ pub mod description;
 pub mod description3;
 pub mod docs;
 mod load;
+pub mod names;
 pub mod platforms;
 pub mod references;
 pub mod structure;
