@@ -3,11 +3,12 @@
 # documentation/index.html generated from the declarations, binaries/linux64 and, when the Windows cross
 # toolchain of the project's scripts/setup.sh is installed, binaries/win64), and fmus/fmi3/<Model>.fmu.
 #
-# It runs the packaging tool fmu-package: $FMU_PACKAGE if set, else the one on PATH. When there is none,
-# it installs it once (cargo install, into ~/.cargo/bin or $CARGO_INSTALL_ROOT/bin) from the very
-# spacecraft_fmus source this crate depends on (the path or git dependency in Cargo.toml, as Cargo
-# resolved it), so that the tool and the library are the same version. Copy this folder anywhere and edit
-# only the spacecraft_fmus line of Cargo.toml; nothing else points at the project.
+# It runs the packaging tool fmu-package: $FMU_PACKAGE if set, else the one on PATH, else
+# ~/.cargo/bin/fmu-package (or $CARGO_INSTALL_ROOT/bin/fmu-package) from an earlier install; when there is
+# none, it installs it there once (cargo install) from the very spacecraft_fmus source this crate depends
+# on (the path or git dependency in Cargo.toml, as Cargo resolved it), so that the tool and the library
+# are the same version. Copy this folder anywhere and edit only the spacecraft_fmus line of Cargo.toml;
+# nothing else points at the project.
 #
 #   ./build.sh                 build, package, write fmus/
 #   ./build.sh --win64 no      linux64 only (also SCFMU_NO_WIN64=1)
@@ -30,9 +31,12 @@ library_source() {
 }
 
 tool="${FMU_PACKAGE:-}"
+root="${CARGO_INSTALL_ROOT:-${CARGO_HOME:-$HOME/.cargo}}"
 if [ -z "$tool" ]; then
     if command -v fmu-package >/dev/null 2>&1; then
         tool="fmu-package"
+    elif [ -x "$root/bin/fmu-package" ]; then
+        tool="$root/bin/fmu-package"  # installed by an earlier run, folder not on PATH
     else
         src="$(library_source)"
         if [ -z "$src" ]; then
@@ -43,9 +47,8 @@ if [ -z "$tool" ]; then
             exit 1
         fi
         echo "build.sh: fmu-package is not on PATH; installing it once from $src/src/package" \
-            "(cargo install --locked --path …; about a minute on top of the first build)" >&2
+            "(cargo install --locked --path …; a few minutes, see docs/export.md)" >&2
         cargo install --quiet --locked --path "$src/src/package"
-        root="${CARGO_INSTALL_ROOT:-${CARGO_HOME:-$HOME/.cargo}}"
         tool="$root/bin/fmu-package"
         if ! command -v fmu-package >/dev/null 2>&1; then
             echo "build.sh: installed $tool; add $root/bin to PATH to run fmu-package yourself" >&2
