@@ -118,8 +118,11 @@ pub fn describe(e: &ModelEntry) -> ModelDescription {
         feedthrough: match i.feedthrough {
             Feedthrough::None => FeedthroughDescription::None,
             Feedthrough::AllInputs => FeedthroughDescription::AllInputs,
-            Feedthrough::Some(l) => FeedthroughDescription::Some(
-                l.iter()
+            // FMI scalar names (a vector stem expanded)
+            Feedthrough::Some(_) => FeedthroughDescription::Some(
+                crate::model::feedthrough::scalar_list(e)
+                    .unwrap_or_default()
+                    .into_iter()
                     .map(|(o, ins)| (o.to_string(), ins.iter().map(|s| s.to_string()).collect()))
                     .collect(),
             ),

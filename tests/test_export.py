@@ -1,11 +1,13 @@
-"""The exporter for users' crates (docs/export.md): examples/custom_controller/build.sh on a clean copy of
-the repository gives a valid FMU that carries only its own model and swaps into the `default` scenario in
-place of PdController with the same trajectory; bad declarations fail at compile time or packaging time
-with messages that name the variable.
+"""The exporter for users' crates (docs/export.md): the template examples/custom_controller, copied outside
+the repository with only its spacecraft_fmus dependency line edited, builds with the installed packaging tool
+into a valid FMU that carries only its own model and swaps into the `default` scenario in place of
+PdController with the same trajectory; bad declarations fail at compile time (feed-through lists included)
+with messages that name the variable and, for feed-through names, the valid ones.
 
-Cargo builds here go to target/export-test (CARGO_TARGET_DIR), one folder shared by these tests and kept
-between runs, never the repository's own target/release: the clean copy's packaging tool would replace
-target/release/fmu-package with one that points at the copy."""
+Cost: the tool is installed with `cargo install --root <tmp>` and every crate is built with
+CARGO_TARGET_DIR = the repository's target/, so the compiled dependencies (and the tool itself) are reused:
+on a warm target/ the install takes seconds and each small crate about a minute of compiling (the
+template, the feed-through crates); on a cold one the first build costs what docs/export.md says."""
 
 from __future__ import annotations
 
@@ -29,12 +31,12 @@ from scfmu.scenario.check import check
 
 ROOT = Path(__file__).resolve().parents[1]
 TARGET = ROOT / "target"
-TOOL = TARGET / "release" / "fmu-package"
-BUILDS = TARGET / "export-test"
+TEMPLATE = ROOT / "examples/custom_controller"
+DEPENDENCY_LINE = 'spacecraft_fmus = { path = "../.." }'
 
 
 def _env(**extra) -> dict:
-    env = dict(os.environ, CARGO_TARGET_DIR=str(BUILDS), CARGO_TERM_COLOR="never")
+    env = dict(os.environ, CARGO_TARGET_DIR=str(TARGET), CARGO_TERM_COLOR="never")
     env.update(extra)
     return env
 
@@ -47,32 +49,73 @@ def _win64_toolchain() -> bool:
 
 
 @pytest.fixture(scope="module")
-def clean_copy(tmp_path_factory) -> Path:
-    """The repository's files as a fresh clone has them (tracked and not ignored), without build output."""
-    dest = tmp_path_factory.mktemp("clone") / "repo"
-    files = subprocess.run(["git", "ls-files", "-co", "--exclude-standard", "-z"], cwd=ROOT, capture_output=True,
-                           check=True).stdout.decode().split("\0")
+def tools(tmp_path_factory) -> Path:
+    """fmu-package installed as docs/export.md says (`cargo install --locked --path src/package`), into a
+    temporary root: its bin/ folder."""
+    root = tmp_path_factory.mktemp("tools")
+    r = subprocess.run(["cargo", "install", "--quiet", "--locked", "--path", str(ROOT / "src/package"), "--root",
+                        str(root)], capture_output=True, text=True, env=_env(), timeout=1800)
+    assert r.returncode == 0, r.stderr[-3000:]
+    assert (root / "bin/fmu-package").is_file()
+    return root / "bin"
+
+
+def _copy_template(dest: Path) -> Path:
+    """The template's tracked files copied to `dest`, with the dependency line (and only it) pointing at this
+    repository by absolute path."""
+    files = subprocess.run(["git", "ls-files", "-co", "--exclude-standard", "-z", "."], cwd=TEMPLATE,
+                           capture_output=True, check=True).stdout.decode().split("\0")
     for rel in filter(None, files):
-        src = ROOT / rel
-        if src.is_file():
-            (dest / rel).parent.mkdir(parents=True, exist_ok=True)
-            shutil.copy2(src, dest / rel)
-    assert not (dest / "examples/custom_controller/target").exists()
+        (dest / rel).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(TEMPLATE / rel, dest / rel)
+    toml = (dest / "Cargo.toml").read_text()
+    assert toml.count(DEPENDENCY_LINE) == 1
+    (dest / "Cargo.toml").write_text(toml.replace(DEPENDENCY_LINE, f'spacecraft_fmus = {{ path = "{ROOT}" }}'))
     return dest
 
 
 @pytest.fixture(scope="module")
-def built(clean_copy) -> Path:
-    script = clean_copy / "examples/custom_controller/build.sh"
-    r = subprocess.run([str(script)], capture_output=True, text=True, env=_env(), timeout=3000)
+def template(tmp_path_factory) -> Path:
+    crate = _copy_template(tmp_path_factory.mktemp("elsewhere") / "my_controller")
+    assert ROOT not in crate.parents
+    assert not (crate / "target").exists() and not (crate / "fmus").exists()
+    return crate
+
+
+def _path_with(bin_dir: Path | None) -> str:
+    """PATH with cargo's folder and the system's, plus `bin_dir`: no other fmu-package."""
+    dirs = [str(Path(shutil.which("cargo")).parent), "/usr/local/bin", "/usr/bin", "/bin"]
+    return os.pathsep.join(([str(bin_dir)] if bin_dir else []) + dirs)
+
+
+@pytest.fixture(scope="module")
+def built(template, tools) -> Path:
+    r = subprocess.run([str(template / "build.sh")], capture_output=True, text=True,
+                       env=_env(PATH=_path_with(tools)), timeout=3000)
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
-    fmu = clean_copy / "examples/custom_controller/fmus/SaturationAwarePd.fmu"
+    fmu = template / "fmus/SaturationAwarePd.fmu"
     assert fmu.is_file(), r.stdout + r.stderr
     assert f"wrote {fmu}" in r.stdout
+    assert (template / "fmus/fmi3/SaturationAwarePd.fmu").is_file()
     return fmu
 
 
-def test_build_sh_on_a_clean_copy_gives_a_valid_fmu_that_carries_only_its_own_model(built):
+def test_without_the_tool_on_path_build_sh_installs_it_from_the_dependency_and_says_so(template, tmp_path):
+    """The same copy, with no fmu-package on PATH: build.sh installs the tool from the spacecraft_fmus source
+    Cargo resolved for the crate (into CARGO_INSTALL_ROOT here), says so, and packages."""
+    if any((Path(d) / "fmu-package").exists() for d in _path_with(None).split(os.pathsep)):
+        pytest.skip("an fmu-package is installed next to cargo")
+    root = tmp_path / "root"
+    out = tmp_path / "fmus"
+    r = subprocess.run([str(template / "build.sh"), "--out", str(out), "--win64", "no"], capture_output=True,
+                       text=True, env=_env(PATH=_path_with(None), CARGO_INSTALL_ROOT=str(root)), timeout=3000)
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    assert f"fmu-package is not on PATH; installing it once from {ROOT}/src/package" in r.stderr, r.stderr[-2000:]
+    assert (root / "bin/fmu-package").is_file()
+    assert validate_fmu(str(out / "SaturationAwarePd.fmu")) == []
+
+
+def test_build_sh_on_a_copy_outside_the_repository_gives_a_valid_fmu_that_carries_only_its_own_model(built):
     assert validate_fmu(str(built)) == []
     names = zipfile.ZipFile(built).namelist()
     expected = ["modelDescription.xml", "binaries/linux64/SaturationAwarePd.so", "documentation/index.html"]
@@ -128,10 +171,10 @@ def test_it_passes_the_preflight_check_and_swaps_into_default_with_the_pd_trajec
     assert not np.array_equal(alt["q_w"], ref["q_w"])
 
 
-def test_the_staleness_check_works_for_a_users_committed_descriptions(built, clean_copy, tmp_path):
-    crate = clean_copy / "examples/custom_controller"
+def test_the_staleness_check_works_for_a_users_committed_descriptions(built, template, tools, tmp_path):
+    crate = template
     xml = tmp_path / "md"
-    common = [str(TOOL), "--crate", str(crate), "--out", str(tmp_path / "fmus"), "--xml", str(xml), "--win64", "no"]
+    common = [str(tools / "fmu-package"), "--crate", str(crate), "--out", str(tmp_path / "fmus"), "--xml", str(xml), "--win64", "no"]
     r = subprocess.run(common, capture_output=True, text=True, env=_env(), timeout=1200)
     assert r.returncode == 0, r.stderr[-2000:]
     assert (xml / "SaturationAwarePd.xml").read_bytes() == zipfile.ZipFile(built).read("modelDescription.xml")
@@ -253,14 +296,36 @@ def test_a_bad_declaration_is_a_compile_error_that_names_the_variable(bad_crate,
         assert BAD[feature][1] in r.stderr, r.stderr[-3000:]
 
 
-def test_a_feedthrough_naming_an_unknown_variable_is_refused_at_packaging_time(tmp_path):
-    """What the type system cannot see (the feed-through list names variables by string) is checked by
-    fmu-package before anything is written."""
-    crate = tmp_path / "bad_feedthrough"
+LEAKY = """\
+    use spacecraft_fmus::export::*;
+    declare_variables! {
+        pub struct Vars {
+            0 => u: Vec3 = [0.0; 3], Input, "", "Input";
+            3 => v: Real = 0.0, Input, "", "Input without feed-through";
+            10 => y: Vec3 = [0.0; 3], Output, "", "Output";
+        }
+    }
+    #[derive(Clone, Serialize, Deserialize)]
+    pub struct Leaky;
+    impl Model for Leaky {
+        type Vars = Vars;
+        const INFO: ModelInfo = ModelInfo { name: "Leaky", description: "A gain on a vector",
+            feedthrough: Feedthrough::Some(&[("y", &["INPUT"])]), ..ModelInfo::DEFAULT };
+        const EVOLVING: &'static [&'static str] = &[];
+        fn initialize(_v: &mut Vars, _e: &Experiment) -> Result<Self, String> { Ok(Leaky) }
+        fn outputs(&self, v: &mut Vars, _t: f64) -> ModelResult { v.y = v.u; Ok(()) }
+    }
+    export_fmus!(Leaky);
+    """
+
+
+@pytest.fixture(scope="module")
+def leaky(tmp_path_factory) -> Path:
+    crate = tmp_path_factory.mktemp("leaky") / "leaky"
     (crate / "src").mkdir(parents=True)
     (crate / "Cargo.toml").write_text(textwrap.dedent(f"""\
         [package]
-        name = "bad_feedthrough"
+        name = "leaky"
         version = "0.1.0"
         edition = "2021"
         publish = false
@@ -280,37 +345,43 @@ def test_a_feedthrough_naming_an_unknown_variable_is_refused_at_packaging_time(t
         codegen-units = 4
         strip = true
         """))
-    (crate / "src/lib.rs").write_text(textwrap.dedent("""\
-        use spacecraft_fmus::export::*;
-        declare_variables! {
-            pub struct Vars {
-                0 => u: Real = 0.0, Input, "", "Input";
-                1 => y: Real = 0.0, Output, "", "Output";
-            }
-        }
-        #[derive(Clone, Serialize, Deserialize)]
-        pub struct Leaky;
-        impl Model for Leaky {
-            type Vars = Vars;
-            const INFO: ModelInfo = ModelInfo { name: "Leaky", description: "Feed-through list with a typo",
-                feedthrough: Feedthrough::Some(&[("y", &["uu"])]), ..ModelInfo::DEFAULT };
-            const EVOLVING: &'static [&'static str] = &[];
-            fn initialize(_v: &mut Vars, _e: &Experiment) -> Result<Self, String> { Ok(Leaky) }
-            fn outputs(&self, v: &mut Vars, _t: f64) -> ModelResult { v.y = v.u; Ok(()) }
-        }
-        export_fmus!(Leaky);
-        """))
     shutil.copyfile(ROOT / "Cargo.lock", crate / "Cargo.lock")
-    r = subprocess.run([str(TOOL), "--crate", str(crate), "--win64", "no"], capture_output=True, text=True, env=_env(),
-                       timeout=1800)
+    return crate
+
+
+def _package_leaky(crate: Path, tools: Path, feedthrough_input: str) -> subprocess.CompletedProcess:
+    (crate / "src/lib.rs").write_text(textwrap.dedent(LEAKY).replace("INPUT", feedthrough_input))
+    shutil.rmtree(crate / "fmus", ignore_errors=True)
+    return subprocess.run([str(tools / "fmu-package"), "--crate", str(crate), "--win64", "no"], capture_output=True,
+                          text=True, env=_env(), timeout=1800)
+
+
+def test_a_feedthrough_naming_an_unknown_variable_is_a_compile_error_listing_the_valid_names(leaky, tools):
+    """The feed-through list names variables by string; the declaration's const check refuses a name that is
+    neither a declared input nor a vector's stem while the crate compiles (no FMU is written)."""
+    r = _package_leaky(leaky, tools, "uu")
     assert r.returncode == 1
-    assert "Leaky: feedthrough input uu is not an input" in r.stderr, r.stderr[-2000:]
-    assert not (crate / "fmus").exists()
+    assert "Leaky: feed-through input `uu` is not an input of the model (nor the stem of a vector input); " \
+        "its inputs are: u_x, u_y, u_z, v" in r.stderr, r.stderr[-3000:]
+    assert "cargo build of" in r.stderr and "failed" in r.stderr
+    assert not (leaky / "fmus").exists()
 
 
-def test_a_library_without_the_export_macro_is_refused_with_the_reason(tmp_path):
+def test_a_vector_stem_in_a_feedthrough_list_stands_for_its_components(leaky, tools):
+    r = _package_leaky(leaky, tools, "u")
+    assert r.returncode == 0, r.stderr[-3000:]
+    for fmu in (leaky / "fmus/Leaky.fmu", leaky / "fmus/fmi3/Leaky.fmu"):
+        assert validate_fmu(str(fmu)) == [], fmu
+        md = read_model_description(str(fmu))
+        u = [v for v in md.modelVariables if v.name in ("u_x", "u_y", "u_z")]
+        assert [o.variable.name for o in md.outputs] == ["y_x", "y_y", "y_z"], fmu
+        for o in md.outputs:
+            assert o.dependencies == u, (fmu, o.variable.name, [d.name for d in o.dependencies])
+
+
+def test_a_library_without_the_export_macro_is_refused_with_the_reason(tools, tmp_path):
     lib = next((TARGET / "release").glob("libscfmu_native_loop.so"))
-    r = subprocess.run([str(TOOL), "--lib", str(lib), "--out", str(tmp_path)], capture_output=True, text=True, timeout=60)
+    r = subprocess.run([str(tools / "fmu-package"), "--lib", str(lib), "--out", str(tmp_path)], capture_output=True, text=True, timeout=60)
     assert r.returncode == 1
     assert "has no spacecraft_fmus_catalogue" in r.stderr and "export_fmus!" in r.stderr
 

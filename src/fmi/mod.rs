@@ -6,10 +6,11 @@
 //! | [`types`] | status codes, logger callback types, the states of the state machine, log categories |
 //! | [`live`] | sets of addresses handed to the master (instances, FMU states) |
 //! | [`boundary`] | live instance table, panic guard, C arrays and out-pointers, one instantiate for every interface |
-//! | [`instance`] | one FMU instance: state machine, logging, value access, initialization, stepping (`me`: Model Exchange, `jacobian`: directional derivatives) |
+//! | [`instance`] | one FMU instance: state machine, initialization, stepping (`logging`, `values`: value access, `me`: Model Exchange, `jacobian`: directional derivatives) |
 //! | [`state`], `state_calls` | FMU state snapshots, their byte format, and the call bodies both versions share |
 //! | [`fmi2`] | FMI 2.0: `common` (C types, state table, `call`, instantiate, life cycle, get/set), `cs`, `me`, `state`, `export` |
-//! | [`fmi3`] | FMI 3.0: `common` (state tables, `call3`, life cycle), `values`, `cs`, `me`, `state`, `unsupported`, `export` |
+//! | [`fmi3`] | FMI 3.0: `common` (state tables, `call3`, life cycle, the instantiate request), `values`, `cs`, `me`, `state`, `unsupported`, `export` (+ `export_values`) |
+//! | `library_path` | the path of the loaded library (the model is picked by its file name) |
 //!
 //! Imports run one way: `fmi2/*` and `fmi3/*` → `boundary` → `state` → `instance` → `types`, `live` (and the model
 //! contract in `crate::model`); the files of a version import their `common`, never each other, and

@@ -167,14 +167,14 @@ macro_rules! declare_variables {
         #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
         $vis struct $Name {
             $( pub $block: $Block, )*
-            $( #[doc = $desc] pub $field: $crate::declare_variables!(@type $kind), )*
+            $( #[doc = $desc] pub $field: $crate::__declare_field!(@type $kind), )*
         }
 
         impl Default for $Name {
             fn default() -> Self {
                 Self {
                     $( $block: Default::default(), )*
-                    $( $field: $crate::declare_variables!(@default $kind $start), )*
+                    $( $field: $crate::__declare_field!(@default $kind $start), )*
                 }
             }
         }
@@ -182,14 +182,14 @@ macro_rules! declare_variables {
         impl $Name {
             const PARTS: &'static [&'static [$crate::model::VarDecl]] = &[
                 $( <$Block as $crate::model::Variables>::DECLS, )*
-                $( &$crate::declare_variables!(@decls $kind $vr, $field, $start, $caus, $unit, $desc,
-                       $crate::declare_variables!(@bound $( $bound $( ( $($barg),* ) )? )? )), )*
+                $( &$crate::__declare_row!(@decls $kind $vr, $field, $start, $caus, $unit, $desc,
+                       $crate::__declare_field!(@bound $( $bound $( ( $($barg),* ) )? )? )), )*
             ];
             const ALL_DECLS: [$crate::model::VarDecl; $crate::model::total_len($Name::PARTS)] =
                 $crate::model::concat($Name::PARTS, $crate::model::VarDecl::PLACEHOLDER);
         }
 
-        $( $crate::declare_variables!(@check $Name, $vr, $field, $kind, $unit); )*
+        $( $crate::__declare_field!(@check $Name, $vr, $field, $kind, $unit); )*
         const _: () = assert!($crate::model::no_duplicate_vrs(&$Name::ALL_DECLS), concat!("duplicate value reference in ", stringify!($Name), " (between its embedded blocks)"));
         const _: () = assert!($crate::model::no_duplicate_names(&$Name::ALL_DECLS), concat!("duplicate variable name in ", stringify!($Name), " (between its embedded blocks)"));
 
@@ -197,7 +197,7 @@ macro_rules! declare_variables {
             const DECLS: &'static [$crate::model::VarDecl] = &$Name::ALL_DECLS;
 
             fn slot(&mut self, index: usize) -> Option<$crate::model::SlotMut<'_>> {
-                const PARTS: &[&[$crate::model::SlotFn<$Name>]] = &[ $( &$crate::declare_variables!(@slots $kind $field), )* ];
+                const PARTS: &[&[$crate::model::SlotFn<$Name>]] = &[ $( &$crate::__declare_row!(@slots $kind $field), )* ];
                 const SLOTS: [$crate::model::SlotFn<$Name>; $crate::model::total_len(PARTS)] = $crate::model::concat(PARTS, |_| unreachable!());
                 #[allow(unused_mut)]
                 let mut i = index;
@@ -212,7 +212,7 @@ macro_rules! declare_variables {
             }
 
             fn value(&self, index: usize) -> Option<$crate::model::Value> {
-                const PARTS: &[&[$crate::model::ValueFn<$Name>]] = &[ $( &$crate::declare_variables!(@values $kind $field), )* ];
+                const PARTS: &[&[$crate::model::ValueFn<$Name>]] = &[ $( &$crate::__declare_row!(@values $kind $field), )* ];
                 const VALUES: [$crate::model::ValueFn<$Name>; $crate::model::total_len(PARTS)] = $crate::model::concat(PARTS, |_| unreachable!());
                 #[allow(unused_mut)]
                 let mut i = index;
@@ -227,11 +227,17 @@ macro_rules! declare_variables {
             }
         }
     };
+}
 
+/// The per-field parts of [`declare_variables!`]: compile-time checks, width, Rust type, default and
+/// bound of one field of each kind. Used by `declare_variables!` only.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __declare_field {
     // compile-time checks of one field, each message naming the field (see `field_problem`)
     (@check $Name:ident, $vr:literal, $field:ident, $kind:ident, $unit:literal) => {
         const _: () = {
-            const P: u8 = $crate::model::field_problem(&$Name::ALL_DECLS, $vr, $crate::declare_variables!(@width $kind));
+            const P: u8 = $crate::model::field_problem(&$Name::ALL_DECLS, $vr, $crate::__declare_field!(@width $kind));
             assert!(P != 1, concat!("declare_variables! ", stringify!($Name), ".", stringify!($field), " (vr ", stringify!($vr), "): its value reference is used by another variable"));
             assert!(P != 2, concat!("declare_variables! ", stringify!($Name), ".", stringify!($field), " (vr ", stringify!($vr), "): its name is used by another variable"));
             assert!(P != 3, concat!("declare_variables! ", stringify!($Name), ".", stringify!($field), " (vr ", stringify!($vr), "): unit \"", $unit, "\" is not in spacecraft_fmus::units (\"\" = dimensionless)"));
@@ -269,7 +275,13 @@ macro_rules! declare_variables {
     (@bound) => { $crate::model::Bound::Any };
     (@bound $b:ident) => { $crate::model::Bound::$b };
     (@bound $b:ident ( $($a:expr),* )) => { $crate::model::Bound::$b($($a),*) };
+}
 
+/// The rows of [`declare_variables!`] for each kind: the `VarDecl`s of one field (three for `Vec3` and
+/// `Diag3`, four for `Quat`), and its slot and value accessors. Used by `declare_variables!` only.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __declare_row {
     (@one $vr:expr, $name:expr, $kind:ident, $start:expr, $caus:ident, $unit:literal, $desc:expr, $bound:expr) => {
         $crate::model::VarDecl {
             vr: $vr,
@@ -284,29 +296,29 @@ macro_rules! declare_variables {
         }
     };
     (@decls Real $vr:literal, $f:ident, $s:expr, $c:ident, $u:literal, $d:literal, $b:expr) => {
-        [$crate::declare_variables!(@one $vr, stringify!($f), Real, $s, $c, $u, $d, $b)]
+        [$crate::__declare_row!(@one $vr, stringify!($f), Real, $s, $c, $u, $d, $b)]
     };
     (@decls Integer $vr:literal, $f:ident, $s:expr, $c:ident, $u:literal, $d:literal, $b:expr) => {
-        [$crate::declare_variables!(@one $vr, stringify!($f), Integer, $s, $c, $u, $d, $b)]
+        [$crate::__declare_row!(@one $vr, stringify!($f), Integer, $s, $c, $u, $d, $b)]
     };
     (@decls Boolean $vr:literal, $f:ident, $s:expr, $c:ident, $u:literal, $d:literal, $b:expr) => {
-        [$crate::declare_variables!(@one $vr, stringify!($f), Boolean, $s, $c, $u, $d, $b)]
+        [$crate::__declare_row!(@one $vr, stringify!($f), Boolean, $s, $c, $u, $d, $b)]
     };
     (@decls Vec3 $vr:literal, $f:ident, $s:expr, $c:ident, $u:literal, $d:literal, $b:expr) => {[
-        $crate::declare_variables!(@one $vr, concat!(stringify!($f), "_x"), Real, $s[0], $c, $u, concat!($d, ", x"), $b),
-        $crate::declare_variables!(@one $vr + 1, concat!(stringify!($f), "_y"), Real, $s[1], $c, $u, concat!($d, ", y"), $b),
-        $crate::declare_variables!(@one $vr + 2, concat!(stringify!($f), "_z"), Real, $s[2], $c, $u, concat!($d, ", z"), $b),
+        $crate::__declare_row!(@one $vr, concat!(stringify!($f), "_x"), Real, $s[0], $c, $u, concat!($d, ", x"), $b),
+        $crate::__declare_row!(@one $vr + 1, concat!(stringify!($f), "_y"), Real, $s[1], $c, $u, concat!($d, ", y"), $b),
+        $crate::__declare_row!(@one $vr + 2, concat!(stringify!($f), "_z"), Real, $s[2], $c, $u, concat!($d, ", z"), $b),
     ]};
     (@decls Diag3 $vr:literal, $f:ident, $s:expr, $c:ident, $u:literal, $d:literal, $b:expr) => {[
-        $crate::declare_variables!(@one $vr, concat!(stringify!($f), "_xx"), Real, $s[0], $c, $u, concat!($d, ", xx"), $b),
-        $crate::declare_variables!(@one $vr + 1, concat!(stringify!($f), "_yy"), Real, $s[1], $c, $u, concat!($d, ", yy"), $b),
-        $crate::declare_variables!(@one $vr + 2, concat!(stringify!($f), "_zz"), Real, $s[2], $c, $u, concat!($d, ", zz"), $b),
+        $crate::__declare_row!(@one $vr, concat!(stringify!($f), "_xx"), Real, $s[0], $c, $u, concat!($d, ", xx"), $b),
+        $crate::__declare_row!(@one $vr + 1, concat!(stringify!($f), "_yy"), Real, $s[1], $c, $u, concat!($d, ", yy"), $b),
+        $crate::__declare_row!(@one $vr + 2, concat!(stringify!($f), "_zz"), Real, $s[2], $c, $u, concat!($d, ", zz"), $b),
     ]};
     (@decls Quat $vr:literal, $f:ident, $s:expr, $c:ident, $u:literal, $d:literal, $b:expr) => {[
-        $crate::declare_variables!(@one $vr, concat!(stringify!($f), "_w"), Real, $s[0], $c, $u, concat!($d, ", scalar part"), $b),
-        $crate::declare_variables!(@one $vr + 1, concat!(stringify!($f), "_x"), Real, $s[1], $c, $u, concat!($d, ", x component"), $b),
-        $crate::declare_variables!(@one $vr + 2, concat!(stringify!($f), "_y"), Real, $s[2], $c, $u, concat!($d, ", y component"), $b),
-        $crate::declare_variables!(@one $vr + 3, concat!(stringify!($f), "_z"), Real, $s[3], $c, $u, concat!($d, ", z component"), $b),
+        $crate::__declare_row!(@one $vr, concat!(stringify!($f), "_w"), Real, $s[0], $c, $u, concat!($d, ", scalar part"), $b),
+        $crate::__declare_row!(@one $vr + 1, concat!(stringify!($f), "_x"), Real, $s[1], $c, $u, concat!($d, ", x component"), $b),
+        $crate::__declare_row!(@one $vr + 2, concat!(stringify!($f), "_y"), Real, $s[2], $c, $u, concat!($d, ", y component"), $b),
+        $crate::__declare_row!(@one $vr + 3, concat!(stringify!($f), "_z"), Real, $s[3], $c, $u, concat!($d, ", z component"), $b),
     ]};
 
     (@slots Real $f:ident) => { [|s| $crate::model::SlotMut::Real(&mut s.$f)] };
@@ -317,7 +329,7 @@ macro_rules! declare_variables {
         |s| $crate::model::SlotMut::Real(&mut s.$f.y),
         |s| $crate::model::SlotMut::Real(&mut s.$f.z),
     ]};
-    (@slots Diag3 $f:ident) => { $crate::declare_variables!(@slots Vec3 $f) };
+    (@slots Diag3 $f:ident) => { $crate::__declare_row!(@slots Vec3 $f) };
     (@slots Quat $f:ident) => {[
         |s| $crate::model::SlotMut::Real(&mut s.$f.w),
         |s| $crate::model::SlotMut::Real(&mut s.$f.i),
@@ -333,7 +345,7 @@ macro_rules! declare_variables {
         |s| $crate::model::Value::Real(s.$f.y),
         |s| $crate::model::Value::Real(s.$f.z),
     ]};
-    (@values Diag3 $f:ident) => { $crate::declare_variables!(@values Vec3 $f) };
+    (@values Diag3 $f:ident) => { $crate::__declare_row!(@values Vec3 $f) };
     (@values Quat $f:ident) => {[
         |s| $crate::model::Value::Real(s.$f.w),
         |s| $crate::model::Value::Real(s.$f.i),

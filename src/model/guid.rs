@@ -17,7 +17,8 @@ fn compute(entry: &ModelEntry) -> [u8; GUID_LEN] {
         feedthrough: match info.feedthrough {
             Feedthrough::None => "none".into(),
             Feedthrough::AllInputs => "all".into(),
-            Feedthrough::Some(list) => format!("{list:?}"),
+            // FMI scalar names (a vector stem expanded), as the catalogue carries them
+            Feedthrough::Some(_) => format!("{:?}", super::feedthrough::scalar_list(entry).unwrap_or_default()),
         },
     };
     let vars = entry.decls.iter().map(|d| VarRow {

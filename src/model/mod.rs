@@ -10,6 +10,7 @@
 //! a built library exports (`crate::export`).
 
 mod declare;
+pub mod feedthrough;
 pub mod guid;
 mod instance;
 pub mod leaves;
@@ -227,6 +228,7 @@ pub struct ModelEntry {
 
 impl ModelEntry {
     pub const fn of<M: Model>() -> Self {
+        let () = feedthrough::Checked::<M>::FEEDTHROUGH; // a compile error naming a mistyped feed-through name
         ModelEntry {
             info: &M::INFO,
             decls: M::Vars::DECLS,

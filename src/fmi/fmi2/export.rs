@@ -1,6 +1,10 @@
 //! The FMI 2.0 half of [`export_fmus!`](crate::export_fmus): `#[no_mangle]` wrappers with the standard
 //! `fmi2*` names over this folder's functions, expanded inside `export_fmus!` (so one library serves
 //! FMI 2.0 and 3.0 from the same models). Not meant to be used on its own.
+//!
+//! Size: `__export_fmi2!` is longer than 80 lines because a `#[no_mangle]` symbol must be spelled out in
+//! the crate that links the library (the user's cdylib), one short wrapper per C function of
+//! `fmi2Functions.h`; each only forwards to the function of the same name in this folder.
 
 /// Expands to the FMI 2.0 entry points for the model list `$models` (a `static [ModelEntry]` slice in
 /// scope). Used by [`export_fmus!`](crate::export_fmus) only.

@@ -19,9 +19,10 @@
 
 use std::ffi::{c_char, c_int, c_void, CStr};
 
-use crate::fmi::boundary::{self, c_str, guarded, instance_of, slice};
+use crate::fmi::boundary::{self, c_str, guarded, instance_of, slice, Request};
 use crate::fmi::instance::{CallResult, Fail, Instance, Logger};
 use crate::fmi::types::{FsmState, Log3Fn, Status};
+use crate::model::ModelEntry;
 
 /// `fmi3Instance`.
 pub type Instance3 = *mut c_void;
@@ -282,4 +283,32 @@ pub extern "C" fn fmi3Reset(c: Instance3) -> c_int {
         inst.reset();
         Ok(())
     })
+}
+
+/// The request both FMI 3.0 instantiate functions start from: a Co-Simulation instance with the FMI
+/// 3.0 logger, no further argument checks and every model accepted; `fmi3InstantiateCoSimulation` adds
+/// its argument checks, `fmi3InstantiateModelExchange` the interface and its refusal.
+pub fn request3(
+    func: &'static str,
+    models: &'static [ModelEntry],
+    instance_name: *const c_char,
+    token: *const c_char,
+    logging_on: u8,
+    env: *mut c_void,
+    log_message: Option<Log3Fn>,
+) -> Request<'static> {
+    Request {
+        func,
+        models,
+        instance_name,
+        token,
+        token_name: "instantiationToken",
+        logger: log_message.map_or(Logger::None, Logger::Fmi3),
+        env,
+        logging_on: logging_on != 0,
+        fmi3: true,
+        model_exchange: false,
+        check_arguments: &|| Ok(()),
+        refuse_model: &|_| None,
+    }
 }

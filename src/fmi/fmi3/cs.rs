@@ -9,9 +9,9 @@
 
 use std::ffi::{c_char, c_int, c_void};
 
-use super::common::{call3, mask3, refuse, require_co_simulation, state_name, Instance3};
+use super::common::{call3, mask3, refuse, request3, require_co_simulation, state_name, Instance3};
 use crate::fmi::boundary::{self, out_ptr, slice, Request};
-use crate::fmi::instance::{Fail, Logger};
+use crate::fmi::instance::Fail;
 use crate::fmi::types::Log3Fn;
 use crate::model::ModelEntry;
 
@@ -33,17 +33,16 @@ pub fn fmi3InstantiateCoSimulation(
     _intermediate_update: *const c_void,
 ) -> Instance3 {
     let _ = early_return_allowed; // allowed, never used: fmi3DoStep always completes the whole step
-    boundary::instantiate(Request {
-        func: "fmi3InstantiateCoSimulation",
+    let request = request3(
+        "fmi3InstantiateCoSimulation",
         models,
         instance_name,
         token,
-        token_name: "instantiationToken",
-        logger: log_message.map_or(Logger::None, Logger::Fmi3),
+        logging_on,
         env,
-        logging_on: logging_on != 0,
-        fmi3: true,
-        model_exchange: false,
+        log_message,
+    );
+    boundary::instantiate(Request {
         check_arguments: &|| {
             if event_mode_used != 0 {
                 return Err("eventModeUsed = true, but this FMU has no Event Mode (hasEventMode = false)".into());
@@ -61,7 +60,7 @@ pub fn fmi3InstantiateCoSimulation(
             }
             Ok(())
         },
-        refuse_model: &|_| None,
+        ..request
     })
 }
 

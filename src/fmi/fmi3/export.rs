@@ -2,7 +2,12 @@
 //! `fmi3*` names over this folder's functions, expanded inside `export_fmus!` (so one
 //! library serves FMI 2.0 and 3.0 from the same models). All 75 functions of `fmi3Functions.h` are
 //! exported, those of interfaces and features the FMUs do not declare included: importers (fmpy, FMI
-//! Library) resolve every one. Not meant to be used on its own.
+//! Library) resolve every one. Not meant to be used on its own. The getters and setters of every
+//! variable type are in `export_values.rs`.
+//!
+//! Size: `__export_fmi3!` is longer than 80 lines because a `#[no_mangle]` symbol must be spelled out in
+//! the crate that links the library (the user's cdylib), one four-line wrapper per C function; each
+//! wrapper only forwards to the function of the same name in this folder, where the code is.
 
 /// Expands to the FMI 3.0 entry points for the model list `$models` (a `static [ModelEntry]` slice in
 /// scope). Used by [`export_fmus!`](crate::export_fmus) only.
@@ -128,144 +133,7 @@ macro_rules! __export_fmi3 {
             pub extern "C" fn fmi3Reset(c: Inst3) -> c_int {
                 co3::fmi3Reset(c)
             }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetFloat64(c: Inst3, vr: *const u32, n: usize, v: *mut f64, nv: usize) -> c_int {
-                va3::fmi3GetFloat64(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3SetFloat64(c: Inst3, vr: *const u32, n: usize, v: *const f64, nv: usize) -> c_int {
-                va3::fmi3SetFloat64(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetInt32(c: Inst3, vr: *const u32, n: usize, v: *mut i32, nv: usize) -> c_int {
-                va3::fmi3GetInt32(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3SetInt32(c: Inst3, vr: *const u32, n: usize, v: *const i32, nv: usize) -> c_int {
-                va3::fmi3SetInt32(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetBoolean(c: Inst3, vr: *const u32, n: usize, v: *mut u8, nv: usize) -> c_int {
-                va3::fmi3GetBoolean(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3SetBoolean(c: Inst3, vr: *const u32, n: usize, v: *const u8, nv: usize) -> c_int {
-                va3::fmi3SetBoolean(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetFloat32(c: Inst3, vr: *const u32, n: usize, v: *mut f32, nv: usize) -> c_int {
-                un3::fmi3GetFloat32(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3SetFloat32(c: Inst3, vr: *const u32, n: usize, v: *const f32, nv: usize) -> c_int {
-                un3::fmi3SetFloat32(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetInt8(c: Inst3, vr: *const u32, n: usize, v: *mut i8, nv: usize) -> c_int {
-                un3::fmi3GetInt8(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3SetInt8(c: Inst3, vr: *const u32, n: usize, v: *const i8, nv: usize) -> c_int {
-                un3::fmi3SetInt8(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetUInt8(c: Inst3, vr: *const u32, n: usize, v: *mut u8, nv: usize) -> c_int {
-                un3::fmi3GetUInt8(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3SetUInt8(c: Inst3, vr: *const u32, n: usize, v: *const u8, nv: usize) -> c_int {
-                un3::fmi3SetUInt8(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetInt16(c: Inst3, vr: *const u32, n: usize, v: *mut i16, nv: usize) -> c_int {
-                un3::fmi3GetInt16(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3SetInt16(c: Inst3, vr: *const u32, n: usize, v: *const i16, nv: usize) -> c_int {
-                un3::fmi3SetInt16(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetUInt16(c: Inst3, vr: *const u32, n: usize, v: *mut u16, nv: usize) -> c_int {
-                un3::fmi3GetUInt16(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3SetUInt16(c: Inst3, vr: *const u32, n: usize, v: *const u16, nv: usize) -> c_int {
-                un3::fmi3SetUInt16(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetUInt32(c: Inst3, vr: *const u32, n: usize, v: *mut u32, nv: usize) -> c_int {
-                un3::fmi3GetUInt32(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3SetUInt32(c: Inst3, vr: *const u32, n: usize, v: *const u32, nv: usize) -> c_int {
-                un3::fmi3SetUInt32(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetInt64(c: Inst3, vr: *const u32, n: usize, v: *mut i64, nv: usize) -> c_int {
-                un3::fmi3GetInt64(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3SetInt64(c: Inst3, vr: *const u32, n: usize, v: *const i64, nv: usize) -> c_int {
-                un3::fmi3SetInt64(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetUInt64(c: Inst3, vr: *const u32, n: usize, v: *mut u64, nv: usize) -> c_int {
-                un3::fmi3GetUInt64(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3SetUInt64(c: Inst3, vr: *const u32, n: usize, v: *const u64, nv: usize) -> c_int {
-                un3::fmi3SetUInt64(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetString(
-                c: Inst3,
-                vr: *const u32,
-                n: usize,
-                v: *mut *const c_char,
-                nv: usize,
-            ) -> c_int {
-                un3::fmi3GetString(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3SetString(
-                c: Inst3,
-                vr: *const u32,
-                n: usize,
-                v: *const *const c_char,
-                nv: usize,
-            ) -> c_int {
-                un3::fmi3SetString(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetBinary(
-                c: Inst3,
-                vr: *const u32,
-                n: usize,
-                sizes: *mut usize,
-                v: *mut *const u8,
-                nv: usize,
-            ) -> c_int {
-                un3::fmi3GetBinary(c, vr, n, sizes, v, nv)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3SetBinary(
-                c: Inst3,
-                vr: *const u32,
-                n: usize,
-                sizes: *const usize,
-                v: *const *const u8,
-                nv: usize,
-            ) -> c_int {
-                un3::fmi3SetBinary(c, vr, n, sizes, v, nv)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetClock(c: Inst3, vr: *const u32, n: usize, v: *mut u8) -> c_int {
-                un3::fmi3GetClock(c, vr, n, v)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3SetClock(c: Inst3, vr: *const u32, n: usize, v: *const u8) -> c_int {
-                un3::fmi3SetClock(c, vr, n, v)
-            }
+            $crate::__export_fmi3_values!();
             #[no_mangle]
             pub extern "C" fn fmi3GetNumberOfVariableDependencies(c: Inst3, vr: u32, n: *mut usize) -> c_int {
                 st3::fmi3GetNumberOfVariableDependencies(c, vr, n)

@@ -20,9 +20,9 @@
 
 use std::ffi::{c_char, c_int, c_void};
 
-use super::common::{call3, is_model_exchange, mask3, mask3me, refuse, state_name, Instance3};
+use super::common::{call3, is_model_exchange, mask3, mask3me, refuse, request3, state_name, Instance3};
 use crate::fmi::boundary::{self, out_ptr, slice, slice_mut, Request};
-use crate::fmi::instance::{CallResult, Fail, Instance, Logger};
+use crate::fmi::instance::{CallResult, Fail, Instance};
 use crate::fmi::types::Log3Fn;
 use crate::model::ModelEntry;
 
@@ -69,18 +69,17 @@ pub fn fmi3InstantiateModelExchange(
     env: *mut c_void,
     log_message: Option<Log3Fn>,
 ) -> Instance3 {
-    boundary::instantiate(Request {
-        func: "fmi3InstantiateModelExchange",
+    let request = request3(
+        "fmi3InstantiateModelExchange",
         models,
         instance_name,
         token,
-        token_name: "instantiationToken",
-        logger: log_message.map_or(Logger::None, Logger::Fmi3),
+        logging_on,
         env,
-        logging_on: logging_on != 0,
-        fmi3: true,
+        log_message,
+    );
+    boundary::instantiate(Request {
         model_exchange: true,
-        check_arguments: &|| Ok(()),
         refuse_model: &|entry| {
             (!entry.model_exchange()).then(|| {
                 format!(
@@ -89,6 +88,7 @@ pub fn fmi3InstantiateModelExchange(
                 )
             })
         },
+        ..request
     })
 }
 

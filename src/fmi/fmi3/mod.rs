@@ -2,12 +2,13 @@
 //! every FMI 3.0 function shares (state tables, `call3`, `time`, life cycle); `values` get/set for both
 //! interfaces; `cs` Co-Simulation, `me` Model Exchange (and the functions both interfaces export with
 //! ME rules); `state` FMU states, directional derivatives and variable dependencies; `unsupported` the
-//! functions of features these FMUs do not declare; `export` the `#[no_mangle]` wrappers. The files
+//! functions of features these FMUs do not declare; `export` (and `export_values`) the `#[no_mangle]` wrappers. The files
 //! import `common`, the boundary and the instance, never each other, and nothing here imports FMI 2.0.
 
 pub mod common;
 pub mod cs;
 mod export;
+mod export_values;
 pub mod me;
 pub mod state;
 #[cfg(test)]

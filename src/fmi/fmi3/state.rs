@@ -13,6 +13,7 @@ use super::common::{call3, mask3, Instance3};
 use crate::fmi::boundary::{out_ptr, slice, slice_mut};
 use crate::fmi::instance::{CallResult, Fail};
 use crate::fmi::state_calls;
+use crate::model::feedthrough::scalar_list;
 use crate::model::{Causality, Feedthrough, ModelEntry, STATE_VR_BASE};
 
 // ----- FMU state ------------------------------------------------------------------------------------
@@ -102,11 +103,12 @@ pub fn output_dependency_vrs(entry: &ModelEntry, output: &str) -> Vec<u32> {
     match entry.info.feedthrough {
         Feedthrough::None => vec![],
         Feedthrough::AllInputs => inputs.map(|d| d.vr).collect(),
-        Feedthrough::Some(list) => {
-            let named: Vec<&str> = list
-                .iter()
+        Feedthrough::Some(_) => {
+            let named: Vec<&str> = scalar_list(entry)
+                .unwrap_or_default()
+                .into_iter()
                 .filter(|(o, _)| *o == output)
-                .flat_map(|(_, ins)| ins.iter().copied())
+                .flat_map(|(_, ins)| ins)
                 .collect();
             inputs.filter(|d| named.contains(&d.name)).map(|d| d.vr).collect()
         }

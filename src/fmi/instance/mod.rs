@@ -1,18 +1,19 @@
-//! One FMU instance: state machine, logging, value access with the causality/variability rules,
-//! initialization and stepping. Called only from the FMI 2.0 and 3.0 functions
-//! (`fmi2/`, `fmi3/`), after their null and state checks; `me.rs` adds the Model Exchange methods and
-//! `jacobian.rs` the directional derivatives.
+//! One FMU instance: state machine, initialization and stepping. Called only from the FMI 2.0 and 3.0
+//! functions (`fmi2/`, `fmi3/`), after their null and state checks; `logging.rs` adds the logging,
+//! `values.rs` value access with the causality/variability rules, `me.rs` the Model Exchange methods and
+//! `jacobian.rs` the directional derivatives (each an `impl Instance` over this file's types).
 
 use std::collections::HashSet;
-use std::ffi::{c_int, c_void, CString};
+use std::ffi::{c_void, CString};
 
 use serde::{Deserialize, Serialize};
 
 mod jacobian;
+mod logging;
 pub mod me;
+mod values;
 
 use crate::fmi::types::{FsmState, Log3Fn, LoggerFn, Status, LOG_CATEGORIES};
-use crate::model::{DERIVATIVE_VR_BASE, STATE_VR_BASE};
 
 /// The master's logger: FMI 2.0 (`fmi2CallbackLogger`) or FMI 3.0 (`fmi3LogMessageCallback`).
 #[derive(Clone, Copy)]
@@ -21,10 +22,7 @@ pub enum Logger {
     Fmi2(LoggerFn),
     Fmi3(Log3Fn),
 }
-use crate::model::{
-    Causality, DynModel, Experiment, ModelEntry, SlotMut, Value, VarDecl, VarKind, Variability, RESERVED_VR_START,
-    TOLERANCE_MAX, TOLERANCE_MIN,
-};
+use crate::model::{DynModel, Experiment, ModelEntry, VarDecl, VarKind, TOLERANCE_MAX, TOLERANCE_MIN};
 
 /// Failure of an FMI call: the status to return and the reason to log.
 #[derive(Debug)]
@@ -175,14 +173,6 @@ pub struct Instance {
     index: VrIndex,
 }
 
-fn kind_name(k: VarKind) -> &'static str {
-    match k {
-        VarKind::Real => "Real",
-        VarKind::Integer => "Integer",
-        VarKind::Boolean => "Boolean",
-    }
-}
-
 impl Instance {
     pub fn new(name: CString, entry: &'static ModelEntry, logger: Logger, env: *mut c_void, logging_on: bool) -> Self {
         Instance {
@@ -198,243 +188,6 @@ impl Instance {
             model: (entry.create)(),
             index: VrIndex::new(entry.decls),
         }
-    }
-
-    // ----- logging -----------------------------------------------------------------------------
-
-    /// Sends a message to the logger callback. Warnings and errors always go out; other messages
-    /// only with debug logging on and their category enabled.
-    pub fn log(&self, status: Status, category: &str, message: &str) {
-        if matches!(self.logger, Logger::None) {
-            return;
-        }
-        if status < Status::Warning
-            && !(self.debug_logging && (self.categories.contains(category) || self.categories.contains("logAll")))
-        {
-            return;
-        }
-        let cat = CString::new(category).unwrap_or_default();
-        match self.logger {
-            Logger::None => {}
-            Logger::Fmi2(logger) => {
-                // The message is a printf format for C loggers: escape '%'; interior NULs cannot pass.
-                let text = CString::new(message.replace('%', "%%").replace('\0', "")).unwrap_or_default();
-                // SAFETY: the logger is the master's callback with the fmi2CallbackLogger signature; all
-                // strings are valid NUL-terminated for the duration of the call.
-                unsafe {
-                    logger(
-                        self.env,
-                        self.name.as_ptr(),
-                        status as c_int,
-                        cat.as_ptr(),
-                        text.as_ptr(),
-                    )
-                };
-            }
-            Logger::Fmi3(logger) => {
-                // FMI 3.0 messages are plain text (no printf format) and carry no instance name: prefix it.
-                let text = CString::new(format!("{}: {}", self.name.to_string_lossy(), message).replace('\0', ""))
-                    .unwrap_or_default();
-                // SAFETY: the master's fmi3LogMessageCallback; strings valid for the duration of the call.
-                unsafe { logger(self.env, status as c_int, cat.as_ptr(), text.as_ptr()) };
-            }
-        }
-    }
-
-    pub fn log_fail(&self, func: &str, fail: &Fail) {
-        let category = match fail.status {
-            Status::Fatal => "logStatusFatal",
-            Status::Error => "logStatusError",
-            _ => "logStatusWarning",
-        };
-        self.log(fail.status, category, &format!("{func}: {}", fail.reason));
-    }
-
-    pub fn trace(&self, message: impl FnOnce() -> String) {
-        if self.debug_logging && (self.categories.contains("logCalls") || self.categories.contains("logAll")) {
-            self.log(Status::Ok, "logCalls", &message());
-        }
-    }
-
-    pub fn set_debug_logging(&mut self, on: bool, categories: &[String]) -> CallResult {
-        let known: Vec<&'static str> = LOG_CATEGORIES.iter().map(|(n, _)| *n).collect();
-        if let Some(bad) = categories.iter().find(|c| !known.contains(&c.as_str())) {
-            return Err(Fail::error(format!(
-                "unknown log category '{bad}' (declared: {})",
-                known.join(", ")
-            )));
-        }
-        self.debug_logging = on;
-        if categories.is_empty() {
-            self.categories = known.into_iter().collect();
-        } else {
-            for c in categories {
-                let c = known
-                    .iter()
-                    .find(|k| **k == c.as_str())
-                    .copied()
-                    .expect("checked above");
-                if on {
-                    self.categories.insert(c);
-                } else {
-                    self.categories.remove(c);
-                }
-            }
-        }
-        Ok(())
-    }
-
-    // ----- variable access ----------------------------------------------------------------------
-
-    /// Declaration index and declaration of a value reference of the given kind.
-    #[inline]
-    pub(super) fn decl(&self, kind: VarKind, vr: u32) -> CallResult<(usize, &'static VarDecl)> {
-        if let Some(i) = self.index.get(kind, vr) {
-            return Ok((i, &self.entry.decls[i]));
-        }
-        self.unknown_vr(kind, vr)
-    }
-
-    #[cold]
-    fn unknown_vr(&self, kind: VarKind, vr: u32) -> CallResult<(usize, &'static VarDecl)> {
-        let other = [VarKind::Real, VarKind::Integer, VarKind::Boolean]
-            .into_iter()
-            .filter(|k| *k != kind)
-            .find_map(|k| self.index.get(k, vr).map(|i| &self.entry.decls[i]));
-        Err(match other {
-            Some(d) => Fail::error(format!(
-                "value reference {vr} is {} ({}), not {}",
-                d.name,
-                kind_name(d.kind),
-                kind_name(kind)
-            )),
-            None => Fail::error(format!("unknown {} value reference {vr}", kind_name(kind))),
-        })
-    }
-
-    /// Whether a variable may be set in the current state (FMI 2.0 section 4.2.4 rules).
-    fn check_settable(&self, d: &VarDecl) -> CallResult {
-        let init = matches!(self.run.fsm, FsmState::Instantiated | FsmState::InitializationMode);
-        let ok = match (d.causality, d.variability) {
-            (_, Variability::Constant) => false,
-            (Causality::Input, _) => true,
-            (Causality::Parameter, Variability::Fixed) => init,
-            (Causality::Parameter, Variability::Tunable) => true,
-            (Causality::Parameter, _) => init,
-            _ => false,
-        };
-        if ok {
-            return Ok(());
-        }
-        Err(Fail::error(match d.causality {
-            Causality::Parameter => format!(
-                "parameter {} is fixed and cannot be set after initialization (state {:?})",
-                d.name, self.run.fsm
-            ),
-            Causality::Output => format!("{} is an output and cannot be set", d.name),
-            Causality::CalculatedParameter => format!("{} is a calculated parameter and cannot be set", d.name),
-            _ => format!("{} ({:?}, {:?}) cannot be set", d.name, d.causality, d.variability),
-        }))
-    }
-
-    /// Sets values of one kind atomically: every entry is checked before any is written, so a
-    /// refused call leaves the instance unchanged. `value(i)` is the value for `vrs[i]`.
-    pub fn set_values(&mut self, kind: VarKind, vrs: &[u32], value: impl Fn(usize) -> Value) -> CallResult {
-        let mut sets_parameter = false;
-        for (i, vr) in vrs.iter().enumerate() {
-            if kind == VarKind::Real {
-                if let Some(var) = self.layer_var(*vr) {
-                    let (LayerVar::State(k) | LayerVar::Derivative(k)) = var;
-                    let name = self.entry.state_decls()[k].name;
-                    return Err(Fail::error(match var {
-                        LayerVar::State(_) => format!(
-                            "{name} is a continuous state: set it with fmi2SetContinuousStates (Model Exchange)"
-                        ),
-                        LayerVar::Derivative(_) => format!("der({name}) is a state derivative and cannot be set"),
-                    }));
-                }
-            }
-            let (_, d) = self.decl(kind, *vr)?;
-            self.check_settable(d)?;
-            if let Value::Real(x) = value(i) {
-                if !x.is_finite() {
-                    return Err(Fail::error(format!(
-                        "value {x} for {} is not finite (use 1e30 for \"no limit\")",
-                        d.name
-                    )));
-                }
-            }
-            sets_parameter |= d.causality == Causality::Parameter;
-        }
-        // All checked: write (the value references are known to exist with this kind).
-        for (i, vr) in vrs.iter().enumerate() {
-            let index = self.index.get(kind, *vr).expect("checked above");
-            match (self.model.slot(index), value(i)) {
-                (Some(SlotMut::Real(s)), Value::Real(x)) => *s = x,
-                (Some(SlotMut::Integer(s)), Value::Integer(x)) => *s = x,
-                (Some(SlotMut::Boolean(s)), Value::Boolean(x)) => *s = x,
-                _ => {
-                    return Err(Fail::error(format!(
-                        "internal: storage of value reference {vr} does not match its declaration"
-                    )))
-                }
-            }
-        }
-        self.run.params_dirty |= sets_parameter;
-        self.run.outputs_dirty = true;
-        Ok(())
-    }
-
-    /// During initialization, (re)applies parameters set since the last initialization (what reads the
-    /// state or the derivatives needs; the outputs are left to be computed when they are read).
-    pub fn ensure_initialized(&mut self) -> CallResult {
-        if self.run.fsm == FsmState::InitializationMode && self.run.params_dirty {
-            self.model.initialize(&self.run.exp).map_err(Fail::error)?;
-            self.run.params_dirty = false;
-            self.run.outputs_dirty = true;
-        }
-        Ok(())
-    }
-
-    /// Brings outputs up to date with the inputs most recently set. During initialization the
-    /// parameters are (re)applied first so that initial outputs reflect them.
-    pub fn ensure_outputs(&mut self) -> CallResult {
-        self.ensure_initialized()?;
-        if self.run.outputs_dirty && self.run.fsm != FsmState::Instantiated {
-            self.model.update_outputs(self.run.time).map_err(Fail::error)?;
-            self.run.outputs_dirty = false;
-        }
-        Ok(())
-    }
-
-    /// Reads values of one kind; `write(i, v)` receives the value of `vrs[i]`. Outputs are computed
-    /// lazily here; a non-finite output puts the instance into the error state.
-    pub fn get_values(&mut self, kind: VarKind, vrs: &[u32], mut write: impl FnMut(usize, Value)) -> CallResult {
-        self.ensure_outputs()?;
-        for (i, vr) in vrs.iter().enumerate() {
-            if kind == VarKind::Real && *vr >= RESERVED_VR_START {
-                if let Some(var) = self.layer_var(*vr) {
-                    write(i, Value::Real(self.layer_value(var)?));
-                    continue;
-                }
-            }
-            let (index, d) = self.decl(kind, *vr)?;
-            let v = self
-                .model
-                .value(index)
-                .ok_or_else(|| Fail::error(format!("internal: no storage for {}", d.name)))?;
-            if let Value::Real(x) = v {
-                if !x.is_finite() && d.causality == Causality::Output {
-                    self.run.fsm = FsmState::Error;
-                    return Err(Fail::error(format!(
-                        "output {} is {x} at t = {}",
-                        d.name, self.run.time
-                    )));
-                }
-            }
-            write(i, v);
-        }
-        Ok(())
     }
 
     // ----- life cycle ---------------------------------------------------------------------------
@@ -539,21 +292,4 @@ impl Instance {
 pub enum LayerVar {
     State(usize),
     Derivative(usize),
-}
-
-/// The Model Exchange variables the layer adds to a model's own (continuous states and their
-/// derivatives, at reserved value references): here, because value access (above) refuses to set them.
-impl Instance {
-    pub fn n_states(&self) -> usize {
-        self.entry.state_decls().len()
-    }
-
-    /// The continuous state or derivative behind a value reference, if it is one.
-    pub fn layer_var(&self, vr: u32) -> Option<LayerVar> {
-        let n = self.n_states();
-        let k = |base: u32| vr.checked_sub(base).map(|k| k as usize).filter(|k| *k < n);
-        k(STATE_VR_BASE)
-            .map(LayerVar::State)
-            .or_else(|| k(DERIVATIVE_VR_BASE).map(LayerVar::Derivative))
-    }
 }

@@ -10,6 +10,7 @@ use spacecraft_fmus::catalogue::{
 };
 use spacecraft_fmus::units;
 
+use crate::names;
 use crate::structure::input_index;
 
 /// Every model of the catalogue passes [`check_model`], and cites only declared references.
@@ -116,15 +117,20 @@ fn check_states(m: &ModelDescription, layer: &LayerInfo) -> Result<(), String> {
         for d in &x.starts_from {
             if input_index(m, d).is_none() {
                 return Err(format!(
-                    "{name}: the start of continuous state {} is taken from {d}, which is not an input",
-                    x.name
+                    "{name}: the start of continuous state {} is taken from {d}, which is not an input (inputs: {})",
+                    x.name,
+                    names::of_causality(m, Causality::Input)
                 ));
             }
         }
         for d in x.depends.as_deref().unwrap_or(&[]) {
             let input = m.decl(d).is_some_and(|v| v.causality == Causality::Input);
             if !input && !states.iter().any(|y| y.name == *d) {
-                return Err(format!("{name}: the derivative of continuous state {} depends on {d}, which is neither an input nor a continuous state", x.name));
+                return Err(format!(
+                    "{name}: the derivative of continuous state {} depends on {d}, which is neither an input nor a continuous state (valid: {})",
+                    x.name,
+                    names::inputs_and_states(m)
+                ));
             }
         }
     }
@@ -142,20 +148,12 @@ fn check_feedthrough(m: &ModelDescription) -> Result<(), String> {
     let FeedthroughDescription::Some(list) = &m.feedthrough else {
         return Ok(());
     };
-    let names = |c: Causality| {
-        m.variables
-            .iter()
-            .filter(|d| d.causality == c)
-            .map(|d| d.name.as_str())
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
     for (o, ins) in list {
         if !m.decl(o).is_some_and(|d| d.causality == Causality::Output) {
             return Err(format!(
                 "{}: feedthrough output {o} is not an output (outputs: {})",
                 m.name,
-                names(Causality::Output)
+                names::of_causality(m, Causality::Output)
             ));
         }
         for i in ins {
@@ -163,7 +161,7 @@ fn check_feedthrough(m: &ModelDescription) -> Result<(), String> {
                 return Err(format!(
                     "{}: feedthrough input {i} is not an input (inputs: {})",
                     m.name,
-                    names(Causality::Input)
+                    names::of_causality(m, Causality::Input)
                 ));
             }
         }

@@ -26,6 +26,7 @@ pub mod fmi2;
 pub mod fmi3;
 pub mod html;
 mod load;
+pub mod names;
 pub mod platforms;
 pub mod structure;
 pub mod xml;

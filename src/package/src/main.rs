@@ -115,10 +115,10 @@ fn main() -> ExitCode {
 
 fn run() -> Result<(), String> {
     let args = parse()?;
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../..")
-        .canonicalize()
-        .map_err(|e| format!("the project folder: {e}"))?;
+    // the project this tool was built from (an installed tool keeps working for a user's crate when
+    // that folder is gone: it is then never the project, and has no Windows cross-build script)
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let root = root.canonicalize().unwrap_or(root);
     let project_crate = root.join("src/cdylib");
     let krate = args
         .krate
