@@ -3,7 +3,7 @@
 //! tests all iterate over [`ALL`].
 
 use crate::model::{concat, total_len, ModelEntry};
-use crate::models::{attitude, formation, sensors, single_axis};
+use crate::models::{attitude, estimation, formation, sensors, single_axis};
 
 /// A family of FMUs (one folder under `src/models/`) and its documentation page `docs/models/<slug>.md`.
 pub struct Family {
@@ -45,14 +45,21 @@ pub const FAMILIES: &[Family] = &[
         overview: include_str!("models/sensors/README.md"),
         fmus: sensors::FMUS,
     },
+    Family {
+        slug: "estimation",
+        title: "Attitude determination: TRIAD, QUEST and the B-dot detumbling law",
+        overview: include_str!("models/estimation/README.md"),
+        fmus: estimation::FMUS,
+    },
 ];
 
-const LISTS: [&[ModelEntry]; 5] = [
+const LISTS: [&[ModelEntry]; 6] = [
     FAMILIES[0].fmus,
     FAMILIES[1].fmus,
     FAMILIES[2].fmus,
     FAMILIES[3].fmus,
     FAMILIES[4].fmus,
+    FAMILIES[5].fmus,
 ];
 const _: () = assert!(FAMILIES.len() == LISTS.len(), "every family goes into the registry");
 

@@ -18,5 +18,6 @@ pub mod riccati;
 pub mod sample_grid;
 pub mod spline;
 pub mod type2_fuzzy;
+pub mod wahba;
 
 pub use nalgebra::{Matrix3, Quaternion, Vector3};

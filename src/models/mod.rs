@@ -36,6 +36,7 @@
 //! - plants of every family: `integrator` is an Integer with codes 0 RK4, 1 Euler, 2 Dormand–Prince.
 
 pub mod attitude;
+pub mod estimation;
 pub mod formation;
 pub mod sensors;
 pub mod single_axis;

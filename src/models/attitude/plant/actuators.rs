@@ -39,8 +39,20 @@ impl AttitudePlant {
         v.actuator_mode == 1
     }
 
+    /// The internal momentum-dumping law runs (mtq_mode 0, wheels, mtq_enable).
     pub(super) fn mtq(v: &AttitudePlantVars) -> bool {
-        Self::wheels(v) && v.mtq_enable == 1
+        v.mtq_mode == 0 && Self::wheels(v) && v.mtq_enable == 1
+    }
+
+    /// The magnetorquers follow the dipole command input m_cmd (mtq_mode 1).
+    pub(super) fn mtq_external(v: &AttitudePlantVars) -> bool {
+        v.mtq_mode == 1
+    }
+
+    /// Commanded dipole (each axis clamped at the dipole limit) and its torque m × B (mtq_mode 1).
+    fn external_dipole(&self, v: &AttitudePlantVars, t: f64, a: &Matrix3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+        let m = clamp3(v.m_cmd, Vector3::repeat(self.d.dipole_max));
+        (m, m.cross(&self.field_body(t, a)))
     }
 
     /// Actuators for state x at time t.
@@ -48,7 +60,12 @@ impl AttitudePlant {
         let u = faulty_cmd(v, seg.faulted);
         let eff = if seg.faulted { v.effectiveness } else { Vector3::repeat(1.0) };
         if !Self::wheels(v) {
-            return Actuation { torque: self.d.actuator_map * clamp3(u, v.u_max.component_mul(&eff)), ..Default::default() };
+            let torque = self.d.actuator_map * clamp3(u, v.u_max.component_mul(&eff));
+            if Self::mtq_external(v) {
+                let (dipole, tau_mtq) = self.external_dipole(v, t, a);
+                return Actuation { torque: torque + tau_mtq, dipole, ..Default::default() };
+            }
+            return Actuation { torque, ..Default::default() };
         }
         let hw = v3(x, HW);
         // magnetorquers: momentum dumping m = k (h_w × B)/|B|², uniformly scaled into ±m_max
@@ -64,8 +81,12 @@ impl AttitudePlant {
                 tau_mtq = dipole.cross(&b);
             }
         }
-        // wheel torque command with the known magnetic torque fed forward, first-order lag
+        // wheel torque command with the known magnetic torque of the dumping law fed forward, first-order lag
         let rw_cmd = (u - tau_mtq) * v.wheel_gain;
+        // an external dipole command (mtq_mode 1) acts besides the wheels, without feed-forward
+        if Self::mtq_external(v) {
+            (dipole, tau_mtq) = self.external_dipole(v, t, a);
+        }
         let (tau_w, lag_rate) = if v.wheel_time_constant > 0.0 {
             let tw = v3(x, TW);
             (tw, (rw_cmd - tw) / v.wheel_time_constant)

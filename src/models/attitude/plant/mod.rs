@@ -62,7 +62,7 @@ impl AttitudePlant {
     /// ẋ with the inputs held.
     fn derivative(&self, v: &AttitudePlantVars, t: f64, x: &State, seg: &Segment) -> State {
         let w = v3(x, W);
-        let needs_a = v.gg_enable == 1 || Self::mtq(v);
+        let needs_a = v.gg_enable == 1 || Self::mtq(v) || Self::mtq_external(v);
         let a = if needs_a { self.attitude(x) } else { Matrix3::identity() };
         let act = self.actuate(v, t, x, &a, seg);
         let tau = act.torque + self.external(v, t, &a, seg);
@@ -96,9 +96,13 @@ impl Model for AttitudePlant {
         feedthrough: Feedthrough::Some(&[
             // every axis on every command: τ_applied = M sat(u) (mode 0) or M sat(K_w (u − τ_mtq)) + τ_mtq (mode 1),
             // M = R(δ) diag(k) couples the axes when the actuators are misaligned
-            ("torque_applied_x", &["torque_cmd_x", "torque_cmd_y", "torque_cmd_z"]),
-            ("torque_applied_y", &["torque_cmd_x", "torque_cmd_y", "torque_cmd_z"]),
-            ("torque_applied_z", &["torque_cmd_x", "torque_cmd_y", "torque_cmd_z"]),
+            ("torque_applied_x", &["torque_cmd_x", "torque_cmd_y", "torque_cmd_z", "m_cmd_x", "m_cmd_y", "m_cmd_z"]),
+            ("torque_applied_y", &["torque_cmd_x", "torque_cmd_y", "torque_cmd_z", "m_cmd_x", "m_cmd_y", "m_cmd_z"]),
+            ("torque_applied_z", &["torque_cmd_x", "torque_cmd_y", "torque_cmd_z", "m_cmd_x", "m_cmd_y", "m_cmd_z"]),
+            // mtq_mode 1: τ_applied includes sat(m_cmd) × B, the dipole output is sat(m_cmd)
+            ("dipole_x", &["m_cmd_x"]),
+            ("dipole_y", &["m_cmd_y"]),
+            ("dipole_z", &["m_cmd_z"]),
             ("torque_ext_x", &["torque_dist_x"]),
             ("torque_ext_y", &["torque_dist_y"]),
             ("torque_ext_z", &["torque_dist_z"]),

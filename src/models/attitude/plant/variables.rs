@@ -1,4 +1,4 @@
-//! The declared variables of `AttitudePlant` (ports 0–43, parameters 100–189, calculated 200–203).
+//! The declared variables of `AttitudePlant` (ports 0–46, parameters 100–190, calculated 200–203).
 
 use super::kinematics::Kinematics;
 use crate::declare_variables;
@@ -26,6 +26,8 @@ declare_variables! {
         35 => wheel_speed: Vec3 = [0.0; 3], Output, "rad/s", "Wheel spin relative to the body h_w/J_w";
         38 => dipole: Vec3 = [0.0; 3], Output, "A.m2", "Magnetorquer dipole m, body axes";
         41 => b_body: Vec3 = [0.0; 3], Output, "T", "Geomagnetic field in body axes";
+        // appended (issue 37): external magnetorquer command
+        44 => m_cmd: Vec3 = [0.0; 3], Input, "A.m2", "Magnetorquer dipole command, body axes (mtq_mode = 1; e.g. from BDot)";
         // parameters: body
         100 => inertia: Diag3 = [1000.0, 500.0, 700.0], Parameter, "kg.m2", "Inertia matrix diagonal entry ([Navabi-2019] default)", Positive;
         103 => inertia_xy: Real = 0.0, Parameter, "kg.m2", "Inertia matrix entry xy (matrix entry, not product of inertia)";
@@ -83,6 +85,8 @@ declare_variables! {
         // actuator errors (both actuator modes; project choice, for Monte Carlo dispersions)
         184 => actuator_scale: Vec3 = [1.0; 3], Parameter, "", "Actuator scale factor k: actuator i delivers k_i times its limited torque (tau_body = R(delta) diag(k) tau_actuators)", Positive;
         187 => actuator_misalignment: Vec3 = [0.0; 3], Parameter, "rad", "Actuator-triad misalignment: rotation vector delta of the actuator axes relative to the body axes (R(delta) = exp([delta x]))";
+        // appended (issue 37): source of the magnetorquer dipole
+        190 => mtq_mode: Integer = 0, Parameter, "", "Magnetorquer dipole: 0 = internal momentum dumping (actuator_mode 1 with mtq_enable 1; otherwise none); 1 = the input m_cmd, each axis clamped at mtq_dipole_max, in either actuator mode (the internal dumping law is off)", Choice(SWITCH);
         // calculated parameters
         200 => wheel_torque_max: Real = 0.05, CalculatedParameter, "N.m", "Wheel torque limit k_t i_max before faults";
         201 => wheel_momentum_max: Real = 0.504, CalculatedParameter, "N.m.s", "Wheel momentum limit J_w Omega_max";

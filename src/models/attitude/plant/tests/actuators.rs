@@ -209,3 +209,30 @@ fn actuator_misalignment_and_scale_factor_closed_form() {
     assert!((out - rod).norm() < 1e-14, "{out:?} vs {rod:?}");
     q.outputs(0.0).unwrap();
 }
+
+#[test]
+fn external_dipole_command_is_clamped_and_acts_in_both_actuator_modes() {
+    // mtq_mode 1: τ_applied = τ_actuators + clamp(m_cmd) × B_b, the dipole output is the clamped command,
+    // the internal dumping law is off (mtq_enable = 1 with wheels has no effect)
+    for mode in [0, 1] {
+        let mut p = plant(|v| {
+            v.mtq_mode = 1;
+            v.actuator_mode = mode;
+            v.mtq_enable = 1;
+            (v.init_h_wheel.x, v.init_h_wheel.y, v.init_h_wheel.z) = (0.01, 0.02, -0.015);
+            (v.m_cmd.x, v.m_cmd.y, v.m_cmd.z) = (0.3, -2.0, 0.5); // limit N A i = 1 A.m2: y clamps
+            (v.torque_cmd.x, v.torque_cmd.y, v.torque_cmd.z) = (1e-3, 0.0, -2e-3);
+        });
+        p.outputs(0.0).unwrap();
+        let m = Vector3::new(0.3, -1.0, 0.5);
+        assert_eq!(Vector3::new(p.v.dipole.x, p.v.dipole.y, p.v.dipole.z), m);
+        let b = Vector3::new(p.v.b_body.x, p.v.b_body.y, p.v.b_body.z);
+        let want = Vector3::new(1e-3, 0.0, -2e-3) + m.cross(&b);
+        let got = Vector3::new(p.v.torque_applied.x, p.v.torque_applied.y, p.v.torque_applied.z);
+        assert!((got - want).norm() < 1e-18, "mode {mode}: {got} vs {want}");
+    }
+    // mode 0 (default): the command input is ignored
+    let mut p = plant(|v| (v.m_cmd.x, v.m_cmd.y, v.m_cmd.z) = (1.0, 1.0, 1.0));
+    p.outputs(0.0).unwrap();
+    assert_eq!((p.v.dipole.x, p.v.dipole.y, p.v.dipole.z, p.v.torque_applied.x), (0.0, 0.0, 0.0, 0.0));
+}
