@@ -113,12 +113,14 @@ def with_sensors(sc: Scenario, name: str | None = None, gyro: dict | None = None
 
 # ----- estimator in the loop (issue 37) -------------------------------------------------------------------
 # Project choice, completing the sensor suite above: a sun sensor (10 Hz, 0.1 deg, 60 deg half-angle field of
-# view about body +z, no measurement in the Earth's shadow), a magnetometer (10 Hz, 100 nT per axis) and the
+# view about body +x, the face that sees the sun at the start of the papers' runs; no measurement in the
+# Earth's shadow), a magnetometer (10 Hz, 100 nT per axis) and the
 # flight computer's on-board Ephemeris (sun direction and dipole field in R) feed a Mekf at the gyro's rate,
 # whose estimated attitude and rate replace the raw measurements at the controller's inputs.
 ORBIT_KEYS = ("mu", "orbit_radius", "orbit_inclination", "orbit_arg_lat0", "earth_dipole", "sun_ecliptic_longitude")
-SUN_SENSOR_DEFAULT = {"sample_period": 0.1, "noise": 1.745e-3, "fov": 1.0471975511965976, "eclipse": 1}
-MAGNETOMETER_DEFAULT = {"sample_period": 0.1, "noise": 1e-7}
+SUN_SENSOR_DEFAULT = {"sample_period": 0.1, "noise": 1.745e-3, "fov": 1.0471975511965976, "eclipse": 1,
+                      "mount_y": 1.5707963267948966}  # boresight (sensor z) on body +x
+MAGNETOMETER_DEFAULT = {"sample_period": 0.1, "noise_x": 1e-7, "noise_y": 1e-7, "noise_z": 1e-7}
 # the sensors' declared defaults the Mekf's noise model is matched to (tests/test_estimation_loop.py reads
 # them back from the packaged FMUs): gyro ARW N² [rad²/s], bias instability B [rad/s] with correlation time
 # tau_c [s]; star tracker 1-sigma cross / about the boresight [rad]
@@ -129,8 +131,9 @@ EST_LOG = ["q_est_w", "q_est_x", "q_est_y", "q_est_z", "w_est_x", "w_est_y", "w_
            "bias_est_z", "p_att_x", "p_att_y", "p_att_z", "nis", "nis_dim"]
 
 
-def _vec(v, i: int) -> float:
-    return float(v[i]) if isinstance(v, (list, tuple)) else float(v)
+def _axis(d: dict, stem: str, a: str) -> float:
+    """Component ``a`` of a vector parameter given per axis (``stem_x``) or as one value for all (``stem``)."""
+    return float(d.get(f"{stem}_{a}", d.get(stem, 0.0)))
 
 
 def mekf_params(gyro: dict, star_tracker: dict, sun_sensor: dict, magnetometer: dict, orbit: dict) -> dict:
@@ -144,12 +147,12 @@ def mekf_params(gyro: dict, star_tracker: dict, sun_sensor: dict, magnetometer: 
     g = {**GYRO_NOISE, **gyro}
     st = {**STAR_TRACKER_NOISE, **star_tracker}
     b_min = float(orbit.get("earth_dipole", 7.96e15)) / float(orbit.get("orbit_radius", 7078137.0)) ** 3
-    rrw = [_vec(g["rrw_psd"], i) + 2.0 * (GM_STD_PER_B * _vec(g["bias_instability"], i)) ** 2
-           / float(g["bias_corr_time"]) for i in range(3)]
-    turn_on = max(abs(_vec(g.get("bias_const", 0.0), i)) for i in range(3))
-    mag_noise = max(_vec(magnetometer["noise"], i) for i in range(3)) / b_min
+    rrw = [_axis(g, "rrw_psd", a) + 2.0 * (GM_STD_PER_B * _axis(g, "bias_instability", a)) ** 2
+           / float(g["bias_corr_time"]) for a in "xyz"]
+    turn_on = max(abs(_axis(g, "bias_const", a)) for a in "xyz")
+    mag_noise = max(float(magnetometer[f"noise_{a}"]) for a in "xyz") / b_min
     return {"sample_period": float(g["sample_period"]),
-            **{f"arw_psd_{a}": _vec(g["arw_psd"], i) for i, a in enumerate("xyz")},
+            **{f"arw_psd_{a}": _axis(g, "arw_psd", a) for a in "xyz"},
             **{f"rrw_psd_{a}": rrw[i] for i, a in enumerate("xyz")},
             "sigma_bias_init": max(1e-4, 2.0 * turn_on),
             "st_noise_cross": float(st["noise_cross"]), "st_noise_about": float(st["noise_about"]),
