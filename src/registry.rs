@@ -47,7 +47,7 @@ pub const FAMILIES: &[Family] = &[
     },
     Family {
         slug: "estimation",
-        title: "Attitude determination: TRIAD, QUEST and the B-dot detumbling law",
+        title: "Attitude estimation, determination and detumbling: MEKF, TRIAD, QUEST, B-dot",
         overview: include_str!("models/estimation/README.md"),
         fmus: estimation::FMUS,
     },

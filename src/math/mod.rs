@@ -6,6 +6,7 @@
 //! Each module carries its own unit tests against closed-form results.
 
 pub mod attitude;
+pub mod attitude_kalman;
 pub mod environment;
 pub mod fractional;
 pub mod fuzzy;

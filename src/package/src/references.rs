@@ -93,6 +93,15 @@ pub const ALL: &[Reference] = &[
         subject: "",
         used_for: "sampled-data timing: zero-order hold and computation delay",
     },
+    Reference {
+        key: "Lefferts-Markley-Shuster-1982",
+        authors: "E. J. Lefferts, F. L. Markley, M. D. Shuster",
+        title: "Kalman Filtering for Spacecraft Attitude Estimation",
+        venue: "Journal of Guidance, Control, and Dynamics 5(5), 1982",
+        subject: "",
+        used_for: "the multiplicative extended Kalman filter of attitude and gyro bias (error state of small-angle \
+                   attitude errors and biases, multiplicative reset)",
+    },
 ];
 
 /// The references whose `[key]` occurs in any of `texts`, in the order of [`ALL`].
