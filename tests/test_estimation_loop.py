@@ -8,13 +8,15 @@
   the dipole field, and a noise-free magnetometer at identity measures the Ephemeris's field;
 * a few variants run on the three engines with bit-identical results;
 * pointing with the estimator is close to pointing with perfect knowledge: over the pointing phase (the
-  last third of paper 000's large slew) the RMS of the Euler-axis error α exceeds the truth-fed loop's by
-  at most 3 σ, σ the RMS over that phase of the filter's own attitude sigma sqrt(tr P_att) — and the same
-  test fails when the star tracker is mounted 0.05 deg off without the filter being told.
+  last third of paper 000's large slew) the RMS difference of the Euler-axis error α between the loop fed
+  by the estimator and the same loop fed the truth is at most 3 σ, σ the RMS over that phase of the
+  filter's own attitude sigma sqrt(tr P_att) — and the same test fails with the sensing loop's 0.1 s
+  star-tracker latency, which the filter does not compensate.
 """
 
 from __future__ import annotations
 
+import copy
 import math
 
 import numpy as np
@@ -121,32 +123,47 @@ def _quat_angle_deg(r: dict) -> np.ndarray:
     return np.degrees(2 * np.arccos(np.clip(dot, -1.0, 1.0)))
 
 
-def pointing_gap(star_tracker_mount_deg: float = 0.0) -> dict:
-    """RMS of α over the pointing phase (last third) of paper 000's large slew, truth-fed and with the
-    estimator, and the filter's σ = RMS of sqrt(tr P_att) [deg] over the same phase."""
-    truth = simulate(scenarios.get("default"))
+def perfect_knowledge(sc):
+    """The same loop (sensors, estimator, 10 Hz flight computer) with the controller fed the plant's truth."""
+    p = copy.deepcopy(sc)
+    p.connections.update({**{f"controller.q_{a}": f"plant.q_{a}" for a in "wxyz"},
+                          **{f"controller.w_{a}": f"plant.w_{a}" for a in "xyz"}})
+    return p
+
+
+def pointing_gap(star_tracker_latency: float = 0.0) -> dict:
+    """Over the pointing phase (last third) of paper 000's large slew with the estimator in the loop: RMS of
+    the Euler-axis error α with the estimate and with perfect knowledge (the same loop, the controller fed
+    the truth), RMS of their difference, the filter's σ = RMS of sqrt(tr P_att) and the RMS of the
+    estimate's own error [deg]."""
     sc = scenarios.get(f"{EST}/default")
-    if star_tracker_mount_deg:
-        sc = sc.with_overrides({"star_tracker.mount_x": math.radians(star_tracker_mount_deg)})
-    est = simulate(sc)
+    if star_tracker_latency:
+        sc = sc.with_overrides({"star_tracker.latency": star_tracker_latency})
+    est, perf = simulate(sc), simulate(perfect_knowledge(sc))
     t = est["time"]
     ph = t >= t[-1] * 2 / 3
-    rms = lambda x: float(np.sqrt(np.mean(np.square(x[ph]))))  # noqa: E731
+    rms = lambda x: float(np.sqrt(np.mean(np.square(np.asarray(x)[ph]))))  # noqa: E731
     sigma = np.degrees(np.sqrt(est["p_att_x"] + est["p_att_y"] + est["p_att_z"]))
-    return {"truth": rms(truth["alpha_deg"]), "est": rms(est["alpha_deg"]), "sigma": rms(sigma),
-            "est_err": rms(_quat_angle_deg(est))}
+    return {"perfect": rms(perf["alpha_deg"]), "est": rms(est["alpha_deg"]),
+            "gap": rms(est["alpha_deg"] - perf["alpha_deg"]), "sigma": rms(sigma), "est_err": rms(_quat_angle_deg(est))}
 
 
 def test_pointing_with_the_estimator_is_close_to_pointing_with_perfect_knowledge():
     g = pointing_gap()
-    print(f"\npointing phase of the large slew: RMS α truth-fed {g['truth']:.3e} deg, with estimator {g['est']:.3e} deg; "
-          f"filter σ {g['sigma']:.3e} deg, RMS estimate error {g['est_err']:.3e} deg")
-    assert g["est"] <= g["truth"] + 3 * g["sigma"], g
-    # the estimate's own error is consistent with its sigma (a χ² with 3 degrees of freedom: RMS ≈ σ)
+    print(f"\npointing phase of the large slew: RMS α with perfect knowledge {g['perfect']:.3e} deg, with the "
+          f"estimator {g['est']:.3e} deg, RMS difference {g['gap']:.3e} deg; filter σ {g['sigma']:.3e} deg, RMS "
+          f"estimate error {g['est_err']:.3e} deg")
+    # the controller drives the *estimated* attitude to the command, so the true pointing differs from the
+    # perfect-knowledge pointing by about the estimation error: within 3 σ of the filter's own sigma
+    assert g["gap"] <= 3 * g["sigma"], g
+    # and the estimate's error is consistent with its sigma (RMS of a 3-axis error ≈ sqrt(tr P))
     assert g["est_err"] <= 2 * g["sigma"], g
-    # the test can fail: a star tracker mounted 0.05 deg off that the filter does not know of
-    bad = pointing_gap(star_tracker_mount_deg=0.05)
-    assert bad["est"] > bad["truth"] + 3 * bad["sigma"], bad
+    # the test can fail: the sensing loop's star tracker latency of 0.1 s, which the filter does not compensate
+    # (it takes each quaternion as measured at its arrival)
+    bad = pointing_gap(star_tracker_latency=0.1)
+    print(f"star tracker with 0.1 s latency: RMS difference {bad['gap']:.3e} deg, σ {bad['sigma']:.3e} deg, RMS "
+          f"estimate error {bad['est_err']:.3e} deg")
+    assert bad["gap"] > 3 * bad["sigma"], bad
 
 
 def test_template_refuses_what_is_not_an_attitude_loop():

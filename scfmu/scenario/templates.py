@@ -127,6 +127,7 @@ MAGNETOMETER_DEFAULT = {"sample_period": 0.1, "noise_x": 1e-7, "noise_y": 1e-7, 
 GYRO_NOISE = {"arw_psd": 1.9e-9, "bias_instability": 4.85e-6, "bias_corr_time": 300.0, "rrw_psd": 0.0}
 STAR_TRACKER_NOISE = {"noise_cross": 2.5e-5, "noise_about": 2.0e-4}
 GM_STD_PER_B = 0.664_282_470_267_960_1 / 0.617_364_283_144_441_4  # the Gyro's σ_b / B (FLICKER_FLOOR / GM_ADEV_PEAK)
+STAR_TRACKER_EST = {"latency": 0.0}  # the star tracker of the estimator variant: as the sensing one, without latency
 EST_LOG = ["q_est_w", "q_est_x", "q_est_y", "q_est_z", "w_est_x", "w_est_y", "w_est_z", "bias_est_x", "bias_est_y",
            "bias_est_z", "p_att_x", "p_att_y", "p_att_z", "nis", "nis_dim"]
 
@@ -161,7 +162,8 @@ def mekf_params(gyro: dict, star_tracker: dict, sun_sensor: dict, magnetometer: 
 
 
 def with_estimation(sc: Scenario, name: str | None = None, mekf: dict | None = None, sun_sensor: dict | None = None,
-                    magnetometer: dict | None = None, vectors: bool = True, description: str = "") -> Scenario:
+                    magnetometer: dict | None = None, star_tracker: dict | None = None, vectors: bool = True,
+                    description: str = "") -> Scenario:
     """``sc`` (an attitude loop, with or without sensors) with the estimator between the sensors and the
     controller: AttitudePlant → Gyro, StarTracker, SunSensor, Magnetometer (+ Ephemeris) → Mekf → controller
     → SampleHold → AttitudePlant. The controller's ``q_*`` ← ``estimator.q_est_*`` and ``w_*`` ←
@@ -169,14 +171,18 @@ def with_estimation(sc: Scenario, name: str | None = None, mekf: dict | None = N
     with ``vectors``, the sun sensor's direction with its validity (sun in its field of view and the
     spacecraft lit: the sensor decides, sample by sample) and the magnetometer's field, each with its reference
     direction from the Ephemeris. The plant's orbit parameters go to every environment-reading unit, so
-    sensors, ephemeris and plant see one environment. ``mekf``: parameters over :func:`mekf_params`."""
+    sensors, ephemeris and plant see one environment. ``mekf``: parameters over :func:`mekf_params`.
+    ``star_tracker``: parameters over :data:`STAR_TRACKER_EST` (no latency: the Mekf takes a quaternion as
+    measured at its arrival and does not compensate a delay; a 0.1 s latency at the slews' rates makes its
+    estimate lag by ~0.1° with a covariance of ~0.004°)."""
     s = copy.deepcopy(sc) if any(c.name == "gyro" for c in sc.components) else with_sensors(sc, name=sc.name)
     if any(c.name == "estimator" for c in s.components):
         raise KeyError(f"with_estimation: scenario {sc.name!r} already has an estimator")
     plant = s.component("plant").params
     orbit = {k: plant[k] for k in ORBIT_KEYS if k in plant}
     gyro = {**GYRO_DEFAULT, **s.component("gyro").params}
-    st = dict(s.component("star_tracker").params)
+    st = {**s.component("star_tracker").params, **STAR_TRACKER_EST, **(star_tracker or {})}
+    s.component("star_tracker").params = st
     ss = {**SUN_SENSOR_DEFAULT, **orbit, **(sun_sensor or {})}
     mg = {**MAGNETOMETER_DEFAULT, **{k: v for k, v in orbit.items() if k != "sun_ecliptic_longitude"},
           **(magnetometer or {})}
