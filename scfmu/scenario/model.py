@@ -14,7 +14,8 @@ name of exactly one *other* instance. Exceptions are explicit:
 * ``unconnected``: glob patterns (``fnmatch``) of inputs, bare (``"torque_dist_*"``) or qualified
   (``"plant.torque_dist_*"``), left at their start value (or at the value given in ``inputs``).
   ``DEFAULT_UNCONNECTED`` lists the optional inputs of the current FMUs (disturbance inputs, wheel
-  momentum, reference-rate feed-forward, leader anomaly) that the historical master left open.
+  momentum, reference-rate feed-forward, leader anomaly, the plant's magnetorquer command, used only with
+  mtq_mode = 1) that the historical master left open.
 
 An input that has no source and matches no ``unconnected`` pattern is an error.
 
@@ -32,7 +33,8 @@ import json
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
-DEFAULT_UNCONNECTED = ("torque_dist_*", "dist_*", "h_wheel*", "q_ref_dot*", "q_ref_ddot*", "leader_true_anomaly", "m_cmd_*")
+DEFAULT_UNCONNECTED = ("torque_dist_*", "dist_*", "h_wheel*", "q_ref_dot*", "q_ref_ddot*", "leader_true_anomaly",
+                       "m_cmd_*")
 
 
 @dataclass

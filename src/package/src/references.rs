@@ -76,6 +76,15 @@ pub const ALL: &[Reference] = &[
                    and magnetometer measurements",
     },
     Reference {
+        key: "Avanzini-Giulietti-2012",
+        authors: "G. Avanzini, F. Giulietti",
+        title: "Magnetic Detumbling of a Rigid Spacecraft",
+        venue: "Journal of Guidance, Control, and Dynamics 35(4), 2012",
+        subject: "",
+        used_for: "B-dot detumbling on the normalised field direction and its gain rule from the orbit rate, the \
+                   orbit's inclination to the geomagnetic equator and the smallest moment of inertia",
+    },
+    Reference {
         key: "IEEE-952",
         authors: "IEEE Aerospace and Electronic Systems Society",
         title: "IEEE Standard Specification Format Guide and Test Procedure for Single-Axis Interferometric \
