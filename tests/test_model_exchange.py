@@ -29,7 +29,7 @@ STATEFUL = {"MracController": 9, "AdaptiveFuzzyController": 9, "ReferenceCorrect
 STATIC_LAWS = {"PdController", "LqrController", "PolePlacementController", "FuzzyPdController", "SlidingModeController",
                "Type2FuzzySmcController", "FeedbackLinearizingController", "AttitudeCommand", "RelativePositionCommand"}
 # sampled laws (a sample time) and the sensors (sampled noise): Co-Simulation only
-CS_ONLY = {"PidController", "FopidController", "Gyro", "StarTracker", "SunSensor", "Magnetometer", "SampleHold"}
+CS_ONLY = {"PidController", "FopidController", "Gyro", "StarTracker", "SunSensor", "Magnetometer", "SampleHold", "Mekf"}
 N_STATES = {**PLANTS, **STATEFUL}
 
 
