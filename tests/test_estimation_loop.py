@@ -171,3 +171,26 @@ def test_template_refuses_what_is_not_an_attitude_loop():
         with_estimation(scenarios.get("paper002/PD"))
     with pytest.raises(KeyError):
         with_estimation(scenarios.get(f"{EST}/default"))  # already has one
+
+
+def test_benchmark_with_estimator_column(tmp_path):
+    """``scfmu benchmark --estimator``: each pair once more on its scenario's sensing+estimation variant; the
+    column's value equals the registered variant run directly (PD on paper 000's small slew is at home there,
+    with its paper's tuning), and the page says how the column was obtained."""
+    import csv
+
+    from scfmu import benchmark
+    from scfmu.metrics import compute as metrics_of
+
+    benchmark.run(None, "attitude", tmp_path, quick=True, controllers=["PdController"], cases=["paper000/000-5"],
+                  workers=1, log=lambda *a: None, estimator=True)
+    rows = list(csv.DictReader(open(tmp_path / "results.csv", encoding="utf-8")))
+    assert len(rows) == 1 and rows[0]["rank with estimator"] == "1", rows
+    got = float(rows[0]["primary value with estimator"])
+    sc = scenarios.get(f"{EST}/paper000/000-5")
+    direct = metrics_of(sc.metrics, simulate(sc, engine="native"))["eulerint_deg_s"]
+    assert math.isclose(got, direct, rel_tol=1e-9), (got, direct)
+    truth = float(rows[0]["primary value"])
+    assert got != truth and math.isclose(got, truth, rel_tol=0.5), (got, truth)  # another loop, same order of magnitude
+    page = (tmp_path / "benchmark.md").read_text(encoding="utf-8")
+    assert "with estimator: EULERINT [deg·s] (rank)" in page and "With estimator: each pair that ran once more" in page
