@@ -39,6 +39,9 @@ def build(ctx) -> PaperSection:
     rows = rankings.run(out, seeds, ctx.workers, QUICK_STOP_003 if ctx.quick else None, log=print,
                         estimator=True, client=ctx.client)
     rankings.write(rows, out)
+    n_runs = len(rows) * (1 + 2 * seeds)
+    if hasattr(ctx, "add_runs"):
+        ctx.add_runs(n_runs)  # the campaigns ran on the report's client outside ctx.campaign
     fig = ctx.figures_dir / "sensing_rankings.png"
     fig.write_bytes((out / "rankings.png").read_bytes())
     g000 = [g for g, *_ in rankings.GROUPS if g.startswith("paper 000")]
@@ -65,7 +68,7 @@ def build(ctx) -> PaperSection:
                f"{r['rank_truth']} / {r['rank_sensed']} / {r['rank_est']}"] for r in rows])
     setup = (f"Paper 000's large slew (one scenario per controller) and paper 003's cases N, C, S, W (GA-SMC, "
              f"T2F-SMC), each run once with the plant's truth and {seeds} times (seeds 1…{seeds}) with sensors and "
-             f"with the estimator in the loop; {len(rows) * (1 + 2 * seeds)} runs on the native engine.")
+             f"with the estimator in the loop; {n_runs} runs on the native engine.")
     notes = ("Sensor suite (project choice): gyro 100 Hz, ARW 0.15 deg/sqrt(h), bias instability 1 deg/h; star "
              "tracker 5 Hz, 5/41 arcsec, 0.1 s latency; sun sensor 10 Hz, 0.1 deg, 60 deg field of view, none in "
              "eclipse; magnetometer 10 Hz, 100 nT; Mekf at 100 Hz with the sensors' own noise; flight computer "
