@@ -111,5 +111,6 @@ def test_plant_state_outputs_do_not_depend_on_torque_inputs():
             for u in root.find("ModelStructure").find("InitialUnknowns")}
     for n in ("q_w", "q_x", "w_x", "w_z"):
         assert deps[index[n]] & inputs == set(), n
-    # every command: the actuator misalignment (actuator_misalignment_*) couples the axes
-    assert deps[index["torque_applied_x"]] & inputs == {index[f"torque_cmd_{a}"] for a in "xyz"}
+    # every command: the actuator misalignment (actuator_misalignment_*) couples the axes; the magnetorquer
+    # dipole command (mtq_mode = 1) acts through m x B on every axis
+    assert deps[index["torque_applied_x"]] & inputs == {index[f"{p}_{a}"] for p in ("torque_cmd", "m_cmd") for a in "xyz"}

@@ -100,6 +100,9 @@ pub fn davenport_k(obs: &[(Vector3<f64>, Vector3<f64>, f64)]) -> (Matrix4<f64>, 
     (k, lambda0)
 }
 
+/// A normalised observation in use: (body direction, reference direction, weight).
+type Used = (Vector3<f64>, Vector3<f64>, f64);
+
 /// The solution of Wahba's problem: the quaternion (scalar first, q_w ≥ 0) and the minimum loss.
 #[derive(Clone, Copy, Debug)]
 pub struct Solution {
@@ -134,7 +137,7 @@ pub fn q_method(obs: &[Observation], names: &[&str], min_sep: f64) -> Result<Sol
         ));
     }
     // at least one pair must span a plane, in both frames
-    let spans = |pick: fn(&(Vector3<f64>, Vector3<f64>, f64)) -> Vector3<f64>| {
+    let spans = |pick: fn(&Used) -> Vector3<f64>| {
         let mut best = 0.0f64;
         for i in 0..used.len() {
             for j in i + 1..used.len() {

@@ -18,7 +18,7 @@ declare_variables! {
         102 => filter_time_constant: Real = 1.0, Parameter, "s", "Time constant tau of the first-order filter on the field-direction derivative (0 = unfiltered backward difference)", Range(0.0, 1e6);
         103 => dipole_max: Real = 1.0, Parameter, "A.m2", "Dipole limit m_max: the largest component of m is scaled down to it, keeping the direction (1e30 = no limit)", Limit;
         104 => orbit_rate: Real = 0.0010602064484506297, Parameter, "rad/s", "Orbital rate n for the gain rule (default: the plant's 700 km circular orbit)", Positive;
-        105 => field_inclination: Real = 1.7104226669544429, Parameter, "rad", "Inclination xi_m of the orbit to the geomagnetic equator for the gain rule (non-tilted dipole: the orbit inclination; default 98 deg)", Range(0.0, 3.141592653589793);
+        105 => field_inclination: Real = 1.710_422_666_954_443, Parameter, "rad", "Inclination xi_m of the orbit to the geomagnetic equator for the gain rule (non-tilted dipole: the orbit inclination; default 98 deg)", Range(0.0, std::f64::consts::PI);
         106 => inertia_min: Real = 500.0, Parameter, "kg.m2", "Smallest principal moment of inertia J_min for the gain rule", Positive;
         120 => gain_rule: Integer = 1, Parameter, "", "0 = explicit gain; 1 = k = 2 n (1 + sin xi_m) J_min", Choice(&[0, 1]);
         200 => k: Real = 0.0, CalculatedParameter, "N.m.s", "Gain k in use";
@@ -171,7 +171,7 @@ mod tests {
     #[test]
     fn gain_rule_and_the_dipole_of_a_turning_field() {
         let f = unit(1, 0.0);
-        let want = 2.0 * 0.0010602064484506297 * (1.0 + 1.7104226669544429f64.sin()) * 500.0;
+        let want = 2.0 * 0.0010602064484506297 * (1.0 + 1.710_422_666_954_443_f64.sin()) * 500.0;
         assert!((f.v.k - want).abs() < 1e-15, "{}", f.v.k);
         // field of 3e-5 T turning about body z at w = 0.01 rad/s (the body turns at -w): unfiltered,
         // the sampled derivative is the chord (b_1 - b_0)/T, m = -(k/|B|) (b_1 - b_0)/T
