@@ -42,7 +42,7 @@ pub const FAMILIES: &[Family] = &[
     },
     Family {
         slug: "estimation",
-        title: "Attitude estimation and determination: MEKF, TRIAD, QUEST and the B-dot detumbling law",
+        title: "Attitude estimation, determination and detumbling: MEKF, TRIAD, QUEST, B-dot",
         overview: include_str!("models/estimation/README.md"),
         fmus: estimation::FMUS,
     },

@@ -36,6 +36,9 @@ def main(argv=None) -> int:
     ap.add_argument("--controllers", help="comma-separated built-in controllers to compare (default: all of the family)")
     ap.add_argument("--cases", help="comma-separated scenario names (or parts of their titles) to run (default: all)")
     ap.add_argument("--quick", action="store_true", help="Monte Carlo cases with 10 draws (the same set-up otherwise)")
+    ap.add_argument("--estimator", action="store_true",
+                    help="also run every pair with the estimator in the loop (sensing+estimation/<scenario>: sensors, "
+                         "ephemeris, Mekf, 10 Hz flight computer) and show its primary metric in a column (twice the runs)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--out", default=None, help="output folder (default out/benchmark/<family>)")
     ap.add_argument("--check", action="store_true", help="first run `scfmu check --quick` on the unit (an .fmu); "
@@ -76,7 +79,8 @@ def main(argv=None) -> int:
         entries = run(unit, a.family, out, label=label, unit_params={k: value(v) for k, v in pairs(a.set, "--set").items()},
                       port_map=pairs(a.map, "--map"), quick=a.quick, workers=a.workers,
                       controllers=[x.strip() for x in a.controllers.split(",")] if a.controllers else None,
-                      cases=[x.strip() for x in a.cases.split(",")] if a.cases else None, profile=prof, strict=a.strict)
+                      cases=[x.strip() for x in a.cases.split(",")] if a.cases else None, profile=prof, strict=a.strict,
+                      estimator=a.estimator)
     except StrictRefusal as e:
         print(f"scfmu benchmark: {e}", file=sys.stderr)
         return 2

@@ -291,7 +291,6 @@ def loop_margins(scenario: Scenario, plant: str = "plant", ports=tuple(f"torque_
                 r = response(i, pm_)
                 r = r[start::m]
             T = m * h
-            n = r.size
             if not _decayed(r):
                 note.append(f"pulse response not decayed within {r.size * T:g} s (a limit cycle, or a loop unstable "
                             f"at this operating point): margins unreliable")

@@ -28,7 +28,12 @@ from .types import Context
 
 def papers_known() -> tuple:
     """The papers whose plug-ins have a report section (all of them in a default build)."""
-    return tuple(p.key for p in REGISTRY.all_papers() if p.report)
+    return tuple(p.key for p in REGISTRY.all_papers() if p.report and p.key.isdigit())
+
+
+def studies_known() -> tuple:
+    """Plug-ins with a report section that are studies across papers, not papers (e.g. ``sensing``)."""
+    return tuple(p.key for p in REGISTRY.all_papers() if p.report and not p.key.isdigit())
 
 
 class ReportContext(Context):
@@ -64,14 +69,17 @@ def git_commit() -> str:
 
 def parse_papers(text: str | None) -> list[str]:
     if not text:
-        return list(papers_known())
+        return list(papers_known()) + list(studies_known())
     out = []
     for p in text.split(","):
         p = p.strip()
         if not p:
             continue
+        if p in studies_known():
+            out.append(p)
+            continue
         if not (p.isdigit() and len(p) <= 3):
-            raise SystemExit(f"--papers: {p!r} is not a paper number (000 … 004)")
+            raise SystemExit(f"--papers: {p!r} is not a paper number (000 … 004) nor a study ({', '.join(studies_known())})")
         out.append(p.zfill(3))
     return out
 

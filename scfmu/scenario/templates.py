@@ -109,3 +109,114 @@ def with_sensors(sc: Scenario, name: str | None = None, gyro: dict | None = None
     s.name = name or f"sensing/{sc.name}"
     s.description = description or f"{sc.description} — with gyro, star tracker and a 10 Hz flight computer"
     return s
+
+
+# ----- estimator in the loop (issue 37) -------------------------------------------------------------------
+# Project choice, completing the sensor suite above: a sun sensor (10 Hz, 0.1 deg, 60 deg half-angle field of
+# view about body +x, the face that sees the sun at the start of the papers' runs; no measurement in the
+# Earth's shadow), a magnetometer (10 Hz, 100 nT per axis) and the
+# flight computer's on-board Ephemeris (sun direction and dipole field in R) feed a Mekf at the gyro's rate,
+# whose estimated attitude and rate replace the raw measurements at the controller's inputs.
+ORBIT_KEYS = ("mu", "orbit_radius", "orbit_inclination", "orbit_arg_lat0", "earth_dipole", "sun_ecliptic_longitude")
+SUN_SENSOR_DEFAULT = {"sample_period": 0.1, "noise": 1.745e-3, "fov": 1.0471975511965976, "eclipse": 1,
+                      "mount_y": 1.5707963267948966}  # boresight (sensor z) on body +x
+MAGNETOMETER_DEFAULT = {"sample_period": 0.1, "noise_x": 1e-7, "noise_y": 1e-7, "noise_z": 1e-7}
+# the sensors' declared defaults the Mekf's noise model is matched to (tests/test_estimation_loop.py reads
+# them back from the packaged FMUs): gyro ARW N² [rad²/s], bias instability B [rad/s] with correlation time
+# tau_c [s]; star tracker 1-sigma cross / about the boresight [rad]
+GYRO_NOISE = {"arw_psd": 1.9e-9, "bias_instability": 4.85e-6, "bias_corr_time": 300.0, "rrw_psd": 0.0}
+STAR_TRACKER_NOISE = {"noise_cross": 2.5e-5, "noise_about": 2.0e-4}
+GM_STD_PER_B = 0.664_282_470_267_960_1 / 0.617_364_283_144_441_4  # the Gyro's σ_b / B (FLICKER_FLOOR / GM_ADEV_PEAK)
+STAR_TRACKER_EST = {"latency": 0.0}  # the star tracker of the estimator variant: as the sensing one, without latency
+EST_LOG = ["q_est_w", "q_est_x", "q_est_y", "q_est_z", "w_est_x", "w_est_y", "w_est_z", "bias_est_x", "bias_est_y",
+           "bias_est_z", "p_att_x", "p_att_y", "p_att_z", "nis", "nis_dim"]
+
+
+def _axis(d: dict, stem: str, a: str) -> float:
+    """Component ``a`` of a vector parameter given per axis (``stem_x``) or as one value for all (``stem``)."""
+    return float(d.get(f"{stem}_{a}", d.get(stem, 0.0)))
+
+
+def mekf_params(gyro: dict, star_tracker: dict, sun_sensor: dict, magnetometer: dict, orbit: dict) -> dict:
+    """The Mekf's parameters matched to the sensors it is fed by (their parameters over the defaults above):
+    its sample period is the gyro's, its ARW is the gyro's; the gyro's bias instability B, realised as a
+    Gauss–Markov bias of stationary sigma σ_b = 0.664 B / 0.6174 and correlation time tau_c, is modelled as
+    the random walk driven by the same white noise, K² = rrw_psd + 2 σ_b² / tau_c (exact for times short
+    against tau_c); the star tracker's and the sun sensor's 1-sigma angles are the filter's; the
+    magnetometer's angular noise is its per-axis noise over the weakest field on the orbit, M_E / r³; the
+    initial bias sigma is twice the largest turn-on bias (at least 1e-4 rad/s)."""
+    g = {**GYRO_NOISE, **gyro}
+    st = {**STAR_TRACKER_NOISE, **star_tracker}
+    b_min = float(orbit.get("earth_dipole", 7.96e15)) / float(orbit.get("orbit_radius", 7078137.0)) ** 3
+    rrw = [_axis(g, "rrw_psd", a) + 2.0 * (GM_STD_PER_B * _axis(g, "bias_instability", a)) ** 2
+           / float(g["bias_corr_time"]) for a in "xyz"]
+    turn_on = max(abs(_axis(g, "bias_const", a)) for a in "xyz")
+    mag_noise = max(float(magnetometer[f"noise_{a}"]) for a in "xyz") / b_min
+    return {"sample_period": float(g["sample_period"]),
+            **{f"arw_psd_{a}": _axis(g, "arw_psd", a) for a in "xyz"},
+            **{f"rrw_psd_{a}": rrw[i] for i, a in enumerate("xyz")},
+            "sigma_bias_init": max(1e-4, 2.0 * turn_on),
+            "st_noise_cross": float(st["noise_cross"]), "st_noise_about": float(st["noise_about"]),
+            "sun_noise": float(sun_sensor["noise"]), "mag_noise": mag_noise,
+            "use_star_tracker": 1, "use_sun": 1, "use_mag": 1, "init_from_star_tracker": 1}
+
+
+def with_estimation(sc: Scenario, name: str | None = None, mekf: dict | None = None, sun_sensor: dict | None = None,
+                    magnetometer: dict | None = None, star_tracker: dict | None = None, vectors: bool = True,
+                    description: str = "") -> Scenario:
+    """``sc`` (an attitude loop, with or without sensors) with the estimator between the sensors and the
+    controller: AttitudePlant → Gyro, StarTracker, SunSensor, Magnetometer (+ Ephemeris) → Mekf → controller
+    → SampleHold → AttitudePlant. The controller's ``q_*`` ← ``estimator.q_est_*`` and ``w_*`` ←
+    ``estimator.w_est_*``; the filter is fed the gyro's rate, the star tracker's quaternion and validity and,
+    with ``vectors``, the sun sensor's direction with its validity (sun in its field of view and the
+    spacecraft lit: the sensor decides, sample by sample) and the magnetometer's field, each with its reference
+    direction from the Ephemeris. The plant's orbit parameters go to every environment-reading unit, so
+    sensors, ephemeris and plant see one environment. ``mekf``: parameters over :func:`mekf_params`.
+    ``star_tracker``: parameters over :data:`STAR_TRACKER_EST` (no latency: the Mekf takes a quaternion as
+    measured at its arrival and does not compensate a delay; a 0.1 s latency at the slews' rates makes its
+    estimate lag by ~0.1° with a covariance of ~0.004°)."""
+    s = copy.deepcopy(sc) if any(c.name == "gyro" for c in sc.components) else with_sensors(sc, name=sc.name)
+    if any(c.name == "estimator" for c in s.components):
+        raise KeyError(f"with_estimation: scenario {sc.name!r} already has an estimator")
+    plant = s.component("plant").params
+    orbit = {k: plant[k] for k in ORBIT_KEYS if k in plant}
+    gyro = {**GYRO_DEFAULT, **s.component("gyro").params}
+    st = {**s.component("star_tracker").params, **STAR_TRACKER_EST, **(star_tracker or {})}
+    s.component("star_tracker").params = st
+    ss = {**SUN_SENSOR_DEFAULT, **orbit, **(sun_sensor or {})}
+    mg = {**MAGNETOMETER_DEFAULT, **{k: v for k, v in orbit.items() if k != "sun_ecliptic_longitude"},
+          **(magnetometer or {})}
+    est = {**mekf_params(gyro, st, ss, mg, orbit), **(mekf or {})}
+    if not vectors:
+        est.update(use_sun=0, use_mag=0)
+    comps = []
+    for c in s.components:
+        if c.name == "controller":
+            if vectors:
+                comps += [Component("sun_sensor", "SunSensor", ss), Component("magnetometer", "Magnetometer", mg),
+                          Component("ephemeris", "Ephemeris", dict(orbit))]
+            comps.append(Component("estimator", "Mekf", est))
+        comps.append(c)
+    s.components = comps
+    conn = {**s.connections,
+            **{f"estimator.w_meas_{a}": f"gyro.w_meas_{a}" for a in "xyz"},
+            **{f"estimator.q_meas_{a}": f"star_tracker.q_meas_{a}" for a in "wxyz"},
+            "estimator.st_valid": "star_tracker.valid",
+            **{f"controller.q_{a}": f"estimator.q_est_{a}" for a in "wxyz"},
+            **{f"controller.w_{a}": f"estimator.w_est_{a}" for a in "xyz"}}
+    if vectors:
+        conn.update({**{f"estimator.sun_meas_{a}": f"sun_sensor.sun_meas_{a}" for a in "xyz"},
+                     "estimator.sun_valid": "sun_sensor.valid",
+                     **{f"estimator.sun_ref_{a}": f"ephemeris.sun_ref_{a}" for a in "xyz"},
+                     **{f"estimator.mag_meas_{a}": f"magnetometer.b_meas_{a}" for a in "xyz"},
+                     **{f"estimator.mag_ref_{a}": f"ephemeris.b_ref_{a}" for a in "xyz"}})
+    else:
+        s.unconnected = [*s.unconnected, "estimator.sun_*", "estimator.mag_*"]
+    s.connections = conn
+    s.seed_params = [*s.seed_params, *(["sun_sensor.seed", "magnetometer.seed"] if vectors else [])]
+    s.log = {**s.log, **log_of("estimator", EST_LOG), **({"sun_valid": "sun_sensor.valid"} if vectors else {})}
+    inner = sc.name.removeprefix("sensing/")
+    s.name = name or f"sensing+estimation/{inner}"
+    s.description = description or (f"{sc.description} — gyro, star tracker"
+                                    f"{', sun sensor, magnetometer' if vectors else ''}, Mekf, 10 Hz flight computer")
+    return s

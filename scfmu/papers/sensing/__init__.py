@@ -9,6 +9,7 @@ from __future__ import annotations
 def register(reg) -> None:
     from . import scenarios
     reg.scenarios("sensing", scenarios.build, scenarios.names, exported=scenarios.EXPORTED)
+    reg.scenarios(scenarios.EST_PREFIX, scenarios.build_estimation, scenarios.names_estimation)
     reg.benchmark("attitude", "sensing/default",
                   "large slew (40, -40, -60) deg with gyro, star tracker, 10 Hz flight computer (sensing)")
     reg.benchmark("attitude", "sensing/default", "large slew with sensors, Monte Carlo over sensor seeds (sensing)",
@@ -21,4 +22,4 @@ def register(reg) -> None:
                                      "scfmu.papers.sensing.rankings:main"),
                         "slew": ("paper 000's large slew with and without sensors: large_slew.png",
                                  "scfmu.papers.sensing.rankings:main_slew")},
-              docs="docs/sensing.md")
+              report="scfmu.papers.sensing.report:build", docs="docs/sensing.md")

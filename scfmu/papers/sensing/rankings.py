@@ -5,8 +5,10 @@ Per group (paper 000's large slew (40, -40, -60) deg, one scenario per controlle
 paper 003's cases 003-N, C, S, W, SMC against T2F-SMC, ranked by ISE) every controller runs once with the
 plant's truth and ``--seeds`` times with sensors (``sensing/<scenario>``: gyro, star tracker, 10 Hz flight
 computer with 0.05 s delay; run seeds 1…n go to the sensors' seeds, and in 003-W to the plant's noise
-seed too). The controllers are ranked by the truth value and by the mean over the sensor seeds; a ranking
-"survives" when the order is the same. Writes ``rankings.csv`` (one row per controller and group) and
+seed too) and as many times with the estimator in the loop (``sensing+estimation/<scenario>``: the same
+sensors plus sun sensor, magnetometer, on-board ephemeris and the ``Mekf`` feeding the controller; the
+seeds also go to the two new sensors). The controllers are ranked by the truth value and by the mean over
+the seeds of each variant; a ranking "survives" when the order is the same as with the truth. Writes ``rankings.csv`` (one row per controller and group) and
 ``rankings.png`` under ``--out``; every run goes through the campaign engine (Dask, native engine).
 """
 
@@ -44,42 +46,66 @@ def _rank(values: dict) -> dict:
     return out
 
 
-def run(out: Path, seeds: int, workers: int, stop_003: float | None, log=print) -> list[dict]:
+VARIANTS = (("truth", ""), ("sensed", "sensing/"), ("est", "sensing+estimation/"))  # (row key, scenario prefix)
+
+
+def _stats(prefix: str, v: np.ndarray) -> dict:
+    ok = np.isfinite(v)
+    return {f"{prefix}_mean": float(np.mean(v[ok])) if ok.any() else math.nan,
+            f"{prefix}_std": float(np.std(v[ok], ddof=1)) if ok.sum() > 1 else 0.0,
+            f"{prefix}_min": float(np.min(v[ok])) if ok.any() else math.nan,
+            f"{prefix}_max": float(np.max(v[ok])) if ok.any() else math.nan,
+            f"{prefix}_runs_ok": int(ok.sum())}
+
+
+def _order(r: dict) -> str:
+    return ", ".join(f"{r[k]}. {k}" for k in sorted(r, key=r.get))
+
+
+def run(out: Path, seeds: int, workers: int, stop_003: float | None, log=print, estimator: bool = True,
+        client=None) -> list[dict]:
+    """One row per controller and group: the truth value, the sensed and (``estimator``) the estimator-in-the-
+    loop statistics over the seeds (over the runs that succeeded; ``*_runs_ok`` counts them), the ranks and
+    whether each ranking survives. ``client``: a Dask client to use (default: one started here)."""
     out.mkdir(parents=True, exist_ok=True)
-    client, cluster = campaign._client(None, workers)
+    own = client is None
+    cluster = None
+    if own:
+        client, cluster = campaign._client(None, workers)
+    variants = VARIANTS if estimator else VARIANTS[:2]
     rows = []
     try:
         for group, metric, _, members in GROUPS:
-            truth, sensed = {}, {}
+            vals: dict = {key: {} for key, _ in variants}
             for name, label in members.items():
                 kw = {"stop_time": stop_003} if (stop_003 and name.startswith("paper003")) else {}
-                for key, sc, sd in ((False, get(name, **kw), [None]),
-                                    (True, get(f"sensing/{name}", **kw), list(range(1, seeds + 1)))):
+                for key, prefix in variants:
+                    sc = get(prefix + name, **kw)
+                    sd = [None] if key == "truth" else list(range(1, seeds + 1))
                     folder = out / "runs" / file_stem(sc.name)
                     t = campaign.run(campaign.Campaign(sc, [{}], sd, engine="native"), folder, client=client,
                                      progress=False, overwrite=True).to_pylist()
-                    vals = np.array([r[metric] if r["status"] == "ok" else math.nan for r in t], dtype=float)
-                    (sensed if key else truth)[label] = vals
-            r_truth = _rank({k: float(v[0]) for k, v in truth.items()})
-            r_sens = _rank({k: float(np.mean(v)) for k, v in sensed.items()})
-            survives = r_truth == r_sens
+                    vals[key][label] = np.array([r[metric] if r["status"] == "ok" else math.nan for r in t], dtype=float)
+            rk = {key: _rank({k: float(np.mean(v)) for k, v in vals[key].items()}) for key, _ in variants}
             for label in members.values():
-                s = sensed[label]
-                ok = np.isfinite(s)
-                rows.append({"group": group, "controller": label, "metric": metric,
-                             "truth": float(truth[label][0]), "sensed_mean": float(np.mean(s[ok])) if ok.any() else math.nan,
-                             "sensed_std": float(np.std(s[ok], ddof=1)) if ok.sum() > 1 else 0.0,
-                             "sensed_min": float(np.min(s[ok])) if ok.any() else math.nan,
-                             "sensed_max": float(np.max(s[ok])) if ok.any() else math.nan,
-                             "runs_ok": int(ok.sum()), "runs": len(s), "rank_truth": r_truth[label],
-                             "rank_sensed": r_sens[label], "ranking_survives": survives})
-            order_t = ", ".join(f"{r_truth[k]}. {k}" for k in sorted(r_truth, key=r_truth.get))
-            order_s = ", ".join(f"{r_sens[k]}. {k}" for k in sorted(r_sens, key=r_sens.get))
-            log(f"{group}: truth {order_t}; with sensors {order_s}: ranking {'survives' if survives else 'CHANGES'}")
+                row = {"group": group, "controller": label, "metric": metric, "truth": float(vals["truth"][label][0]),
+                       "runs": seeds}
+                for key, _ in variants[1:]:
+                    row.update(_stats(key, vals[key][label]))
+                row.update({f"rank_{key}": rk[key][label] for key, _ in variants})
+                row["ranking_survives"] = rk["sensed"] == rk["truth"]
+                if estimator:
+                    row["ranking_survives_estimator"] = rk["est"] == rk["truth"]
+                rows.append(row)
+            log(f"{group}: truth {_order(rk['truth'])}; with sensors {_order(rk['sensed'])}: ranking "
+                f"{'survives' if rk['sensed'] == rk['truth'] else 'CHANGES'}"
+                + (f"; with the estimator {_order(rk['est'])}: ranking "
+                   f"{'survives' if rk['est'] == rk['truth'] else 'CHANGES'}" if estimator else ""))
     finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+        if own:
+            client.close()
+            if cluster is not None:
+                cluster.close()
     return rows
 
 
@@ -95,15 +121,23 @@ def write(rows: list[dict], out: Path) -> None:
     for ax, (group, _, unit, members) in zip(axes, GROUPS):
         rs = [r for r in rows if r["group"] == group]
         x = np.arange(len(rs))
-        ax.bar(x - 0.2, [r["truth"] for r in rs], 0.4, label="truth")
-        ax.bar(x + 0.2, [r["sensed_mean"] for r in rs], 0.4, yerr=[r["sensed_std"] for r in rs], capsize=3,
+        est = "est_mean" in rs[0]
+        w = 0.27 if est else 0.4
+        ax.bar(x - w, [r["truth"] for r in rs], w, label="truth")
+        ax.bar(x, [r["sensed_mean"] for r in rs], w, yerr=[r["sensed_std"] for r in rs], capsize=3,
                label=f"sensors (mean ± sd, {rs[0]['runs']} seeds)")
+        if est:
+            ax.bar(x + w, [r["est_mean"] for r in rs], w, yerr=[r["est_std"] for r in rs], capsize=3,
+                   label=f"sensors + Mekf (mean ± sd, {rs[0]['runs']} seeds)")
         ax.set_xticks(x, [r["controller"] for r in rs], rotation=40, ha="right", fontsize=8)
         ax.set_ylabel(unit)
-        ax.set_title(f"{group}\nranking {'survives' if rs[0]['ranking_survives'] else 'changes'}", fontsize=9)
+        verdict = f"sensors: {'survives' if rs[0]['ranking_survives'] else 'changes'}"
+        if est:
+            verdict += f"; Mekf: {'survives' if rs[0]['ranking_survives_estimator'] else 'changes'}"
+        ax.set_title(f"{group}\n{verdict}", fontsize=9)
         ax.grid(True, axis="y", alpha=0.3)
         if rs[0]["metric"] == "ise":
-            lo = min(min(r["truth"], r["sensed_mean"]) for r in rs)
+            lo = np.nanmin([min(r["truth"], r["sensed_mean"], r.get("est_mean", math.inf)) for r in rs])
             ax.set_ylim(bottom=0.9 * lo)
     axes[0].legend(fontsize=7)
     fig.tight_layout()
@@ -117,10 +151,11 @@ def main(argv=None) -> int:
     ap.add_argument("--seeds", type=int, default=10, help="sensor seeds per controller (default 10)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--quick", action="store_true", help="3 seeds, paper 003 cases over 30 s instead of 150 s")
+    ap.add_argument("--no-estimator", action="store_true", help="truth and sensors only (no sensing+estimation runs)")
     a = ap.parse_args(argv)
     out = Path(a.out)
     t0 = time.time()
-    rows = run(out, 3 if a.quick else a.seeds, a.workers, 30.0 if a.quick else None)
+    rows = run(out, 3 if a.quick else a.seeds, a.workers, 30.0 if a.quick else None, estimator=not a.no_estimator)
     write(rows, out)
     print(f"wrote {out / 'rankings.csv'} and {out / 'rankings.png'} ({time.time() - t0:.0f} s)")
     return 0

@@ -7,9 +7,12 @@ controller) and paper 003's cases."""
 
 from __future__ import annotations
 
+import functools
+
+from ...registry import REGISTRY
 from ...scenario import get
 from ...scenario.model import Scenario
-from ...scenario.templates import with_sensors
+from ...scenario.templates import with_estimation, with_sensors
 
 PAPER000_LARGE = {"default": "PD (quaternion)", "paper000/000-7L": "LQR", "paper000/000-8L": "pole placement",
                   "paper000/000-9L": "MRAC (quaternion)", "paper000/000-10L": "fuzzy PD",
@@ -31,3 +34,40 @@ def names() -> list[tuple[str, str]]:
                             f" with gyro, star tracker, 10 Hz flight computer") for n, label in PAPER000_LARGE.items()]
     out += [(f"sensing/{n}", f"{text} with gyro, star tracker, 10 Hz flight computer") for n, text in PAPER003.items()]
     return out
+
+
+# ----- the estimator in the loop (issue 37) ----------------------------------------------------------------
+EST_PREFIX = "sensing+estimation"
+DERIVED = ("sensing", EST_PREFIX)  # prefixes of variants, not attitude scenarios of their own
+
+
+def build_estimation(name: str, **kw) -> Scenario:
+    """``sensing+estimation/<registered attitude scenario>``: its sensing variant with the sun sensor,
+    magnetometer, on-board ephemeris and the Mekf between the sensors and the controller
+    (:func:`scfmu.scenario.templates.with_estimation`); keyword arguments go to that scenario's builder."""
+    inner = name.partition("/")[2]
+    if not inner or inner.split("/")[0] in DERIVED:
+        raise KeyError(f"unknown scenario {name!r}: expected {EST_PREFIX}/<attitude scenario>, e.g. "
+                       f"{EST_PREFIX}/default")
+    return with_estimation(get(inner, **kw), name=name)
+
+
+@functools.cache
+def attitude_scenarios() -> tuple:
+    """(name, description) of every registered three-axis attitude loop (an ``AttitudePlant`` with a
+    ``controller``), the variants excluded: the scenarios that take the estimator."""
+    out = []
+    for src in list(REGISTRY.scenario_sources.values()):
+        if src.prefix in DERIVED:
+            continue
+        for n, d in src.names():
+            sc = get(n)
+            names = {c.name for c in sc.components}
+            if {"plant", "controller"} <= names and sc.component("plant").model == "AttitudePlant":
+                out.append((n, d))
+    return tuple(out)
+
+
+def names_estimation() -> list[tuple[str, str]]:
+    return [(f"{EST_PREFIX}/{n}", f"{d} with gyro, star tracker, sun sensor, magnetometer, Mekf, 10 Hz flight computer")
+            for n, d in attitude_scenarios()]

@@ -13,4 +13,5 @@ crate::fmus! {
     sun_sensor::SunSensor,
     magnetometer::Magnetometer,
     sample_hold::SampleHold,
+    ephemeris::Ephemeris,
 }
