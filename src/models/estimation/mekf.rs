@@ -379,8 +379,11 @@ mod tests {
         Vector3::new(0.01 + 0.005 * (0.2 * t).sin(), -0.02, 0.015 * (0.3 * t).cos())
     }
 
-    /// Runs the filter with a communication step h = T; returns per sample (err δθ, P_att diag, bias err, nis, dim).
-    fn run(f: &mut Fmu<Mekf>, n: usize, seed: i64, arw: f64, sc: f64, b: Vector3<f64>) -> Vec<(Vector3<f64>, Vector3<f64>, Vector3<f64>, f64, i32)> {
+    /// One sample of a test run: (err δθ, P_att diag, bias err, nis, dim).
+    type Sample = (Vector3<f64>, Vector3<f64>, Vector3<f64>, f64, i32);
+
+    /// Runs the filter with a communication step h = T; returns one [`Sample`] per sample.
+    fn run(f: &mut Fmu<Mekf>, n: usize, seed: i64, arw: f64, sc: f64, b: Vector3<f64>) -> Vec<Sample> {
         f.initialize(&Experiment::default()).unwrap();
         let tp = f.v.sample_period;
         let mut tr = Truth { q: quat_from_euler321(0.3, -0.2, 1.0), b };

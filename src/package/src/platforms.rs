@@ -95,11 +95,12 @@ pub fn universal_macho(slices: &[&[u8]]) -> Result<Vec<u8>, String> {
     Ok(header)
 }
 
+/// One binary of an archive: (platform folder, file extension, bytes).
+pub type Binary<'a> = (&'static str, &'static str, Cow<'a, [u8]>);
+
 /// The FMI 2.0 archive's binaries: `(folder, extension, bytes)` in the order given, the two macOS builds
 /// joined into one universal `darwin64` file at the place of the first.
-pub fn fmi2_binaries<'a>(
-    builds: &[(&'a str, &'a [u8])],
-) -> Result<Vec<(&'static str, &'static str, Cow<'a, [u8]>)>, String> {
+pub fn fmi2_binaries<'a>(builds: &[(&'a str, &'a [u8])]) -> Result<Vec<Binary<'a>>, String> {
     let macs: Vec<&[u8]> = builds
         .iter()
         .filter(|(k, _)| matches!(*k, "x86_64-darwin" | "aarch64-darwin"))
