@@ -1,6 +1,6 @@
 """B-dot detumbling: runs the ``detumble`` and ``detumble/slow`` scenarios (AttitudePlant → Magnetometer →
 BDot → the plant's magnetorquers) and plots the body-rate magnitude against the orbit-averaged model of the
-law (tests/test_bdot_detumble.py derives it), writing ``detumble.png`` and ``detumble.csv``.
+law (src/models/estimation/tests/test_bdot_detumble.py derives it), writing ``detumble.png`` and ``detumble.csv``.
 
     python examples/detumble/detumble.py [output folder, default docs/]
 """

@@ -6,7 +6,7 @@
   k = 2 n (1 + sin ξ_m) J_min; magnetorquers of 0.2 A·m² per axis (500 turns, 0.01 m², 0.04 A). Two orbits.
 * ``detumble/slow``: the same with a twentieth of the rule's gain and three orbits: the decay is slow
   against the field's rotation, the regime in which the orbit-averaged model holds
-  (``tests/test_bdot_detumble.py`` compares its decay rate with that model).
+  (``src/models/estimation/tests/test_bdot_detumble.py`` compares its decay rate with that model).
 
 Any plant, magnetometer or law parameter can be overridden (``plant.init_w_x``, ``bdot.gain``, ...)."""
 

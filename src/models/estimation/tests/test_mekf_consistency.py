@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[4]  # the repository (this file: src/models/estimation/tests/)
 _spec = importlib.util.spec_from_file_location("mekf_consistency", ROOT / "scripts" / "mekf_consistency.py")
 mc_mod = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(mc_mod)
