@@ -32,6 +32,8 @@ ATTITUDE_FEATURES = [
     {"actuator_mode": 1, "mtq_enable": 1, "gg_enable": 1, "wheel_time_constant": 0.5, **FULL_INERTIA, **MISALIGNED},
     # reaction wheels without lag: the wheel torque follows the command directly
     {"actuator_mode": 1, "mtq_enable": 1, "gg_enable": 0, "wheel_time_constant": 0.0, **FULL_INERTIA, **MISALIGNED},
+    # magnetorquers following the dipole command input m_cmd (B-dot), besides lagging wheels
+    {"actuator_mode": 1, "mtq_mode": 1, "gg_enable": 1, "wheel_time_constant": 0.5, **FULL_INERTIA, **MISALIGNED},
 ]
 CASES = {
     "AttitudePlant": [dict(p, kinematics=k) for k in (0, 1, 2, 3, 4) for p in ATTITUDE_FEATURES],

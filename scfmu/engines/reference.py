@@ -11,11 +11,13 @@ direct feed-through, so reading them first is exact.
 
 from __future__ import annotations
 
+import fnmatch
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..fmu import Fmu, scalar_type
+from ..scenario.model import DEFAULT_UNCONNECTED
 
 
 @dataclass
@@ -54,9 +56,9 @@ class CoSimulation:
 
     @staticmethod
     def _required(name: str) -> bool:
-        # Disturbance and optional extra inputs may stay at their start value.
-        return not (name.startswith("torque_dist") or name.startswith("dist_") or name.startswith("h_wheel")
-                    or name.startswith("q_ref_dot") or name.startswith("q_ref_ddot") or name == "leader_true_anomaly")
+        # The optional inputs (disturbances, wheel momenta, reference derivatives, the magnetorquer dipole
+        # command, ...) may stay at their start value: the scenarios' one list of them.
+        return not any(fnmatch.fnmatchcase(name, p) for p in DEFAULT_UNCONNECTED)
 
     def propagate(self) -> None:
         for dst in self.fmus:
