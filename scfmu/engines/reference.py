@@ -58,7 +58,8 @@ class CoSimulation:
     def _required(name: str) -> bool:
         # The optional inputs (disturbances, wheel momenta, reference derivatives, the magnetorquer dipole
         # command, ...) may stay at their start value: the scenarios' one list of them.
-        return not any(fnmatch.fnmatchcase(name, p) for p in DEFAULT_UNCONNECTED)
+        # A pattern "x_*" also covers the scalar port "x" (SingleAxisPlant's torque_dist).
+        return not any(fnmatch.fnmatchcase(name, p) or name == p.removesuffix("_*") for p in DEFAULT_UNCONNECTED)
 
     def propagate(self) -> None:
         for dst in self.fmus:
