@@ -17,6 +17,7 @@ import os
 import re
 import subprocess
 import sys
+import time
 
 import numpy as np
 import pytest
@@ -172,6 +173,52 @@ def test_a_failing_unit_costs_its_own_runs_only(units, variant, status):
     assert rows[0]["eulerint_deg_s"] == rows[2]["eulerint_deg_s"]
     want = {"crash": "SIGSEGV", "hang": "4 s", "nan": "not finite", "error": "deliberate failure"}[variant]
     assert want in rows[1]["message"], rows[1]["message"]
+
+
+_ONE_RUN = """
+import sys
+from scfmu import campaign
+from scfmu.scenario import get
+spec = campaign.Campaign(get("default", stop_time=1.0).with_models({"controller": sys.argv[1]}), timeout=600).runs()[0]
+print("running", flush=True)
+print(campaign.run_chunk([spec])[0][0]["status"], flush=True)
+"""
+
+
+def test_a_crash_is_a_row_not_a_fatal_error_dump(units):
+    """With Python's fault handler on (as pytest and `python -X faulthandler` have it), a unit's crash in
+    an isolated run is a row with status crash and nothing else: the child drops the inherited handler, so
+    no 'Fatal Python error' dump reaches the terminal and no handler re-raises the signal from user space."""
+    p = subprocess.run([sys.executable, "-X", "faulthandler", "-c", _ONE_RUN, str(units.c_pd("crash"))],
+                       capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0 and p.stdout.split() == ["running", "crash"], p.stdout + p.stderr[-2000:]
+    assert "Fatal Python error" not in p.stderr, p.stderr[-2000:]
+
+
+def test_an_isolated_run_dies_with_its_campaign(units):
+    """A campaign process killed (SIGKILL) while a unit hangs in its isolated child takes the child with
+    it: the child is in a session of its own (no group signal from a crashing unit reaches the campaign)
+    but is tied to its parent's life, so a hanging unit cannot spin on after the campaign is gone."""
+    import psutil
+    p = subprocess.Popen([sys.executable, "-c", _ONE_RUN, str(units.c_pd("hang"))], stdout=subprocess.PIPE,
+                         text=True)
+    try:
+        assert p.stdout.readline().strip() == "running"
+        deadline, kids = time.monotonic() + 60, []
+        while not kids and time.monotonic() < deadline:
+            kids = psutil.Process(p.pid).children()
+            time.sleep(0.1)
+        assert len(kids) == 1, "the isolated child did not start"
+        child = kids[0]
+        assert os.getsid(child.pid) == child.pid != os.getsid(p.pid)  # a session of its own
+        time.sleep(1.0)  # past the fail time: the unit spins in fmi2DoStep
+        assert child.status() != psutil.STATUS_ZOMBIE
+        p.kill()
+        p.wait(10)
+        gone, alive = psutil.wait_procs([child], timeout=10)
+        assert not alive, "the isolated child outlived its campaign"
+    finally:
+        p.kill()
 
 
 def test_campaign_cli_with_a_crashing_unit_exits_1_with_counts(units, tmp_path):

@@ -8,7 +8,6 @@ from __future__ import annotations
 import json
 import math
 import os
-import time
 import traceback
 from pathlib import Path
 
@@ -16,6 +15,7 @@ import numpy as np
 
 from .. import fmu as fmu_access
 from .. import metrics as run_metrics
+from ..fmu import isolate
 from ..engines import SimulationError, resolve_engine, simulate
 from ..scenario.model import Scenario
 from ..scenario.plan import build_plan
@@ -62,7 +62,7 @@ def run_one(spec: dict, fmu_dir: str | None = None, blobs: dict | None = None) -
         spec = _materialize(spec, blobs)
     except Exception as e:
         return _failed_row(spec, "error", f"{type(e).__name__}: {e}"), None
-    if spec.get("isolate") and hasattr(os, "fork"):
+    if spec.get("isolate") and isolate.available():
         return _run_isolated(spec, fmu_dir)
     return _run_body(spec, fmu_dir)
 
@@ -79,59 +79,20 @@ def _failed_row(spec: dict, status: str, message: str) -> dict:
 
 
 def _run_isolated(spec: dict, fmu_dir: str | None) -> tuple[dict, dict | None]:
-    """``_run_body`` in a forked child; the result comes back pickled through a pipe. A child that dies
-    (e.g. a segmentation fault inside an FMU) gives status ``crash`` with the signal; one that gives no
-    result within ``spec["timeout"]`` seconds is killed: status ``timeout``."""
-    import pickle
-    import select
-    import signal
-    rfd, wfd = os.pipe()
-    pid = os.fork()
-    if pid == 0:  # child: run, send, exit without running the parent's cleanup handlers
-        code = 0
-        try:
-            os.close(rfd)
-            data = pickle.dumps(_run_body(spec, fmu_dir))
-            with os.fdopen(wfd, "wb") as w:
-                w.write(data)
-        except BaseException:
-            code = 3
-        finally:
-            os._exit(code)
-    os.close(wfd)
-    chunks, deadline = [], time.monotonic() + float(spec.get("timeout", 600.0))
-    timed_out = False
-    with os.fdopen(rfd, "rb") as r:
-        while True:
-            left = deadline - time.monotonic()
-            if left <= 0:
-                timed_out = True
-                break
-            ready, _, _ = select.select([r], [], [], min(left, 1.0))
-            if ready:
-                b = os.read(r.fileno(), 1 << 20)
-                if not b:
-                    break
-                chunks.append(b)
-    if timed_out:
-        try:
-            os.kill(pid, signal.SIGKILL)
-        except ProcessLookupError:
-            pass
-    _, status = os.waitpid(pid, 0)
-    if timed_out:
-        return _failed_row(spec, "timeout", f"no result within {spec.get('timeout', 600.0):g} s of wall time: "
-                                            f"the run was stopped (a unit that hangs?)"), None
-    if os.WIFSIGNALED(status):
-        sig = os.WTERMSIG(status)
-        name = signal.Signals(sig).name if sig in signal.Signals._value2member_map_ else str(sig)
-        return _failed_row(spec, "crash", f"the run's process died with {name} (a crash inside a unit's native "
+    """``_run_body`` in a forked child (scfmu.fmu.isolate): a child that dies (e.g. a segmentation fault
+    inside an FMU) gives status ``crash`` with the signal; one that gives no result within
+    ``spec["timeout"]`` seconds is killed: status ``timeout``."""
+    limit = float(spec.get("timeout", 600.0))
+    kind, value = isolate.in_child(lambda: _run_body(spec, fmu_dir), limit)
+    if kind == "timeout":
+        return _failed_row(spec, "timeout", f"no result within {limit:g} s of wall time: the run was stopped "
+                                            f"(a unit that hangs?)"), None
+    if kind == "crash" and value.startswith("exit code"):
+        return _failed_row(spec, "crash", f"the run's process exited with {value} and no result"), None
+    if kind == "crash":
+        return _failed_row(spec, "crash", f"the run's process died with {value} (a crash inside a unit's native "
                                           f"code)"), None
-    try:
-        return pickle.loads(b"".join(chunks))
-    except Exception:
-        return _failed_row(spec, "crash", f"the run's process exited with code {os.WEXITSTATUS(status)} and no "
-                                          f"result"), None
+    return value
 
 
 def _run_body(spec: dict, fmu_dir: str | None = None) -> tuple[dict, dict | None]:

@@ -290,64 +290,19 @@ def _trial(c, start_time: float) -> str | None:
             + (" | ".join(msg) if msg else str(refused)))
 
 
-def _in_child(fn, timeout: float):
-    """``fn()`` in a forked child with a wall-time limit: ("ok", result), ("crash", signal name) or
-    ("timeout", None); a foreign unit that crashes or hangs cannot take this process with it."""
-    import os
-    import pickle
-    import select
-    import signal
-    import time
-    rfd, wfd = os.pipe()
-    pid = os.fork()
-    if pid == 0:
-        code = 0
-        try:
-            os.close(rfd)
-            with os.fdopen(wfd, "wb") as w:
-                w.write(pickle.dumps(fn()))
-        except BaseException:
-            code = 3
-        finally:
-            os._exit(code)
-    os.close(wfd)
-    chunks, deadline = [], time.monotonic() + timeout
-    with os.fdopen(rfd, "rb") as r:
-        while True:
-            left = deadline - time.monotonic()
-            if left <= 0:
-                os.kill(pid, signal.SIGKILL)
-                os.waitpid(pid, 0)
-                return "timeout", None
-            ready, _, _ = select.select([r], [], [], min(left, 1.0))
-            if ready:
-                b = os.read(r.fileno(), 1 << 16)
-                if not b:
-                    break
-                chunks.append(b)
-    _, status = os.waitpid(pid, 0)
-    if os.WIFSIGNALED(status):
-        return "crash", signal.Signals(os.WTERMSIG(status)).name
-    try:
-        return "ok", pickle.loads(b"".join(chunks))
-    except Exception:
-        return "crash", f"exit code {os.WEXITSTATUS(status)}"
-
-
 def trial_initialization(sc: Scenario, warnings: list | None = None) -> list[str]:
     """Each instance that is given parameters is instantiated and initialized alone with them (the calls
     every engine makes); when it refuses them but initializes with its defaults, the unit's own log
     message is the error (e.g. an exclusive bound the model description cannot declare). A unit given as
     a file is tried in a child process (``TRIAL_TIMEOUT``): a crash or a hang there is a warning (the runs,
     isolated, report it), not the end of this process."""
-    import os
-    from ..fmu import is_path
+    from ..fmu import is_path, isolate
     errors = []
     for c in sc.components:
         if not c.params:
             continue
-        if is_path(c.model) and hasattr(os, "fork"):
-            kind, result = _in_child(lambda c=c: _trial(c, sc.start_time), TRIAL_TIMEOUT)
+        if is_path(c.model) and isolate.available():
+            kind, result = isolate.in_child(lambda c=c: _trial(c, sc.start_time), TRIAL_TIMEOUT)
             if kind != "ok":
                 if warnings is not None:
                     warnings.append(f"{c.name} ({Path(str(c.model)).name}): its trial initialization "
