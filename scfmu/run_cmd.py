@@ -205,7 +205,8 @@ def main(argv=None) -> int:
         return 2
     if args.engine is None:
         args.engine = "native"
-        if plan.model_exchange:  # fmpy's container (native) hosts Co-Simulation units only
+        if plan.model_exchange:  # native nests a Model Exchange unit as its Co-Simulation face (scfmu.engines.
+            # cs_face: the wrapper library of this platform); the compiled loop integrates it directly
             from .engines.compiled import available
             args.engine = "compiled" if available() else "lean"
     if args.log_every != 1 and args.engine != "native":

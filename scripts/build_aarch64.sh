@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Cross-builds cdylibs for Linux aarch64 (ARM 64-bit) on an x86-64 Linux machine. Without arguments: the
-# two shared libraries of the workspace, giving
-# target/aarch64/aarch64-unknown-linux-gnu/release/libspacecraft_fmus_cdylib.so (the FMUs' binary) and
-# libscfmu_native_loop.so (the compiled engine's loop, shipped in the aarch64 wheel).
+# three shared libraries of the workspace, giving
+# target/aarch64/aarch64-unknown-linux-gnu/release/libspacecraft_fmus_cdylib.so (the FMUs' binary),
+# libscfmu_native_loop.so (the compiled engine's loop, shipped in the aarch64 wheel) and libscfmu_me_cs.so
+# (the Model Exchange wrapper of Co-Simulation faces, scfmu/engines/cs_face.py; shipped in every wheel;
+# built in a cargo run of its own that may fail without costing the FMUs their binary: it then says why).
 #
 # Uses Debian's Rust (rustc-web, cargo-web: /usr/bin/rustc, /usr/bin/cargo) with its prebuilt standard
 # library for the target from Debian's arm64 architecture (libstd-rust-web-dev:arm64, the same 1.96
@@ -53,14 +55,16 @@ trap 'rm -f "$json"' EXIT
 build() {
     RUSTC_BOOTSTRAP=1 RUSTC="$RUSTC_DEB" RUSTDOC=/usr/bin/rustdoc \
     CARGO_TARGET_AARCH64_UNKNOWN_LINUX_GNU_LINKER="$LINKER" \
-        "$CARGO_DEB" build --release --locked --lib -p spacecraft_fmus_cdylib -p scfmu_native_loop \
+        "$CARGO_DEB" build --release --locked --lib "$@" \
         ${build_std[@]+"${build_std[@]}"} --target "$TARGET" --target-dir "$cache" --message-format=json-render-diagnostics >"$json"
 }
 start=$(date +%s)
-build
+build -p spacecraft_fmus_cdylib -p scfmu_native_loop
 out=target/aarch64/$TARGET/release
 cross_products "$json" "$out" >/dev/null
 so=$out/libspacecraft_fmus_cdylib.so
 [ -f "$so" ] || { echo "build_aarch64: $so was not produced" >&2; exit 1; }
+# the Model Exchange wrapper (scfmu_me_cs: Co-Simulation faces, scfmu/engines/cs_face.py), a run of its own
+cross_optional build_aarch64 libscfmu_me_cs.so "$out" "$json" build -p scfmu_me_cs
 echo "build_aarch64: built in $(( $(date +%s) - start )) s (cargo target folder: $cache)" >&2
 echo "$so"

@@ -2,6 +2,9 @@
 # Cross-builds the FMUs' shared library for macOS on Linux, for both Mac CPUs: Intel (x86_64-apple-darwin,
 # macOS 10.12 or later) and Apple silicon (aarch64-apple-darwin, macOS 11 or later):
 #   target/macos/<triple>/release/libspacecraft_fmus_cdylib.dylib
+# and, beside it, libscfmu_me_cs.dylib: the Model Exchange wrapper of Co-Simulation faces
+# (scfmu/engines/cs_face.py joins the two into the universal darwin64 file of an FMI 2.0 face), built in a
+# `cargo rustc` of its own that may fail without costing the FMUs their library (it then says why).
 # The compiled engine's loop library (scfmu/engines/native_loop) is not built for macOS: a second cargo run
 # with its own install name compiles std again (cargo hashes std differently per run), which doubles an
 # already long build; the macOS wheels therefore carry no compiled loop and campaigns there use the
@@ -72,18 +75,20 @@ for pair in x86_64-darwin:x86_64-apple-darwin aarch64-darwin:aarch64-apple-darwi
     # (else it stamps its newest macOS into the library and older ones refuse to load it); `cargo rustc`
     # to give the library the install name @rpath/<file> (not the build folder)
     case "$triple" in x86_64-*) min=10.12 ;; *) min=11.0 ;; esac
-    : >"$json"
-    for pkg in spacecraft_fmus_cdylib; do
+    build() {  # build PACKAGE: one `cargo rustc` (its JSON messages into $json)
         PATH="$tools:$PATH" CARGO="$CARGO_DEB" RUSTC="$RUSTC_DEB" RUSTDOC=/usr/bin/rustdoc RUSTC_BOOTSTRAP=1 \
         MACOSX_DEPLOYMENT_TARGET=$min CARGO_ZIGBUILD_CACHE_DIR="$cache/zigbuild" CARGO_PROFILE_RELEASE_STRIP=false \
-            "$tools/cargo-zigbuild" rustc --release --locked --lib -p "$pkg" \
+            "$tools/cargo-zigbuild" rustc --release --locked --lib -p "$1" \
             -Z build-std=std,panic_unwind --target "$triple" --target-dir "$cache" \
-            --message-format=json-render-diagnostics -- -C "link-arg=-Wl,-install_name,@rpath/lib$pkg.dylib" >>"$json"
-    done
+            --message-format=json-render-diagnostics -- -C "link-arg=-Wl,-install_name,@rpath/lib$1.dylib" >"$json"
+    }
+    build spacecraft_fmus_cdylib
     out=target/macos/$triple/release
     cross_products "$json" "$out" >/dev/null
     lib=$out/libspacecraft_fmus_cdylib.dylib
     [ -f "$lib" ] || { echo "build_macos: $lib was not produced" >&2; exit 1; }
+    # the Model Exchange wrapper (scfmu_me_cs: Co-Simulation faces, scfmu/engines/cs_face.py), a run of its own
+    cross_optional build_macos libscfmu_me_cs.dylib "$out" "$json" build scfmu_me_cs
     echo "build_macos: $triple built in $(( $(date +%s) - start )) s (cargo target folder: $cache)" >&2
     echo "$key=$lib"
 done

@@ -2,7 +2,8 @@
 # Builds the FMUs (scripts/build_fmus.sh, without the SSP files and loop FMUs: the wheel ships neither)
 # and writes platform wheels of the scfmu package into dist/: each carries the FMUs (scfmu/fmus/<Model>.fmu,
 # FMI 2.0, and scfmu/fmus/fmi3/<Model>.fmu, FMI 3.0) with only its platform's binary, and the compiled
-# engine's loop library for that platform (scfmu/engines/native_loop/bin/<platform>/). `pip install` of
+# engine's loop library for that platform (scfmu/engines/native_loop/bin/<platform>/) and the Model Exchange
+# wrapper of Co-Simulation faces for that platform (scfmu/engines/me_cs/bin/<tuple>/). `pip install` of
 # the wheel gives a machine without a Rust toolchain the FMUs, the scenarios and the `scfmu` command;
 # pip picks the wheel of its platform by the tag. `scfmu export ssp|loop` writes the scenario files from
 # the installed package.
@@ -71,6 +72,17 @@ loop_lib() {
         macos-*) echo "darwin64 -" ;;
     esac
 }
+# The Model Exchange wrapper of each platform (scfmu/engines/me_cs: cargo build --release and the cross-build
+# scripts), as scfmu/engines/me_cs/bin/<FMI 3.0 platform tuple>/ (scfmu/engines/cs_face.py, wrapper_libraries)
+me_cs_lib() {
+    case "$1" in
+        linux-x86_64) echo "x86_64-linux target/release/libscfmu_me_cs.so" ;;
+        linux-aarch64) echo "aarch64-linux target/aarch64/aarch64-unknown-linux-gnu/release/libscfmu_me_cs.so" ;;
+        win-amd64) echo "x86_64-windows target/win64/x86_64-win7-windows-gnu/release/scfmu_me_cs.dll" ;;
+        macos-x86_64) echo "x86_64-darwin target/macos/x86_64-apple-darwin/release/libscfmu_me_cs.dylib" ;;
+        macos-arm64) echo "aarch64-darwin target/macos/aarch64-apple-darwin/release/libscfmu_me_cs.dylib" ;;
+    esac
+}
 mkdir -p "$out"
 for plat in "${platforms[@]}"; do
     # Stage the package with the FMUs inside it, so that the source tree is never written to.
@@ -86,10 +98,13 @@ for plat in "${platforms[@]}"; do
         echo "build_wheel: $plat: no compiled loop library ($lib): not shipped, campaigns use the \"native\" engine" >&2
         lib=-
     fi
-    # the Co-Simulation face of Model Exchange units (scfmu/engines/cs_face.py): built on this host only
-    if [ "$plat" = linux-x86_64 ] && [ -f target/release/libscfmu_me_cs.so ]; then
-        mkdir -p "$stage/scfmu/engines/me_cs/bin/linux64"
-        cp target/release/libscfmu_me_cs.so "$stage/scfmu/engines/me_cs/bin/linux64/"
+    # the Model Exchange wrapper of Co-Simulation faces for that platform (scfmu/engines/cs_face.py)
+    read -r tuple3 me_cs <<<"$(me_cs_lib "$plat")"
+    if [ -f "$me_cs" ]; then
+        mkdir -p "$stage/scfmu/engines/me_cs/bin/$tuple3"
+        cp "$me_cs" "$stage/scfmu/engines/me_cs/bin/$tuple3/"
+    else
+        echo "build_wheel: $plat: no Model Exchange wrapper ($me_cs): not shipped, the native engine refuses Model Exchange units there" >&2
     fi
     tag=$(.venv/bin/python scripts/wheel_platform.py "$plat" "$stage/scfmu/fmus" "$lib")
     .venv/bin/python -m build --wheel --no-isolation --outdir "$stage/dist" "$stage" >"$stage/build.log" 2>&1 ||

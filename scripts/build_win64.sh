@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# Cross-builds cdylibs for Windows x86-64 on Linux. Without arguments: the two shared libraries of the
-# workspace, giving target/win64/x86_64-win7-windows-gnu/release/spacecraft_fmus_cdylib.dll (the FMUs' binary) and
-# scfmu_native_loop.dll (the compiled engine's loop, shipped in the wheel by scripts/build_wheel.sh).
+# Cross-builds cdylibs for Windows x86-64 on Linux. Without arguments: the shared libraries of the
+# workspace, giving target/win64/x86_64-win7-windows-gnu/release/spacecraft_fmus_cdylib.dll (the FMUs' binary),
+# scfmu_native_loop.dll (the compiled engine's loop, shipped in the wheel by scripts/build_wheel.sh) and
+# scfmu_me_cs.dll (the Model Exchange wrapper of Co-Simulation faces, scfmu/engines/cs_face.py; built in a
+# cargo run of its own that may fail without costing the FMUs their DLL: it then says why).
 # With --manifest-path PATH: that package (a user's model crate; fmu-package calls this), into
 # <its target folder>/win64.
 # Uses Debian's Rust (rustc-web, cargo-web, rust-web-src: /usr/bin/rustc, /usr/bin/cargo and the std
@@ -74,5 +76,7 @@ build --locked -p spacecraft_fmus_cdylib -p scfmu_native_loop
 cross_products "$json" "target/win64/$TARGET/release" >/dev/null
 dll=target/win64/$TARGET/release/spacecraft_fmus_cdylib.dll
 [ -f "$dll" ] || { echo "build_win64: $dll was not produced" >&2; exit 1; }
+# the Model Exchange wrapper (scfmu_me_cs: Co-Simulation faces, scfmu/engines/cs_face.py), a run of its own
+cross_optional build_win64 scfmu_me_cs.dll "target/win64/$TARGET/release" "$json" build --locked -p scfmu_me_cs
 echo "build_win64: built in $(( $(date +%s) - start )) s (cargo target folder: $cache)" >&2
 echo "$dll"

@@ -41,3 +41,23 @@ for line in open(sys.argv[1]):
                 print(dest)
 PY
 }
+
+# cross_optional NAME LIB OUT_DIR JSON_FILE COMMAND...: runs COMMAND (a cargo build of one more package, its
+# JSON messages written to JSON_FILE by COMMAND itself) for a library that may fail to build without failing the
+# caller: the Model Exchange wrapper scfmu_me_cs (scfmu/engines/me_cs), built in a cargo run of its own after
+# the FMUs' one, so that a wrapper that does not compile for a target never costs the FMUs their binary.
+# On success its cdylib is copied into OUT_DIR (cross_products); on failure OUT_DIR/LIB is removed (never a
+# stale library from an earlier build) and one line names the first compiler error. Always returns 0.
+cross_optional() {
+    local name=$1 lib=$2 out=$3 json=$4 err
+    shift 4
+    err=$(mktemp)
+    rm -f "$out/$lib"
+    if "$@" 2>"$err"; then
+        cross_products "$json" "$out" >/dev/null
+    fi
+    if [ ! -f "$out/$lib" ]; then
+        echo "$name: $lib not built (Model Exchange faces get no binary for this platform): $(grep -m1 -E '^error' "$err" || tail -n 1 "$err")" >&2
+    fi
+    rm -f "$err"
+}

@@ -194,7 +194,6 @@ def test_model_exchange_in_the_native_engine_needs_the_wrapper_library(monkeypat
     """Without the built wrapper library the native engine refuses an ME unit in one line saying how to build it."""
     from scfmu.engines import cs_face, native
     monkeypatch.setattr(cs_face, "wrapper_library", lambda: None)
-    monkeypatch.setattr(native, "wrapper_library", lambda: None)
     monkeypatch.setattr(native, "CACHE", tmp_path)
     with pytest.raises(PlanError, match=r"^plant: a Model Exchange unit runs in fmpy's container FMU through "
                                         r"scfmu's Co-Simulation wrapper, which is not built: run `cargo build"):

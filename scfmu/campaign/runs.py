@@ -114,7 +114,8 @@ def _run_body(spec: dict, fmu_dir: str | None = None) -> tuple[dict, dict | None
         engine = spec["engine"]
         plan = build_plan(sc)  # the run's one plan (the scenario resolved once)
         if engine == "auto":  # the compiled loop logs every step; a coarser log grid is the native engine's,
-            # which hosts Co-Simulation units only
+            # except with Model Exchange units, which the compiled loop integrates directly (native would nest
+            # each as its Co-Simulation face, scfmu.engines.cs_face)
             engine = resolve_engine("auto") if every == 1 or plan.model_exchange else "native"
         kw = {"log_every": every} if engine == "native" else {}
         r = simulate(plan, engine, **kw)

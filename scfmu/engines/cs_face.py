@@ -12,8 +12,23 @@ compiled engine does), with time events, state events located by bisection to 1e
 ``completedIntegratorStep`` and the event iteration. fmpy 0.3.32 ships no such wrapper (older fmpy releases
 had one for FMI 2.0 only).
 
+Platforms. The wrapper library is built for every platform the project's FMUs carry (Linux x86-64 by
+``cargo build --release``; Windows x86-64, Linux aarch64 and macOS x86-64/arm64 by the cross-build scripts
+``scripts/build_win64.sh``, ``build_aarch64.sh``, ``build_macos.sh``); a wheel ships every one that was built
+under ``scfmu/engines/me_cs/bin/<platform tuple>/`` (:func:`wrapper_libraries`). A face carries the wrapper
+in every platform folder for which BOTH the wrapper was built AND the unit carries its own binary of that
+CPU (checked from the binaries' headers): ``linux64``/``win64``/``aarch64-linux``/``darwin64`` for an FMI
+2.0 unit (``darwin64``: one universal file with the Mac CPUs the unit's own ``darwin64`` file holds), the
+platform tuples for an FMI 3.0 unit. Every other platform is simply not offered: its folder is left out of
+the face, unit binary included (a loop FMU then drops that platform too, :mod:`scfmu.export.loops`). One
+exception: an FMI 3.0 face is not offered on Apple-silicon Macs (``aarch64-darwin``), because the
+wrapper's build for that CPU looks for the unit's FMI 3.0 library under ``x86_64-darwin``
+(``scfmu/engines/me_cs/src/lib.rs``, ``load``); FMI 2.0 faces serve both Mac CPUs. The Windows wrapper does
+not build today (the wrapper opens the unit's library with ``dlopen``, which Windows lacks): the build says
+so and faces carry no ``win64``/``x86_64-windows`` until it does.
+
 Faces are cached next to the containers (``$SCFMU_CONTAINER_DIR``), keyed by the FMU file's SHA-256, the
-solver settings and the wrapper library's identity.
+solver settings and the wrapper libraries' identity.
 """
 
 from __future__ import annotations
@@ -21,6 +36,7 @@ from __future__ import annotations
 import hashlib
 import os
 import platform
+import struct
 import sys
 import zipfile
 from importlib import resources
@@ -33,28 +49,104 @@ from ..scenario.plan import PlanError, Unit
 LIB = "scfmu_me_cs"
 
 
-def _platform(fmi: int) -> tuple[str, str]:
-    """(binary folder, library file name) of this platform for an FMI ``fmi`` unit."""
-    if sys.platform == "win32":
-        return ("win64" if fmi == 2 else "x86_64-windows"), f"{LIB}.dll"
-    if sys.platform == "darwin":
-        return ("darwin64" if fmi == 2 else "x86_64-darwin"), f"{LIB}.dylib"
-    if platform.machine().lower() in ("aarch64", "arm64"):  # the project's folder for both versions
-        return "aarch64-linux", f"{LIB}.so"
-    return ("linux64" if fmi == 2 else "x86_64-linux"), f"{LIB}.so"
+# The wrapper's builds, by FMI 3.0 platform tuple (one per OS and CPU): (file name as cargo writes it, file
+# name inside a face, the cross build's folder in a source checkout). The host's own build is cargo's
+# target/release; a wheel ships each under scfmu/engines/me_cs/bin/<tuple>/ (scripts/build_wheel.sh).
+_BUILDS = {
+    "x86_64-linux": (f"lib{LIB}.so", f"{LIB}.so", None),
+    "aarch64-linux": (f"lib{LIB}.so", f"{LIB}.so", "target/aarch64/aarch64-unknown-linux-gnu/release"),
+    "x86_64-windows": (f"{LIB}.dll", f"{LIB}.dll", "target/win64/x86_64-win7-windows-gnu/release"),
+    "x86_64-darwin": (f"lib{LIB}.dylib", f"{LIB}.dylib", "target/macos/x86_64-apple-darwin/release"),
+    "aarch64-darwin": (f"lib{LIB}.dylib", f"{LIB}.dylib", "target/macos/aarch64-apple-darwin/release"),
+}
+# FMI 2.0 folder -> the tuples whose builds it holds (darwin64: one universal file of both Mac CPUs; the
+# project's FMUs carry the aarch64 Linux build under the FMI 3.0 name, where the wrapper looks for it too)
+_FMI2_FOLDERS = {"linux64": ("x86_64-linux",), "aarch64-linux": ("aarch64-linux",),
+                 "win64": ("x86_64-windows",), "darwin64": ("x86_64-darwin", "aarch64-darwin")}
+# FMI 3.0 tuples the wrapper can serve: its aarch64-darwin build looks for an FMI 3.0 unit's library under
+# x86_64-darwin (scfmu/engines/me_cs/src/lib.rs, load), so an FMI 3.0 face offers no aarch64-darwin
+_FMI3_TUPLES = ("x86_64-linux", "aarch64-linux", "x86_64-windows", "x86_64-darwin")
+_EXT = {"linux": "so", "windows": "dll", "darwin": "dylib"}
+_MACHO_CPU = {0x01000007: "x86_64", 0x0100000C: "aarch64"}  # mach-o/machine.h CPU_TYPE_X86_64, CPU_TYPE_ARM64
+_ELF_CPU = {62: "x86_64", 183: "aarch64"}  # e_machine EM_X86_64, EM_AARCH64
+_PE_CPU = {0x8664: "x86_64", 0xAA64: "aarch64"}  # IMAGE_FILE_MACHINE_AMD64, _ARM64
+
+
+def binary_tuples(data: bytes) -> set[str]:
+    """The platform tuples (``x86_64-linux``, ``aarch64-darwin``, ...) of a shared library's bytes, read
+    from its header: ELF, PE or (thin or universal) Mach-O; empty when unknown."""
+    if data[:4] == b"\x7fELF" and len(data) > 20:
+        cpu = _ELF_CPU.get(struct.unpack_from("<H" if data[5] == 1 else ">H", data, 18)[0])
+        return {f"{cpu}-linux"} if cpu else set()
+    if data[:2] == b"MZ" and len(data) > 0x40:
+        pe = struct.unpack_from("<I", data, 0x3C)[0]
+        if data[pe:pe + 4] == b"PE\0\0":
+            cpu = _PE_CPU.get(struct.unpack_from("<H", data, pe + 4)[0])
+            return {f"{cpu}-windows"} if cpu else set()
+        return set()
+    if data[:4] == b"\xcf\xfa\xed\xfe":
+        cpu = _MACHO_CPU.get(struct.unpack_from("<I", data, 4)[0])
+        return {f"{cpu}-darwin"} if cpu else set()
+    if data[:4] == b"\xca\xfe\xba\xbe":
+        n = struct.unpack_from(">I", data, 4)[0]
+        return {f"{_MACHO_CPU[c]}-darwin" for i in range(min(n, 16))
+                if (c := struct.unpack_from(">I", data, 8 + 20 * i)[0]) in _MACHO_CPU}
+    return set()
+
+
+def _ext(folder: str) -> str:
+    """File extension of the libraries in platform folder ``folder`` (FMI 2.0 folder or FMI 3.0 tuple)."""
+    return _EXT[_FMI2_FOLDERS.get(folder, (folder,))[0].split("-")[1]]
+
+
+def universal_macho(slices: list[bytes]) -> bytes:
+    """One universal ("fat") Mach-O file of thin 64-bit slices, each at a 2^14-byte aligned offset
+    (mach-o/fat.h, big-endian; the layout fmu-package gives the FMUs' darwin64 files)."""
+    align = 14
+    header = struct.pack(">II", 0xCAFEBABE, len(slices))
+    body, offset = b"", 1 << align
+    for sl in slices:
+        cpu, sub = struct.unpack_from("<II", sl, 4)
+        header += struct.pack(">IIIII", cpu, sub, offset, len(sl), align)
+        body += b"\0" * (offset - (1 << align) - len(body)) + sl
+        offset = (1 << align) + -(-len(body) // (1 << align)) * (1 << align)
+    return header.ljust(1 << align, b"\0") + body
+
+
+def _host() -> str:
+    """This machine's platform tuple."""
+    cpu = "aarch64" if platform.machine().lower() in ("aarch64", "arm64") else "x86_64"
+    osname = {"win32": "windows", "darwin": "darwin"}.get(sys.platform, "linux")
+    return f"{cpu}-{osname}"
+
+
+def wrapper_libraries() -> dict[str, Path]:
+    """``{platform tuple: wrapper library}`` of every platform whose build is found: the package's
+    ``scfmu/engines/me_cs/bin/<tuple>/`` (a wheel), else, in a source checkout (an editable install),
+    cargo's ``target/release`` for this machine's platform and the cross builds' folders for the others."""
+    pkg = Path(str(resources.files("scfmu")))
+    root = pkg.parent  # the source checkout holding this package (editable install), if it is one
+    checkout = (root / "Cargo.toml").is_file()
+    out = {}
+    for tup, (built, _, cross) in _BUILDS.items():
+        shipped = pkg / "engines" / "me_cs" / "bin" / tup / built
+        local = root / ("target/release" if tup == _host() else cross or "-") / built
+        if shipped.is_file():
+            out[tup] = shipped
+        elif checkout and local.is_file():
+            out[tup] = local
+    return out
 
 
 def wrapper_library() -> Path | None:
-    """The built wrapper library: ``scfmu/engines/me_cs/bin/<folder>/`` (a wheel) or ``target/release/`` (a
-    source checkout built with ``cargo build --release``), else None."""
-    name = {"win32": f"{LIB}.dll", "darwin": f"lib{LIB}.dylib"}.get(sys.platform, f"lib{LIB}.so")
-    pkg = Path(str(resources.files("scfmu")))
-    shipped = pkg / "engines" / "me_cs" / "bin" / _platform(2)[0] / name
-    if shipped.is_file():
-        return shipped
-    root = pkg.parent  # the source checkout holding this package (editable install), if it is one
-    built = root / "target" / "release" / name
-    return built if (root / "Cargo.toml").is_file() and built.is_file() else None
+    """This machine's wrapper library (see :func:`wrapper_libraries`), else None."""
+    return wrapper_libraries().get(_host())
+
+
+def wrapper_identity() -> tuple:
+    """What the faces depend on of the wrapper libraries (platform, size, modification time of each): part of
+    the faces' and the containers' cache keys."""
+    return tuple((t, p.stat().st_size, p.stat().st_mtime_ns) for t, p in sorted(wrapper_libraries().items()))
 
 
 def _config(u: Unit) -> str:
@@ -86,23 +178,47 @@ def _description(xml: bytes) -> bytes:
     return ET.tostring(root, encoding="UTF-8", xml_declaration=True)
 
 
+def _face_binaries(u: Unit, names: set[str], read, libs: dict[str, Path]) -> dict[str, bytes]:
+    """``{folder: wrapper bytes}`` of the face of ``u``: every platform folder where the unit carries its own
+    library (``read(name)`` gives an archive member) for a CPU whose wrapper was built (``libs``)."""
+    ident = u.md.modelExchange.modelIdentifier
+    folders = _FMI2_FOLDERS if u.fmi == 2 else {t: (t,) for t in _FMI3_TUPLES}
+    out = {}
+    for folder, tuples in folders.items():
+        member = f"binaries/{folder}/{ident}.{_ext(folder)}"
+        if member not in names:
+            continue
+        have = binary_tuples(read(member)) & set(tuples)  # the unit's own CPUs in that folder
+        slices = [libs[t].read_bytes() for t in tuples if t in have and t in libs]
+        if not slices:
+            continue
+        out[folder] = universal_macho(slices) if folder == "darwin64" else slices[0]
+    return out
+
+
 def cs_face(u: Unit, cache: Path) -> Path:
-    """The Co-Simulation face of Model Exchange instance ``u`` (built once, then cached in ``cache``)."""
-    lib = wrapper_library()
-    if lib is None:
+    """The Co-Simulation face of Model Exchange instance ``u`` (built once, then cached in ``cache``): the
+    wrapper in every platform folder where both it and the unit have a binary (module docstring)."""
+    if wrapper_library() is None:  # this machine's: the face must at least run here
         raise PlanError(f"{u.name}: a Model Exchange unit runs in fmpy's container FMU through scfmu's "
                         f"Co-Simulation wrapper, which is not built: run `cargo build --release -p {LIB}`")
+    libs = wrapper_libraries()
     if u.md.modelExchange is None:
         raise PlanError(f"{u.name}: {Path(u.path).name} has no Model Exchange interface")
-    st = lib.stat()
     cfg = _config(u)
-    key = hashlib.sha256(repr((fmu_digest(u.path), cfg, st.st_size, st.st_mtime_ns)).encode()).hexdigest()[:16]
+    key = hashlib.sha256(repr((fmu_digest(u.path), cfg, wrapper_identity())).encode()).hexdigest()[:16]
     path = cache / f"{Path(u.path).stem}.me_{key}.fmu"
     if path.exists():
         return path
-    folder, fname = _platform(u.fmi)
     with zipfile.ZipFile(u.path) as z:
-        if f"binaries/{folder}/{fname}" in z.namelist():
+        names = set(z.namelist())
+        faces = _face_binaries(u, names, z.read, libs)
+    if not faces:
+        raise PlanError(f"{u.name}: {Path(u.path).name} carries no binary of a platform for which scfmu's "
+                        f"Co-Simulation wrapper is built ({', '.join(sorted(libs))})")
+    for folder in faces:
+        fname = f"binaries/{folder}/{LIB}.{_ext(folder)}"
+        if fname in names:
             raise PlanError(f"{u.name}: {Path(u.path).name} already carries a library named {fname}")
     cache.mkdir(parents=True, exist_ok=True)
     tmp = cache / f".{path.name}.{os.getpid()}"
@@ -112,10 +228,11 @@ def cs_face(u: Unit, cache: Path) -> Path:
             if info.filename == "modelDescription.xml":
                 data = _description(data)
             elif info.filename == f"resources/{LIB}.txt" or (info.filename.startswith("binaries/")
-                                                              and not info.filename.startswith(f"binaries/{folder}/")):
-                continue  # the face runs where its wrapper library was built: this platform only
+                                                              and info.filename.split("/")[1] not in faces):
+                continue  # a platform without a wrapper or without the unit's binary is not offered
             zo.writestr(info, data, compress_type=zipfile.ZIP_DEFLATED)
-        zo.write(lib, f"binaries/{folder}/{fname}")
+        for folder, data in faces.items():
+            zo.writestr(f"binaries/{folder}/{LIB}.{_ext(folder)}", data)
         zo.writestr(f"resources/{LIB}.txt", cfg)
     os.replace(tmp, path)
     return path

@@ -52,7 +52,7 @@ from ..fmu import Fmu, fmu_digest, safe_extract, scalar_type, unpacked
 from ..scenario.model import Scenario
 from ..scenario.plan import Plan
 from .calls import SimulationError, raw_calls
-from .cs_face import cs_face, wrapper_library
+from .cs_face import cs_face, wrapper_identity
 from .instances import as_plan
 
 CACHE = Path(os.environ.get("SCFMU_CONTAINER_DIR", Path.home() / ".cache" / "scfmu" / "containers"))
@@ -84,8 +84,7 @@ def container_key(plan: Plan, starts: dict | None = None) -> str:
         key["starts"] = sorted((k, repr(v)) for k, v in starts.items())
     me = [(u.name, sorted((k, repr(v)) for k, v in u.solver.items())) for u in plan.units if u.interface == "me"]
     if me:  # Model Exchange units run through their Co-Simulation face (scfmu.engines.cs_face)
-        lib = wrapper_library()
-        key["me"] = [me, None if lib is None else (lib.stat().st_size, lib.stat().st_mtime_ns)]
+        key["me"] = [me, wrapper_identity()]  # every platform's wrapper library the faces may carry
     h = hashlib.sha256(json.dumps(key, sort_keys=True).encode()).hexdigest()[:20]
     _KEYS[sig] = h
     return h

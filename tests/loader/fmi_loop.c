@@ -9,6 +9,8 @@
  *   PLANT_SET, CTRL_SET  start values set in initialization mode: "vr=value,vr=value" (or "-")
  *   P2C, C2P             wires plant output -> controller input and back: "from:to,from:to" (or "-")
  *   OUT                  plant output value references printed after every step: "vr,vr,..."
+ *   environment FMI_LOOP_PLANT_RESOURCES / FMI_LOOP_CONTROLLER_RESOURCES: the fmuResourceLocation passed to
+ *                        that FMU's fmi2Instantiate (unset: NULL, which the project's FMUs accept)
  *
  * Sampled-data loop (Jacobi, zero-order hold): at t_k the controller reads the plant outputs and
  * steps; its outputs are fed to the plant, which steps over [t_k, t_k + DT]. Output: one line
@@ -140,7 +142,9 @@ static int parse_list(const char *s, unsigned *out, int max) {
 }
 
 static C start(const Fmu *f, const char *name, const char *guid, const unsigned *vr, const double *v, int n) {
-    C c = f->instantiate(name, 1 /* fmi2CoSimulation */, guid, NULL, &CB, 0, 0);
+    /* resource location (a file: URI) of an FMU that needs one, e.g. a Co-Simulation face (tests/test_me_cs_platforms.py) */
+    const char *res = getenv(strcmp(name, "plant") == 0 ? "FMI_LOOP_PLANT_RESOURCES" : "FMI_LOOP_CONTROLLER_RESOURCES");
+    C c = f->instantiate(name, 1 /* fmi2CoSimulation */, guid, res, &CB, 0, 0);
     CHECK(c, "fmi2Instantiate");
     CHECK(f->setup(c, 0, 0.0, 0.0, 0, 0.0) == 0, "fmi2SetupExperiment");
     CHECK(f->enter_init(c) == 0, "fmi2EnterInitializationMode");
