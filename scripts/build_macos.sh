@@ -4,7 +4,9 @@
 #   target/macos/<triple>/release/libspacecraft_fmus_cdylib.dylib
 # and, beside it, libscfmu_me_cs.dylib: the Model Exchange wrapper of Co-Simulation faces
 # (scfmu/engines/cs_face.py joins the two into the universal darwin64 file of an FMI 2.0 face), built in a
-# `cargo rustc` of its own that may fail without costing the FMUs their library (it then says why).
+# `cargo rustc` of its own that may fail without costing the FMUs their library (it then says why). Cargo
+# compiles std once more for that run (its own hash of std), once per machine and toolchain like the first:
+# ~2.5 min per CPU on a cold cache, seconds afterwards (docs/benchmarks.md, cross builds).
 # The compiled engine's loop library (scfmu/engines/native_loop) is not built for macOS: a second cargo run
 # with its own install name compiles std again (cargo hashes std differently per run), which doubles an
 # already long build; the macOS wheels therefore carry no compiled loop and campaigns there use the

@@ -30,6 +30,12 @@ PLATFORMS = {
     "macos-x86_64": ("darwin64", "x86_64-darwin", MACHO_X86_64, None, r"macosx_10_12_x86_64"),
     "macos-arm64": ("darwin64", "aarch64-darwin", MACHO_ARM64, None, r"macosx_11_0_arm64"),
 }
+# each platform's Model Exchange wrapper (cargo build --release, the cross-build scripts)
+ME_CS = {"linux-x86_64": "target/release/libscfmu_me_cs.so",
+         "linux-aarch64": "target/aarch64/aarch64-unknown-linux-gnu/release/libscfmu_me_cs.so",
+         "win-amd64": "target/win64/x86_64-win7-windows-gnu/release/scfmu_me_cs.dll",
+         "macos-x86_64": "target/macos/x86_64-apple-darwin/release/libscfmu_me_cs.dylib",
+         "macos-arm64": "target/macos/aarch64-apple-darwin/release/libscfmu_me_cs.dylib"}
 # the FMI 2.0 folders of fmus/<Model>.fmu that make each platform's wheel
 SOURCE_FOLDER = {"linux-x86_64": "linux64", "linux-aarch64": "aarch64-linux", "win-amd64": "win64",
                  "macos-x86_64": "darwin64", "macos-arm64": "darwin64"}
@@ -153,6 +159,13 @@ def test_platform_wheel_is_tagged_and_carries_only_its_platform_binaries(wheels,
     shipped += [z.read(n) for n in loops]
     for data in shipped[-len(loops):] if loops else []:
         assert binary_kind(data) == kind
+    # the Model Exchange wrapper of this platform (scfmu/engines/cs_face.py), wherever it was built
+    me_cs = [n for n in z.namelist() if n.startswith("scfmu/engines/me_cs/bin/")]
+    lib = ROOT / ME_CS[plat]
+    assert me_cs == ([f"scfmu/engines/me_cs/bin/{tuple3}/{lib.name}"] if lib.is_file() else []), me_cs
+    for n in me_cs:
+        assert z.read(n) == lib.read_bytes() and binary_kind(z.read(n)) == kind
+        shipped.append(z.read(n))
     assert not [n for n in z.namelist() if n.endswith((".ssp",)) or "/loops/" in n], "no SSP or loop files"
     if plat.startswith("linux"):
         # manylinux_2_N: N is the newest glibc symbol version any shipped binary needs (PEP 600)
@@ -176,6 +189,17 @@ def test_installed_wheel_uses_its_compiled_loop(installed, tmp_path):
     assert r.returncode == 0, r.stderr[-2000:]
     path, engine = r.stdout.split()
     assert Path(path).is_relative_to(env_dir) and engine == "compiled"
+
+
+def test_installed_wheel_finds_its_model_exchange_wrapper(installed, tmp_path):
+    """The installed wheel's Co-Simulation faces take the wrapper the wheel ships, not the checkout's."""
+    env_dir, _ = installed
+    r = subprocess.run([str(env_dir / "bin" / "python"), "-c",
+                        "from scfmu.engines.cs_face import wrapper_libraries; print(wrapper_libraries())"],
+                       cwd=tmp_path, env=_clean_env(env_dir), capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert "'x86_64-linux': " in r.stdout and "me_cs/bin/x86_64-linux/libscfmu_me_cs.so" in r.stdout, r.stdout
+    assert str(env_dir) in r.stdout and str(ROOT / "target") not in r.stdout, r.stdout
 
 
 def test_installed_wheel_runs_default_outside_the_repository(installed, tmp_path):
