@@ -25,7 +25,9 @@ else
 fi
 # Linux aarch64 and macOS (x86_64 + arm64) cross builds (scripts/build_aarch64.sh, scripts/build_macos.sh;
 # folders: docs/tools.md), each when its toolchain is installed (scripts/setup.sh), built once here and
-# reused by the tests and the wheels. SCFMU_NO_AARCH64=1 / SCFMU_NO_MACOS=1 skip them. A macOS build
+# reused by the tests and the wheels. Each cross script also builds the Model Exchange wrapper of
+# Co-Simulation faces (scfmu_me_cs, scfmu/engines/cs_face.py) for its platform where it compiles.
+# SCFMU_NO_AARCH64=1 / SCFMU_NO_MACOS=1 skip them. A macOS build
 # made on a Mac (SCFMU_DARWIN64_LIB) joins as darwin64 instead of the cross builds.
 if [ "${SCFMU_NO_AARCH64:-0}" != 1 ] && scripts/build_aarch64.sh --check; then
     package_args+=(--add-lib "aarch64-linux=$(scripts/build_aarch64.sh | tail -n 1)")
