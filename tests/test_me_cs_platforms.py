@@ -221,7 +221,8 @@ def test_face_offers_no_platform_or_cpu_the_unit_lacks(tmp_path):
     assert set(fat_slices(wrapper)) == {CPU_TYPE_X86_64}
 
 
-def test_loop_fmu_with_the_model_exchange_plant_carries_the_platforms_of_the_cs_loop(tmp_path, monkeypatch):
+@pytest.mark.parametrize("fmi", [2, 3])
+def test_loop_fmu_with_the_model_exchange_plant_carries_the_platforms_of_the_cs_loop(fmi, tmp_path, monkeypatch):
     """fmus/loops/default.fmu (Co-Simulation units) against the same loop with the plant as Model Exchange
     (nested as its face): the same platforms wherever the wrapper is built (darwin64 with the macOS builds;
     not aarch64-linux, for which fmpy ships no container binary; win64 once the Windows wrapper builds)."""
@@ -235,6 +236,8 @@ def test_loop_fmu_with_the_model_exchange_plant_carries_the_platforms_of_the_cs_
     cs = _platforms(zipfile.ZipFile(cs_loop).namelist())
     monkeypatch.setattr(native, "CACHE", tmp_path / "cache")
     sc = get("default", stop_time=1.0)
+    if fmi == 3:
+        sc = sc.with_models({"plant": str(FMUS / "fmi3" / "AttitudePlant.fmu")})
     sc.component("plant").interface = "me"
     loop = write_loop_fmu(sc, tmp_path / "loop_me.fmu")
     names = zipfile.ZipFile(loop).namelist()
@@ -245,10 +248,11 @@ def test_loop_fmu_with_the_model_exchange_plant_carries_the_platforms_of_the_cs_
         assert "darwin64" in want
     plant = next(n.split("/")[1] for n in names if n.endswith("/resources/scfmu_me_cs.txt"))
     inner = _platforms(names, f"resources/{plant}/")
-    assert inner == want
+    folder = {"linux64": "x86_64-linux", "win64": "x86_64-windows", "darwin64": "x86_64-darwin"} if fmi == 3 else {}
+    assert inner == {folder.get(p, p) for p in want}
     for p in want:
         ext = {"linux64": "so", "win64": "dll", "darwin64": "dylib"}[p]
-        assert f"resources/{plant}/binaries/{p}/scfmu_me_cs.{ext}" in names
+        assert f"resources/{plant}/binaries/{folder.get(p, p)}/scfmu_me_cs.{ext}" in names
 
 
 @pytest.fixture(scope="module")
