@@ -237,6 +237,22 @@ def test_campaign_cli_with_a_crashing_unit_exits_1_with_counts(units, tmp_path):
     assert r.returncode == 1 and "(timeout: 1)" in r.stdout, r.stdout + r.stderr
 
 
+def test_campaign_check_stops_before_a_unit_that_fails_it(units, tmp_path):
+    """`scfmu campaign --check` runs `scfmu check --quick` on each unit given as a file first: the crashing
+    unit fails it (exit 1, the failed checks named, no run made); our PdController given as a file passes
+    and its runs go. (The hand-written C unit is not check-clean: it does not guard against hostile call
+    sequences, which `scfmu check` exercises.)"""
+    r = scfmu("campaign", "default", "--t-end", "1", "--fmu", f"controller={units.c_pd('crash')}", "--check",
+              "--workers", "1", "--out", tmp_path / "c", "--no-progress", "--no-plots")
+    assert r.returncode == 1, r.stdout + r.stderr
+    assert "fails scfmu check" in r.stderr and "the campaign was not run" in r.stderr, r.stderr[-2000:]
+    assert not (tmp_path / "c" / "results.parquet").exists()
+    from scfmu.fmu import fmu_path
+    r = scfmu("campaign", "default", "--t-end", "1", "--fmu", f"controller={fmu_path('PdController')}", "--check",
+              "--workers", "1", "--out", tmp_path / "ok", "--no-progress", "--no-plots")
+    assert r.returncode == 0 and "1 of 1 runs ok" in r.stdout, r.stdout + r.stderr[-2000:]
+
+
 def test_benchmark_with_the_c_unit(units, tmp_path):
     r = scfmu("benchmark", units.c_pd(), "--family", "attitude", "--controllers", "PdController", "--cases",
               "default", "--out", tmp_path, timeout=900)
