@@ -4,7 +4,8 @@
 //! scfmu's native engine and loop FMUs) can run the unit.
 //!
 //! It exports the FMI 2.0 Co-Simulation functions ([`fmi2`], for an FMI 2.0 Model Exchange unit) and the
-//! FMI 3.0 ones ([`fmi3`], for an FMI 3.0 unit). At instantiation it reads `scfmu_me_cs.txt` from the
+//! FMI 3.0 ones ([`fmi3`], for an FMI 3.0 unit): one thin C-ABI file per version, translating its types and
+//! arguments, over one version-neutral body of every entry point ([`face`]). At instantiation it reads `scfmu_me_cs.txt` from the
 //! unit's resources folder (the Model Exchange model identifier, the numbers of states and event indicators,
 //! the method and its tolerances), opens the unit's own library `binaries/<platform>/<identifier>` and
 //! instantiates it as Model Exchange. Getters, setters and the other common functions are forwarded; a
@@ -28,6 +29,7 @@ use std::ffi::{c_char, c_void, CStr, CString};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
+pub mod face;
 pub mod fmi2;
 pub mod fmi3;
 mod solver;
