@@ -305,6 +305,10 @@ EXPORT fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) {
 EXPORT fmi3Status fmi3Terminate(fmi3Instance instance) {
     Instance *c = instance;
     if (!c) return fmi3Error;
+    if (c->state == ST_INSTANTIATED) {
+        logmsg(c, fmi3Error, "fmi3Terminate: not allowed before initialization");
+        return fmi3Error;
+    }
     c->state = ST_TERMINATED;
     return fmi3OK;
 }
@@ -323,11 +327,16 @@ EXPORT fmi3Status fmi3Reset(fmi3Instance instance) {
     return fmi3OK;
 }
 
-#define GETSET(NAME, CT, FN, MODE)                                                                          \
+/* SETTER: 1 for the fmi3Set* functions (refused after fmi3Terminate) */
+#define GETSET(NAME, CT, FN, MODE, SETTER)                                                                  \
     EXPORT fmi3Status NAME(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, CT values[],     \
                            size_t nValues) {                                                                \
         Instance *c = instance;                                                                             \
         if (!c || (nvr && (!vr || !values)) || nValues != nvr) return fmi3Error;                            \
+        if (SETTER && c->state == ST_TERMINATED) {                                                          \
+            logmsg(c, fmi3Error, #NAME ": not allowed after fmi3Terminate");                                \
+            return fmi3Error;                                                                               \
+        }                                                                                                   \
         for (size_t k = 0; k < nvr; k++)                                                                    \
             if (FN(c, vr[k], MODE values[k]) != fmi3OK) {                                                   \
                 logmsg(c, fmi3Error, #NAME ": value reference %u is not allowed here", (unsigned)vr[k]);     \
@@ -335,12 +344,12 @@ EXPORT fmi3Status fmi3Reset(fmi3Instance instance) {
             }                                                                                               \
         return fmi3OK;                                                                                      \
     }
-GETSET(fmi3GetFloat64, fmi3Float64, get_real, &)
-GETSET(fmi3GetInt32, fmi3Int32, get_int, &)
-GETSET(fmi3GetBoolean, fmi3Boolean, get_bool, &)
-GETSET(fmi3SetFloat64, const fmi3Float64, set_real, )
-GETSET(fmi3SetInt32, const fmi3Int32, set_int, )
-GETSET(fmi3SetBoolean, const fmi3Boolean, set_bool, )
+GETSET(fmi3GetFloat64, fmi3Float64, get_real, &, 0)
+GETSET(fmi3GetInt32, fmi3Int32, get_int, &, 0)
+GETSET(fmi3GetBoolean, fmi3Boolean, get_bool, &, 0)
+GETSET(fmi3SetFloat64, const fmi3Float64, set_real, , 1)
+GETSET(fmi3SetInt32, const fmi3Int32, set_int, , 1)
+GETSET(fmi3SetBoolean, const fmi3Boolean, set_bool, , 1)
 
 #if MODEL == 1
 EXPORT fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoint,
@@ -349,7 +358,9 @@ EXPORT fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunica
         fmi3Float64 *lastSuccessfulTime) {
     Instance *c = instance;
     (void)noSetFMUStatePriorToCurrentPoint;
-    if (!c || c->state != ST_RUN || !(communicationStepSize > 0)) return fmi3Error;
+    if (!c || c->state != ST_RUN || !(communicationStepSize > 0) || !isfinite(currentCommunicationPoint) ||
+        !isfinite(communicationStepSize))
+        return fmi3Error;
     c->time = currentCommunicationPoint + communicationStepSize;
     c->i[STEP_COUNT] += 1;
     if (eventHandlingNeeded) *eventHandlingNeeded = false;
@@ -400,6 +411,14 @@ EXPORT fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance, fmi3Boolean
 EXPORT fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time) {
     Instance *c = instance;
     if (!c) return fmi3Error;
+    if (c->state != ST_EVENT && c->state != ST_CONT) {
+        logmsg(c, fmi3Error, "fmi3SetTime: allowed in Event and Continuous-Time Mode only");
+        return fmi3Error;
+    }
+    if (!isfinite(time)) {
+        logmsg(c, fmi3Error, "fmi3SetTime: time = %g must be finite", time);
+        return fmi3Error;
+    }
     c->time = time;
     return fmi3OK;
 }
