@@ -1,6 +1,6 @@
 """The controller benchmark: a unit (an FMI 2.0 or 3.0 FMU, Co-Simulation or Model Exchange, or a model name)
-runs through a family's
-standard scenarios beside the built-in controllers of that family, and one page compares them.
+runs through a family's standard scenarios beside the built-in controllers of that family, and one page
+compares them; the unit's configuration on the page says which FMI version and interface it ran with.
 
 The scenarios (``BenchmarkCase``) and the built-in controllers (``BuiltinController``) come from the
 plug-ins' registrations (:mod:`scfmu.registry`); this module names no paper. Every (scenario, controller)
