@@ -297,3 +297,50 @@ def test_benchmark_ranks_the_me_controller_as_pd_controller(units, tmp_path, fmi
     assert len(metrics) >= 5
     for k in metrics:
         assert abs(float(a[k]) - float(b[k])) <= ROUND_OFF * max(abs(float(b[k])), 1.0), (k, a[k], b[k])
+
+
+# ----- SSP and loop FMU -----------------------------------------------------------------------------------
+def test_ssp_keeps_the_model_exchange_interface(units, tmp_path):
+    """An SSP 1.0 file of the loop with the FMI 2.0 ME-only controller and the plant asked to run as Model
+    Exchange (it offers both): schema-valid, both components marked implementation="ModelExchange" (the
+    others left "any"), read back with their interface, and the read-back scenario on the reference master
+    gives the original run to the bit (before, the plant came back as Co-Simulation)."""
+    import xml.etree.ElementTree as ET
+    import zipfile
+    from scfmu.engines import run_reference
+    from scfmu.scenario.ssp import read_ssp, validate_ssp, write_ssp
+    sc = get("default", stop_time=3.0).with_models({"controller": me_unit(units, 2)})
+    sc.component("plant").interface = "me"
+    p = write_ssp(sc, tmp_path / "loop.ssp")
+    assert validate_ssp(p) == []
+    with zipfile.ZipFile(p) as z:
+        root = ET.fromstring(z.read("SystemStructure.ssd"))
+    impl = {c.get("name"): c.get("implementation") for c in root.iter() if c.tag.endswith("}Component")}
+    assert impl == {"command": None, "controller": "ModelExchange", "plant": "ModelExchange", "metrics": None}
+    back, files = read_ssp(p, tmp_path / "x")
+    assert {c.name: c.interface for c in back.components} == {"command": "", "controller": "me", "plant": "me",
+                                                               "metrics": ""}
+    assert build_plan(back, path_of=files.__getitem__).model_exchange == {"controller", "plant"}
+    ref = simulate(sc, "reference")
+    got = run_reference(back, path_of=files.__getitem__)
+    assert ref["eulerint_deg_s"][-1] > 10.0
+    assert all(np.array_equal(ref[k], got[k]) for k in ref)
+
+
+@pytest.mark.parametrize("fmi", [2, 3])
+def test_loop_fmu_with_the_me_controller_runs_in_fmpy(units, reference, tmp_path, fmi):
+    """A loop FMU whose controller is the ME-only unit (nested as its Co-Simulation face) passes fmpy's
+    validation, and fmpy.simulate_fmu of the single file gives PdController's loop to round-off."""
+    from fmpy import simulate_fmu
+    from fmpy.validation import validate_fmu
+    from scfmu.export.loops import write_loop_fmu
+    t = 3.0
+    sc = get("default", stop_time=t).with_models({"controller": me_unit(units, fmi)})
+    p = write_loop_fmu(sc, tmp_path / "loop.fmu")
+    assert validate_fmu(str(p)) == []
+    keys = [k for k in reference if k != "time"]
+    r = simulate_fmu(str(p), stop_time=t, output_interval=sc.step, output=[sc.log[k] for k in keys])
+    n = len(r)
+    assert n == int(round(t / sc.step)) + 1
+    ref = {k: reference[k][:n] for k in keys}
+    assert worst_rel(ref, {k: r[sc.log[k]] for k in keys}) < ROUND_OFF
