@@ -6,8 +6,9 @@ tests themselves, to plug into our scenarios in place of `PdController` (issue 2
   (tests/foreign/c_pd/modelDescription.xml), compiled with gcc; healthy or broken on purpose (`C_VARIANTS`).
 - `build_c3(dest, model)`: FMI 3.0 units written by hand in C against the FMI 3.0 headers that fmpy ships
   (tests/foreign/c3/c3_units.c, modelDescription written here): "C3PdController" (Co-Simulation only, the PD
-  law plus Int32/Boolean ports) and "C3AxisBody" (Model Exchange only, a one-axis rigid body with a state event
-  and a time event).
+  law plus Int32/Boolean ports), "C3AxisBody" (Model Exchange only, a one-axis rigid body with a state event
+  and a time event) and "C3PdControllerME" (Model Exchange only: the PD law as a continuous-time controller
+  with direct feedthrough, no states, no event indicators, no Int32/Boolean ports).
 - `build_python_pd(dest)`: the same law as a PythonFMU (tests/foreign/python_pd/PyPdController.py).
 - `python_fmu_loadable(path)`: whether this host can run a PythonFMU, with the reason when it cannot.
 - `pd_law(...)`: the PD law in numpy, the tests' independent oracle.
@@ -54,6 +55,9 @@ C_VARIANTS = {
     "no_unit": "no unit on any port (w_*, w_ref_*, torque_cmd_*)",
     "no_binary": "the FMU has no binaries/ folder at all (nothing to load on any platform)",
     "me_only": "the modelDescription declares ModelExchange only (no CoSimulation element)",
+    "me": ("Model Exchange only and implemented (the binary has the FMI 2.0 Model Exchange functions for 0 "
+           "states and 0 event indicators; fmi2Instantiate refuses Co-Simulation): the PD law as a continuous-"
+           "time controller"),
 }
 _FAIL_MODE = {"ok": 0, "crash": 1, "hang": 2, "nan": 3, "error": 4}
 
@@ -113,7 +117,7 @@ def c_model_description(variant: str = "ok", guid: str | None = None, fail_time:
     elif variant == "no_unit":
         sub(r'(name="(?:w_|w_ref_|torque_cmd_)[xyz]"[^>]*>\s*<Real) unit="[^"]*"', r"\1", 9)
         sub(r'\s*<Unit name="N.m">\s*<BaseUnit[^>]*/>\s*</Unit>', "", 1)
-    elif variant == "me_only":
+    elif variant in ("me_only", "me"):
         sub(r"<CoSimulation modelIdentifier=\"CPdController\"[^>]*/>",
             '<ModelExchange modelIdentifier="CPdController" canNotUseMemoryManagementFunctions="true"/>', 1)
     return xml
@@ -126,7 +130,7 @@ def compile_c_pd(out: Path, variant: str = "ok", guid: str | None = None, fail_t
     mode = _FAIL_MODE.get(variant, 0)
     cmd = ["gcc", "-O2", "-shared", "-fPIC", "-fvisibility=hidden", "-std=gnu11", "-Wall", "-Wextra", "-Werror",
            f"-I{fmi_headers_dir()}", f'-DMODEL_GUID="{guid or c_guid(variant, fail_time)}"',
-           f"-DFAIL_MODE={mode}", f"-DFAIL_TIME={float(fail_time)!r}",
+           f"-DFAIL_MODE={mode}", f"-DFAIL_TIME={float(fail_time)!r}", f"-DMODEL_EXCHANGE={int(variant == 'me')}",
            "-o", str(out), str(C_DIR / "c_pd.c"), "-lm"]
     p = subprocess.run(cmd, capture_output=True, text=True)
     if p.returncode != 0:
@@ -160,7 +164,8 @@ def build_c_pd(dest, variant: str = "ok", *, fail_time: float = 0.5) -> Path:
 # ------------------------------------------------------------------------------------------------ FMI 3.0 C units
 
 C3_DIR = FOREIGN / "c3"
-C3_MODELS = ("C3PdController", "C3AxisBody")
+C3_MODELS = ("C3PdController", "C3AxisBody", "C3PdControllerME")
+C3_PD_MODELS = ("C3PdController", "C3PdControllerME")
 _C3_UNITS = """  <UnitDefinitions>
     <Unit name="rad"><BaseUnit rad="1"/></Unit>
     <Unit name="deg"><BaseUnit rad="1" factor="0.017453292519943295"/></Unit>
@@ -175,7 +180,7 @@ _C3_UNITS = """  <UnitDefinitions>
 def _c3_variables(model: str) -> tuple[list[str], list[str]]:
     """(variable elements, ModelStructure elements) of a C3 unit (value references of c3_units.c)."""
     v = ['<Float64 name="time" valueReference="999" causality="independent" variability="continuous"/>']
-    if model == "C3PdController":
+    if model in C3_PD_MODELS:
         names = ["q_w", "q_x", "q_y", "q_z", "w_x", "w_y", "w_z", "q_ref_w", "q_ref_x", "q_ref_y", "q_ref_z",
                  "w_ref_x", "w_ref_y", "w_ref_z"]
         for i, n in enumerate(names):
@@ -189,13 +194,15 @@ def _c3_variables(model: str) -> tuple[list[str], list[str]]:
         for i, (a, x) in enumerate(zip(("xx", "yy", "zz"), ("1000", "500", "700"))):
             v.append(f'<Float64 name="inertia_{a}" valueReference="{19 + i}" causality="parameter" variability="fixed" '
                      f'unit="kg.m2" start="{x}"/>')
-        v += ['<Boolean name="enable" valueReference="22" causality="input" start="true"/>',
-              '<Int32 name="count_in" valueReference="23" causality="input" start="0"/>',
-              '<Int32 name="step_count" valueReference="24" causality="output"/>',
-              '<Boolean name="active" valueReference="25" causality="output"/>',
-              '<Int32 name="count_echo" valueReference="26" causality="output"/>',
-              '<Boolean name="enable_echo" valueReference="27" causality="output"/>']
-        outs = [14, 15, 16, 24, 25, 26, 27]
+        outs = [14, 15, 16]
+        if model == "C3PdController":  # the Model Exchange controller has no Int32/Boolean ports
+            v += ['<Boolean name="enable" valueReference="22" causality="input" start="true"/>',
+                  '<Int32 name="count_in" valueReference="23" causality="input" start="0"/>',
+                  '<Int32 name="step_count" valueReference="24" causality="output"/>',
+                  '<Boolean name="active" valueReference="25" causality="output"/>',
+                  '<Int32 name="count_echo" valueReference="26" causality="output"/>',
+                  '<Boolean name="enable_echo" valueReference="27" causality="output"/>']
+            outs += [24, 25, 26, 27]
         structure = [f'<Output valueReference="{r}"/>' for r in outs] + [f'<InitialUnknown valueReference="{r}"/>' for r in outs]
     else:
         v += ['<Float64 name="u" valueReference="0" causality="input" start="0"/>',
@@ -232,7 +239,7 @@ def c3_model_description(model: str) -> str:
     itf = (f'<CoSimulation modelIdentifier="{model}" canHandleVariableCommunicationStepSize="true" '
            f'canBeInstantiatedOnlyOncePerProcess="false"/>' if model == "C3PdController" else
            f'<ModelExchange modelIdentifier="{model}" canBeInstantiatedOnlyOncePerProcess="false" '
-           f'needsCompletedIntegratorStep="true"/>')
+           f'needsCompletedIntegratorStep="true"/>')  # C3AxisBody, C3PdControllerME: Model Exchange only
     return (f'<?xml version="1.0" encoding="UTF-8"?>\n'
             f'<fmiModelDescription fmiVersion="3.0" modelName="{model}" instantiationToken="{c3_token(model)}" '
             f'description="written by hand in C (a foreign FMI 3.0 unit for the tests)" '

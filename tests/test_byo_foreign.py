@@ -17,6 +17,7 @@ import os
 import re
 import subprocess
 import sys
+import tempfile
 import time
 
 import numpy as np
@@ -160,15 +161,20 @@ def test_units_and_interfaces_are_checked(units):
 # could reach a logged signal (which would give "nonfinite")
 @pytest.mark.parametrize("variant, status", [("crash", "crash"), ("hang", "timeout"), ("nan", "fmu_error"),
                                              ("error", "fmu_error")])
-def test_a_failing_unit_costs_its_own_runs_only(units, variant, status):
+def test_a_failing_unit_costs_its_own_runs_only(units, variant, status, tmp_path, monkeypatch):
     """One chunk of three runs on one worker: healthy, broken, healthy. The broken run becomes a row with
-    its status and message; the runs after it complete."""
+    its status and message; the runs after it complete. No run leaves a temporary file behind (the
+    isolated child's unpacked units included, whether it crashed, hung or ended)."""
     good = campaign.Campaign(get("default", stop_time=1.0).with_models({"controller": str(units.c_pd())}),
                              timeout=30).runs()[0]
     bad = campaign.Campaign(get("default", stop_time=1.0).with_models({"controller": str(units.c_pd(variant))}),
                             timeout=4.0).runs()[0]
     specs = [dict(good, run=0), dict(bad, run=1), dict(good, run=2)]
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(scratch))
     rows = [r for r, _ in campaign.run_chunk(specs)]
+    assert list(scratch.iterdir()) == []
     assert [r["status"] for r in rows] == ["ok", status, "ok"], rows[1]["message"]
     assert rows[0]["eulerint_deg_s"] == rows[2]["eulerint_deg_s"]
     want = {"crash": "SIGSEGV", "hang": "4 s", "nan": "not finite", "error": "deliberate failure"}[variant]
@@ -195,13 +201,13 @@ def test_a_crash_is_a_row_not_a_fatal_error_dump(units):
     assert "Fatal Python error" not in p.stderr, p.stderr[-2000:]
 
 
-def test_an_isolated_run_dies_with_its_campaign(units):
+def test_an_isolated_run_dies_with_its_campaign(units, tmp_path):
     """A campaign process killed (SIGKILL) while a unit hangs in its isolated child takes the child with
     it: the child is in a session of its own (no group signal from a crashing unit reaches the campaign)
     but is tied to its parent's life, so a hanging unit cannot spin on after the campaign is gone."""
     import psutil
     p = subprocess.Popen([sys.executable, "-c", _ONE_RUN, str(units.c_pd("hang"))], stdout=subprocess.PIPE,
-                         text=True)
+                         text=True, env=dict(os.environ, TMPDIR=str(tmp_path)))  # what a killed run leaves
     try:
         assert p.stdout.readline().strip() == "running"
         deadline, kids = time.monotonic() + 60, []
@@ -229,6 +235,22 @@ def test_campaign_cli_with_a_crashing_unit_exits_1_with_counts(units, tmp_path):
     r = scfmu("campaign", "default", "--t-end", "1", "--fmu", f"controller={units.c_pd('hang')}", "--timeout", "3",
               "--workers", "1", "--out", tmp_path / "h", "--no-progress", "--no-plots")
     assert r.returncode == 1 and "(timeout: 1)" in r.stdout, r.stdout + r.stderr
+
+
+def test_campaign_check_stops_before_a_unit_that_fails_it(units, tmp_path):
+    """`scfmu campaign --check` runs `scfmu check --quick` on each unit given as a file first: the crashing
+    unit fails it (exit 1, the failed checks named, no run made); our PdController given as a file passes
+    and its runs go. (The hand-written C unit is not check-clean: it does not guard against hostile call
+    sequences, which `scfmu check` exercises.)"""
+    r = scfmu("campaign", "default", "--t-end", "1", "--fmu", f"controller={units.c_pd('crash')}", "--check",
+              "--workers", "1", "--out", tmp_path / "c", "--no-progress", "--no-plots")
+    assert r.returncode == 1, r.stdout + r.stderr
+    assert "fails scfmu check" in r.stderr and "the campaign was not run" in r.stderr, r.stderr[-2000:]
+    assert not (tmp_path / "c" / "results.parquet").exists()
+    from scfmu.fmu import fmu_path
+    r = scfmu("campaign", "default", "--t-end", "1", "--fmu", f"controller={fmu_path('PdController')}", "--check",
+              "--workers", "1", "--out", tmp_path / "ok", "--no-progress", "--no-plots")
+    assert r.returncode == 0 and "1 of 1 runs ok" in r.stdout, r.stdout + r.stderr[-2000:]
 
 
 def test_benchmark_with_the_c_unit(units, tmp_path):

@@ -1,5 +1,6 @@
-"""The controller benchmark: a unit (any FMI 2.0 Co-Simulation FMU, or a model name) runs through a family's
-standard scenarios beside the built-in controllers of that family, and one page compares them.
+"""The controller benchmark: a unit (an FMI 2.0 or 3.0 FMU, Co-Simulation or Model Exchange, or a model name)
+runs through a family's standard scenarios beside the built-in controllers of that family, and one page
+compares them; the unit's configuration on the page says which FMI version and interface it ran with.
 
 The scenarios (``BenchmarkCase``) and the built-in controllers (``BuiltinController``) come from the
 plug-ins' registrations (:mod:`scfmu.registry`); this module names no paper. Every (scenario, controller)
@@ -38,6 +39,7 @@ from ..registry import REGISTRY, resolve
 from ..scenario import get
 from ..scenario import profile as profiles
 from ..scenario.check import IncompatibleUnit, require
+from ..scenario.plan import PlanError, build_plan
 from ..scenario.resolve import unbound_slots
 from . import engineering, engineering_page
 from . import estimator as estimator_runs
@@ -135,6 +137,8 @@ def run(unit: str | None, family: str, out: str | Path, label: str | None = None
                                pairs, log)
                 if job is not None:
                     jobs.append(job)
+        for how in dict.fromkeys(e.config for e in entries if e.envelope == "unit" and not e.status):
+            log(f"  {unit_label}: {how}")
         # the pairs' campaigns run side by side (threads sharing the Dask client), so that single-run pairs keep
         # every worker busy; each pair's rows and series are its own, so the results do not depend on the order
         from concurrent.futures import ThreadPoolExecutor
@@ -228,6 +232,8 @@ def _prepare(e: Entry, case, base, draws: tuple, name: str, model: str, b, bindi
         e.status = "n/a: " + str(err.args[0] if err.args else err).replace("\n", " ")[:400]
         log(f"  {case.label} / {name}: {e.status}")
         return None
+    if b is None:  # how the unit under test runs: its FMI version and interface, on the page and in the log
+        e.config += _runs_as(sc, case.slot)
     e.unbound_items = unbound_slots(sc, [case.slot])
     e.unbound = [u.text() for u in e.unbound_items]
     for u in e.unbound:
@@ -241,6 +247,18 @@ def _prepare(e: Entry, case, base, draws: tuple, name: str, model: str, b, bindi
     c = campaign.Campaign(sc, sets, seeds, timeseries=ts or None, ts_every=every)
     folder = out / "runs" / _slug(case.label) / _slug(name)  # one folder per case (two cases may share a scenario)
     return e, case, sc, c, folder
+
+
+def _runs_as(sc, slot: str) -> str:
+    """", run as FMI 3.0 Model Exchange" (or 2.0, Co-Simulation): the interface the engines give the unit in
+    ``slot`` (Co-Simulation when it offers it, Model Exchange when it offers only that or is asked to); "" when
+    the plan cannot be made (the run then reports why)."""
+    try:
+        u = next(u for u in build_plan(sc).units if u.name == slot)
+    except (PlanError, OSError, KeyError, StopIteration):
+        return ""
+    itf = "Model Exchange, integrated by the engine" if u.interface == "me" else "Co-Simulation"
+    return f", run as FMI {u.fmi}.0 {itf}"
 
 
 def _run_pair(client, log, e: Entry, case, sc, c, folder: Path) -> None:

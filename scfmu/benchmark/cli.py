@@ -1,5 +1,5 @@
-"""``scfmu benchmark [PATH] --family attitude|single_axis|formation``: a controller (any FMI 2.0
-Co-Simulation FMU, or a model name) through the family's standard scenarios beside the built-in
+"""``scfmu benchmark [PATH] --family attitude|single_axis|formation``: a controller (an FMI 2.0 or 3.0
+FMU, Co-Simulation or Model Exchange, or a model name) through the family's standard scenarios beside the built-in
 controllers; one HTML + Markdown page (``out/benchmark/<family>/``) with the warnings first (slot values
 that reached no parameter of the unit, built-ins re-tuned for or not designed for a plant, runs whose error
 grew, ties), the metrics with their units, pass/fail, the unit's rank per scenario and overlaid responses.

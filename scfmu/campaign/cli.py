@@ -182,6 +182,8 @@ def _parser() -> argparse.ArgumentParser:
     ap.add_argument("--metric", default="eulerint_deg_s", help="metric of the figures")
     ap.add_argument("--plot-vs", action="append", default=[], metavar="INST.VAR", help="metric-vs-parameter figure")
     ap.add_argument("--no-plots", action="store_true")
+    ap.add_argument("--check", action="store_true", help="first run `scfmu check --quick` on every unit given as "
+                    "an .fmu file; stop with exit status 1 if a check fails")
     return ap
 
 
@@ -219,6 +221,24 @@ def _figures(c, table, out: Path, args) -> None:
     print("figures: " + ", ".join(str(f) for f in figs))
 
 
+def _units_pass_check(scenario) -> bool:
+    """``--check``: `scfmu check --quick` on each unit given as a file (the report on stderr); False (and
+    one line naming the unit and the failed checks) when any fails."""
+    from ..check import check_quick
+    from ..fmu import is_path
+    ok = True
+    for comp in scenario.components:
+        if not is_path(comp.model):
+            continue
+        rep = check_quick(str(comp.model))
+        print(rep.text(), file=sys.stderr)
+        if not rep.ok:
+            print(f"scfmu campaign: {comp.name} ({comp.model}) fails scfmu check "
+                  f"({', '.join(sorted(rep.failed_checks()))}); the campaign was not run", file=sys.stderr)
+            ok = False
+    return ok
+
+
 def main(argv=None) -> int:
     args = _parser().parse_args(argv)
 
@@ -229,6 +249,8 @@ def main(argv=None) -> int:
         print(f"scfmu campaign: {e.one_line()}", file=sys.stderr)
         return 2
     options.binding_report(c.scenario, "scfmu campaign", args.strict, lambda t: print(t, file=sys.stderr))
+    if args.check and not _units_pass_check(c.scenario):
+        return 1
     bad = override_problems(c.scenario, c.overrides)
     if bad:
         more = " (and more)" if len(bad) > 1 else ""

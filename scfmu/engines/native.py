@@ -28,8 +28,8 @@ nested as its Co-Simulation face (:mod:`scfmu.engines.cs_face`: the unit's FMU w
 which integrates it over each fixed step with the instance's solver, events included).
 
 Containers are cached on disk by a hash of their configuration (FMU GUIDs and file SHA-256, wiring,
-step), in
-``$SCFMU_CONTAINER_DIR`` or ``~/.cache/scfmu/containers``.
+step), in ``$SCFMU_CONTAINER_DIR`` or ``~/.cache/scfmu/containers``, a cache bounded in size
+(:mod:`scfmu.engines.cache`).
 """
 
 from __future__ import annotations
@@ -51,11 +51,12 @@ from fmpy import read_model_description
 from ..fmu import Fmu, fmu_digest, safe_extract, scalar_type, unpacked
 from ..scenario.model import Scenario
 from ..scenario.plan import Plan
+from . import cache
+from .cache import CACHE
 from .calls import SimulationError, raw_calls
 from .cs_face import cs_face, wrapper_identity
 from .instances import as_plan
 
-CACHE = Path(os.environ.get("SCFMU_CONTAINER_DIR", Path.home() / ".cache" / "scfmu" / "containers"))
 _KINDS = ("parameter", "calculatedParameter", "input", "output")
 LAYOUT = 5  # version of the container layout below (part of the cache key)
 _KEYS: dict = {}  # structure of a plan (+ FMU file identities) -> hash, per process
@@ -120,7 +121,7 @@ def build_container(scenario, starts: dict | None = None) -> Path:
     h = container_key(plan, starts)
     path = CACHE / f"loop_{h}.fmu"
     if path.exists():
-        return path
+        return cache.used(path)
     units = _nested_units(plan)
     comps, cvars, container_vars, mappings, cv_of = _container_variables(units, starts)
     # one connection per link group of the plan (destination, source, type), in Gauss–Seidel order
@@ -130,6 +131,7 @@ def build_container(scenario, starts: dict | None = None) -> Path:
     config = Configuration(parallelDoStep=False, modelDescription=md, components=list(comps.values()),
                            connections=connections, variableMappings=mappings)
     _write_container(config, h, path)
+    cache.prune()
     return path
 
 

@@ -11,13 +11,12 @@ direct feed-through, so reading them first is exact.
 
 from __future__ import annotations
 
-import fnmatch
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..fmu import Fmu, scalar_type
-from ..scenario.model import DEFAULT_UNCONNECTED
+from ..scenario.model import DEFAULT_UNCONNECTED, matches_input
 
 
 @dataclass
@@ -59,7 +58,7 @@ class CoSimulation:
         # The optional inputs (disturbances, wheel momenta, reference derivatives, the magnetorquer dipole
         # command, ...) may stay at their start value: the scenarios' one list of them.
         # A pattern "x_*" also covers the scalar port "x" (SingleAxisPlant's torque_dist).
-        return not any(fnmatch.fnmatchcase(name, p) or name == p.removesuffix("_*") for p in DEFAULT_UNCONNECTED)
+        return not matches_input(name, DEFAULT_UNCONNECTED, stems=True)
 
     def propagate(self) -> None:
         for dst in self.fmus:

@@ -9,7 +9,10 @@ or ends its process costs that call only, never the caller (a campaign worker, t
   (Python's faulthandler, which pytest and ``python -X faulthandler`` turn on, would print a 'Fatal Python
   error' dump for what is a reported result, and re-raise the signal from user space);
 * on Linux, is killed with its parent (``PR_SET_PDEATHSIG``), so a unit that hangs cannot spin on after a
-  killed campaign.
+  killed campaign;
+* writes its temporary files (the FMUs it unpacks, a unit's own) into a folder of its own, which the
+  caller removes afterwards: a child that crashes, hangs or ends with ``os._exit`` never runs its cleanup,
+  and a campaign of thousands of isolated runs must not leave thousands of unpacked units behind.
 
 The caller kills the child on every way out: the limit, an exception, Ctrl-C.
 """
@@ -19,8 +22,10 @@ from __future__ import annotations
 import os
 import pickle
 import select
+import shutil
 import signal
 import sys
+import tempfile
 import time
 from typing import Any, Callable
 
@@ -38,13 +43,21 @@ def in_child(fn: Callable[[], Any], timeout: float) -> tuple[str, Any]:
     ("crash", the signal's name or "exit code N") or ("timeout", None) when no result came within
     ``timeout`` seconds of wall time (the child is killed)."""
     parent = os.getpid()
+    scratch = tempfile.mkdtemp(prefix="scfmu_isolated_")
+    try:
+        return _fork_and_wait(fn, timeout, parent, scratch)
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)
+
+
+def _fork_and_wait(fn: Callable[[], Any], timeout: float, parent: int, scratch: str) -> tuple[str, Any]:
     rfd, wfd = os.pipe()
     pid = os.fork()
     if pid == 0:  # child: run, send, exit without running the caller's cleanup handlers
         code = 0
         try:
             os.close(rfd)
-            _detach(parent)
+            _detach(parent, scratch)
             data = pickle.dumps(fn())
             with os.fdopen(wfd, "wb") as w:
                 w.write(data)
@@ -89,10 +102,12 @@ def in_child(fn: Callable[[], Any], timeout: float) -> tuple[str, Any]:
         return "crash", f"exit code {os.WEXITSTATUS(status)}"
 
 
-def _detach(parent: int) -> None:
+def _detach(parent: int, scratch: str) -> None:
     """The child's set-up (the module's opening comment says why)."""
     import faulthandler
     os.setsid()
+    tempfile.tempdir = scratch  # Python's temporary files (fmpy's unpacking included)
+    os.environ["TMPDIR"] = scratch  # a unit's native code
     faulthandler.disable()
     for name in FATAL_SIGNALS:  # after a fork the forking thread is the child's main thread: allowed
         signal.signal(getattr(signal, name), signal.SIG_DFL)

@@ -5,9 +5,10 @@ registry that the paper plug-ins fill (:func:`get`, :func:`names`), read from an
 from __future__ import annotations
 
 from ..registry import REGISTRY
-from .model import DEFAULT_UNCONNECTED, Component, Scenario, load, log_of
+from .model import DEFAULT_UNCONNECTED, Component, Scenario, load, log_of, matches_input
 
-__all__ = ["DEFAULT_UNCONNECTED", "Component", "Scenario", "get", "load", "log_of", "names", "describe"]
+__all__ = ["DEFAULT_UNCONNECTED", "Component", "Scenario", "get", "load", "log_of", "matches_input", "names",
+           "describe"]
 
 
 def get(name: str, **kw) -> Scenario:

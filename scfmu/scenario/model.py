@@ -37,6 +37,24 @@ DEFAULT_UNCONNECTED = ("torque_dist_*", "dist_*", "h_wheel*", "q_ref_dot*", "q_r
                        "m_cmd_*")
 
 
+def matches_input(port: str, patterns, instance: str | None = None, *, stems: bool = False) -> bool:
+    """Whether input ``port`` (of ``instance``, when given) matches one of the glob ``patterns`` (``fnmatch``,
+    case-sensitive): the one matcher of the ``unconnected`` lists.
+
+    A bare pattern (``"torque_dist_*"``) names that port of any instance; a qualified one
+    (``"plant.torque_dist_*"``) names it in one instance and matches only when ``instance`` is given. With
+    ``stems``, a pattern ``"x_*"`` also covers the scalar port ``"x"`` (SingleAxisPlant's ``torque_dist``
+    against ``"torque_dist_*"``): the reference master's reading of the optional inputs; a scenario's own
+    ``unconnected`` list names such a port as it is (paper002 lists ``"torque_dist"``)."""
+    for pat in patterns:
+        if "." in pat:
+            if instance is not None and fnmatch.fnmatchcase(f"{instance}.{port}", pat):
+                return True
+        elif fnmatch.fnmatchcase(port, pat) or (stems and port == pat.removesuffix("_*")):
+            return True
+    return False
+
+
 @dataclass
 class Component:
     """One FMU instance in a place of the loop.
@@ -284,13 +302,7 @@ class Scenario:
         return out
 
     def _is_unconnected(self, inst: str, port: str) -> bool:
-        for pat in self.unconnected:
-            if "." in pat:
-                if fnmatch.fnmatchcase(f"{inst}.{port}", pat):
-                    return True
-            elif fnmatch.fnmatchcase(port, pat):
-                return True
-        return False
+        return matches_input(port, self.unconnected, inst)
 
     def log_items(self) -> list[tuple[str, str, str]]:
         """(key, instance, variable) of every logged signal."""

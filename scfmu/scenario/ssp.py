@@ -4,7 +4,8 @@ One scenario declaration is the only source of the wiring: :func:`write_ssp` res
 it with :meth:`Scenario.wiring` (the same call the masters use) and writes
 
 * ``SystemStructure.ssd`` (named by the scenario's name made an identifier, :func:`identifier`; the
-  instance names must be identifiers already): one ``ssd:Component`` per instance (``source="resources/<Model>.fmu"``) with a
+  instance names must be identifiers already): one ``ssd:Component`` per instance (``source="resources/<Model>.fmu"``;
+  ``implementation="ModelExchange"`` when the instance runs as Model Exchange, read back as its ``interface``) with a
   connector for every input and output of its FMU, one ``ssd:Connection`` per link, a
   ``ssd:DefaultExperiment`` (start and stop time) and, as an ``ssc:Annotation`` of type
   ``com.github.spacecraft-fmus.scfmu``, the master settings that SSP 1.0 has no element for
@@ -177,9 +178,12 @@ def _system(system, scenario: Scenario, mds: dict) -> dict:
     elements = ET.SubElement(system, _q("ssd", "Elements"))
     ssv_files = {}
     for c in scenario.components:
-        comp = ET.SubElement(elements, _q("ssd", "Component"),
-                             {"name": c.name, "type": "application/x-fmu-sharedlibrary",
-                              "source": f"resources/{resource_name(c.model)}"})
+        attrs = {"name": c.name, "type": "application/x-fmu-sharedlibrary",
+                 "source": f"resources/{resource_name(c.model)}"}
+        impl = _implementation(c, mds[c.model])
+        if impl:
+            attrs["implementation"] = impl
+        comp = ET.SubElement(elements, _q("ssd", "Component"), attrs)
         conns = ET.SubElement(comp, _q("ssd", "Connectors"))
         for v in mds[c.model].modelVariables:
             if v.causality in ("input", "output"):
@@ -207,6 +211,15 @@ def _system(system, scenario: Scenario, mds: dict) -> dict:
                   {"description": "oms-ma", "stepSize": repr(float(scenario.step)), "absoluteTolerance": "0.0001",
                    "relativeTolerance": "0.0001"})
     return ssv_files
+
+
+def _implementation(c, md) -> str:
+    """SSP's ``implementation`` of a component: "ModelExchange" when the instance runs as Model Exchange
+    (``Component.interface`` "me", or a unit that offers Model Exchange only), "CoSimulation" when the
+    scenario asks for it explicitly, "" (SSP's default "any") otherwise."""
+    if c.interface == "me" or (not c.interface and md.coSimulation is None and md.modelExchange is not None):
+        return "ModelExchange"
+    return "CoSimulation" if c.interface == "cs" else ""
 
 
 def _experiment(root, scenario: Scenario) -> None:
@@ -256,7 +269,9 @@ def read_ssp(path: str | Path, workdir: str | Path | None = None) -> tuple[Scena
                     fixed[f"{name}.{p.get('name')}"] = value
                 else:
                     params[p.get("name")] = value
-        components.append(Component(name, model, params))
+        comp = Component(name, model, params)
+        comp.interface = {"ModelExchange": "me", "CoSimulation": "cs"}.get(c.get("implementation", ""), "")
+        components.append(comp)
     connections = {f"{e.get('endElement')}.{e.get('endConnector')}": f"{e.get('startElement')}.{e.get('startConnector')}"
                    for e in system.findall("ssd:Connections/ssd:Connection", NS)}
     exp = root.find("ssd:DefaultExperiment", NS)

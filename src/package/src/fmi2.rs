@@ -8,38 +8,20 @@ use spacecraft_fmus::catalogue::{Catalogue, Causality, LayerInfo, ModelDescripti
 
 use crate::structure::{derivative_dependencies, initial_unknowns, output_dependencies, state_indices};
 use crate::xml::{
-    author, comment, document, empty, end, finish, join, start, value_attrs, variable_attrs,
-    write_categories_and_experiment, write_unit_definitions, GENERATION_TOOL, W,
+    comment, empty, end, join, local_attrs, model_description_document, start, value_attrs, variable_attrs, Version, W,
 };
 
 /// The complete FMI 2.0 modelDescription.xml of model `m` of the catalogue `cat`.
 pub fn model_description(cat: &Catalogue, m: &ModelDescription) -> String {
-    let mut w = document();
-    start(
-        &mut w,
-        "fmiModelDescription",
-        &[
-            ("fmiVersion", "2.0".into()),
-            ("modelName", m.name.clone()),
-            ("guid", m.guid.clone()),
-            ("description", m.description.clone()),
-            ("author", author(&cat.package)),
-            ("version", cat.package.version.clone()),
-            ("license", cat.package.license.clone()),
-            ("generationTool", GENERATION_TOOL.into()),
-            ("variableNamingConvention", "flat".into()),
-            ("numberOfEventIndicators", "0".into()),
-        ],
-    );
-    write_interfaces(&mut w, m);
-    write_unit_definitions(&mut w, m);
-    write_categories_and_experiment(&mut w, m, &cat.layer);
-    start(&mut w, "ModelVariables", &[]);
-    write_variables(&mut w, m, &cat.layer);
-    end(&mut w, "ModelVariables");
-    write_structure(&mut w, m);
-    end(&mut w, "fmiModelDescription");
-    finish(w)
+    let v = Version {
+        fmi_version: "2.0",
+        token: "guid",
+        extra: &[("numberOfEventIndicators", "0")],
+        interfaces: write_interfaces,
+        variables: write_variables,
+        structure: write_structure,
+    };
+    model_description_document(cat, m, &v)
 }
 
 /// `<ModelExchange>` (models with continuous states) and `<CoSimulation>`.
@@ -94,20 +76,10 @@ fn write_variables(w: &mut W, m: &ModelDescription, layer: &LayerInfo) {
     }
     let n_decl = m.variables.len();
     let states = m.state_decls();
-    let local = |name: String, vr: u32, description: String| -> Vec<(&str, String)> {
-        vec![
-            ("name", name),
-            ("valueReference", vr.to_string()),
-            ("description", description),
-            ("causality", "local".into()),
-            ("variability", "continuous".into()),
-            ("initial", "calculated".into()),
-        ]
-    };
     for (k, x) in states.iter().enumerate() {
         comment(w, &format!(" index {}: continuous state {} ", n_decl + k + 1, k + 1));
-        let vr = layer.state_vr_base + k as u32;
-        start(w, "ScalarVariable", &local(x.name.clone(), vr, x.description.clone()));
+        let attrs = local_attrs(x.name.clone(), layer.state_vr_base + k as u32, x.description.clone());
+        start(w, "ScalarVariable", &attrs);
         let t: Vec<(&str, String)> = if x.unit.is_empty() {
             vec![]
         } else {
@@ -120,15 +92,15 @@ fn write_variables(w: &mut W, m: &ModelDescription, layer: &LayerInfo) {
         let ix = n_decl + states.len() + k + 1;
         comment(w, &format!(" index {ix}: derivative of state {} ", k + 1));
         let vr = layer.derivative_vr_base + k as u32;
-        let description = format!("Time derivative of {}", x.name);
-        start(w, "ScalarVariable", &local(format!("der({})", x.name), vr, description));
+        let attrs = local_attrs(format!("der({})", x.name), vr, format!("Time derivative of {}", x.name));
+        start(w, "ScalarVariable", &attrs);
         empty(w, "Real", &[("derivative", (n_decl + k + 1).to_string())]);
         end(w, "ScalarVariable");
     }
 }
 
 /// `<ModelStructure>`: outputs, derivatives and initial unknowns with their dependencies.
-fn write_structure(w: &mut W, m: &ModelDescription) {
+fn write_structure(w: &mut W, m: &ModelDescription, _layer: &LayerInfo) {
     start(w, "ModelStructure", &[]);
     let outputs: Vec<_> = m
         .variables

@@ -17,8 +17,7 @@ use spacecraft_fmus::catalogue::{Catalogue, Causality, LayerInfo, ModelDescripti
 
 use crate::structure::{derivative_dependencies, initial_unknowns, output_dependencies, state_indices};
 use crate::xml::{
-    author, document, empty, end, finish, join, start, value_attrs, variable_attrs, write_categories_and_experiment,
-    write_unit_definitions, GENERATION_TOOL, W,
+    empty, end, join, local_attrs, model_description_document, start, value_attrs, variable_attrs, Version, W,
 };
 
 /// Value reference of the variable at 1-based FMI 2.0 ScalarVariable index `ix`: the declared variables,
@@ -45,31 +44,15 @@ fn vrs_of(m: &ModelDescription, layer: &LayerInfo, ix: &[usize]) -> String {
 
 /// The complete FMI 3.0 modelDescription.xml of model `m` of the catalogue `cat`.
 pub fn model_description3(cat: &Catalogue, m: &ModelDescription) -> String {
-    let mut w = document();
-    start(
-        &mut w,
-        "fmiModelDescription",
-        &[
-            ("fmiVersion", "3.0".into()),
-            ("modelName", m.name.clone()),
-            ("instantiationToken", m.guid.clone()),
-            ("description", m.description.clone()),
-            ("author", author(&cat.package)),
-            ("version", cat.package.version.clone()),
-            ("license", cat.package.license.clone()),
-            ("generationTool", GENERATION_TOOL.into()),
-            ("variableNamingConvention", "flat".into()),
-        ],
-    );
-    write_interfaces(&mut w, m);
-    write_unit_definitions(&mut w, m);
-    write_categories_and_experiment(&mut w, m, &cat.layer);
-    start(&mut w, "ModelVariables", &[]);
-    write_variables(&mut w, m, &cat.layer);
-    end(&mut w, "ModelVariables");
-    write_structure(&mut w, m, &cat.layer);
-    end(&mut w, "fmiModelDescription");
-    finish(w)
+    let v = Version {
+        fmi_version: "3.0",
+        token: "instantiationToken",
+        extra: &[],
+        interfaces: write_interfaces,
+        variables: write_variables,
+        structure: write_structure,
+    };
+    model_description_document(cat, m, &v)
 }
 
 /// `<ModelExchange>` (models with continuous states) and `<CoSimulation>`.
@@ -132,19 +115,9 @@ fn write_variables(w: &mut W, m: &ModelDescription, layer: &LayerInfo) {
         };
         empty(w, tag, &attrs);
     }
-    let local = |name: String, vr: u32, description: String| -> Vec<(&str, String)> {
-        vec![
-            ("name", name),
-            ("valueReference", vr.to_string()),
-            ("description", description),
-            ("causality", "local".into()),
-            ("variability", "continuous".into()),
-            ("initial", "calculated".into()),
-        ]
-    };
     let states = m.state_decls();
     for (k, x) in states.iter().enumerate() {
-        let mut attrs = local(x.name.clone(), layer.state_vr_base + k as u32, x.description.clone());
+        let mut attrs = local_attrs(x.name.clone(), layer.state_vr_base + k as u32, x.description.clone());
         if !x.unit.is_empty() {
             attrs.push(("unit", x.unit.clone()));
         }
@@ -152,7 +125,7 @@ fn write_variables(w: &mut W, m: &ModelDescription, layer: &LayerInfo) {
     }
     for (k, x) in states.iter().enumerate() {
         let description = format!("Time derivative of {}", x.name);
-        let mut attrs = local(
+        let mut attrs = local_attrs(
             format!("der({})", x.name),
             layer.derivative_vr_base + k as u32,
             description,

@@ -1,7 +1,8 @@
 //! XML helpers both model-description writers use ([`crate::fmi2`], [`crate::fmi3`]): quick-xml events,
 //! the text form of values and enumerations, the attributes of a variable's type element, and the
-//! elements that are the same in FMI 2.0 and 3.0 (`<UnitDefinitions>`, `<LogCategories>`,
-//! `<DefaultExperiment>`).
+//! elements that are the same in FMI 2.0 and 3.0 (the root element's attributes, `<UnitDefinitions>`,
+//! `<LogCategories>`, `<DefaultExperiment>`), and the document's outline both follow
+//! ([`model_description_document`], given a [`Version`]).
 //!
 //! XML is written with quick-xml. (fmi-schema's FMI 2 types were the first choice, but their `<Real>`
 //! has no `unit` attribute and an empty `dependencies=""` list, which says "no direct feed-through",
@@ -13,7 +14,8 @@ use quick_xml::events::{BytesDecl, BytesEnd, BytesStart, BytesText, Event};
 use quick_xml::Writer;
 
 use spacecraft_fmus::catalogue::{
-    Causality, Initial, LayerInfo, ModelDescription, PackageInfo, Start, VarKind, Variability, VariableDescription,
+    Catalogue, Causality, Initial, LayerInfo, ModelDescription, PackageInfo, Start, VarKind, Variability,
+    VariableDescription,
 };
 use spacecraft_fmus::units;
 
@@ -155,8 +157,67 @@ pub(crate) fn variable_attrs(d: &VariableDescription) -> Vec<(&'static str, Stri
     attrs
 }
 
+/// What the FMI 2.0 and 3.0 descriptions differ in, for [`model_description_document`].
+pub(crate) struct Version {
+    /// `fmiVersion`.
+    pub fmi_version: &'static str,
+    /// The attribute that carries the model's GUID: `guid` (2.0), `instantiationToken` (3.0).
+    pub token: &'static str,
+    /// Root attributes after the shared ones (FMI 2.0: `numberOfEventIndicators`).
+    pub extra: &'static [(&'static str, &'static str)],
+    /// `<ModelExchange>` / `<CoSimulation>`.
+    pub interfaces: fn(&mut W, &ModelDescription),
+    /// The contents of `<ModelVariables>`.
+    pub variables: fn(&mut W, &ModelDescription, &LayerInfo),
+    /// `<ModelStructure>`.
+    pub structure: fn(&mut W, &ModelDescription, &LayerInfo),
+}
+
+/// The complete modelDescription.xml of model `m` of the catalogue `cat` in FMI version `v`: the root
+/// element with the attributes both versions share (model name, GUID, description, author, version,
+/// license, generation tool, naming convention), the interfaces, `<UnitDefinitions>`, `<LogCategories>`,
+/// `<DefaultExperiment>`, `<ModelVariables>` and `<ModelStructure>`, in the order both schemas prescribe.
+pub(crate) fn model_description_document(cat: &Catalogue, m: &ModelDescription, v: &Version) -> String {
+    let mut w = document();
+    let mut attrs: Vec<(&str, String)> = vec![
+        ("fmiVersion", v.fmi_version.into()),
+        ("modelName", m.name.clone()),
+        (v.token, m.guid.clone()),
+        ("description", m.description.clone()),
+        ("author", author(&cat.package)),
+        ("version", cat.package.version.clone()),
+        ("license", cat.package.license.clone()),
+        ("generationTool", GENERATION_TOOL.into()),
+        ("variableNamingConvention", "flat".into()),
+    ];
+    attrs.extend(v.extra.iter().map(|(k, x)| (*k, x.to_string())));
+    start(&mut w, "fmiModelDescription", &attrs);
+    (v.interfaces)(&mut w, m);
+    write_unit_definitions(&mut w, m);
+    write_categories_and_experiment(&mut w, m, &cat.layer);
+    start(&mut w, "ModelVariables", &[]);
+    (v.variables)(&mut w, m, &cat.layer);
+    end(&mut w, "ModelVariables");
+    (v.structure)(&mut w, m, &cat.layer);
+    end(&mut w, "fmiModelDescription");
+    finish(w)
+}
+
+/// The attributes of a continuous state's or a derivative's variable element (both versions): a local,
+/// continuous, calculated variable.
+pub(crate) fn local_attrs(name: String, vr: u32, description: String) -> Vec<(&'static str, String)> {
+    vec![
+        ("name", name),
+        ("valueReference", vr.to_string()),
+        ("description", description),
+        ("causality", "local".into()),
+        ("variability", "continuous".into()),
+        ("initial", "calculated".into()),
+    ]
+}
+
 /// `<LogCategories>` (the layer's, from the catalogue) and `<DefaultExperiment>`, the same in FMI 2.0 and 3.0.
-pub(crate) fn write_categories_and_experiment(w: &mut W, m: &ModelDescription, layer: &LayerInfo) {
+fn write_categories_and_experiment(w: &mut W, m: &ModelDescription, layer: &LayerInfo) {
     start(w, "LogCategories", &[]);
     for (name, desc) in &layer.log_categories {
         empty(w, "Category", &[("name", name.clone()), ("description", desc.clone())]);
@@ -173,7 +234,7 @@ pub(crate) fn write_categories_and_experiment(w: &mut W, m: &ModelDescription, l
 
 /// `<UnitDefinitions>` of the units a model uses, in table order (deterministic); nothing when it uses
 /// none. The same element in FMI 2.0 and 3.0.
-pub(crate) fn write_unit_definitions(w: &mut W, m: &ModelDescription) {
+fn write_unit_definitions(w: &mut W, m: &ModelDescription) {
     let used: Vec<_> = units::UNITS
         .iter()
         .filter(|(n, _, _)| m.variables.iter().any(|d| d.unit == *n) || m.state_decls().iter().any(|x| x.unit == *n))

@@ -1,4 +1,4 @@
-/* Two FMI 3.0 units written by hand in plain C against the FMI 3.0 headers that fmpy ships (foreign units:
+/* Three FMI 3.0 units written by hand in plain C against the FMI 3.0 headers that fmpy ships (foreign units:
  * not built by our exporter), for the engine tests (tests/foreign_units.py builds them):
  *
  * MODEL == 1  C3PdController, Co-Simulation only. The quaternion PD law of PdController (error_law 0):
@@ -13,6 +13,12 @@
  *   with one event indicator z = theta - theta_mark (a state event: each sign change is counted in the
  *   Int32 output `crossings`, the first one's time is the output `t_cross`), and one time event at
  *   `kick_time` (if >= 0) where omega jumps by `kick_domega`.
+ *
+ * MODEL == 3  C3PdControllerME, Model Exchange only: the PD law of MODEL 1 (same inputs, outputs, parameters and
+ *   value references, without the Int32/Boolean ports), as a continuous-time controller exported from a
+ *   modelling tool would come: no continuous states, no event indicators, no time events; the torque is a
+ *   direct feedthrough of the inputs, evaluated on every get in every mode (initialization, event,
+ *   continuous-time). The Model Exchange calls an importer makes work on 0 states and 0 indicators.
  *
  * Only the functions these units support do real work; every other FMI 3.0 function is exported (fmpy
  * binds all of them) and returns fmi3Error.
@@ -30,7 +36,7 @@
 #define EXPORT __attribute__((visibility("default")))
 
 #ifndef MODEL
-#error "MODEL must be 1 (C3PdController) or 2 (C3AxisBody)"
+#error "MODEL must be 1 (C3PdController), 2 (C3AxisBody) or 3 (C3PdControllerME)"
 #endif
 #ifndef MODEL_TOKEN
 #error "MODEL_TOKEN must be defined"
@@ -61,7 +67,14 @@ static void logmsg(Instance *c, fmi3Status st, const char *fmt, ...) {
     c->log(c->env, st, "logStatusError", buf);
 }
 
-#if MODEL == 1
+#if MODEL == 1 || MODEL == 3
+#define PD_LAW 1
+#endif
+#if MODEL == 2 || MODEL == 3
+#define ME_ONLY 1
+#endif
+
+#ifdef PD_LAW
 /* value references */
 enum { IN0 = 0, N_IN = 14, OUT0 = 14, WN = 17, ZETA = 18, IXX = 19, ENABLE = 22, COUNT_IN = 23, STEP_COUNT = 24,
        ACTIVE = 25, COUNT_ECHO = 26, ENABLE_ECHO = 27 };
@@ -97,22 +110,31 @@ static fmi3Status set_real(Instance *c, fmi3ValueReference v, double x) {
     c->r[v] = x;
     return fmi3OK;
 }
+#if MODEL == 3 /* no Int32/Boolean ports: every such value reference is refused */
+#define NO_DISCRETE_PORTS(v) if (v >= ENABLE) return fmi3Error
+#else
+#define NO_DISCRETE_PORTS(v) (void)0
+#endif
 static fmi3Status get_int(Instance *c, fmi3ValueReference v, int32_t *out) {
+    NO_DISCRETE_PORTS(v);
     if (v == COUNT_IN || v == STEP_COUNT) { *out = c->i[v]; return fmi3OK; }
     if (v == COUNT_ECHO) { *out = c->i[COUNT_IN]; return fmi3OK; }
     return fmi3Error;
 }
 static fmi3Status set_int(Instance *c, fmi3ValueReference v, int32_t x) {
+    NO_DISCRETE_PORTS(v);
     if (v != COUNT_IN) return fmi3Error;
     c->i[v] = x;
     return fmi3OK;
 }
 static fmi3Status get_bool(Instance *c, fmi3ValueReference v, bool *out) {
+    NO_DISCRETE_PORTS(v);
     if (v == ENABLE || v == ENABLE_ECHO) { *out = c->b[ENABLE]; return fmi3OK; }
     if (v == ACTIVE) { *out = (c->i[STEP_COUNT] % 2) == 0; return fmi3OK; }
     return fmi3Error;
 }
 static fmi3Status set_bool(Instance *c, fmi3ValueReference v, bool x) {
+    NO_DISCRETE_PORTS(v);
     if (v != ENABLE) return fmi3Error;
     c->b[v] = x;
     return fmi3OK;
@@ -179,6 +201,36 @@ static void update(Instance *c, bool *next_defined, double *next) {
 }
 #endif
 
+/* ----- the Model Exchange units' continuous part: NX states, NZ event indicators ----------------------- */
+#if MODEL == 2
+#define NX 2
+#define NZ 1
+static void states_get(const Instance *c, double *x) { x[0] = c->r[THETA]; x[1] = c->r[OMEGA]; }
+static void states_set(Instance *c, const double *x) { c->r[THETA] = x[0]; c->r[OMEGA] = x[1]; }
+static void derivatives(Instance *c, double *dx) { get_real(c, DER_THETA, &dx[0]); get_real(c, DER_OMEGA, &dx[1]); }
+static void indicators(const Instance *c, double *z) { z[0] = c->r[THETA] - c->r[MARK]; }
+static void init_discrete(Instance *c) { c->above = c->r[THETA] > c->r[MARK]; }
+static void discrete(Instance *c, bool *states_changed, bool *next_defined, double *next) {
+    double w0 = c->r[OMEGA];
+    update(c, next_defined, next);
+    *states_changed = c->r[OMEGA] != w0;
+}
+#elif MODEL == 3
+#define NX 0
+#define NZ 0
+static void states_get(const Instance *c, double *x) { (void)c; (void)x; }
+static void states_set(Instance *c, const double *x) { (void)c; (void)x; }
+static void derivatives(Instance *c, double *dx) { (void)c; (void)dx; }
+static void indicators(const Instance *c, double *z) { (void)c; (void)z; }
+static void init_discrete(Instance *c) { (void)c; }
+static void discrete(Instance *c, bool *states_changed, bool *next_defined, double *next) {
+    (void)c;
+    *states_changed = false;
+    *next_defined = false;
+    *next = 0.0;
+}
+#endif
+
 /* ----- the functions this unit supports ------------------------------------------------------------- */
 EXPORT const char *fmi3GetVersion(void) { return "3.0"; }
 EXPORT fmi3Status fmi3SetDebugLogging(fmi3Instance instance, fmi3Boolean loggingOn, size_t nCategories,
@@ -205,7 +257,7 @@ EXPORT fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3Str
         fmi3LogMessageCallback logMessage, fmi3IntermediateUpdateCallback intermediateUpdate) {
     (void)instanceName; (void)resourcePath; (void)visible; (void)loggingOn; (void)earlyReturnAllowed;
     (void)requiredIntermediateVariables; (void)nRequiredIntermediateVariables; (void)intermediateUpdate;
-#if MODEL == 1
+#ifndef ME_ONLY
     if (eventModeUsed) return NULL;
     return create(instantiationToken, instanceEnvironment, logMessage);
 #else
@@ -218,7 +270,7 @@ EXPORT fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3St
         fmi3String resourcePath, fmi3Boolean visible, fmi3Boolean loggingOn,
         fmi3InstanceEnvironment instanceEnvironment, fmi3LogMessageCallback logMessage) {
     (void)instanceName; (void)resourcePath; (void)visible; (void)loggingOn;
-#if MODEL == 2
+#ifdef ME_ONLY
     return create(instantiationToken, instanceEnvironment, logMessage);
 #else
     (void)instantiationToken; (void)instanceEnvironment; (void)logMessage;
@@ -241,10 +293,10 @@ EXPORT fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean
 EXPORT fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) {
     Instance *c = instance;
     if (!c || c->state != ST_INIT) return fmi3Error;
-#if MODEL == 1
+#ifndef ME_ONLY
     c->state = ST_RUN;
 #else
-    c->above = c->r[THETA] > c->r[MARK];
+    init_discrete(c);
     c->state = ST_EVENT;
 #endif
     return fmi3OK;
@@ -253,6 +305,10 @@ EXPORT fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) {
 EXPORT fmi3Status fmi3Terminate(fmi3Instance instance) {
     Instance *c = instance;
     if (!c) return fmi3Error;
+    if (c->state == ST_INSTANTIATED) {
+        logmsg(c, fmi3Error, "fmi3Terminate: not allowed before initialization");
+        return fmi3Error;
+    }
     c->state = ST_TERMINATED;
     return fmi3OK;
 }
@@ -271,11 +327,16 @@ EXPORT fmi3Status fmi3Reset(fmi3Instance instance) {
     return fmi3OK;
 }
 
-#define GETSET(NAME, CT, FN, MODE)                                                                          \
+/* SETTER: 1 for the fmi3Set* functions (refused after fmi3Terminate) */
+#define GETSET(NAME, CT, FN, MODE, SETTER)                                                                  \
     EXPORT fmi3Status NAME(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, CT values[],     \
                            size_t nValues) {                                                                \
         Instance *c = instance;                                                                             \
         if (!c || (nvr && (!vr || !values)) || nValues != nvr) return fmi3Error;                            \
+        if (SETTER && c->state == ST_TERMINATED) {                                                          \
+            logmsg(c, fmi3Error, #NAME ": not allowed after fmi3Terminate");                                \
+            return fmi3Error;                                                                               \
+        }                                                                                                   \
         for (size_t k = 0; k < nvr; k++)                                                                    \
             if (FN(c, vr[k], MODE values[k]) != fmi3OK) {                                                   \
                 logmsg(c, fmi3Error, #NAME ": value reference %u is not allowed here", (unsigned)vr[k]);     \
@@ -283,12 +344,12 @@ EXPORT fmi3Status fmi3Reset(fmi3Instance instance) {
             }                                                                                               \
         return fmi3OK;                                                                                      \
     }
-GETSET(fmi3GetFloat64, fmi3Float64, get_real, &)
-GETSET(fmi3GetInt32, fmi3Int32, get_int, &)
-GETSET(fmi3GetBoolean, fmi3Boolean, get_bool, &)
-GETSET(fmi3SetFloat64, const fmi3Float64, set_real, )
-GETSET(fmi3SetInt32, const fmi3Int32, set_int, )
-GETSET(fmi3SetBoolean, const fmi3Boolean, set_bool, )
+GETSET(fmi3GetFloat64, fmi3Float64, get_real, &, 0)
+GETSET(fmi3GetInt32, fmi3Int32, get_int, &, 0)
+GETSET(fmi3GetBoolean, fmi3Boolean, get_bool, &, 0)
+GETSET(fmi3SetFloat64, const fmi3Float64, set_real, , 1)
+GETSET(fmi3SetInt32, const fmi3Int32, set_int, , 1)
+GETSET(fmi3SetBoolean, const fmi3Boolean, set_bool, , 1)
 
 #if MODEL == 1
 EXPORT fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoint,
@@ -297,7 +358,9 @@ EXPORT fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunica
         fmi3Float64 *lastSuccessfulTime) {
     Instance *c = instance;
     (void)noSetFMUStatePriorToCurrentPoint;
-    if (!c || c->state != ST_RUN || !(communicationStepSize > 0)) return fmi3Error;
+    if (!c || c->state != ST_RUN || !(communicationStepSize > 0) || !isfinite(currentCommunicationPoint) ||
+        !isfinite(communicationStepSize))
+        return fmi3Error;
     c->time = currentCommunicationPoint + communicationStepSize;
     c->i[STEP_COUNT] += 1;
     if (eventHandlingNeeded) *eventHandlingNeeded = false;
@@ -318,18 +381,16 @@ EXPORT fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *d
         fmi3Boolean *valuesOfContinuousStatesChanged, fmi3Boolean *nextEventTimeDefined,
         fmi3Float64 *nextEventTime) {
     Instance *c = instance;
-    bool defined;
+    bool changed, defined;
     double next;
-    double w0;
     if (!c || c->state != ST_EVENT) return fmi3Error;
-    w0 = c->r[OMEGA];
-    update(c, &defined, &next);
-    *discreteStatesNeedUpdate = false;
-    *terminateSimulation = false;
-    *nominalsOfContinuousStatesChanged = false;
-    *valuesOfContinuousStatesChanged = c->r[OMEGA] != w0;
-    *nextEventTimeDefined = defined;
-    *nextEventTime = next;
+    discrete(c, &changed, &defined, &next);
+    if (discreteStatesNeedUpdate) *discreteStatesNeedUpdate = false;
+    if (terminateSimulation) *terminateSimulation = false;
+    if (nominalsOfContinuousStatesChanged) *nominalsOfContinuousStatesChanged = false;
+    if (valuesOfContinuousStatesChanged) *valuesOfContinuousStatesChanged = changed;
+    if (nextEventTimeDefined) *nextEventTimeDefined = defined;
+    if (nextEventTime) *nextEventTime = next;
     return fmi3OK;
 }
 EXPORT fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance instance) {
@@ -343,50 +404,64 @@ EXPORT fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance, fmi3Boolean
     Instance *c = instance;
     (void)noSetFMUStatePriorToCurrentPoint;
     if (!c || c->state != ST_CONT) return fmi3Error;
-    *enterEventMode = false;
-    *terminateSimulation = false;
+    if (enterEventMode) *enterEventMode = false;
+    if (terminateSimulation) *terminateSimulation = false;
     return fmi3OK;
 }
 EXPORT fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time) {
     Instance *c = instance;
     if (!c) return fmi3Error;
+    if (c->state != ST_EVENT && c->state != ST_CONT) {
+        logmsg(c, fmi3Error, "fmi3SetTime: allowed in Event and Continuous-Time Mode only");
+        return fmi3Error;
+    }
+    if (!isfinite(time)) {
+        logmsg(c, fmi3Error, "fmi3SetTime: time = %g must be finite", time);
+        return fmi3Error;
+    }
     c->time = time;
     return fmi3OK;
 }
+/* the vectors' lengths must be NX (states) and NZ (event indicators); with 0, any pointer (NULL too) is fine */
 EXPORT fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 x[], size_t n) {
     Instance *c = instance;
-    if (!c || n != 2 || !x) return fmi3Error;
-    c->r[THETA] = x[0];
-    c->r[OMEGA] = x[1];
+    if (!c || n != NX || (n && !x)) return fmi3Error;
+    states_set(c, x);
     return fmi3OK;
 }
 EXPORT fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 x[], size_t n) {
     Instance *c = instance;
-    if (!c || n != 2 || !x) return fmi3Error;
-    x[0] = c->r[THETA];
-    x[1] = c->r[OMEGA];
+    if (!c || n != NX || (n && !x)) return fmi3Error;
+    states_get(c, x);
     return fmi3OK;
 }
 EXPORT fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 dx[], size_t n) {
     Instance *c = instance;
-    if (!c || n != 2 || !dx) return fmi3Error;
-    get_real(c, DER_THETA, &dx[0]);
-    get_real(c, DER_OMEGA, &dx[1]);
+    if (!c || n != NX || (n && !dx)) return fmi3Error;
+    derivatives(c, dx);
     return fmi3OK;
 }
 EXPORT fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 z[], size_t n) {
     Instance *c = instance;
-    if (!c || n != 1 || !z) return fmi3Error;
-    z[0] = c->r[THETA] - c->r[MARK];
+    if (!c || n != NZ || (n && !z)) return fmi3Error;
+    indicators(c, z);
     return fmi3OK;
 }
 EXPORT fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 nominals[], size_t n) {
-    (void)instance;
+    if (!instance || n != NX || (n && !nominals)) return fmi3Error;
     for (size_t k = 0; k < n; k++) nominals[k] = 1.0;
     return fmi3OK;
 }
-EXPORT fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, size_t *n) { (void)instance; *n = 1; return fmi3OK; }
-EXPORT fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t *n) { (void)instance; *n = 2; return fmi3OK; }
+EXPORT fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, size_t *n) {
+    if (!instance || !n) return fmi3Error;
+    *n = NZ;
+    return fmi3OK;
+}
+EXPORT fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t *n) {
+    if (!instance || !n) return fmi3Error;
+    *n = NX;
+    return fmi3OK;
+}
 #endif
 
 /* ----- every other FMI 3.0 function: exported, refused ---------------------------------------------- */
@@ -426,6 +501,13 @@ static fmi3DoStepTYPE *const check_step = fmi3DoStep;
 #else
 static fmi3UpdateDiscreteStatesTYPE *const check_update = fmi3UpdateDiscreteStates;
 static fmi3CompletedIntegratorStepTYPE *const check_completed = fmi3CompletedIntegratorStep;
+static fmi3EnterEventModeTYPE *const check_event = fmi3EnterEventMode;
+static fmi3EnterContinuousTimeModeTYPE *const check_cont = fmi3EnterContinuousTimeMode;
+static fmi3SetTimeTYPE *const check_time = fmi3SetTime;
+static fmi3SetContinuousStatesTYPE *const check_setx = fmi3SetContinuousStates;
+static fmi3GetContinuousStatesTYPE *const check_getx = fmi3GetContinuousStates;
+static fmi3GetContinuousStateDerivativesTYPE *const check_der = fmi3GetContinuousStateDerivatives;
+static fmi3GetEventIndicatorsTYPE *const check_z = fmi3GetEventIndicators;
 #endif
 EXPORT const void *c3_signature_checks[] = {
     (const void *)check_cs, (const void *)check_me, (const void *)check_get, (const void *)check_setb,
@@ -433,6 +515,8 @@ EXPORT const void *c3_signature_checks[] = {
 #if MODEL == 1
     (const void *)check_step,
 #else
-    (const void *)check_update, (const void *)check_completed,
+    (const void *)check_update, (const void *)check_completed, (const void *)check_event, (const void *)check_cont,
+    (const void *)check_time, (const void *)check_setx, (const void *)check_getx, (const void *)check_der,
+    (const void *)check_z,
 #endif
 };

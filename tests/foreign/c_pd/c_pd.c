@@ -13,6 +13,12 @@
  *                    3 NaN outputs, 4 fmi2DoStep returns fmi2Error with a logged message
  *   FAIL_TIME        the model time from which the failure happens (s): the fmi2DoStep that starts at
  *                    t >= FAIL_TIME crashes / hangs / fails; outputs are NaN once the instance time >= FAIL_TIME
+ *   MODEL_EXCHANGE   1: the unit is instantiated as Model Exchange only (fmi2Instantiate refuses
+ *                    fmi2CoSimulation) and implements the Model Exchange functions for its 0 continuous states
+ *                    and 0 event indicators: the PD law as a continuous-time controller with direct
+ *                    feedthrough, evaluated on every fmi2GetReal in initialization, event and continuous-time
+ *                    mode. 0 (default): Co-Simulation only; the Model Exchange functions are not in the binary
+ *                    (the "me_only" variant declares Model Exchange anyway, to test that masters refuse it).
  */
 #include <math.h>
 #include <stdarg.h>
@@ -31,13 +37,24 @@
 #ifndef FAIL_TIME
 #define FAIL_TIME 0.5
 #endif
+#ifndef MODEL_EXCHANGE
+#define MODEL_EXCHANGE 0
+#endif
+#if MODEL_EXCHANGE
+#define UNIT_TYPE fmi2ModelExchange
+#define UNIT_TYPE_TEXT "fmi2Instantiate: only Model Exchange is supported"
+#else
+#define UNIT_TYPE fmi2CoSimulation
+#define UNIT_TYPE_TEXT "fmi2Instantiate: only Co-Simulation is supported"
+#endif
 
 /* value references */
 enum { VR_WN = 1, VR_ZETA = 2, VR_IXX = 3, VR_IYY = 4, VR_IZZ = 5 };
 enum { VR_IN0 = 10, N_IN = 14 };   /* q_w q_x q_y q_z w_x w_y w_z q_ref_w..z w_ref_x..z */
 enum { VR_OUT0 = 30, N_OUT = 3 };  /* torque_cmd_x _y _z */
 
-typedef enum { ST_INSTANTIATED, ST_INIT, ST_STEP, ST_TERMINATED, ST_ERROR } State;
+/* ST_STEP: Co-Simulation step mode; ST_EVENT, ST_CONT: Model Exchange event and continuous-time modes */
+typedef enum { ST_INSTANTIATED, ST_INIT, ST_STEP, ST_EVENT, ST_CONT, ST_TERMINATED, ST_ERROR } State;
 
 typedef struct {
     fmi2CallbackFunctions cb;
@@ -128,12 +145,12 @@ FMI2_Export fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuT
                                           fmi2Boolean loggingOn) {
     (void)fmuResourceLocation; (void)visible;
     if (!functions) return NULL;
-    if (fmuType != fmi2CoSimulation || !fmuGUID || strcmp(fmuGUID, MODEL_GUID) != 0) {
+    if (fmuType != UNIT_TYPE || !fmuGUID || strcmp(fmuGUID, MODEL_GUID) != 0) {
         if (functions->logger)
             functions->logger(functions->componentEnvironment, instanceName ? instanceName : "?", fmi2Error,
                               "logStatusError",
-                              fmuType != fmi2CoSimulation ? "fmi2Instantiate: only Co-Simulation is supported"
-                                                          : "fmi2Instantiate: GUID does not match the modelDescription");
+                              fmuType != UNIT_TYPE ? UNIT_TYPE_TEXT
+                                                   : "fmi2Instantiate: GUID does not match the modelDescription");
         return NULL;
     }
     Instance *c = calloc(1, sizeof *c);
@@ -179,7 +196,7 @@ FMI2_Export fmi2Status fmi2ExitInitializationMode(fmi2Component comp) {
         c->state = ST_ERROR;
         return fmi2Error;
     }
-    c->state = ST_STEP;
+    c->state = MODEL_EXCHANGE ? ST_EVENT : ST_STEP; /* Model Exchange: initialization ends in event mode */
     return fmi2OK;
 }
 
@@ -348,3 +365,79 @@ FMI2_Export fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKin
 FMI2_Export fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value) {
     (void)c; (void)s; (void)value; return fmi2Discard;
 }
+
+/* ---------------------------------------------------------------- Model Exchange (MODEL_EXCHANGE = 1) */
+#if MODEL_EXCHANGE
+static fmi2Status in_mode(Instance *c, const char *fn, int ok) {
+    if (bad_instance(c, fn)) return fmi2Error;
+    if (!ok) {
+        logmsg(c, fmi2Error, "logStatusError", "%s: not allowed in this mode", fn);
+        return fmi2Error;
+    }
+    return fmi2OK;
+}
+FMI2_Export fmi2Status fmi2EnterEventMode(fmi2Component comp) {
+    Instance *c = comp;
+    if (in_mode(c, "fmi2EnterEventMode", c && (c->state == ST_CONT || c->state == ST_EVENT)) != fmi2OK) return fmi2Error;
+    c->state = ST_EVENT;
+    return fmi2OK;
+}
+FMI2_Export fmi2Status fmi2NewDiscreteStates(fmi2Component comp, fmi2EventInfo *info) {
+    Instance *c = comp;
+    if (in_mode(c, "fmi2NewDiscreteStates", c && c->state == ST_EVENT) != fmi2OK || !info) return fmi2Error;
+    info->newDiscreteStatesNeeded = fmi2False;
+    info->terminateSimulation = fmi2False;
+    info->nominalsOfContinuousStatesChanged = fmi2False;
+    info->valuesOfContinuousStatesChanged = fmi2False;
+    info->nextEventTimeDefined = fmi2False;
+    info->nextEventTime = 0.0;
+    return fmi2OK;
+}
+FMI2_Export fmi2Status fmi2EnterContinuousTimeMode(fmi2Component comp) {
+    Instance *c = comp;
+    if (in_mode(c, "fmi2EnterContinuousTimeMode", c && c->state == ST_EVENT) != fmi2OK) return fmi2Error;
+    c->state = ST_CONT;
+    return fmi2OK;
+}
+FMI2_Export fmi2Status fmi2CompletedIntegratorStep(fmi2Component comp, fmi2Boolean noSetFMUStatePriorToCurrentPoint,
+                                                   fmi2Boolean *enterEventMode, fmi2Boolean *terminateSimulation) {
+    Instance *c = comp;
+    (void)noSetFMUStatePriorToCurrentPoint;
+    if (in_mode(c, "fmi2CompletedIntegratorStep", c && c->state == ST_CONT) != fmi2OK) return fmi2Error;
+    if (enterEventMode) *enterEventMode = fmi2False;
+    if (terminateSimulation) *terminateSimulation = fmi2False;
+    return fmi2OK;
+}
+FMI2_Export fmi2Status fmi2SetTime(fmi2Component comp, fmi2Real time) {
+    Instance *c = comp;
+    if (bad_instance(c, "fmi2SetTime")) return fmi2Error;
+    c->time = time;
+    return fmi2OK;
+}
+/* 0 continuous states, 0 event indicators: only empty vectors (any pointer) are accepted */
+#define EMPTY_VECTOR(fn, T)                                                                              \
+    FMI2_Export fmi2Status fn(fmi2Component comp, T x[], size_t n) {                                     \
+        Instance *c = comp;                                                                              \
+        (void)x;                                                                                         \
+        if (bad_instance(c, #fn)) return fmi2Error;                                                      \
+        if (n == 0) return fmi2OK;                                                                       \
+        logmsg(c, fmi2Error, "logStatusError", #fn ": %u elements asked, the unit has 0", (unsigned)n);  \
+        return fmi2Error;                                                                                \
+    }
+EMPTY_VECTOR(fmi2SetContinuousStates, const fmi2Real)
+EMPTY_VECTOR(fmi2GetContinuousStates, fmi2Real)
+EMPTY_VECTOR(fmi2GetDerivatives, fmi2Real)
+EMPTY_VECTOR(fmi2GetEventIndicators, fmi2Real)
+EMPTY_VECTOR(fmi2GetNominalsOfContinuousStates, fmi2Real)
+
+/* the Model Exchange functions have the signatures of the FMI 2.0 headers (checked at compile time) */
+static fmi2NewDiscreteStatesTYPE *const check_nds = fmi2NewDiscreteStates;
+static fmi2CompletedIntegratorStepTYPE *const check_cis = fmi2CompletedIntegratorStep;
+static fmi2SetContinuousStatesTYPE *const check_setx = fmi2SetContinuousStates;
+static fmi2GetDerivativesTYPE *const check_der = fmi2GetDerivatives;
+static fmi2GetEventIndicatorsTYPE *const check_z = fmi2GetEventIndicators;
+static fmi2GetNominalsOfContinuousStatesTYPE *const check_nom = fmi2GetNominalsOfContinuousStates;
+FMI2_Export const void *c_pd_me_signature_checks[] = {(const void *)check_nds, (const void *)check_cis,
+                                                       (const void *)check_setx, (const void *)check_der,
+                                                       (const void *)check_z, (const void *)check_nom};
+#endif

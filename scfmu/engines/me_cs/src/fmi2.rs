@@ -1,8 +1,11 @@
-//! FMI 2.0 Co-Simulation functions over an FMI 2.0 Model Exchange unit.
+//! FMI 2.0 Co-Simulation functions over an FMI 2.0 Model Exchange unit: the exported C signatures over the
+//! shared bodies of [`crate::face`]. What is FMI 2.0's own stays here: the unit's `fmi2…` functions
+//! (`fmi2EventInfo`, `fmi2Boolean` as an int), the `fmuType` check and fmi2Discard for a unit that terminates.
 
 use std::ffi::{c_char, c_void};
 
-use crate::{instance, load, me, Instance, Solver, Unit, DISCARD, ERROR, MAGIC, OK};
+use crate::face::{self, call, forward, refuse, Face, Step};
+use crate::{instance, me, Unit, DISCARD, ERROR, OK};
 
 type Comp = *mut c_void;
 
@@ -18,15 +21,6 @@ struct EventInfo {
 }
 
 struct Me2(Comp);
-
-macro_rules! call {
-    ($name:ident, ($($ty:ty),*), $($arg:expr),*) => {
-        match me!($name, unsafe extern "C" fn($($ty),*) -> i32) {
-            Some(f) => unsafe { f($($arg),*) },
-            None => ERROR,
-        }
-    };
-}
 
 impl Unit for Me2 {
     fn set_time(&mut self, t: f64) -> i32 {
@@ -97,6 +91,24 @@ impl Unit for Me2 {
     }
 }
 
+impl Face for Me2 {
+    const V3: bool = false;
+    fn of(inner: Comp) -> Self {
+        Me2(inner)
+    }
+    fn free(&mut self) {
+        if let Some(f) = me!(fmi2FreeInstance, unsafe extern "C" fn(Comp)) {
+            unsafe { f(self.0) }
+        }
+    }
+    fn exit_initialization_mode(&mut self) -> i32 {
+        call!(fmi2ExitInitializationMode, (Comp), self.0)
+    }
+    fn reset(&mut self) -> i32 {
+        call!(fmi2Reset, (Comp), self.0)
+    }
+}
+
 #[no_mangle]
 pub extern "C" fn fmi2GetTypesPlatform() -> *const c_char {
     c"default".as_ptr()
@@ -124,35 +136,15 @@ pub unsafe extern "C" fn fmi2Instantiate(
     if fmu_type != 1 {
         return std::ptr::null_mut();
     }
-    let Ok(cfg) = load(location, false) else {
-        return std::ptr::null_mut();
-    };
-    let Some(f) = me!(fmi2Instantiate, Instantiate) else {
-        return std::ptr::null_mut();
-    };
-    let inner = f(name, 0, guid, location, functions, visible, logging_on);
-    if inner.is_null() {
-        return std::ptr::null_mut();
-    }
-    let w = Instance {
-        magic: MAGIC,
-        inner,
-        solver: Solver::new(cfg),
-        start_time: 0.0,
-        terminated: false,
-    };
-    Box::into_raw(Box::new(w)) as Comp
+    face::instantiate::<Me2>(location, || match me!(fmi2Instantiate, Instantiate) {
+        Some(f) => f(name, 0, guid, location, functions, visible, logging_on),
+        None => std::ptr::null_mut(),
+    })
 }
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2FreeInstance(c: Comp) {
-    if let Some(w) = instance(c) {
-        if let Some(f) = me!(fmi2FreeInstance, unsafe extern "C" fn(Comp)) {
-            f(w.inner);
-        }
-        w.magic = 0;
-        drop(Box::from_raw(c as *mut Instance));
-    }
+    face::free::<Me2>(c)
 }
 
 #[no_mangle]
@@ -164,84 +156,42 @@ pub unsafe extern "C" fn fmi2SetupExperiment(
     stop_defined: i32,
     stop: f64,
 ) -> i32 {
-    let Some(w) = instance(c) else { return ERROR };
-    w.start_time = start;
-    call!(
-        fmi2SetupExperiment,
-        (Comp, i32, f64, f64, i32, f64),
-        w.inner,
-        tol_defined,
-        tol,
-        start,
-        stop_defined,
-        stop
-    )
+    face::setup(c, start, |inner| {
+        call!(
+            fmi2SetupExperiment,
+            (Comp, i32, f64, f64, i32, f64),
+            inner,
+            tol_defined,
+            tol,
+            start,
+            stop_defined,
+            stop
+        )
+    })
 }
 
 /// Leaves initialization mode, runs the initial event iteration and enters continuous-time mode.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2ExitInitializationMode(c: Comp) -> i32 {
-    let Some(w) = instance(c) else { return ERROR };
-    let st = call!(fmi2ExitInitializationMode, (Comp), w.inner);
-    if st > 1 {
-        return st;
-    }
-    w.solver.t = w.start_time;
-    match w.solver.event_iteration(&mut Me2(w.inner), true) {
-        Ok(false) => st,
-        Ok(true) => {
-            w.terminated = true;
-            ERROR
-        }
-        Err((s, _)) => s,
-    }
+    face::exit_initialization_mode::<Me2>(c)
 }
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2Reset(c: Comp) -> i32 {
-    let Some(w) = instance(c) else { return ERROR };
-    let cfg = w.solver.cfg.clone();
-    w.solver = Solver::new(cfg);
-    w.terminated = false;
-    call!(fmi2Reset, (Comp), w.inner)
+    face::reset::<Me2>(c)
 }
 
-/// Integrates the unit from t to t + h (inputs held): see the crate documentation.
+/// Integrates the unit from t to t + h (inputs held): see the crate documentation. A unit that asks to
+/// terminate ends the step with fmi2Discard.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2DoStep(c: Comp, t: f64, h: f64, _no_set_prior: i32) -> i32 {
     let Some(w) = instance(c) else { return ERROR };
-    if w.terminated || h.is_nan() || h <= 0.0 || !t.is_finite() {
-        return ERROR;
+    match face::do_step::<Me2>(w, t, h) {
+        Step::Refused => ERROR,
+        Step::Reached => OK,
+        Step::Terminated => DISCARD,
+        Step::Failed(s) => s,
     }
-    w.solver.t = t;
-    match w.solver.advance(&mut Me2(w.inner), t + h) {
-        Ok(false) => OK,
-        Ok(true) => {
-            w.terminated = true;
-            DISCARD
-        }
-        Err((s, _)) => s.max(ERROR),
-    }
-}
-
-macro_rules! forward {
-    ($($name:ident ( $($arg:ident : $ty:ty),* );)*) => { $(
-        #[no_mangle]
-        pub unsafe extern "C" fn $name(c: Comp $(, $arg: $ty)*) -> i32 {
-            let Some(w) = instance(c) else { return ERROR };
-            call!($name, (Comp $(, $ty)*), w.inner $(, $arg)*)
-        }
-    )* };
-}
-
-macro_rules! refuse {
-    ($($name:ident ( $($arg:ident : $ty:ty),* );)*) => { $(
-        #[no_mangle]
-        pub unsafe extern "C" fn $name(_c: Comp $(, $arg: $ty)*) -> i32 {
-            $(let _ = $arg;)*
-            ERROR
-        }
-    )* };
 }
 
 forward! {

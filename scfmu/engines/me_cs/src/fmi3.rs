@@ -1,22 +1,17 @@
-//! FMI 3.0 Co-Simulation functions over an FMI 3.0 Model Exchange unit.
+//! FMI 3.0 Co-Simulation functions over an FMI 3.0 Model Exchange unit: the exported C signatures over the
+//! shared bodies of [`crate::face`]. What is FMI 3.0's own stays here: the unit's `fmi3…` functions, the
+//! numbers of states and event indicators asked at instantiation, the `eventModeUsed` check, step mode and
+//! the output arguments of `fmi3DoStep`.
 
 use std::ffi::{c_char, c_void};
 
-use crate::{instance, load, me, Instance, Solver, Unit, ERROR, MAGIC, OK};
+use crate::face::{self, call, forward, refuse, Face, Step};
+use crate::{instance, me, Config, Unit, ERROR, OK};
 
 type Inst = *mut c_void;
 type Vr = *const u32;
 
 struct Me3(Inst);
-
-macro_rules! call {
-    ($name:ident, ($($ty:ty),*), $($arg:expr),*) => {
-        match me!($name, unsafe extern "C" fn($($ty),*) -> i32) {
-            Some(f) => unsafe { f($($arg),*) },
-            None => ERROR,
-        }
-    };
-}
 
 impl Unit for Me3 {
     fn set_time(&mut self, t: f64) -> i32 {
@@ -96,6 +91,34 @@ impl Unit for Me3 {
     }
 }
 
+impl Face for Me3 {
+    const V3: bool = true;
+    fn of(inner: Inst) -> Self {
+        Me3(inner)
+    }
+    fn free(&mut self) {
+        if let Some(f) = me!(fmi3FreeInstance, unsafe extern "C" fn(Inst)) {
+            unsafe { f(self.0) }
+        }
+    }
+    fn exit_initialization_mode(&mut self) -> i32 {
+        call!(fmi3ExitInitializationMode, (Inst), self.0)
+    }
+    fn reset(&mut self) -> i32 {
+        call!(fmi3Reset, (Inst), self.0)
+    }
+    fn sizes(&mut self, cfg: &mut Config) -> bool {
+        let (mut nx, mut nz) = (0usize, 0usize);
+        if call!(fmi3GetNumberOfContinuousStates, (Inst, *mut usize), self.0, &mut nx) > 1
+            || call!(fmi3GetNumberOfEventIndicators, (Inst, *mut usize), self.0, &mut nz) > 1
+        {
+            return false;
+        }
+        (cfg.states, cfg.event_indicators) = (nx, nz);
+        true
+    }
+}
+
 #[no_mangle]
 pub extern "C" fn fmi3GetVersion() -> *const c_char {
     c"3.0".as_ptr()
@@ -124,34 +147,10 @@ pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
     if event_mode_used {
         return std::ptr::null_mut();
     }
-    let Ok(mut cfg) = load(location, true) else {
-        return std::ptr::null_mut();
-    };
-    let Some(f) = me!(fmi3InstantiateModelExchange, InstantiateMe) else {
-        return std::ptr::null_mut();
-    };
-    let inner = f(name, token, location, visible, logging_on, env, log);
-    if inner.is_null() {
-        return std::ptr::null_mut();
-    }
-    let (mut nx, mut nz) = (0usize, 0usize);
-    if call!(fmi3GetNumberOfContinuousStates, (Inst, *mut usize), inner, &mut nx) > 1
-        || call!(fmi3GetNumberOfEventIndicators, (Inst, *mut usize), inner, &mut nz) > 1
-    {
-        if let Some(free) = me!(fmi3FreeInstance, unsafe extern "C" fn(Inst)) {
-            free(inner);
-        }
-        return std::ptr::null_mut();
-    }
-    (cfg.states, cfg.event_indicators) = (nx, nz);
-    let w = Instance {
-        magic: MAGIC,
-        inner,
-        solver: Solver::new(cfg),
-        start_time: 0.0,
-        terminated: false,
-    };
-    Box::into_raw(Box::new(w)) as Inst
+    face::instantiate::<Me3>(location, || match me!(fmi3InstantiateModelExchange, InstantiateMe) {
+        Some(f) => f(name, token, location, visible, logging_on, env, log),
+        None => std::ptr::null_mut(),
+    })
 }
 
 #[no_mangle]
@@ -185,13 +184,7 @@ pub unsafe extern "C" fn fmi3InstantiateScheduledExecution(
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3FreeInstance(i: Inst) {
-    if let Some(w) = instance(i) {
-        if let Some(f) = me!(fmi3FreeInstance, unsafe extern "C" fn(Inst)) {
-            f(w.inner);
-        }
-        w.magic = 0;
-        drop(Box::from_raw(i as *mut Instance));
-    }
+    face::free::<Me3>(i)
 }
 
 #[no_mangle]
@@ -203,47 +196,30 @@ pub unsafe extern "C" fn fmi3EnterInitializationMode(
     stop_defined: bool,
     stop: f64,
 ) -> i32 {
-    let Some(w) = instance(i) else { return ERROR };
-    w.start_time = start;
-    call!(
-        fmi3EnterInitializationMode,
-        (Inst, bool, f64, f64, bool, f64),
-        w.inner,
-        tol_defined,
-        tol,
-        start,
-        stop_defined,
-        stop
-    )
+    face::setup(i, start, |inner| {
+        call!(
+            fmi3EnterInitializationMode,
+            (Inst, bool, f64, f64, bool, f64),
+            inner,
+            tol_defined,
+            tol,
+            start,
+            stop_defined,
+            stop
+        )
+    })
 }
 
 /// Leaves initialization mode (the unit is then in event mode), runs the initial event iteration and
 /// enters continuous-time mode; the wrapper is then in step mode.
 #[no_mangle]
 pub unsafe extern "C" fn fmi3ExitInitializationMode(i: Inst) -> i32 {
-    let Some(w) = instance(i) else { return ERROR };
-    let st = call!(fmi3ExitInitializationMode, (Inst), w.inner);
-    if st > 1 {
-        return st;
-    }
-    w.solver.t = w.start_time;
-    match w.solver.event_iteration(&mut Me3(w.inner), true) {
-        Ok(false) => st,
-        Ok(true) => {
-            w.terminated = true;
-            ERROR
-        }
-        Err((s, _)) => s,
-    }
+    face::exit_initialization_mode::<Me3>(i)
 }
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3Reset(i: Inst) -> i32 {
-    let Some(w) = instance(i) else { return ERROR };
-    let cfg = w.solver.cfg.clone();
-    w.solver = Solver::new(cfg);
-    w.terminated = false;
-    call!(fmi3Reset, (Inst), w.inner)
+    face::reset::<Me3>(i)
 }
 
 #[no_mangle]
@@ -255,7 +231,8 @@ pub unsafe extern "C" fn fmi3EnterStepMode(i: Inst) -> i32 {
     }
 }
 
-/// Integrates the unit from t to t + h (inputs held): see the crate documentation.
+/// Integrates the unit from t to t + h (inputs held): see the crate documentation. A unit that asks to
+/// terminate ends the step with fmi3OK and `terminateSimulation`; `lastSuccessfulTime` is the time reached.
 #[no_mangle]
 pub unsafe extern "C" fn fmi3DoStep(
     i: Inst,
@@ -273,45 +250,21 @@ pub unsafe extern "C" fn fmi3DoStep(
             *p = false;
         }
     }
-    if w.terminated || h.is_nan() || h <= 0.0 || !t.is_finite() {
-        return ERROR;
-    }
-    w.solver.t = t;
-    let r = w.solver.advance(&mut Me3(w.inner), t + h);
-    if !last.is_null() {
+    let r = face::do_step::<Me3>(w, t, h);
+    if r != Step::Refused && !last.is_null() {
         *last = w.solver.t;
     }
     match r {
-        Ok(false) => OK,
-        Ok(true) => {
-            w.terminated = true;
+        Step::Refused => ERROR,
+        Step::Reached => OK,
+        Step::Terminated => {
             if !terminate.is_null() {
                 *terminate = true;
             }
             OK
         }
-        Err((s, _)) => s.max(ERROR),
+        Step::Failed(s) => s,
     }
-}
-
-macro_rules! forward {
-    ($($name:ident ( $($arg:ident : $ty:ty),* );)*) => { $(
-        #[no_mangle]
-        pub unsafe extern "C" fn $name(i: Inst $(, $arg: $ty)*) -> i32 {
-            let Some(w) = instance(i) else { return ERROR };
-            call!($name, (Inst $(, $ty)*), w.inner $(, $arg)*)
-        }
-    )* };
-}
-
-macro_rules! refuse {
-    ($($name:ident ( $($arg:ident : $ty:ty),* );)*) => { $(
-        #[no_mangle]
-        pub unsafe extern "C" fn $name(_i: Inst $(, $arg: $ty)*) -> i32 {
-            $(let _ = $arg;)*
-            ERROR
-        }
-    )* };
 }
 
 type St = *mut c_void;

@@ -4,7 +4,8 @@
 //! scfmu's native engine and loop FMUs) can run the unit.
 //!
 //! It exports the FMI 2.0 Co-Simulation functions ([`fmi2`], for an FMI 2.0 Model Exchange unit) and the
-//! FMI 3.0 ones ([`fmi3`], for an FMI 3.0 unit). At instantiation it reads `scfmu_me_cs.txt` from the
+//! FMI 3.0 ones ([`fmi3`], for an FMI 3.0 unit): one thin C-ABI file per version, translating its types and
+//! arguments, over one version-neutral body of every entry point ([`face`]). At instantiation it reads `scfmu_me_cs.txt` from the
 //! unit's resources folder (the Model Exchange model identifier, the numbers of states and event indicators,
 //! the method and its tolerances), opens the unit's own library `binaries/<platform>/<identifier>` and
 //! instantiates it as Model Exchange. Getters, setters and the other common functions are forwarded; a
@@ -24,10 +25,12 @@
 
 #![allow(clippy::missing_safety_doc)]
 
-use std::ffi::{c_char, c_void, CStr, CString};
+use std::ffi::{c_char, c_void, CStr};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
+mod dynlib;
+pub mod face;
 pub mod fmi2;
 pub mod fmi3;
 mod solver;
@@ -39,7 +42,7 @@ pub const WARNING: i32 = 1;
 pub const DISCARD: i32 = 2;
 pub const ERROR: i32 = 3;
 
-static LIB: AtomicUsize = AtomicUsize::new(0); // dlopen handle of the unit's own library
+static LIB: AtomicUsize = AtomicUsize::new(0); // the handle of the unit's own library (dynlib::open)
 static LIB_PATH: Mutex<Option<String>> = Mutex::new(None);
 
 /// The wrapped unit's settings (`resources/scfmu_me_cs.txt`, `key=value` lines).
@@ -167,17 +170,7 @@ pub unsafe fn load(location: *const c_char, v3: bool) -> Result<Config, String> 
         Some(_) => return Ok(cfg),
         None => {}
     }
-    let c = CString::new(lib.clone()).map_err(|_| "library path with a NUL byte".to_string())?;
-    let h = libc::dlopen(c.as_ptr(), libc::RTLD_NOW | libc::RTLD_LOCAL);
-    if h.is_null() {
-        let why = libc::dlerror();
-        let why = if why.is_null() {
-            String::new()
-        } else {
-            CStr::from_ptr(why).to_string_lossy().into()
-        };
-        return Err(format!("cannot open {lib}: {why}"));
-    }
+    let h = dynlib::open(&lib).map_err(|why| format!("cannot open {lib}: {why}"))?;
     LIB.store(h as usize, Ordering::SeqCst);
     *open = Some(lib);
     Ok(cfg)
@@ -193,7 +186,7 @@ pub fn sym(cache: &AtomicUsize, name: &[u8]) -> Option<*const c_void> {
     if h == 0 {
         return None;
     }
-    let f = unsafe { libc::dlsym(h as *mut c_void, name.as_ptr() as *const c_char) };
+    let f = dynlib::symbol(h as *mut c_void, name);
     if f.is_null() {
         return None;
     }

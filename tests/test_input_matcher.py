@@ -1,0 +1,55 @@
+"""The one matcher of the ``unconnected`` lists (:func:`scfmu.scenario.matches_input`), used by the scenarios'
+wiring check and by the reference master's optional inputs: bare and qualified glob patterns, and the
+reference master's reading of ``x_*`` as covering the scalar port ``x`` (SingleAxisPlant's ``torque_dist``)."""
+
+from __future__ import annotations
+
+import pytest
+
+from scfmu.engines.reference import CoSimulation
+from scfmu.scenario import DEFAULT_UNCONNECTED, Scenario, matches_input
+
+
+@pytest.mark.parametrize("port, stems, expected", [
+    ("torque_dist_x", False, True),  # a vector element, the glob itself
+    ("torque_dist_z", True, True),
+    ("torque_dist", False, False),  # the scalar stem only with stems
+    ("torque_dist", True, True),
+    ("torque_dist_", False, True),  # "*" matches the empty tail
+    ("torque_distx", True, False),  # not the stem, not "stem_..."
+    ("torque_dis", True, False),
+    ("dist", True, True),  # "dist_*" covers the scalar "dist" too
+    ("h_wheel", True, True),  # "h_wheel*": a glob without "_*", matched as a glob only
+    ("h_wheel_1", False, True),
+    ("h_whee", True, False),
+    ("m_cmd", True, True),
+    ("m_cmd_y", False, True),
+    ("leader_true_anomaly", False, True),  # a plain name
+    ("leader_true_anomaly_x", True, False),
+    ("q_ref_dot_w", False, True),
+    ("torque_cmd_x", True, False),
+    ("Torque_dist_x", True, False),  # case-sensitive
+])
+def test_default_optional_inputs(port, stems, expected):
+    assert matches_input(port, DEFAULT_UNCONNECTED, stems=stems) is expected
+
+
+def test_qualified_patterns_name_one_instance():
+    pats = ["plant.torque_cmd_*", "hold.u_*"]
+    assert matches_input("torque_cmd_x", pats, "plant")
+    assert not matches_input("torque_cmd_x", pats, "other")
+    assert not matches_input("torque_cmd_x", pats)  # no instance: a qualified pattern names none
+    assert not matches_input("torque_cmd", pats, "plant", stems=False)
+    assert matches_input("u_1", pats, "hold") and not matches_input("u_1", pats, "plant")
+    assert not matches_input("x", [])
+
+
+def test_scenario_and_reference_master_read_the_lists_through_the_matcher():
+    """The scenario's wiring check takes its own list as written (paper002 names "torque_dist" itself); the
+    reference master's required-input rule covers the scalar stem of the default list."""
+    sc = Scenario(name="t", components=[], stop_time=1.0, step=0.1, unconnected=[*DEFAULT_UNCONNECTED, "plant.torque_cmd_*"])
+    assert sc._is_unconnected("plant", "torque_dist_y") and sc._is_unconnected("plant", "torque_cmd_x")
+    assert not sc._is_unconnected("ctrl", "torque_cmd_x")
+    assert not sc._is_unconnected("plant", "torque_dist")
+    assert not CoSimulation._required("torque_dist") and not CoSimulation._required("torque_dist_x")
+    assert CoSimulation._required("torque_cmd") and CoSimulation._required("torque_distx")
