@@ -16,10 +16,12 @@ scfmu/engines/cs_face.py) on every platform the project's FMUs carry:
   with the adaptive Dormand-Prince method (whose step control calls the C library's pow) within 1e-12
   relative, and within 1e-9 of the loop with the plant's own Co-Simulation build.
 
-The Windows wrapper does not compile today (scfmu/engines/me_cs/src/lib.rs opens the unit's library with
-libc::dlopen, which the libc crate does not offer on Windows): its checks are marked xfail(strict), so they
-fail loudly the day it builds and this file must be updated. Skipped where the FMUs carry no binaries of a
-platform (its cross toolchain not installed); in CI (CI=true) the missing tools are a failure."""
+- under Wine the win64 face, driven the same way by the MinGW build of the master, gives the linux64 face's
+  trajectory: attitude, rates, torques and wheel momentum bit for bit, the Euler angles (each platform's
+  C library) within 1 ulp.
+
+Skipped where the FMUs carry no binaries of a platform (its cross toolchain not installed) or qemu/Wine are
+missing; in CI (CI=true) the missing tools are a failure."""
 
 from __future__ import annotations
 
@@ -48,9 +50,7 @@ CROSS = {
     "x86_64-darwin": ("target/macos/x86_64-apple-darwin/release/libscfmu_me_cs.dylib", "darwin64"),
     "aarch64-darwin": ("target/macos/aarch64-apple-darwin/release/libscfmu_me_cs.dylib", "darwin64"),
 }
-NO_WINDOWS = pytest.mark.xfail(strict=True, reason="scfmu_me_cs does not compile for Windows: lib.rs calls "
-                                                   "libc::dlopen/dlsym/dlerror, absent from libc on Windows")
-TUPLES = [pytest.param(t, marks=NO_WINDOWS) if t == "x86_64-windows" else t for t in CROSS]
+TUPLES = list(CROSS)
 # The Co-Simulation entry points fmpy's container (and any master) calls on a face, written out from the
 # FMI 2.0.4 (section 4.2) and FMI 3.0 (section 4.2) standards rather than read from our own binary
 FMI2_FACE = {"fmi2GetTypesPlatform", "fmi2GetVersion", "fmi2SetDebugLogging", "fmi2Instantiate", "fmi2FreeInstance",
@@ -92,7 +92,7 @@ def pe_header(data: bytes) -> tuple[int, int]:
     """(PE machine, characteristics) of a PE image (Microsoft PE/COFF specification)."""
     pe = struct.unpack_from("<I", data, 0x3C)[0]
     assert data[:2] == b"MZ" and data[pe:pe + 4] == b"PE\0\0"
-    return struct.unpack_from("<HxxxxxxxxxxxxxxxxxH", data, pe + 4)
+    return struct.unpack_from("<H", data, pe + 4)[0], struct.unpack_from("<H", data, pe + 4 + 18)[0]
 
 
 @pytest.mark.parametrize("tup", TUPLES)
@@ -344,3 +344,66 @@ def test_adaptive_face_on_aarch64_agrees_with_x86_64(qemu_work):
             worst = max(worst, abs(va - vb) / max(abs(va), abs(vb), 1e-300) if abs(va - vb) > 1e-300 else 0.0)
     print(f"largest relative difference aarch64 vs x86-64: {worst:.3g}")
     assert worst <= 1e-12
+
+
+@pytest.fixture(scope="module")
+def wine_work(tmp_path_factory):
+    """The C master built for Windows (MinGW, static), PdController's DLL and the AttitudePlant face (FMI 2.0,
+    RK4) unpacked, beside the Linux master and PdController's .so."""
+    from test_win64 import MINGW_GCC, WINE
+
+    if WINE is None or shutil.which(MINGW_GCC) is None:
+        if os.environ.get("CI") == "true":
+            pytest.fail("Wine or x86_64-w64-mingw32-gcc not installed (scripts/setup.sh)")
+        pytest.skip("Wine or x86_64-w64-mingw32-gcc not installed (scripts/setup.sh)")
+    built("x86_64-windows")
+    import xml.etree.ElementTree as ET
+
+    from scfmu.engines.cs_face import cs_face
+    d = tmp_path_factory.mktemp("face_win64")
+    subprocess.run(["gcc", "-O1", "-Wall", "-Werror", "-o", str(d / "fmi_loop"), str(LOADER), "-ldl"], check=True)
+    subprocess.run([MINGW_GCC, "-O1", "-Wall", "-Werror", "-D__USE_MINGW_ANSI_STDIO=1", "-static",
+                    "-o", str(d / "fmi_loop.exe"), str(LOADER)], check=True)
+    info = {}
+    for model in ("AttitudePlant", "PdController"):
+        with zipfile.ZipFile(FMUS / f"{model}.fmu") as z:
+            (d / f"{model}.so").write_bytes(z.read(f"binaries/linux64/{model}.so"))
+            (d / f"{model}.dll").write_bytes(z.read(f"binaries/win64/{model}.dll"))
+            root = ET.fromstring(z.read("modelDescription.xml"))
+        info[model] = (root.get("guid"), {v.get("name"): int(v.get("valueReference"))
+                                          for v in root.iter("ScalarVariable")})
+    face = cs_face(_unit(FMUS / "AttitudePlant.fmu", {"method": "RK4"}), d / "cache")
+    with zipfile.ZipFile(face) as z:
+        z.extractall(d / "face")
+    return d, info
+
+
+def test_rk4_face_under_wine_is_bit_identical_to_linux64(wine_work, monkeypatch):
+    """AttitudePlant's win64 face (the Windows wrapper over the unit's win64 DLL) + PdController's DLL under
+    Wine, 200 steps of 0.05 s: the same bits as the linux64 face with the .so files, except the Euler angles
+    (msvcrt's and glibc's atan2/asin) within 1 ulp."""
+    from test_win64 import run_wine
+
+    d, info = wine_work
+    face = d / "face"
+    args = loop_args(info, "so", 200, 0.05, "PdController")
+    args[0] = str(face / "binaries" / "linux64" / "scfmu_me_cs.so")
+    env = dict(os.environ, FMI_LOOP_PLANT_RESOURCES=(face / "resources").as_uri())
+    linux = subprocess.run([str(d / "fmi_loop"), *args], cwd=d, env=env, capture_output=True, text=True, timeout=300)
+    assert linux.returncode == 0, linux.stdout[-2000:] + linux.stderr[-2000:]
+    win_args = loop_args(info, "dll", 200, 0.05, "PdController")
+    win_args[0] = "Z:" + str(face / "binaries" / "win64" / "scfmu_me_cs.dll").replace("/", "\\")
+    monkeypatch.setenv("FMI_LOOP_PLANT_RESOURCES", "file:///Z:" + (face / "resources").as_posix())  # Wine's Z: is /
+    win = run_wine(d, *win_args)
+    assert win.returncode == 0, win.stdout[-2000:] + win.stderr[-2000:]
+    (_, rows_linux), (_, rows_win) = parse_loop(linux.stdout), parse_loop(win.stdout)
+    assert len(rows_linux) == len(rows_win) == 200
+    for k, (a, b) in enumerate(zip(rows_linux, rows_win), start=1):
+        for name, (va, ba), (vb, bb) in zip(OUT, a, b):
+            if name in LIBM_OUTPUTS:
+                assert ulps(va, vb) <= 1, f"step {k} {name}: linux64 {va!r} win64 {vb!r}"
+            else:
+                assert ba == bb, f"step {k} {name}: linux64 {va!r} ({ba:016x}) != win64 {vb!r} ({bb:016x})"
+    last = [v for v, _ in rows_win[-1]]
+    print(f"q0 after 10 s: {last[0]!r} on both platforms")
+    assert max(abs(x) for x in last[4:7]) < 1e-3

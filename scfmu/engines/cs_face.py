@@ -14,8 +14,8 @@ had one for FMI 2.0 only).
 
 Platforms. The wrapper library is built for every platform the project's FMUs carry (Linux x86-64 by
 ``cargo build --release``; Windows x86-64, Linux aarch64 and macOS x86-64/arm64 by the cross-build scripts
-``scripts/build_win64.sh``, ``build_aarch64.sh``, ``build_macos.sh``); a wheel ships every one that was built
-under ``scfmu/engines/me_cs/bin/<platform tuple>/`` (:func:`wrapper_libraries`). A face carries the wrapper
+``scripts/build_win64.sh``, ``build_aarch64.sh``, ``build_macos.sh``); each platform's wheel ships that
+platform's build under ``scfmu/engines/me_cs/bin/<platform tuple>/`` (:func:`wrapper_libraries`). A face carries the wrapper
 in every platform folder for which BOTH the wrapper was built AND the unit carries its own binary of that
 CPU (checked from the binaries' headers): ``linux64``/``win64``/``aarch64-linux``/``darwin64`` for an FMI
 2.0 unit (``darwin64``: one universal file with the Mac CPUs the unit's own ``darwin64`` file holds), the
@@ -23,9 +23,8 @@ platform tuples for an FMI 3.0 unit. Every other platform is simply not offered:
 the face, unit binary included (a loop FMU then drops that platform too, :mod:`scfmu.export.loops`). One
 exception: an FMI 3.0 face is not offered on Apple-silicon Macs (``aarch64-darwin``), because the
 wrapper's build for that CPU looks for the unit's FMI 3.0 library under ``x86_64-darwin``
-(``scfmu/engines/me_cs/src/lib.rs``, ``load``); FMI 2.0 faces serve both Mac CPUs. The Windows wrapper does
-not build today (the wrapper opens the unit's library with ``dlopen``, which Windows lacks): the build says
-so and faces carry no ``win64``/``x86_64-windows`` until it does.
+(``scfmu/engines/me_cs/src/lib.rs``, ``load``); FMI 2.0 faces serve both Mac CPUs. A cross build of the
+wrapper that fails costs the FMUs nothing: the script says why, and faces then carry no such platform.
 
 Faces are cached next to the containers (``$SCFMU_CONTAINER_DIR``), keyed by the FMU file's SHA-256, the
 solver settings and the wrapper libraries' identity.
