@@ -407,3 +407,33 @@ def test_rk4_face_under_wine_is_bit_identical_to_linux64(wine_work, monkeypatch)
     last = [v for v, _ in rows_win[-1]]
     print(f"q0 after 10 s: {last[0]!r} on both platforms")
     assert max(abs(x) for x in last[4:7]) < 1e-3
+
+
+@pytest.mark.parametrize("sys_platform,machine,tup,name", [
+    ("linux", "x86_64", "x86_64-linux", "libscfmu_me_cs.so"),
+    ("linux", "aarch64", "aarch64-linux", "libscfmu_me_cs.so"),
+    ("win32", "AMD64", "x86_64-windows", "scfmu_me_cs.dll"),
+    ("darwin", "x86_64", "x86_64-darwin", "libscfmu_me_cs.dylib"),
+    ("darwin", "arm64", "aarch64-darwin", "libscfmu_me_cs.dylib"),
+])
+def test_an_installed_package_takes_the_wrapper_of_its_own_platform(sys_platform, machine, tup, name, tmp_path,
+                                                                     monkeypatch):
+    """An installed package (a wheel: no source checkout around it) with every platform's wrapper under
+    scfmu/engines/me_cs/bin/<tuple>/: on each platform, the native engine's wrapper is that platform's."""
+    from scfmu.engines import cs_face
+
+    pkg = tmp_path / "site-packages" / "scfmu"
+    files = {t: pkg / "engines" / "me_cs" / "bin" / t / n for t, n in (
+        ("x86_64-linux", "libscfmu_me_cs.so"), ("aarch64-linux", "libscfmu_me_cs.so"),
+        ("x86_64-windows", "scfmu_me_cs.dll"), ("x86_64-darwin", "libscfmu_me_cs.dylib"),
+        ("aarch64-darwin", "libscfmu_me_cs.dylib"))}
+    for t, f in files.items():
+        f.parent.mkdir(parents=True)
+        f.write_bytes(t.encode())
+    monkeypatch.setattr(cs_face.resources, "files", lambda _: pkg)
+    monkeypatch.setattr(cs_face.sys, "platform", sys_platform)
+    monkeypatch.setattr(cs_face.platform, "machine", lambda: machine)
+    assert cs_face.wrapper_libraries() == files
+    assert cs_face.wrapper_library() == files[tup] and files[tup].name == name
+    files[tup].unlink()  # that platform's wrapper missing: none (the native engine refuses ME units in one line)
+    assert cs_face.wrapper_library() is None
