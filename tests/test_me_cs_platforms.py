@@ -172,8 +172,8 @@ def test_face_carries_the_wrapper_wherever_the_unit_and_the_wrapper_have_a_binar
         want = {f for f, tups in {"linux64": {"x86_64-linux"}, "aarch64-linux": {"aarch64-linux"},
                                   "win64": {"x86_64-windows"}, "darwin64": {"x86_64-darwin", "aarch64-darwin"}}.items()
                 if f in unit_folders and tups & have}
-    else:  # no Apple-silicon FMI 3.0 face (cs_face.py says why)
-        want = unit_folders & have - {"aarch64-darwin"}
+    else:
+        want = unit_folders & have
     face = cs_face(_unit(fmu), tmp_path)
     z = zipfile.ZipFile(face)
     names = z.namelist()

@@ -20,11 +20,10 @@ in every platform folder for which BOTH the wrapper was built AND the unit carri
 CPU (checked from the binaries' headers): ``linux64``/``win64``/``aarch64-linux``/``darwin64`` for an FMI
 2.0 unit (``darwin64``: one universal file with the Mac CPUs the unit's own ``darwin64`` file holds), the
 platform tuples for an FMI 3.0 unit. Every other platform is simply not offered: its folder is left out of
-the face, unit binary included (a loop FMU then drops that platform too, :mod:`scfmu.export.loops`). One
-exception: an FMI 3.0 face is not offered on Apple-silicon Macs (``aarch64-darwin``), because the
-wrapper's build for that CPU looks for the unit's FMI 3.0 library under ``x86_64-darwin``
-(``scfmu/engines/me_cs/src/lib.rs``, ``load``); FMI 2.0 faces serve both Mac CPUs. A cross build of the
-wrapper that fails costs the FMUs nothing: the script says why, and faces then carry no such platform.
+the face, unit binary included (a loop FMU then drops that platform too, :mod:`scfmu.export.loops`). The
+wrapper looks for the unit's library in its platform's standard folder (``platform_folder`` in
+``scfmu/engines/me_cs/src/lib.rs``). A cross build of the wrapper that fails costs the FMUs nothing: the
+script says why, and faces then carry no such platform.
 
 Faces are cached next to the containers (``$SCFMU_CONTAINER_DIR``), keyed by the FMU file's SHA-256, the
 solver settings and the wrapper libraries' identity.
@@ -62,9 +61,8 @@ _BUILDS = {
 # project's FMUs carry the aarch64 Linux build under the FMI 3.0 name, where the wrapper looks for it too)
 _FMI2_FOLDERS = {"linux64": ("x86_64-linux",), "aarch64-linux": ("aarch64-linux",),
                  "win64": ("x86_64-windows",), "darwin64": ("x86_64-darwin", "aarch64-darwin")}
-# FMI 3.0 tuples the wrapper can serve: its aarch64-darwin build looks for an FMI 3.0 unit's library under
-# x86_64-darwin (scfmu/engines/me_cs/src/lib.rs, load), so an FMI 3.0 face offers no aarch64-darwin
-_FMI3_TUPLES = ("x86_64-linux", "aarch64-linux", "x86_64-windows", "x86_64-darwin")
+# FMI 3.0 tuples the wrapper can serve (scfmu/engines/me_cs/src/lib.rs, platform_folder)
+_FMI3_TUPLES = ("x86_64-linux", "aarch64-linux", "x86_64-windows", "x86_64-darwin", "aarch64-darwin")
 _EXT = {"linux": "so", "windows": "dll", "darwin": "dylib"}
 _MACHO_CPU = {0x01000007: "x86_64", 0x0100000C: "aarch64"}  # mach-o/machine.h CPU_TYPE_X86_64, CPU_TYPE_ARM64
 _ELF_CPU = {62: "x86_64", 183: "aarch64"}  # e_machine EM_X86_64, EM_AARCH64

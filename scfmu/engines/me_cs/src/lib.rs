@@ -131,6 +131,25 @@ pub fn resource_dir(location: &str) -> String {
     s.trim_end_matches('/').to_string()
 }
 
+/// The unit's binaries folder on this platform: FMI 2.0's `linux64`/`win64`/`darwin64` (no standard name
+/// for 64-bit ARM Linux: `aarch64-linux`, as the project's FMUs use), FMI 3.0's `<arch>-<os>` tuples.
+pub fn platform_folder(v3: bool) -> &'static str {
+    let arm = cfg!(target_arch = "aarch64");
+    let (windows, macos) = (cfg!(windows), cfg!(target_os = "macos"));
+    match (v3, arm, windows, macos) {
+        (false, _, true, _) => "win64",
+        (false, _, _, true) => "darwin64", // one universal file for both Mac CPUs
+        (false, true, _, _) => "aarch64-linux",
+        (false, false, _, _) => "linux64",
+        (true, true, true, _) => "aarch64-windows",
+        (true, true, _, true) => "aarch64-darwin",
+        (true, true, _, _) => "aarch64-linux",
+        (true, false, true, _) => "x86_64-windows",
+        (true, false, _, true) => "x86_64-darwin",
+        (true, false, _, _) => "x86_64-linux",
+    }
+}
+
 /// Reads the settings and opens the unit's own library (`<resources>/../binaries/<folder>/<identifier>`).
 ///
 /// # Safety
@@ -143,19 +162,7 @@ pub unsafe fn load(location: *const c_char, v3: bool) -> Result<Config, String> 
     let cfg_path = format!("{res}/scfmu_me_cs.txt");
     let text = std::fs::read_to_string(&cfg_path).map_err(|e| format!("{cfg_path}: {e}"))?;
     let cfg = Config::parse(&text).map_err(|e| format!("{cfg_path}: {e}"))?;
-    let folder = match (
-        v3 || cfg!(target_arch = "aarch64"),
-        cfg!(windows),
-        cfg!(target_os = "macos"),
-    ) {
-        (true, false, false) if cfg!(target_arch = "aarch64") => "aarch64-linux",
-        (false, true, _) => "win64",
-        (false, _, true) => "darwin64",
-        (false, _, _) => "linux64",
-        (true, true, _) => "x86_64-windows",
-        (true, _, true) => "x86_64-darwin",
-        (true, _, _) => "x86_64-linux",
-    };
+    let folder = platform_folder(v3);
     let ext = if cfg!(windows) {
         "dll"
     } else if cfg!(target_os = "macos") {
@@ -243,6 +250,22 @@ pub unsafe fn instance<'a>(p: *mut c_void) -> Option<&'a mut Instance> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_platform_folder_is_the_standards_name_for_this_build() {
+        let want = if cfg!(all(target_arch = "x86_64", target_os = "linux")) {
+            ("linux64", "x86_64-linux")
+        } else if cfg!(all(target_arch = "aarch64", target_os = "linux")) {
+            ("aarch64-linux", "aarch64-linux")
+        } else if cfg!(all(target_arch = "aarch64", target_os = "macos")) {
+            ("darwin64", "aarch64-darwin")
+        } else if cfg!(all(target_arch = "x86_64", target_os = "macos")) {
+            ("darwin64", "x86_64-darwin")
+        } else {
+            ("win64", "x86_64-windows")
+        };
+        assert_eq!((platform_folder(false), platform_folder(true)), want);
+    }
 
     #[test]
     fn config_parses_and_refuses_bad_values() {
