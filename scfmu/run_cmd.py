@@ -148,13 +148,26 @@ def _parser() -> argparse.ArgumentParser:
     return ap
 
 
-def _write(sc, r, args, out: Path, ident: dict, unbound: list) -> None:
+def _unit_labels(sc, plan) -> str:
+    """``plant=AttitudePlant.fmu, controller=X.fmu (FMI 3.0 Model Exchange)``: each unit's file, with how it
+    runs when that is not FMI 2.0 Co-Simulation."""
+    how = {u.name: (u.fmi, u.interface) for u in plan.units} if plan is not None else {}
+    out = []
+    for c in sc.components:
+        fmi, itf = how.get(c.name, (2, "cs"))
+        note = "" if (fmi, itf) == (2, "cs") else \
+            f" (FMI {fmi}.0 {'Model Exchange' if itf == 'me' else 'Co-Simulation'})"
+        out.append(f"{c.name}={Path(c.model).name}{note}")
+    return ", ".join(out)
+
+
+def _write(sc, r, args, out: Path, ident: dict, unbound: list, plan=None) -> None:
     """Prints the run's summary and metrics and writes the CSV, run.json, the manifest and the plot."""
     stem = file_stem(sc.name)
     out.mkdir(parents=True, exist_ok=True)
     m, mu = r.metrics, r.metric_units
     print(f"{sc.name}: {sc.description or ''}".rstrip(": "))
-    models = ", ".join(f"{c.name}={Path(c.model).name}" for c in sc.components)
+    models = _unit_labels(sc, plan)
     print(f"  {len(r['time']) - 1} steps of {sc.step:g} s to t = {sc.stop_time:g} s on the {args.engine} engine; "
           f"units {models}; metric set {sc.metrics or '(none)'}")
     for k, v in m.items():
@@ -228,5 +241,5 @@ def main(argv=None) -> int:
     except FmuError as e:
         print(f"scfmu run: the run failed: {e}", file=sys.stderr)
         return 1
-    _write(sc, r, args, out, ident, unbound)
+    _write(sc, r, args, out, ident, unbound, plan)
     return 0

@@ -365,7 +365,7 @@ def test_cli_run_with_a_model_exchange_only_unit_picks_an_engine_that_runs_it(un
     p = units.c3("C3AxisBody")
     r = _cli("run", "paper002/PD", "--t-end", "1", "--no-plot", "--fmu", f"plant={p}", "--out", tmp_path / "a")
     assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
-    assert "on the compiled engine" in r.stdout
+    assert "on the compiled engine" in r.stdout and "plant=C3AxisBody.fmu (FMI 3.0 Model Exchange)" in r.stdout, r.stdout
     r = _cli("run", "paper002/PD", "--t-end", "1", "--no-plot", "--engine", "native", "--fmu", f"plant={p}",
              "--out", tmp_path / "b")
     assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
