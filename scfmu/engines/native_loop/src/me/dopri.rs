@@ -116,13 +116,14 @@ impl Solver {
                 return Err((3, PHASE_SOLVER));
             }
             w = w.max(self.dp_stages(f, t, h)?);
-            // the error estimate h·Σ_j E_j k_j, summed stage by stage over the whole vector (the same
-            // operations in the same order per component as a component-by-component sum; a zero weight
-            // would add a zero)
-            self.y.fill(0.0);
-            for (e, kj) in E.iter().zip(&self.k).filter(|(e, _)| **e != 0.0) {
-                axpy(&mut self.y, *e, kj);
-            }
+            // the error estimate h·Σ_j E_j k_j (E[1] = 0: that term would add a zero)
+            let [k0, _, k2, k3, k4, k5, k6] = &self.k;
+            combine(
+                &mut self.y,
+                None,
+                [E[0], E[2], E[3], E[4], E[5], E[6]],
+                [k0, k2, k3, k4, k5, k6],
+            );
             self.y.iter_mut().for_each(|yi| *yi *= h);
             let en = self.norm(&self.y, &self.x, &self.x_new);
             if en <= 1.0 {
@@ -151,9 +152,19 @@ impl Solver {
     unsafe fn dp_stages(&mut self, f: &Fmu, t: f64, h: f64) -> Result<i32, Fail> {
         let mut w = 0;
         for s in 1..6 {
-            self.y.copy_from_slice(&self.x);
-            for (a, kj) in A[s].iter().zip(&self.k).take(s) {
-                axpy(&mut self.y, h * a, kj);
+            let c: [f64; 6] = std::array::from_fn(|j| h * A[s][j]);
+            let [k0, k1, k2, k3, k4, ..] = &self.k;
+            match s {
+                1 => combine(&mut self.y, Some(&self.x), [c[0]], [k0]),
+                2 => combine(&mut self.y, Some(&self.x), [c[0], c[1]], [k0, k1]),
+                3 => combine(&mut self.y, Some(&self.x), [c[0], c[1], c[2]], [k0, k1, k2]),
+                4 => combine(&mut self.y, Some(&self.x), [c[0], c[1], c[2], c[3]], [k0, k1, k2, k3]),
+                _ => combine(
+                    &mut self.y,
+                    Some(&self.x),
+                    [c[0], c[1], c[2], c[3], c[4]],
+                    [k0, k1, k2, k3, k4],
+                ),
             }
             let y = std::mem::take(&mut self.y);
             let mut ks = std::mem::take(&mut self.k[s]);
@@ -162,10 +173,14 @@ impl Solver {
             self.k[s] = ks;
             w = w.max(r?);
         }
-        self.x_new.copy_from_slice(&self.x);
-        for (b, kj) in B.iter().zip(&self.k).take(6).filter(|(b, _)| **b != 0.0) {
-            axpy(&mut self.x_new, h * b, kj);
-        }
+        // the 5th-order point (B[1] = 0: that term would add a zero)
+        let [k0, _, k2, k3, k4, k5, _] = &self.k;
+        combine(
+            &mut self.x_new,
+            Some(&self.x),
+            [h * B[0], h * B[2], h * B[3], h * B[4], h * B[5]],
+            [k0, k2, k3, k4, k5],
+        );
         // FSAL stage f(t + h, x_new): the unit's time is already t + h (stage 6, C[5] = 1)
         let mut k6 = std::mem::take(&mut self.k[6]);
         let r = self
@@ -214,10 +229,24 @@ impl Solver {
     }
 }
 
-/// y += a·x, component by component (whole vectors: no bounds check per element, vectorised).
+/// out = x + Σ_j c_j·k_j (x = 0 when None), component by component with the terms added in the order of
+/// j: the formula of a stage written per component, as one loop over the components that the compiler
+/// vectorises (the number of terms is a constant; no bounds check per element).
 #[inline]
-fn axpy(y: &mut [f64], a: f64, x: &[f64]) {
-    for (yi, xi) in y.iter_mut().zip(x) {
-        *yi += a * xi;
+fn combine<const S: usize>(out: &mut [f64], x: Option<&[f64]>, c: [f64; S], k: [&[f64]; S]) {
+    let n = out.len();
+    assert!(x.is_none_or(|x| x.len() == n) && k.iter().all(|kj| kj.len() == n));
+    for i in 0..n {
+        // SAFETY: i < n, and every slice has length n (asserted above)
+        unsafe {
+            let mut acc = match x {
+                Some(x) => *x.get_unchecked(i),
+                None => 0.0,
+            };
+            for j in 0..S {
+                acc += c[j] * *k[j].get_unchecked(i);
+            }
+            *out.get_unchecked_mut(i) = acc;
+        }
     }
 }
