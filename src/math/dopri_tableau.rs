@@ -109,6 +109,8 @@ pub const P: [[f64; 4]; 7] = [
 ];
 
 #[cfg(test)]
+// index loops over stages and powers read like the order conditions they check
+#[allow(clippy::needless_range_loop)]
 mod tests {
     use super::{A, B, C, E, P};
 
