@@ -6,14 +6,12 @@
 //! function name beyond what the caller passes in.
 
 use std::cell::{Cell, RefCell};
-use std::collections::HashSet;
 use std::ffi::{c_char, c_int, c_void, CStr, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::sync::MutexGuard;
 
 use super::instance::{CallResult, Fail, Instance, Logger};
 use super::library_path::own_library_stem;
-use super::live::{BuildAddrHasher, LiveSet};
+use super::live::LiveSet;
 use super::state::Snapshot;
 use super::types::Status;
 use crate::model::guid::guid;
@@ -24,17 +22,17 @@ pub type Handle = *mut c_void;
 
 // ----- live instances ----------------------------------------------------------------------------
 
-fn live_instances() -> MutexGuard<'static, HashSet<usize, BuildAddrHasher>> {
-    static LIVE: LiveSet = LiveSet::new();
-    LIVE.lock()
-}
+/// The live instances of this library (`live` describes the lock-free check in front of the set).
+static LIVE: LiveSet = LiveSet::new();
 
 /// The instance behind a pointer if it is live and was created through the FMI version asked for
 /// (`fmi3`: by an `fmi3Instantiate*` function); an FMI 2.0 instance is foreign to the FMI 3.0
 /// functions and the other way round. A null, foreign or freed pointer gives None (and the call
-/// returns an error status: there is no logger to tell).
+/// returns an error status: there is no logger to tell). The address is checked against the set of
+/// live instances before anything behind it is read; on every FMI call, so without a lock when the
+/// address is in the set's cache.
 pub fn instance_of<'a>(c: Handle, fmi3: bool) -> Option<&'a mut Instance> {
-    if c.is_null() || !live_instances().contains(&(c as usize)) {
+    if c.is_null() || !LIVE.contains(c as usize) {
         return None;
     }
     // SAFETY: the address is registered by `instantiate` and removed by `free_instance`.
@@ -45,17 +43,17 @@ pub fn instance_of<'a>(c: Handle, fmi3: bool) -> Option<&'a mut Instance> {
 /// Registers a new instance (installing the panic hook with the first one).
 fn register(inst: Box<Instance>) -> Handle {
     let p = Box::into_raw(inst) as Handle;
-    let mut live = live_instances();
+    let mut live = LIVE.lock();
     if live.is_empty() {
         install_panic_hook();
     }
-    live.insert(p as usize);
+    LIVE.insert(&mut live, p as usize);
     p
 }
 
 /// Frees an instance of the given FMI version (and its FMU states); anything else is ignored.
 pub fn free_instance(c: Handle, fmi3: bool) {
-    if instance_of(c, fmi3).is_none() || !live_instances().remove(&(c as usize)) {
+    if instance_of(c, fmi3).is_none() || !LIVE.remove(&mut LIVE.lock(), c as usize) {
         return; // null, not ours or of the other FMI version: nothing to free, nothing to log to
     }
     let _ = guarded(|| {
@@ -63,7 +61,7 @@ pub fn free_instance(c: Handle, fmi3: bool) {
         // SAFETY: it was registered (so it is a leaked Box<Instance>) and is now unregistered.
         drop(unsafe { Box::from_raw(c as *mut Instance) });
     });
-    let mut live = live_instances();
+    let mut live = LIVE.lock();
     if live.is_empty() {
         // the last instance: give the set's memory back and remove the panic hook (not while the
         // calling thread unwinds: take_hook panics then, which would abort inside extern "C")

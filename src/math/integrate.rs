@@ -3,6 +3,8 @@
 
 use nalgebra::SVector;
 
+// Dormand & Prince (1980) RK5(4)7M coefficients: the one tableau of every integrator of the project
+use super::dopri_tableau::{A as DP_A, C as DP_C, E as DP_E};
 use crate::model::{Experiment, ParamEnum};
 
 /// Most internal integration steps one call may take (one `fmi2DoStep` of a plant, one adaptive
@@ -56,49 +58,6 @@ pub struct AdaptiveOutcome<const N: usize> {
     pub accepted: usize,
     pub rejected: usize,
 }
-
-// Dormand & Prince (1980) RK5(4)7M coefficients.
-const DP_C: [f64; 7] = [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0, 1.0];
-const DP_A: [[f64; 6]; 7] = [
-    [0.0; 6],
-    [1.0 / 5.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-    [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
-    [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0],
-    [
-        19372.0 / 6561.0,
-        -25360.0 / 2187.0,
-        64448.0 / 6561.0,
-        -212.0 / 729.0,
-        0.0,
-        0.0,
-    ],
-    [
-        9017.0 / 3168.0,
-        -355.0 / 33.0,
-        46732.0 / 5247.0,
-        49.0 / 176.0,
-        -5103.0 / 18656.0,
-        0.0,
-    ],
-    [
-        35.0 / 384.0,
-        0.0,
-        500.0 / 1113.0,
-        125.0 / 192.0,
-        -2187.0 / 6784.0,
-        11.0 / 84.0,
-    ],
-];
-/// 5th-order weights minus 4th-order weights (error estimate).
-const DP_E: [f64; 7] = [
-    71.0 / 57600.0,
-    0.0,
-    -71.0 / 16695.0,
-    71.0 / 1920.0,
-    -17253.0 / 339200.0,
-    22.0 / 525.0,
-    -1.0 / 40.0,
-];
 
 /// The step's error estimate as the RMS over components of e_i / (atol + rtol · max(|x_i|, |x_new,i|)),
 /// with e = step · Σ_j E_j k_j.

@@ -7,6 +7,7 @@
 
 pub mod attitude;
 pub mod attitude_kalman;
+pub mod dopri_tableau;
 pub mod environment;
 pub mod fractional;
 pub mod fuzzy;

@@ -98,6 +98,7 @@ pub mod status_kind {
 }
 
 /// Runs an instance call: state check, panic guard, logging of failures.
+#[inline(always)]
 pub(crate) fn call(c: Component, func: &str, allowed: u16, f: impl FnOnce(&mut Instance) -> CallResult) -> c_int {
     let Some(inst) = instance_of(c, false) else {
         return Status::Error as c_int;

@@ -29,6 +29,7 @@ pub struct EventInfo2 {
 
 /// `call` for a Model Exchange function: a Co-Simulation instance is refused as such (before the
 /// state check, whose message would not say why).
+#[inline(always)]
 fn me_call(c: Component, func: &str, allowed: u16, f: impl FnOnce(&mut Instance) -> CallResult) -> c_int {
     call(c, func, mask::SET_DEBUG_LOGGING, |inst| {
         inst.require_model_exchange()?;

@@ -101,6 +101,7 @@ pub mod mask3me {
 
 /// Runs an FMI 3.0 call on an instance: state check, panic guard, logging; `fmi3Error` moves the
 /// instance to Terminated, a panic to Fatal.
+#[inline(always)]
 pub fn call3(c: Instance3, func: &str, allowed: u16, f: impl FnOnce(&mut Instance) -> CallResult) -> c_int {
     let Some(inst) = instance_of(c, true) else {
         return Status::Error as c_int;

@@ -40,6 +40,7 @@ fn not_me_reason(inst: &Instance) -> String {
 
 /// `call3` for a Model Exchange function: a Co-Simulation instance is refused as such (before the state
 /// check, whose message would not say why), then the state is checked against `allowed`.
+#[inline(always)]
 fn me3(c: Instance3, func: &str, allowed: u16, f: impl FnOnce(&mut Instance) -> CallResult) -> c_int {
     call3(c, func, mask3::ANY, |inst| {
         if !inst.model_exchange {

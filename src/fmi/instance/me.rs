@@ -71,7 +71,7 @@ impl Instance {
 
     pub fn set_continuous_states(&mut self, x: &[f64]) -> CallResult {
         self.check_len("x[]", x.len())?;
-        if let Some((k, v)) = x.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        if let Some((k, v)) = first_non_finite(x) {
             return Err(Fail::error(format!(
                 "x[{k}] ({}) = {v} is not finite",
                 self.entry.state_decls()[k].name
@@ -103,7 +103,7 @@ impl Instance {
         self.model
             .derivatives(self.run.time, dx)
             .map_err(|e| Fail::error(format!("derivatives at t = {}: {e}", self.run.time)))?;
-        if let Some((k, v)) = dx.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        if let Some((k, v)) = first_non_finite(dx) {
             return Err(Fail::error(format!(
                 "der({}) = {v} at t = {}",
                 self.entry.state_decls()[k].name,
@@ -162,4 +162,14 @@ impl Instance {
         let t = self.run.time;
         Ok(self.model.completed_integrator_step(t))
     }
+}
+
+/// The first element that is not finite (index, value): a solver calls the functions that check this
+/// several times per step, so the usual all-finite case is one pass without a branch per element
+/// (vectorised); only a vector with a bad element is searched for its index.
+fn first_non_finite(v: &[f64]) -> Option<(usize, f64)> {
+    if v.iter().fold(true, |ok, x| ok & x.is_finite()) {
+        return None;
+    }
+    v.iter().copied().enumerate().find(|(_, x)| !x.is_finite())
 }

@@ -5,84 +5,13 @@
 use super::Solver;
 use crate::{Fail, Fmu, PHASE_SOLVER};
 
-// Dormand–Prince 5(4): nodes, stage coefficients, 5th-order weights, error weights, dense output.
-const C: [f64; 6] = [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0];
-const A: [[f64; 5]; 6] = [
-    [0.0, 0.0, 0.0, 0.0, 0.0],
-    [1.0 / 5.0, 0.0, 0.0, 0.0, 0.0],
-    [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0],
-    [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0],
-    [
-        19372.0 / 6561.0,
-        -25360.0 / 2187.0,
-        64448.0 / 6561.0,
-        -212.0 / 729.0,
-        0.0,
-    ],
-    [
-        9017.0 / 3168.0,
-        -355.0 / 33.0,
-        46732.0 / 5247.0,
-        49.0 / 176.0,
-        -5103.0 / 18656.0,
-    ],
-];
-const B: [f64; 6] = [
-    35.0 / 384.0,
-    0.0,
-    500.0 / 1113.0,
-    125.0 / 192.0,
-    -2187.0 / 6784.0,
-    11.0 / 84.0,
-];
-const E: [f64; 7] = [
-    -71.0 / 57600.0,
-    0.0,
-    71.0 / 16695.0,
-    -71.0 / 1920.0,
-    17253.0 / 339200.0,
-    -22.0 / 525.0,
-    1.0 / 40.0,
-];
-const P: [[f64; 4]; 7] = [
-    [
-        1.0,
-        -8048581381.0 / 2820520608.0,
-        8663915743.0 / 2820520608.0,
-        -12715105075.0 / 11282082432.0,
-    ],
-    [0.0, 0.0, 0.0, 0.0],
-    [
-        0.0,
-        131558114200.0 / 32700410799.0,
-        -68118460800.0 / 10900136933.0,
-        87487479700.0 / 32700410799.0,
-    ],
-    [
-        0.0,
-        -1754552775.0 / 470086768.0,
-        14199869525.0 / 1410260304.0,
-        -10690763975.0 / 1880347072.0,
-    ],
-    [
-        0.0,
-        127303824393.0 / 49829197408.0,
-        -318862633887.0 / 49829197408.0,
-        701980252875.0 / 199316789632.0,
-    ],
-    [
-        0.0,
-        -282668133.0 / 205662961.0,
-        2019193451.0 / 616988883.0,
-        -1453857185.0 / 822651844.0,
-    ],
-    [
-        0.0,
-        40617522.0 / 29380423.0,
-        -110615467.0 / 29380423.0,
-        69997945.0 / 29380423.0,
-    ],
-];
+// Dormand–Prince 5(4): nodes, stage coefficients, 5th-order weights, error weights, dense output; the one
+// tableau of the project (this crate does not depend on it, so the file of constants is included).
+#[allow(dead_code)]
+#[path = "../../../../../src/math/dopri_tableau.rs"]
+mod dopri_tableau;
+use dopri_tableau::{A, B, C, E, P};
+
 const SAFETY: f64 = 0.9;
 const MIN_FACTOR: f64 = 0.2;
 const MAX_FACTOR: f64 = 10.0;
@@ -187,13 +116,15 @@ impl Solver {
                 return Err((3, PHASE_SOLVER));
             }
             w = w.max(self.dp_stages(f, t, h)?);
-            for i in 0..self.nx {
-                let mut acc = 0.0;
-                for (e, kj) in E.iter().zip(&self.k) {
-                    acc += e * kj[i];
-                }
-                self.y[i] = h * acc; // the error estimate
-            }
+            // the error estimate h·Σ_j E_j k_j (E[1] = 0: that term would add a zero)
+            let [k0, _, k2, k3, k4, k5, k6] = &self.k;
+            combine(
+                &mut self.y,
+                None,
+                [E[0], E[2], E[3], E[4], E[5], E[6]],
+                [k0, k2, k3, k4, k5, k6],
+            );
+            self.y.iter_mut().for_each(|yi| *yi *= h);
             let en = self.norm(&self.y, &self.x, &self.x_new);
             if en <= 1.0 {
                 let mut fac = if en == 0.0 {
@@ -221,12 +152,19 @@ impl Solver {
     unsafe fn dp_stages(&mut self, f: &Fmu, t: f64, h: f64) -> Result<i32, Fail> {
         let mut w = 0;
         for s in 1..6 {
-            for i in 0..self.nx {
-                let mut acc = self.x[i];
-                for (a, kj) in A[s].iter().zip(&self.k).take(s) {
-                    acc += h * a * kj[i];
-                }
-                self.y[i] = acc;
+            let c: [f64; 6] = std::array::from_fn(|j| h * A[s][j]);
+            let [k0, k1, k2, k3, k4, ..] = &self.k;
+            match s {
+                1 => combine(&mut self.y, Some(&self.x), [c[0]], [k0]),
+                2 => combine(&mut self.y, Some(&self.x), [c[0], c[1]], [k0, k1]),
+                3 => combine(&mut self.y, Some(&self.x), [c[0], c[1], c[2]], [k0, k1, k2]),
+                4 => combine(&mut self.y, Some(&self.x), [c[0], c[1], c[2], c[3]], [k0, k1, k2, k3]),
+                _ => combine(
+                    &mut self.y,
+                    Some(&self.x),
+                    [c[0], c[1], c[2], c[3], c[4]],
+                    [k0, k1, k2, k3, k4],
+                ),
             }
             let y = std::mem::take(&mut self.y);
             let mut ks = std::mem::take(&mut self.k[s]);
@@ -235,13 +173,14 @@ impl Solver {
             self.k[s] = ks;
             w = w.max(r?);
         }
-        for i in 0..self.nx {
-            let mut acc = self.x[i];
-            for (b, kj) in B.iter().zip(&self.k).take(6) {
-                acc += h * b * kj[i];
-            }
-            self.x_new[i] = acc;
-        }
+        // the 5th-order point (B[1] = 0: that term would add a zero)
+        let [k0, _, k2, k3, k4, k5, _] = &self.k;
+        combine(
+            &mut self.x_new,
+            Some(&self.x),
+            [h * B[0], h * B[2], h * B[3], h * B[4], h * B[5]],
+            [k0, k2, k3, k4, k5],
+        );
         // FSAL stage f(t + h, x_new): the unit's time is already t + h (stage 6, C[5] = 1)
         let mut k6 = std::mem::take(&mut self.k[6]);
         let r = self
@@ -282,11 +221,32 @@ impl Solver {
             return 0.0;
         }
         let mut s = 0.0;
-        for i in 0..self.nx {
-            let sc = self.atol + self.rtol * a[i].abs().max(b[i].abs());
-            let e = err[i] / sc;
+        for ((e, a), b) in err.iter().zip(a).zip(b) {
+            let e = e / (self.atol + self.rtol * a.abs().max(b.abs()));
             s += e * e;
         }
         (s / self.nx as f64).sqrt()
+    }
+}
+
+/// out = x + Σ_j c_j·k_j (x = 0 when None), component by component with the terms added in the order of
+/// j: the formula of a stage written per component, as one loop over the components that the compiler
+/// vectorises (the number of terms is a constant; no bounds check per element).
+#[inline]
+fn combine<const S: usize>(out: &mut [f64], x: Option<&[f64]>, c: [f64; S], k: [&[f64]; S]) {
+    let n = out.len();
+    assert!(x.is_none_or(|x| x.len() == n) && k.iter().all(|kj| kj.len() == n));
+    for i in 0..n {
+        // SAFETY: i < n, and every slice has length n (asserted above)
+        unsafe {
+            let mut acc = match x {
+                Some(x) => *x.get_unchecked(i),
+                None => 0.0,
+            };
+            for j in 0..S {
+                acc += c[j] * *k[j].get_unchecked(i);
+            }
+            *out.get_unchecked_mut(i) = acc;
+        }
     }
 }
