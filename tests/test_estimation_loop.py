@@ -45,6 +45,7 @@ def test_every_attitude_scenario_has_an_estimator_variant_that_preflights():
         sc = scenarios.get(n)
         require(sc, instantiate=False)  # raises IncompatibleUnit naming every unwired or unknown port
         assert sc.connections["controller.q_x"] == "estimator.q_est_x" and sc.connections["controller.w_z"] == "estimator.w_est_z"
+        assert not any(k.startswith("estimator.") for k in sc.connections)  # the filter is wired by name
     for bad in ("paper001/a", "paper002/PD", "sensing/default"):
         with pytest.raises(KeyError):
             scenarios.get(f"{EST}/{bad}")
