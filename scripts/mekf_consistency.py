@@ -90,13 +90,8 @@ def scenario(plant: str, stop_time: float, filters: dict = FILTERS):
                      Component("star_tracker", "StarTracker", {"sample_period": 0.2, "latency": 0.0, "sun_exclusion": 0.0,
                                                                "noise_cross": ST_CROSS, "noise_about": ST_ABOUT}),
                      *[Component(n, "Mekf", filter_params(s)) for n, s in filters.items()]]
-    conns = {}
-    for n in filters:
-        conns.update({f"{n}.w_meas_{a}": f"gyro.w_meas_{a}" for a in AX})
-        conns.update({f"{n}.q_meas_{a}": f"star_tracker.q_meas_{a}" for a in QN})
-        conns[f"{n}.st_valid"] = "star_tracker.valid"
-    sc.connections = {**sc.connections, **conns}
-    sc.unconnected = [*sc.unconnected, *[f"{n}.{p}" for n in filters for p in ("sun_*", "mag_*")]]
+    # each filter's w_meas_*, q_meas_*, st_valid connect by name to the gyro's and the star tracker's outputs
+    sc.unconnected = [*sc.unconnected, *[f"{n}.{p}" for n in filters for p in ("sun_*", "b_meas_*", "b_ref_*")]]
     sc.seed_params = [*sc.seed_params, "gyro.seed", "star_tracker.seed"]
     log = {**log_of("plant", [f"q_{a}" for a in QN]), **{f"b_true_{a}": f"gyro.bias_total_{a}" for a in AX}}
     for n in filters:

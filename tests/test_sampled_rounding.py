@@ -1,7 +1,7 @@
 """Sampled units under masters that round their time (issue 35 item 1).
 
 Three masters drive every sampled unit (PidController, FopidController, SampleHold, Gyro, StarTracker,
-SunSensor, Magnetometer) through fmpy's low-level FMI calls for 10^5 communication steps:
+SunSensor, Magnetometer, Mekf, BDot) through fmpy's low-level FMI calls for 10^5 communication steps:
 
 * ``exact``: the point k h (a product) and the step h every time;
 * ``summed``: t += h, the last step clipped to the stop time (``min(h, stop - t)`` while ``t < stop``, as
@@ -42,6 +42,10 @@ UNITS = {
     "StarTracker": lambda T: {"sample_period": T, "latency": T},
     "SunSensor": lambda T: {"sample_period": T, "fov": math.pi, "eclipse": 0},
     "Magnetometer": lambda T: {"sample_period": T},
+    # the estimation family's sampled units: the Mekf with every update enabled (its inputs change every step,
+    # so each of its samples inside a step updates from the step's held measurements once), the B-dot law
+    "Mekf": lambda T: {"sample_period": T, "use_sun": 1, "use_mag": 1, "init_from_star_tracker": 0},
+    "BDot": lambda T: {"sample_period": T},
 }
 
 # outputs that are continuous functions of the master's time, not samples: the star tracker's sun angle
@@ -54,14 +58,17 @@ CONFIGS = [(1e-3, 1e-3), (1e-2, 1e-2), (0.1, 0.1), (0.1, 0.01)]
 
 def _inputs(names: list[str], n: int) -> np.ndarray:
     """Input rows for steps 0..n (a function of the step index only): a slowly turning unit quaternion
-    for q_w..q_z, smooth signals for everything else."""
+    for q_w..q_z (and q_meas_*), validity flags (``*valid``) that are 1 for about two thirds of the steps,
+    smooth signals for everything else."""
     k = np.arange(n + 1, dtype=float)
     cols = []
     for i, name in enumerate(names):
-        if name.startswith("q_"):
+        if name.endswith("valid"):
+            cols.append((np.sin(1e-3 * (i + 1) * k) > -0.5).astype(float))
+        elif name.startswith("q_"):
             a = 0.3 * np.sin(1e-4 * k)  # rotation about (1, 2, 2)/3
-            axis = {"q_x": 1 / 3, "q_y": 2 / 3, "q_z": 2 / 3}
-            cols.append(np.cos(a) if name == "q_w" else np.sin(a) * axis[name])
+            axis = {"x": 1 / 3, "y": 2 / 3, "z": 2 / 3}
+            cols.append(np.cos(a) if name.endswith("_w") else np.sin(a) * axis[name[-1]])
         else:
             cols.append(0.2 * np.sin(1e-3 * (i + 1) * k + 0.3 * i) + 0.01 * i)
     return np.ascontiguousarray(np.column_stack(cols))
@@ -176,6 +183,10 @@ def test_rounded_masters_equal_the_exact_master(unpacked, h, T):
                 r[:N, j] = results["exact"][:, j]
         ref = results["exact"]
         assert np.ptp(ref, axis=0).max() > 0, f"{model}: constant outputs would prove nothing"
+        if model == "Mekf":  # the measurement updates ran: they shrank the attitude covariance from 0.1² rad²
+            # (the outputs read right after a step show its last sample with the step's held inputs, a
+            # measurement already used, so nis there is 0; the covariance shows the updates)
+            assert ref[-1, u.out_names.index("p_att_x")] < 1e-6, ref[-1, u.out_names.index("p_att_x")]
         for name in ("summed", "difference"):
             out = results[name]
             np.testing.assert_array_equal(out[:N], ref, err_msg=f"{model} under the {name} master (h = {h}, T = {T})")
@@ -183,12 +194,13 @@ def test_rounded_masters_equal_the_exact_master(unpacked, h, T):
                 assert len(out) == N + 1 and np.array_equal(out[N], ref[N - 1]), model
 
 
-def test_fmi3_pid_and_gyro_under_a_summed_clock():
+def test_fmi3_sampled_units_under_a_summed_clock():
     """The FMI 3.0 Co-Simulation path (fmpy's FMI 3.0 master calls) takes the same rule: the summed,
-    clipped master runs 10^5 steps of 1 ms without refusal and gives the exact master's outputs."""
+    clipped master runs 10^5 steps of 1 ms without refusal and gives the exact master's outputs
+    (PidController, Gyro and the estimation family's Mekf and BDot)."""
     from fmpy.fmi3 import FMU3Slave
     stop, ms = masters(1e-3, N)
-    for model in ("PidController", "Gyro"):
+    for model in ("PidController", "Gyro", "Mekf", "BDot"):
         path = ROOT / "fmus" / "fmi3" / f"{model}.fmu"
         md = read_model_description(str(path))
         d = extract(str(path))
@@ -204,7 +216,10 @@ def test_fmi3_pid_and_gyro_under_a_summed_clock():
                 s.instantiate()
                 s.enterInitializationMode(startTime=0.0, stopTime=stop)
                 for k, v in UNITS[model](1e-3).items():
-                    s.setFloat64([byname[k].valueReference], [float(v)])
+                    if byname[k].type == "Float64":
+                        s.setFloat64([byname[k].valueReference], [float(v)])
+                    else:
+                        s.setInt32([byname[k].valueReference], [int(v)])
                 s.exitInitializationMode()
                 u = _inputs(ins, N - 1)
                 rows = []
@@ -215,6 +230,7 @@ def test_fmi3_pid_and_gyro_under_a_summed_clock():
                 s.terminate()
                 s.freeInstance()
                 res[name] = np.array(rows)
+            assert np.ptp(res["exact"], axis=0).max() > 0, model
             np.testing.assert_array_equal(res["summed"][:N], res["exact"], err_msg=model)
         finally:
             shutil.rmtree(d, ignore_errors=True)

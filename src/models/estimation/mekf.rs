@@ -21,12 +21,12 @@ declare_variables! {
     pub struct MekfVars {
         0 => w_meas: Vec3 = [0.0; 3], Input, "rad/s", "Measured body rate (the Gyro's w_meas)";
         3 => q_meas: Quat = [1.0, 0.0, 0.0, 0.0], Input, "", "Measured attitude quaternion of B relative to R (the StarTracker's q_meas)";
-        7 => st_valid: Real = 1.0, Input, "", "Star-tracker validity (the StarTracker's valid): >= 0.5 = q_meas usable";
+        7 => st_valid: Real = 1.0, Input, "", "Star-tracker validity (the StarTracker's st_valid, equal to its valid): >= 0.5 = q_meas usable";
         8 => sun_meas: Vec3 = [0.0, 0.0, 1.0], Input, "", "Measured sun direction, body axes (the SunSensor's sun_meas; normalised by the filter)";
         11 => sun_ref: Vec3 = [1.0, 0.0, 0.0], Input, "", "Sun direction in the reference frame R (ephemeris; normalised by the filter)";
-        14 => sun_valid: Real = 1.0, Input, "", "Sun-sensor validity (the SunSensor's valid): >= 0.5 = sun_meas usable";
-        15 => mag_meas: Vec3 = [0.0, 0.0, 1.0], Input, "T", "Measured geomagnetic field, body axes (the Magnetometer's b_meas; only its direction is used)";
-        18 => mag_ref: Vec3 = [1.0, 0.0, 0.0], Input, "T", "Geomagnetic field in R (field model; only its direction is used)";
+        14 => sun_valid: Real = 1.0, Input, "", "Sun-sensor validity (the SunSensor's sun_valid, equal to its valid): >= 0.5 = sun_meas usable";
+        15 => b_meas: Vec3 = [0.0, 0.0, 1.0], Input, "T", "Measured geomagnetic field, body axes (the Magnetometer's b_meas; only its direction is used)";
+        18 => b_ref: Vec3 = [1.0, 0.0, 0.0], Input, "T", "Geomagnetic field in R (the Ephemeris' b_ref or another field model; only its direction is used)";
         40 => q_est: Quat = [1.0, 0.0, 0.0, 0.0], Output, "", "Estimated attitude quaternion of B relative to R (the plant's q convention), held between samples";
         44 => w_est: Vec3 = [0.0; 3], Output, "rad/s", "Estimated body rate: gyro rate minus estimated bias";
         47 => bias_est: Vec3 = [0.0; 3], Output, "rad/s", "Estimated gyro bias";
@@ -50,7 +50,7 @@ declare_variables! {
         123 => init_from_star_tracker: Integer = 1, Parameter, "", "1 = the first usable star-tracker measurement initialises the attitude (covariance = its noise), 0 = it is an update of q_init", Choice(SWITCH);
         124 => use_star_tracker: Integer = 1, Parameter, "", "1 = update with q_meas when st_valid >= 0.5 and q_meas is new", Choice(SWITCH);
         125 => use_sun: Integer = 0, Parameter, "", "1 = update with sun_meas when sun_valid >= 0.5 and sun_meas is new", Choice(SWITCH);
-        126 => use_mag: Integer = 0, Parameter, "", "1 = update with mag_meas whenever it is new", Choice(SWITCH);
+        126 => use_mag: Integer = 0, Parameter, "", "1 = update with b_meas whenever it is new", Choice(SWITCH);
     }
 }
 
@@ -136,9 +136,10 @@ impl Mekf {
     /// Update with a measured body direction `meas` of the reference direction `refd`: the innovation is
     /// the measured unit vector's components on two unit vectors E = [e₁ e₂] perpendicular to the
     /// predicted b̂ = A(q̂) r, H = [Eᵀ [b̂×], 0], R = σ² I₂.
-    fn vector_update(s: &mut Est, meas: &Vector3<f64>, refd: &Vector3<f64>, var: f64, what: &str) -> ModelResult {
-        let bm = unit(&format!("{what}_meas"), meas)?;
-        let r = unit(&format!("{what}_ref"), refd)?;
+    /// `port`: the inputs' stem (`sun`, `b`), `what`: the sensor named in a message.
+    fn vector_update(s: &mut Est, meas: &Vector3<f64>, refd: &Vector3<f64>, var: f64, port: &str, what: &str) -> ModelResult {
+        let bm = unit(&format!("{port}_meas"), meas)?;
+        let r = unit(&format!("{port}_ref"), refd)?;
         let bh = attitude_matrix(&s.q) * r;
         // the coordinate axis least aligned with b̂ gives e₁ ⟂ b̂
         let i = bh.iamin();
@@ -204,16 +205,16 @@ impl Mekf {
             unit("sun_ref", &v.sun_ref)?;
         }
         if d.use_sun && v.sun_valid >= 0.5 && sm != s.last_sun {
-            Self::vector_update(&mut s, &v.sun_meas, &v.sun_ref, d.sun_var, "sun")?;
+            Self::vector_update(&mut s, &v.sun_meas, &v.sun_ref, d.sun_var, "sun", "sun-sensor")?;
             s.last_sun = sm;
         }
-        let mm = [v.mag_meas.x, v.mag_meas.y, v.mag_meas.z];
+        let mm = [v.b_meas.x, v.b_meas.y, v.b_meas.z];
         if d.use_mag {
-            unit("mag_meas", &v.mag_meas)?;
-            unit("mag_ref", &v.mag_ref)?;
+            unit("b_meas", &v.b_meas)?;
+            unit("b_ref", &v.b_ref)?;
         }
         if d.use_mag && mm != s.last_mag {
-            Self::vector_update(&mut s, &v.mag_meas, &v.mag_ref, d.mag_var, "mag")?;
+            Self::vector_update(&mut s, &v.b_meas, &v.b_ref, d.mag_var, "b", "magnetometer")?;
             s.last_mag = mm;
         }
         s.w = v.w_meas;

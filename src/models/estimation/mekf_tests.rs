@@ -147,9 +147,9 @@ fn vector_updates_observe_the_attitude() {
     for i in 0..200 {
         let t = i as f64 * tp;
         let nse = |c: u64| Vector3::from_fn(|j, _| 1e-3 * normal(5, i, c + j as u64));
-        (f.v.sun_ref, f.v.mag_ref) = (s, m * 3e-5);
+        (f.v.sun_ref, f.v.b_ref) = (s, m * 3e-5);
         f.v.sun_meas = (a * s + nse(0)).normalize();
-        f.v.mag_meas = (a * m + nse(3)) * 3e-5;
+        f.v.b_meas = (a * m + nse(3)) * 3e-5;
         f.outputs(t).unwrap();
         assert_eq!(f.v.nis_dim, 4);
         f.step(t, tp).unwrap();

@@ -17,6 +17,7 @@ declare_variables! {
         sun: SunParams;
         20 => q_meas: Quat = [1.0, 0.0, 0.0, 0.0], Output, "", "Measured attitude quaternion of B relative to R (the last valid one while valid = 0)";
         24 => valid: Real = 0.0, Output, "", "1 = q_meas is the measurement delivered now, 0 = none delivered yet or sun in the exclusion cone (q_meas held)";
+        25 => st_valid: Real = 0.0, Output, "", "The same flag as valid, under the name of the Mekf's input (so that the two connect by name beside a SunSensor, whose valid is another flag)";
         30 => sun_angle: Real = 0.0, Output, "rad", "Diagnostic: angle between the boresight and the sun at the current true attitude";
         100 => sample_period: Real = 0.2, Parameter, "s", "Update period T of the star tracker", Range(1e-6, 1e4);
         103 => noise_cross: Real = 2.5e-5, Parameter, "rad", "1-sigma error about each cross-boresight axis (sensor x, y; default 5 arcsec)", NonNegative;
@@ -116,6 +117,7 @@ attitude held at the step's start.</p>", crate::sample_grid_note!()),
         let (s, ok) = self.line.at(t, self.d.period, self.d.latency, |k| self.sample(k, &q), |s| s.valid);
         v.q_meas = Quaternion::new(s.q[0], s.q[1], s.q[2], s.q[3]);
         v.valid = if ok { 1.0 } else { 0.0 };
+        v.st_valid = v.valid;
         v.sun_angle = self.boresight_sun_cos(&q, t).clamp(-1.0, 1.0).acos();
         Ok(())
     }
@@ -199,6 +201,7 @@ mod tests {
             let t = i as f64 * h;
             st.v.truth.q = truth(t);
             st.outputs(t).unwrap();
+            assert_eq!(st.v.st_valid, st.v.valid, "t = {t}"); // the Mekf's name for the same flag
             let kd = ((t - 0.3) / 0.2 + 1e-9).floor();
             if kd < 0.0 {
                 assert_eq!((st.v.q_meas, st.v.valid), (Quaternion::new(1.0, 0.0, 0.0, 0.0), 0.0), "t = {t}");

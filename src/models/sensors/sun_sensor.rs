@@ -18,6 +18,7 @@ declare_variables! {
         sun: SunParams;
         20 => sun_meas: Vec3 = [0.0, 0.0, 1.0], Output, "", "Measured unit sun direction, body axes (the last valid one while valid = 0)";
         23 => valid: Real = 0.0, Output, "", "1 = sun in the field of view and not in the Earth's shadow; 0 = sun_meas held";
+        24 => sun_valid: Real = 0.0, Output, "", "The same flag as valid, under the name of the Mekf's input (so that the two connect by name beside a StarTracker, whose valid is another flag)";
         100 => sample_period: Real = 0.1, Parameter, "s", "Sample period T", Range(1e-6, 1e4);
         103 => noise: Real = 1.745e-3, Parameter, "rad", "1-sigma angular noise about each axis perpendicular to the sun line (default 0.1 deg)", NonNegative;
         110 => bias: Vec3 = [0.0; 3], Parameter, "rad", "Bias: fixed rotation vector applied to the measured direction, body axes", Range(-0.5, 0.5);
@@ -113,6 +114,7 @@ is Rayleigh-distributed with mean square 2 sigma^2.</p>", crate::sample_grid_not
         let (s, ok) = self.line.at(t, self.d.period, 0.0, |k| self.sample(k, &q), |s| s.valid);
         v.sun_meas = Vector3::from(s.s);
         v.valid = if ok { 1.0 } else { 0.0 };
+        v.sun_valid = v.valid;
         Ok(())
     }
 
@@ -155,7 +157,7 @@ mod tests {
         let (sn, c) = 0.01f64.sin_cos();
         let want = Vector3::new(sb.x, sb.y * c - sb.z * sn, sb.y * sn + sb.z * c);
         assert!((s.v.sun_meas - want).norm() < 1e-14, "{} vs {want}", s.v.sun_meas);
-        assert_eq!(s.v.valid, 1.0);
+        assert_eq!((s.v.valid, s.v.sun_valid), (1.0, 1.0));
 
         // noise: mean square angle 2 σ² (Rayleigh), over 20 000 samples
         let mut s = Fmu::<SunSensor>::default();
@@ -182,7 +184,7 @@ mod tests {
         s.v.fov = std::f64::consts::PI;
         s.initialize(&Experiment::default()).unwrap();
         s.outputs(0.0).unwrap();
-        assert_eq!((s.v.valid, s.v.sun_meas), (0.0, Vector3::new(0.0, 0.0, 1.0)));
+        assert_eq!((s.v.valid, s.v.sun_valid, s.v.sun_meas), (0.0, 0.0, Vector3::new(0.0, 0.0, 1.0)));
         // field of view: the boresight body z at identity is 90° from the sun: outside a 60° cone
         s.v.orbit.orbit_arg_lat0 = 0.0;
         s.v.fov = 1.0;
