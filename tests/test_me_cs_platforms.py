@@ -437,3 +437,14 @@ def test_an_installed_package_takes_the_wrapper_of_its_own_platform(sys_platform
     assert cs_face.wrapper_library() == files[tup] and files[tup].name == name
     files[tup].unlink()  # that platform's wrapper missing: none (the native engine refuses ME units in one line)
     assert cs_face.wrapper_library() is None
+
+
+def test_a_truncated_or_foreign_header_is_no_platform():
+    """A unit's binary is not trusted: a header that points past the end of the file names no platform
+    (and raises nothing)."""
+    from scfmu.engines.cs_face import binary_tuples
+    pe_cut = b"MZ" + b"\0" * 0x3A + (0x40).to_bytes(4, "little") + b"PE\0\0"  # machine field missing
+    fat_cut = b"\xca\xfe\xba\xbe" + (5).to_bytes(4, "big")  # five slices announced, none present
+    assert binary_tuples(pe_cut) == set() and binary_tuples(fat_cut) == set()
+    assert binary_tuples(b"\x7fELF") == set() and binary_tuples(b"") == set()
+    assert binary_tuples(pe_cut + (0x8664).to_bytes(2, "little")) == {"x86_64-windows"}

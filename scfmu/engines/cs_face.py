@@ -71,7 +71,15 @@ _PE_CPU = {0x8664: "x86_64", 0xAA64: "aarch64"}  # IMAGE_FILE_MACHINE_AMD64, _AR
 
 def binary_tuples(data: bytes) -> set[str]:
     """The platform tuples (``x86_64-linux``, ``aarch64-darwin``, ...) of a shared library's bytes, read
-    from its header: ELF, PE or (thin or universal) Mach-O; empty when unknown."""
+    from its header: ELF, PE or (thin or universal) Mach-O; empty when unknown or truncated (a unit's
+    binary is not trusted: a header that points past the end is no platform)."""
+    try:
+        return _header_tuples(data)
+    except struct.error:
+        return set()
+
+
+def _header_tuples(data: bytes) -> set[str]:
     if data[:4] == b"\x7fELF" and len(data) > 20:
         cpu = _ELF_CPU.get(struct.unpack_from("<H" if data[5] == 1 else ">H", data, 18)[0])
         return {f"{cpu}-linux"} if cpu else set()
