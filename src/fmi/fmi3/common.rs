@@ -111,50 +111,55 @@ pub fn call3(c: Instance3, func: &str, allowed: u16, f: impl FnOnce(&mut Instanc
         // state serialized by an FMI 2.0 instance) is FMI 3.0's Terminated
         inst.run.fsm = FsmState::Terminated;
     }
-    let result = if allowed & inst.run.fsm.bit() == 0 {
-        let status = if inst.run.fsm == FsmState::Fatal {
-            Status::Fatal
-        } else {
-            Status::Error
-        };
-        Err(Fail {
-            status,
-            reason: format!(
-                "not allowed in state {} (illegal call sequence)",
-                state_name(inst.run.fsm)
-            ),
-        })
-    } else {
-        match guarded(|| f(&mut *inst)) {
-            Ok(r) => r,
-            Err(panic) => Err(Fail {
-                status: Status::Fatal,
-                reason: format!("internal error (panic): {panic}"),
-            }),
-        }
-    };
-    match result {
-        Ok(()) => Status::Ok as c_int,
-        Err(fail) => {
-            match fail.status {
-                Status::Fatal => inst.run.fsm = FsmState::Fatal,
-                Status::Error => inst.run.fsm = FsmState::Terminated,
-                _ => {}
-            }
-            let reason = fail
-                .reason
-                .replace("fmi2SetupExperiment", "fmi3EnterInitializationMode")
-                .replace("fmi2SetContinuousStates", "fmi3SetContinuousStates");
-            inst.log_fail(
+    if allowed & inst.run.fsm.bit() != 0 {
+        // the path of every successful call: nothing else on it (the failures are out of line)
+        return match guarded(|| f(&mut *inst)) {
+            Ok(Ok(())) => Status::Ok as c_int,
+            Ok(Err(fail)) => failed3(inst, func, fail),
+            Err(panic) => failed3(
+                inst,
                 func,
-                &Fail {
-                    status: fail.status,
-                    reason,
+                Fail {
+                    status: Status::Fatal,
+                    reason: format!("internal error (panic): {panic}"),
                 },
-            );
-            fail.status as c_int
-        }
+            ),
+        };
     }
+    let status = if inst.run.fsm == FsmState::Fatal {
+        Status::Fatal
+    } else {
+        Status::Error
+    };
+    let reason = format!(
+        "not allowed in state {} (illegal call sequence)",
+        state_name(inst.run.fsm)
+    );
+    failed3(inst, func, Fail { status, reason })
+}
+
+/// A failed FMI 3.0 call: `fmi3Error` moves the instance to Terminated, `fmi3Fatal` to Fatal; the reason is
+/// logged in FMI 3.0 terms; returns the status.
+#[cold]
+#[inline(never)]
+fn failed3(inst: &mut Instance, func: &str, fail: Fail) -> c_int {
+    match fail.status {
+        Status::Fatal => inst.run.fsm = FsmState::Fatal,
+        Status::Error => inst.run.fsm = FsmState::Terminated,
+        _ => {}
+    }
+    let reason = fail
+        .reason
+        .replace("fmi2SetupExperiment", "fmi3EnterInitializationMode")
+        .replace("fmi2SetContinuousStates", "fmi3SetContinuousStates");
+    inst.log_fail(
+        func,
+        &Fail {
+            status: fail.status,
+            reason,
+        },
+    );
+    fail.status as c_int
 }
 
 /// FMI 3.0 name of a state.
