@@ -135,7 +135,12 @@ def test_long_campaign_worker_memory_levels_off(tmp_path):
     """Dask workers: the memory levels off once Dask's own bounded, time-based histories (the statistical
     profiler's cycles and the system monitor's samples) are full. CI shortens those histories to a few
     seconds and runs 1,600 runs; SCFMU_LONG=1 runs 10,000 with the short histories and prints 10,000 more with
-    Dask's defaults (where the histories take 17 min and 1 h to fill: about 2 kB per run until then)."""
+    Dask's defaults (where the histories take 17 min and 1 h to fill: about 2 kB per run until then).
+
+    The Python objects per run are counted with Dask's statistical profiler off: the profiler keeps one
+    call tree per one-second cycle, so while its history fills it adds a few hundred objects per second
+    of wall time, not per run (1,600 runs take ~2.5 s here; measured 300-400 objects over the second half
+    with it on, 6-46 with it off), and a bound per run would then depend on the machine's speed."""
     long = os.environ.get("SCFMU_LONG") == "1"
     runs, segments = (10_000, 20) if long else (1_600, 8)
     rows = measure(tmp_path / "short", runs, segments, short_history=True)
@@ -143,12 +148,14 @@ def test_long_campaign_worker_memory_levels_off(tmp_path):
         print(r)
     assert rows[-1]["runs"] == runs and rows[-1]["ok"] == runs
     second_half = growth_per_run(rows, len(rows) // 2, "trimmed_kB")
-    objs = [sum(r["objects"]) for r in rows]
     print(f"worker memory after gc + malloc_trim: {growth_per_run(rows[:2], 0, 'trimmed_kB'):.0f} B/run in the "
-          f"first segment, {second_half:.0f} B/run over the second half; Python objects {objs}")
+          f"first segment, {second_half:.0f} B/run over the second half")
     assert second_half < 1024, rows
+    rows = measure(tmp_path / "noprofile", runs, segments, profiler=False, short_history=True)
+    objs = [sum(r["objects"]) for r in rows]
     half = len(rows) // 2
-    assert objs[-1] - objs[half] < 0.5 * (rows[-1]["runs"] - rows[half]["runs"]), objs  # no object per run
+    print(f"Python objects (profiler off): {objs}")
+    assert objs[-1] - objs[half] < 0.25 * (rows[-1]["runs"] - rows[half]["runs"]), objs  # no object per run
     if long:
         rows = measure(tmp_path / "default", runs, segments)
         for r in rows:
