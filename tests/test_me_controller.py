@@ -94,6 +94,24 @@ def test_the_units_are_model_exchange_only_without_states_or_event_indicators(un
     assert {"torque_cmd_x", "wn", "zeta", "inertia_xx"} <= names and "enable" not in names
 
 
+def _law_check(set_values, get_values, vr, *, seed, wn, zeta, inertia):
+    """check(mode): random unit quaternions and rates into the unit's inputs (``set_values``), its torque
+    (``get_values``) against the NumPy law to 1e-12."""
+    rng = np.random.default_rng(seed)
+
+    def check(mode):
+        q = rng.normal(size=4)
+        q /= np.linalg.norm(q)
+        r = rng.normal(size=4)
+        r /= np.linalg.norm(r)
+        w = rng.normal(size=3) * 0.1
+        set_values([vr[n] for n in INPUTS], list(q) + list(w) + list(r))
+        got = np.array(get_values([vr[f"torque_cmd_{a}"] for a in "xyz"]))
+        want = foreign_units.pd_law(q, w, r, wn=wn, zeta=zeta, inertia=inertia)
+        assert np.allclose(got, want, rtol=1e-12, atol=1e-12), (mode, got, want)
+    return check
+
+
 def test_fmi3_unit_follows_the_numpy_law_through_the_model_exchange_calls(units):
     """FMI 3.0 Model Exchange calls as an importer makes them (fmpy's FMU3Model): initialization, event mode,
     continuous-time mode with set time, 0 states and 0 event indicators, completed integrator step; the torque
@@ -113,18 +131,7 @@ def test_fmi3_unit_follows_the_numpy_law_through_the_model_exchange_calls(units)
     m.instantiate()
     m.setFloat64([vr["wn"], vr["zeta"], vr["inertia_yy"]], [0.7, 0.9, 321.0])
     m.enterInitializationMode(startTime=0.0)
-    rng = np.random.default_rng(7)
-
-    def check(mode):
-        q = rng.normal(size=4)
-        q /= np.linalg.norm(q)
-        r = rng.normal(size=4)
-        r /= np.linalg.norm(r)
-        w = rng.normal(size=3) * 0.1
-        m.setFloat64([vr[n] for n in INPUTS], list(q) + list(w) + list(r))
-        got = np.array(m.getFloat64([vr[f"torque_cmd_{a}"] for a in "xyz"]))
-        want = foreign_units.pd_law(q, w, r, wn=0.7, zeta=0.9, inertia=(1000.0, 321.0, 700.0))
-        assert np.allclose(got, want, rtol=1e-12, atol=1e-12), (mode, got, want)
+    check = _law_check(m.setFloat64, m.getFloat64, vr, seed=7, wn=0.7, zeta=0.9, inertia=(1000.0, 321.0, 700.0))
 
     check("initialization")
     m.exitInitializationMode()
@@ -162,18 +169,7 @@ def test_fmi2_unit_follows_the_numpy_law_through_the_model_exchange_calls(units)
     m.setReal([vr["wn"], vr["zeta"], vr["inertia_zz"]], [1.3, 0.6, 99.0])
     m.setupExperiment(startTime=0.0)
     m.enterInitializationMode()
-    rng = np.random.default_rng(11)
-
-    def check(mode):
-        q = rng.normal(size=4)
-        q /= np.linalg.norm(q)
-        r = rng.normal(size=4)
-        r /= np.linalg.norm(r)
-        w = rng.normal(size=3) * 0.1
-        m.setReal([vr[n] for n in INPUTS], list(q) + list(w) + list(r))
-        got = np.array(m.getReal([vr[f"torque_cmd_{a}"] for a in "xyz"]))
-        want = foreign_units.pd_law(q, w, r, wn=1.3, zeta=0.6, inertia=(1000.0, 500.0, 99.0))
-        assert np.allclose(got, want, rtol=1e-12, atol=1e-12), (mode, got, want)
+    check = _law_check(m.setReal, m.getReal, vr, seed=11, wn=1.3, zeta=0.6, inertia=(1000.0, 500.0, 99.0))
 
     check("initialization")
     m.exitInitializationMode()
