@@ -37,7 +37,7 @@ import pytest
 from test_aarch64 import CROSS_GCC, CROSS_NM, CROSS_READELF, EM_AARCH64, EM_X86_64, QEMU, SYSROOT, SYSTEM_SONAMES
 from test_aarch64 import elf_machine, exported
 from test_macos_binaries import CPU_TYPE_ARM64, CPU_TYPE_X86_64, MH_DYLIB, MachO, fat_slices
-from test_win64 import LIBM_OUTPUTS, OUT, SYSTEM_DLLS, loop_args, parse_loop, ulps
+from test_win64 import SYSTEM_DLLS, assert_same_bits, loop_args, parse_loop
 
 ROOT = Path(__file__).resolve().parents[1]
 FMUS = ROOT / "fmus"
@@ -317,12 +317,7 @@ def test_rk4_face_on_aarch64_is_bit_identical_to_x86_64(qemu_work):
     states, rates, torques and wheel momentum have the same bits on both CPUs; the Euler angles (glibc's
     atan2/asin per CPU) within 1 ulp; the loop really moves and settles towards the command."""
     x86, arm = _run_face(qemu_work, "rk4", False), _run_face(qemu_work, "rk4", True)
-    for k, (a, b) in enumerate(zip(x86, arm), start=1):
-        for name, (va, ba), (vb, bb) in zip(OUT, a, b):
-            if name in LIBM_OUTPUTS:
-                assert ulps(va, vb) <= 1, f"step {k} {name}: x86-64 {va!r} aarch64 {vb!r}"
-            else:
-                assert ba == bb, f"step {k} {name}: x86-64 {va!r} ({ba:016x}) != aarch64 {vb!r} ({bb:016x})"
+    assert_same_bits(x86, arm, "x86-64", "aarch64")
     first, last = np.array([v for v, _ in x86[0]]), np.array([v for v, _ in x86[-1]])
     assert max(abs(first[4:7])) > 1e-3 and max(abs(last[4:7])) < max(abs(first[4:7]))
     print(f"q0 after 10 s: {last[0]!r} on both CPUs")
@@ -398,12 +393,7 @@ def test_rk4_face_under_wine_is_bit_identical_to_linux64(wine_work, monkeypatch)
     assert win.returncode == 0, win.stdout[-2000:] + win.stderr[-2000:]
     (_, rows_linux), (_, rows_win) = parse_loop(linux.stdout), parse_loop(win.stdout)
     assert len(rows_linux) == len(rows_win) == 200
-    for k, (a, b) in enumerate(zip(rows_linux, rows_win), start=1):
-        for name, (va, ba), (vb, bb) in zip(OUT, a, b):
-            if name in LIBM_OUTPUTS:
-                assert ulps(va, vb) <= 1, f"step {k} {name}: linux64 {va!r} win64 {vb!r}"
-            else:
-                assert ba == bb, f"step {k} {name}: linux64 {va!r} ({ba:016x}) != win64 {vb!r} ({bb:016x})"
+    assert_same_bits(rows_linux, rows_win, "linux64", "win64")
     last = [v for v, _ in rows_win[-1]]
     print(f"q0 after 10 s: {last[0]!r} on both platforms")
     assert max(abs(x) for x in last[4:7]) < 1e-3

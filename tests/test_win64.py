@@ -250,18 +250,24 @@ def ulps(a: float, b: float) -> float:
     return 0.0 if a == b else abs(a - b) / math.ulp(max(abs(a), abs(b)))
 
 
+def assert_same_bits(rows_a, rows_b, label_a: str, label_b: str) -> None:
+    """Two loop runs (``parse_loop`` rows) step by step: every output has the same IEEE-754 bits, except the
+    Euler angles (the C library's atan2/asin on each side), which agree within 1 ulp."""
+    for k, (a, b) in enumerate(zip(rows_a, rows_b), start=1):
+        for name, (va, ba), (vb, bb) in zip(OUT, a, b):
+            if name in LIBM_OUTPUTS:
+                assert ulps(va, vb) <= 1, f"step {k} {name}: {label_a} {va!r} {label_b} {vb!r}"
+            else:
+                assert ba == bb, f"step {k} {name}: {label_a} {va!r} ({ba:016x}) != {label_b} {vb!r} ({bb:016x})"
+
+
 def test_pd_loop_under_wine_is_bit_identical_to_linux64(loop_dir):
     """AttitudePlant + PdController (default gains: wn = 1 rad/s, zeta = 1), 1000 steps of 0.05 s from a
     0.5/-0.3/0.8 rad attitude with a small body rate: attitude, rates, torques and wheel momentum have
     the same IEEE-754 bits at every step on Windows (win64 DLLs under Wine) and Linux (linux64 .so);
     the Euler angles (atan2/asin of the C library) agree within 1 ulp."""
     rows_linux, rows_win = run_both(loop_dir, "PdController")
-    for k, (a, b) in enumerate(zip(rows_linux, rows_win), start=1):
-        for name, (va, ba), (vb, bb) in zip(OUT, a, b):
-            if name in LIBM_OUTPUTS:
-                assert ulps(va, vb) <= 1, f"step {k} {name}: linux64 {va!r} win64 {vb!r}"
-            else:
-                assert ba == bb, f"step {k} {name}: linux64 {va!r} ({ba:016x}) != win64 {vb!r} ({bb:016x})"
+    assert_same_bits(rows_linux, rows_win, "linux64", "win64")
     # Not a trivial agreement: the loop moved the spacecraft and the critically damped PD loop
     # (time constant 1 s) brought it to the reference q = (1, 0, 0, 0) within 50 s.
     first = [v for v, _ in rows_linux[0]]
