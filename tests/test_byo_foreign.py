@@ -174,7 +174,9 @@ def test_a_failing_unit_costs_its_own_runs_only(units, variant, status, tmp_path
     scratch.mkdir()
     monkeypatch.setattr(tempfile, "tempdir", str(scratch))
     rows = [r for r, _ in campaign.run_chunk(specs)]
-    assert list(scratch.iterdir()) == []
+    from scfmu.fmu.scratch import LOCK, PREFIX  # only this process's scratch folder, holding only its lock
+    assert [p.name[:len(PREFIX)] for p in scratch.iterdir()] in ([], [PREFIX])
+    assert [p.name for f in scratch.iterdir() for p in f.iterdir()] in ([], [LOCK])
     assert [r["status"] for r in rows] == ["ok", status, "ok"], rows[1]["message"]
     assert rows[0]["eulerint_deg_s"] == rows[2]["eulerint_deg_s"]
     want = {"crash": "SIGSEGV", "hang": "4 s", "nan": "not finite", "error": "deliberate failure"}[variant]

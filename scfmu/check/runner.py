@@ -13,6 +13,8 @@ import sys
 import tempfile
 import time
 
+from ..fmu import scratch
+
 
 def _signame(rc: int) -> str:
     try:
@@ -34,7 +36,7 @@ def run_checks(spec: dict, checks: list[str], options: dict, timeout: float) -> 
 def _one_child(spec, checks, options, timeout) -> dict:
     job = json.dumps({"spec": spec, "checks": checks, "options": options}).encode()
     results: dict = {}
-    with tempfile.TemporaryDirectory(prefix="scfmu_check_") as tmp, \
+    with tempfile.TemporaryDirectory(prefix="scfmu_check_", dir=scratch.process_folder()) as tmp, \
             tempfile.TemporaryFile(dir=tmp) as err:
         env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
         env.pop("PYTHONFAULTHANDLER", None)  # the FMU's signal is reported from the exit status

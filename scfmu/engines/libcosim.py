@@ -28,6 +28,14 @@ def _libcosimpy_version() -> str:
         return "(not installed)"
 
 
+def _last_error() -> str:
+    try:
+        from libcosimpy._internal import get_last_error_message
+        return get_last_error_message() or "(no message)"
+    except Exception as e:  # a libcosimpy without it
+        return f"(no message: {e})"
+
+
 def run_libcosim(scenario: Scenario) -> dict:
     """Runs the scenario (or its plan) to its stop time; returns the final value of every logged key plus
     ``wall_s`` (the simulate_until call only). Co-Simulation units only (libcosim hosts no Model Exchange
@@ -52,7 +60,10 @@ def run_libcosim(scenario: Scenario) -> dict:
     ex = CosimExecution.from_step_size(step_size=step_ns)
     idx, mds = {}, {}
     for u in plan.units:
-        idx[u.name] = ex.add_local_slave(CosimLocalSlave(fmu_path=str(u.path), instance_name=u.name))
+        slave = CosimLocalSlave(fmu_path=str(u.path), instance_name=u.name)
+        if not slave.ptr():  # libcosimpy hands a NULL slave on to libcosim: a segmentation fault, not an error
+            raise RuntimeError(f"libcosim cannot load {u.name} ({u.path}): {_last_error()}")
+        idx[u.name] = ex.add_local_slave(slave)
         mds[u.name] = u.vars
     for c in scenario.components:
         for k, v in c.params.items():
@@ -90,17 +101,17 @@ def run_libcosim_ssp(ssp_path, stop_time: float | None = None) -> dict:
     bindings and connections all come from the archive; the fixed step from the scfmu annotation).
     Returns the final value of every logged key of the scenario, like :func:`run_libcosim`."""
     import shutil
-    import tempfile
 
     from fmpy import read_model_description
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
     from libcosimpy.CosimObserver import CosimObserver
 
+    from ..fmu import scratch
     from ..scenario.ssp import read_ssp
 
     log_output_level(CosimLogLevel.WARNING)
-    work = tempfile.mkdtemp(prefix="scfmu_lcssp_")
+    work = scratch.mkdtemp(prefix="scfmu_lcssp_")
     try:
         sc, files = read_ssp(ssp_path, work)
         t_end = sc.stop_time if stop_time is None else stop_time

@@ -39,7 +39,6 @@ import hashlib
 import json
 import os
 import shutil
-import tempfile
 import zipfile
 from ctypes import c_int32, c_uint
 from dataclasses import replace
@@ -48,7 +47,7 @@ from pathlib import Path
 import numpy as np
 from fmpy import read_model_description
 
-from ..fmu import Fmu, fmu_digest, safe_extract, scalar_type, unpacked
+from ..fmu import Fmu, fmu_digest, safe_extract, scalar_type, scratch, unpacked
 from ..scenario.model import Scenario
 from ..scenario.plan import Plan
 from . import cache
@@ -248,7 +247,7 @@ def _write_container(config, h: str, path: Path) -> None:
     from fmpy.model_description import write_model_description
 
     CACHE.mkdir(parents=True, exist_ok=True)
-    work = Path(tempfile.mkdtemp(prefix="scfmu_container_"))
+    work = Path(scratch.mkdtemp(prefix="scfmu_container_"))
     try:
         for c in config.components:  # nested FMUs unpacked under resources/<file stem>
             safe_extract(c.filename, work / "resources" / Path(c.filename).stem)  # archive limits (scfmu.fmu)

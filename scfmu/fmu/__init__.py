@@ -126,20 +126,19 @@ _UNPACKED: dict = {}
 
 def unpacked(path: Path) -> tuple:
     """(model description, unzip directory) of an FMU, extracted once per process and kept until exit
-    (for runs that instantiate the same FMUs many times, e.g. campaigns)."""
+    (for runs that instantiate the same FMUs many times, e.g. campaigns); the folder is in the process's
+    scratch folder (scfmu.fmu.scratch), removed at exit or, after a killed process, by the next one."""
     path = Path(path).resolve()
     st = path.stat()
     key = (str(path), st.st_mtime_ns, st.st_size)
     hit = _UNPACKED.get(key)
     if hit is None:
-        import atexit
         d = safe_extract(path)
         try:
             hit = (read_model_description(d), d)
         except Exception:
             shutil.rmtree(d, ignore_errors=True)
             raise
-        atexit.register(shutil.rmtree, d, True)
         _UNPACKED[key] = hit
     return hit
 

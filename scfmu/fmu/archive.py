@@ -21,7 +21,6 @@ from __future__ import annotations
 import os
 import shutil
 import stat
-import tempfile
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -152,7 +151,8 @@ def safe_extract(path: str | Path, dest: str | Path | None = None, limits: Archi
     limits = limits or archive_limits()
     infos = inspect_archive(path, limits)
     if dest is None:
-        root = Path(tempfile.mkdtemp(prefix="scfmu_fmu_"))
+        from .scratch import mkdtemp  # inside the process's scratch folder: removed however the process ends
+        root = Path(mkdtemp(prefix="scfmu_fmu_"))
         created = root
     else:
         root = Path(dest)

@@ -43,7 +43,8 @@ def in_child(fn: Callable[[], Any], timeout: float) -> tuple[str, Any]:
     ("crash", the signal's name or "exit code N") or ("timeout", None) when no result came within
     ``timeout`` seconds of wall time (the child is killed)."""
     parent = os.getpid()
-    scratch = tempfile.mkdtemp(prefix="scfmu_isolated_")
+    from .scratch import mkdtemp
+    scratch = mkdtemp(prefix="scfmu_isolated_")  # in the caller's scratch folder: gone with a killed caller too
     try:
         return _fork_and_wait(fn, timeout, parent, scratch)
     finally:

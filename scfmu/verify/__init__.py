@@ -43,7 +43,6 @@ import os
 import shutil
 import subprocess
 import sys
-import tempfile
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -182,7 +181,8 @@ def _run_fmpy(fmu: Path, md, exp: Experiment, ins: list[str], outs: list[str]) -
 
 
 def _run_fmusim(fmu: Path, md, exp: Experiment, ins: list[str], outs: list[str], exe: str) -> np.ndarray:
-    work = Path(tempfile.mkdtemp(prefix="scfmu_verify_"))
+    from ..fmu import scratch
+    work = Path(scratch.mkdtemp(prefix="scfmu_verify_"))
     try:
         cmd = [exe, "--interface-type", "cs", "--start-time", repr(exp.start), "--stop-time", repr(exp.stop),
                "--output-interval", repr(exp.step), "--output-file", str(work / "out.csv")]
