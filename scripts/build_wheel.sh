@@ -75,13 +75,15 @@ loop_lib() {
 # The Model Exchange wrapper of each platform (scfmu/engines/me_cs: cargo build --release and the cross-build
 # scripts), as scfmu/engines/me_cs/bin/<FMI 3.0 platform tuple>/ (scfmu/engines/cs_face.py, wrapper_libraries)
 me_cs_lib() {
+    local tuple
     case "$1" in
-        linux-x86_64) echo "x86_64-linux target/release/libscfmu_me_cs.so" ;;
-        linux-aarch64) echo "aarch64-linux target/aarch64/aarch64-unknown-linux-gnu/release/libscfmu_me_cs.so" ;;
-        win-amd64) echo "x86_64-windows target/win64/x86_64-win7-windows-gnu/release/scfmu_me_cs.dll" ;;
-        macos-x86_64) echo "x86_64-darwin target/macos/x86_64-apple-darwin/release/libscfmu_me_cs.dylib" ;;
-        macos-arm64) echo "aarch64-darwin target/macos/aarch64-apple-darwin/release/libscfmu_me_cs.dylib" ;;
+        linux-x86_64) tuple=x86_64-linux ;;
+        linux-aarch64) tuple=aarch64-linux ;;
+        win-amd64) tuple=x86_64-windows ;;
+        macos-x86_64) tuple=x86_64-darwin ;;
+        macos-arm64) tuple=aarch64-darwin ;;
     esac
+    echo "$tuple $(.venv/bin/python -c 'import sys; from scfmu.engines.cs_face import checkout_build as b; print(b(sys.argv[1]))' "$tuple")"
 }
 mkdir -p "$out"
 for plat in "${platforms[@]}"; do

@@ -38,18 +38,16 @@ from test_aarch64 import CROSS_GCC, CROSS_NM, CROSS_READELF, EM_AARCH64, EM_X86_
 from test_aarch64 import elf_machine, exported
 from test_macos_binaries import CPU_TYPE_ARM64, CPU_TYPE_X86_64, MH_DYLIB, MachO, fat_slices
 from test_win64 import SYSTEM_DLLS, assert_same_bits, loop_args, parse_loop
+from scfmu.engines.cs_face import checkout_build
 
 ROOT = Path(__file__).resolve().parents[1]
 FMUS = ROOT / "fmus"
 LOADER = ROOT / "tests" / "loader" / "fmi_loop.c"
-HOST = ROOT / "target" / "release" / "libscfmu_me_cs.so"
+HOST = ROOT / checkout_build("x86_64-linux")
 # platform tuple -> (the cross script's output, the FMI 2.0 folder of fmus/<Model>.fmu that says it was built)
-CROSS = {
-    "aarch64-linux": ("target/aarch64/aarch64-unknown-linux-gnu/release/libscfmu_me_cs.so", "aarch64-linux"),
-    "x86_64-windows": ("target/win64/x86_64-win7-windows-gnu/release/scfmu_me_cs.dll", "win64"),
-    "x86_64-darwin": ("target/macos/x86_64-apple-darwin/release/libscfmu_me_cs.dylib", "darwin64"),
-    "aarch64-darwin": ("target/macos/aarch64-apple-darwin/release/libscfmu_me_cs.dylib", "darwin64"),
-}
+CROSS = {tup: (checkout_build(tup), folder) for tup, folder in
+         [("aarch64-linux", "aarch64-linux"), ("x86_64-windows", "win64"), ("x86_64-darwin", "darwin64"),
+          ("aarch64-darwin", "darwin64")]}
 TUPLES = list(CROSS)
 # The Co-Simulation entry points fmpy's container (and any master) calls on a face, written out from the
 # FMI 2.0.4 (section 4.2) and FMI 3.0 (section 4.2) standards rather than read from our own binary

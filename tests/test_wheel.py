@@ -17,6 +17,7 @@ from pathlib import Path
 import pytest
 from packaging.tags import sys_tags
 from packaging.utils import parse_wheel_filename
+from scfmu.engines.cs_face import checkout_build
 
 ROOT = Path(__file__).resolve().parents[1]
 # platform -> (FMI 2.0 folder in the wheel, FMI 3.0 tuple, binary check, compiled loop library (None: not built
@@ -31,11 +32,7 @@ PLATFORMS = {
     "macos-arm64": ("darwin64", "aarch64-darwin", MACHO_ARM64, None, r"macosx_11_0_arm64"),
 }
 # each platform's Model Exchange wrapper (cargo build --release, the cross-build scripts)
-ME_CS = {"linux-x86_64": "target/release/libscfmu_me_cs.so",
-         "linux-aarch64": "target/aarch64/aarch64-unknown-linux-gnu/release/libscfmu_me_cs.so",
-         "win-amd64": "target/win64/x86_64-win7-windows-gnu/release/scfmu_me_cs.dll",
-         "macos-x86_64": "target/macos/x86_64-apple-darwin/release/libscfmu_me_cs.dylib",
-         "macos-arm64": "target/macos/aarch64-apple-darwin/release/libscfmu_me_cs.dylib"}
+ME_CS = {plat: checkout_build(p[1]) for plat, p in PLATFORMS.items()}
 # the FMI 2.0 folders of fmus/<Model>.fmu that make each platform's wheel
 SOURCE_FOLDER = {"linux-x86_64": "linux64", "linux-aarch64": "aarch64-linux", "win-amd64": "win64",
                  "macos-x86_64": "darwin64", "macos-arm64": "darwin64"}

@@ -125,6 +125,14 @@ def _host() -> str:
     return f"{cpu}-{osname}"
 
 
+def checkout_build(tup: str) -> str:
+    """Where a source checkout's build of the wrapper for platform ``tup`` is, relative to the checkout:
+    ``target/release/...`` for ``x86_64-linux`` (the build and test machine), the cross-build script's
+    folder for the others. The one list of these paths (scripts/build_wheel.sh and the tests ask here)."""
+    built, _, cross = _BUILDS[tup]
+    return f"{cross or 'target/release'}/{built}"
+
+
 def wrapper_libraries() -> dict[str, Path]:
     """``{platform tuple: wrapper library}`` of every platform whose build is found: the package's
     ``scfmu/engines/me_cs/bin/<tuple>/`` (a wheel), else, in a source checkout (an editable install),
