@@ -101,7 +101,7 @@ static double torque(const Instance *c, int k) {
 static fmi3Status get_real(Instance *c, fmi3ValueReference v, double *out) {
     if (!is_real(v)) return fmi3Error;
     *out = (v >= OUT0 && v < OUT0 + 3) ? torque(c, (int)(v - OUT0)) : c->r[v];
-    return fmi3OK;
+    return isfinite(*out) ? fmi3OK : fmi3Error; /* finite inputs can overflow the law: say so, never pass inf on */
 }
 static fmi3Status set_real(Instance *c, fmi3ValueReference v, double x) {
     if (!is_settable_real(v)) return fmi3Error;
@@ -426,6 +426,7 @@ EXPORT fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time) {
 EXPORT fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 x[], size_t n) {
     Instance *c = instance;
     if (!c || n != NX || (n && !x)) return fmi3Error;
+    if (c->state != ST_CONT) return fmi3Error; /* Continuous-Time Mode only (FMI 3.0, section 3.2.1) */
     states_set(c, x);
     return fmi3OK;
 }
@@ -438,6 +439,7 @@ EXPORT fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 x[]
 EXPORT fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 dx[], size_t n) {
     Instance *c = instance;
     if (!c || n != NX || (n && !dx)) return fmi3Error;
+    if (c->state == ST_INSTANTIATED) return fmi3Error; /* not before Initialization Mode */
     derivatives(c, dx);
     return fmi3OK;
 }
