@@ -55,7 +55,8 @@ def process_folder() -> Path:
 
 
 def mkdtemp(prefix: str) -> str:
-    """A new folder inside this process's scratch folder (:func:`tempfile.mkdtemp` otherwise)."""
+    """A new folder inside this process's scratch folder (as :func:`tempfile.mkdtemp` makes one; the caller
+    may remove it earlier, else it goes with the process's folder)."""
     return tempfile.mkdtemp(prefix=prefix, dir=process_folder())
 
 
@@ -134,11 +135,11 @@ def sweep(base: str | None = None) -> list[str]:
 def _remove(pid: int, folder: str) -> None:
     if os.getpid() != pid:  # a forked child never removes its parent's folder
         return
-    shutil.rmtree(folder, ignore_errors=True)
     for key, (f, fd) in list(_current.items()):
-        if f == folder:
+        if f == folder:  # the lock first: on Windows an open file cannot be removed
             del _current[key]
             try:
                 os.close(fd)
             except OSError:
                 pass
+    shutil.rmtree(folder, ignore_errors=True)
