@@ -131,3 +131,29 @@ def test_libcosim_that_cannot_unpack_a_unit_is_an_error_not_a_crash(tmp_path):
     out, err = p.communicate(timeout=120)
     assert p.returncode == 0, (p.returncode, err[-2000:])
     assert "error: libcosim cannot load command" in out and "temp_directory_path" in out, out
+
+
+def test_copies_of_a_unit_share_one_folder_and_a_description_unpacks_nothing(tmp_path, monkeypatch):
+    """A test session or a notebook meets the same FMU at many paths (copies, rebuilt identical files):
+    unpacked once per content, not per path; and reading a model description (planning, resolving,
+    recording a run) unpacks nothing at all."""
+    import shutil
+    import tempfile
+
+    from scfmu import fmu as fmu_mod
+    tmp = tmp_path / "tmp"
+    tmp.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp))
+    src = fmu_path("PdController")
+    copies = []
+    for i in range(3):
+        copies.append(tmp_path / f"copy{i}" / "PdController.fmu")
+        copies[-1].parent.mkdir()
+        shutil.copy(src, copies[-1])
+    mds = [fmu_mod.described(p) for p in copies]
+    assert all(md.modelName == "PdController" for md in mds)
+    assert not tmp.exists() or [p for p in tmp.rglob("modelDescription.xml")] == []
+    dirs = {fmu_mod.unpacked(p)[1] for p in copies}
+    assert len(dirs) == 1 and Path(next(iter(dirs)), "modelDescription.xml").is_file()
+    other = fmu_path("PdController").parent / "fmi3" / "PdController.fmu"  # another file: its own folder
+    assert fmu_mod.unpacked(other)[1] not in dirs

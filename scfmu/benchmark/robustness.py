@@ -27,7 +27,7 @@ import math
 
 import numpy as np
 
-from ..fmu import fmu_path, unpacked
+from ..fmu import described, fmu_path
 
 INERTIA_SPREAD = 0.20
 AXIS_TILT_DEG = 10.0
@@ -42,7 +42,7 @@ QUICK_RUNS = 8
 
 
 def _defaults(model: str) -> dict:
-    md = unpacked(fmu_path(model))[0]
+    md = described(fmu_path(model))
     out = {}
     for v in md.modelVariables:
         if v.causality == "parameter" and v.start is not None:

@@ -33,7 +33,7 @@ def fmu_versions(scenario: Scenario) -> dict:
     out = {}
     for c in scenario.components:
         p = fmu_access.fmu_path(c.model)
-        md = fmu_access.unpacked(p)[0]
+        md = fmu_access.described(p)
         entry = {"guid": md.guid, "sha256": fmu_access.fmu_digest(p)}
         if fmu_access.is_path(c.model):
             entry.update(model_name=md.modelName, file=str(p), instance=c.name)

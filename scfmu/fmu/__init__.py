@@ -121,26 +121,35 @@ def model_description(path: str | Path):
     return read_model_description(str(path), validate=False)
 
 
+_DESCRIBED: dict = {}
 _UNPACKED: dict = {}
+
+
+def described(path: str | Path):
+    """fmpy's model description of an FMU file (validated against the schema), read from the archive after
+    :func:`inspect_archive`, without unpacking anything; cached per process by path, modification time and
+    size. Planning, resolving and recording a run need no more than this."""
+    path = Path(path).resolve()
+    st = path.stat()
+    key = (str(path), st.st_mtime_ns, st.st_size)
+    hit = _DESCRIBED.get(key)
+    if hit is None:
+        inspect_archive(path)
+        hit = _DESCRIBED[key] = read_model_description(str(path))
+    return hit
 
 
 def unpacked(path: Path) -> tuple:
     """(model description, unzip directory) of an FMU, extracted once per process and kept until exit
-    (for runs that instantiate the same FMUs many times, e.g. campaigns); the folder is in the process's
-    scratch folder (scfmu.fmu.scratch), removed at exit or, after a killed process, by the next one."""
-    path = Path(path).resolve()
-    st = path.stat()
-    key = (str(path), st.st_mtime_ns, st.st_size)
-    hit = _UNPACKED.get(key)
-    if hit is None:
-        d = safe_extract(path)
-        try:
-            hit = (read_model_description(d), d)
-        except Exception:
-            shutil.rmtree(d, ignore_errors=True)
-            raise
-        _UNPACKED[key] = hit
-    return hit
+    (for runs that instantiate the same FMUs many times, e.g. campaigns). Copies of one file at other paths
+    share one folder (the cache is keyed by the file's SHA-256). The folder is in the process's scratch
+    folder (scfmu.fmu.scratch), removed at exit or, after a killed process, by the next one."""
+    md = described(path)
+    digest = fmu_digest(path)
+    d = _UNPACKED.get(digest)
+    if d is None or not os.path.isdir(d):
+        d = _UNPACKED[digest] = safe_extract(path)
+    return md, d
 
 
 _DIGESTS: dict = {}

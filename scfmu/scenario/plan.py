@@ -24,7 +24,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..fmu import fmu_path, scalar_type, unpacked
+from ..fmu import described, fmu_path, scalar_type
 from .model import Scenario
 from .resolve import resolve
 
@@ -217,7 +217,7 @@ def _signature(sc: Scenario, paths, model_exchange) -> tuple:
 def _build(sc: Scenario, paths, model_exchange) -> Plan:
     units = []
     for c, p in zip(sc.components, paths):
-        md = unpacked(p)[0]
+        md = described(p)
         fmi = int(str(md.fmiVersion).split(".")[0])
         if fmi not in (2, 3):
             raise PlanError(f"{c.name} ({c.model}): FMI {md.fmiVersion} is not supported (FMI 2.0 or 3.0)")

@@ -14,7 +14,7 @@ import copy
 import dataclasses
 from dataclasses import dataclass, field
 
-from ..fmu import fmu_path, is_path, unpacked
+from ..fmu import described, fmu_path, is_path
 from .model import Component, Scenario
 from .profile import ProfileError, evaluate, names_in
 
@@ -29,7 +29,7 @@ def declared(model: str) -> dict:
     key = (str(p), st.st_mtime_ns, st.st_size)
     hit = _DECLARED.get(key)
     if hit is None:
-        md = unpacked(p)[0]
+        md = described(p)
         hit = _DECLARED[key] = {v.name: v for v in md.modelVariables}
     return hit
 
