@@ -374,8 +374,11 @@ class Started:
 
     def __init__(self, args, cwd):
         import threading
+        # SIGINT back at its default in the child: a test run started in the background (`cmd &` without job
+        # control) ignores SIGINT, and a Python started with SIGINT ignored never raises KeyboardInterrupt
         self.p = subprocess.Popen([sys.executable, "-m", "scfmu", *map(str, args)], stdout=subprocess.PIPE,
-                                  stderr=subprocess.PIPE, text=True, start_new_session=True, cwd=cwd)
+                                  stderr=subprocess.PIPE, text=True, start_new_session=True, cwd=cwd,
+                                  preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
         self.out, self.err = [], []
         self.threads = [threading.Thread(target=self._read, args=(f, buf), daemon=True)
                         for f, buf in ((self.p.stdout, self.out), (self.p.stderr, self.err))]
