@@ -140,7 +140,8 @@ def test_long_campaign_worker_memory_levels_off(tmp_path):
     The Python objects per run are counted with Dask's statistical profiler off: the profiler keeps one
     call tree per one-second cycle, so while its history fills it adds a few hundred objects per second
     of wall time, not per run (1,600 runs take ~2.5 s here; measured 300-400 objects over the second half
-    with it on, 6-46 with it off), and a bound per run would then depend on the machine's speed."""
+    with it on, 6-46 with it off), and a bound per run would then depend on the machine's speed. For the
+    same reason the memory bound of 1 kB/run holds with the profiler off; with it on the bound is 4 kB/run."""
     long = os.environ.get("SCFMU_LONG") == "1"
     runs, segments = (10_000, 20) if long else (1_600, 8)
     rows = measure(tmp_path / "short", runs, segments, short_history=True)
@@ -150,11 +151,17 @@ def test_long_campaign_worker_memory_levels_off(tmp_path):
     second_half = growth_per_run(rows, len(rows) // 2, "trimmed_kB")
     print(f"worker memory after gc + malloc_trim: {growth_per_run(rows[:2], 0, 'trimmed_kB'):.0f} B/run in the "
           f"first segment, {second_half:.0f} B/run over the second half")
-    assert second_half < 1024, rows
+    # with the profiler on, its history fills per second of wall time, not per run: a loose bound here (a
+    # loaded machine measured 1.5 kB/run over a 1.4 s second half), the tight ones with the profiler off
+    assert second_half < 4096, rows
     rows = measure(tmp_path / "noprofile", runs, segments, profiler=False, short_history=True)
+    for r in rows:
+        print(r)
+    quiet = growth_per_run(rows, len(rows) // 2, "trimmed_kB")
     objs = [sum(r["objects"]) for r in rows]
     half = len(rows) // 2
-    print(f"Python objects (profiler off): {objs}")
+    print(f"profiler off: {quiet:.0f} B/run over the second half; Python objects {objs}")
+    assert quiet < 1024, rows
     assert objs[-1] - objs[half] < 0.25 * (rows[-1]["runs"] - rows[half]["runs"]), objs  # no object per run
     if long:
         rows = measure(tmp_path / "default", runs, segments)
