@@ -3,14 +3,19 @@
 //! multiplicative reset, propagation with the gyro, Joseph-form updates from star-tracker quaternions
 //! and from body-frame unit vectors (sun sensor, magnetometer) with their reference directions.
 
+use std::collections::VecDeque;
+
 use nalgebra::{Matrix3, Quaternion, Rotation3, SMatrix, SVector, Vector3};
 use serde::{Deserialize, Serialize};
 
 use crate::declare_variables;
 use crate::math::attitude::{attitude_matrix, skew};
-use crate::math::attitude_kalman::{error_transition, gyro_process_noise, joseph_update, quat_exp, quat_log, Matrix6};
+use crate::math::attitude_kalman::{error_transition, gyro_process_noise, joseph_update_with_gain, quat_exp, quat_log, Matrix6};
 use crate::math::sample_grid;
 use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult};
+
+#[path = "mekf_delay.rs"]
+mod delay;
 
 /// At most this many filter samples per doStep (bounded work: a longer step is refused before any work).
 pub const MAX_SAMPLES_PER_CALL: i64 = 1_000_000;
@@ -51,6 +56,7 @@ declare_variables! {
         124 => use_star_tracker: Integer = 1, Parameter, "", "1 = update with q_meas when st_valid >= 0.5 and q_meas is new", Choice(SWITCH);
         125 => use_sun: Integer = 0, Parameter, "", "1 = update with sun_meas when sun_valid >= 0.5 and sun_meas is new", Choice(SWITCH);
         126 => use_mag: Integer = 0, Parameter, "", "1 = update with b_meas whenever it is new", Choice(SWITCH);
+        127 => st_latency: Real = 0.0, Parameter, "s", "Star-tracker latency compensated by the filter (as the StarTracker's latency): a quaternion arriving at sample k was measured at sample k - st_latency/sample_period (a whole number, at most 1000)", Range(0.0, 10.0);
     }
 }
 
@@ -73,6 +79,8 @@ struct Derived {
     use_st: bool,
     use_sun: bool,
     use_mag: bool,
+    /// Star-tracker latency in samples (0: no compensation, the history stays empty).
+    delay: usize,
 }
 
 /// The filter after sample k: estimate, covariance, the gyro rate to propagate with, the last used
@@ -91,6 +99,9 @@ struct Est {
     innovation: Vector3<f64>,
     nis: f64,
     nis_dim: i32,
+    /// With a star-tracker latency: the filter after each of the last `delay` + 1 samples (the newest is
+    /// this one), for the delayed update (`mekf_delay`).
+    hist: VecDeque<delay::Entry>,
 }
 
 #[derive(Clone, Serialize, Deserialize)]
@@ -124,20 +135,21 @@ impl Mekf {
         s.b += dx.fixed_rows::<3>(3);
     }
 
-    fn update<const M: usize>(s: &mut Est, h: &SMatrix<f64, M, 6>, r: &SMatrix<f64, M, M>, nu: &SVector<f64, M>, what: &str) -> ModelResult {
-        let (dx, p, nis) = joseph_update(&s.p, h, r, nu).ok_or_else(|| format!("{what} update: innovation covariance is not positive definite"))?;
+    /// Joseph-form update of the current sample; returns its error-state transition I − K H.
+    fn update<const M: usize>(s: &mut Est, h: &SMatrix<f64, M, 6>, r: &SMatrix<f64, M, M>, nu: &SVector<f64, M>, what: &str) -> Result<Matrix6, String> {
+        let (dx, p, nis, k) = joseph_update_with_gain(&s.p, h, r, nu).ok_or_else(|| format!("{what} update: innovation covariance is not positive definite"))?;
         s.p = p;
         Self::reset(s, &dx);
         s.nis += nis;
         s.nis_dim += M as i32;
-        Ok(())
+        Ok(Matrix6::identity() - k * h)
     }
 
     /// Update with a measured body direction `meas` of the reference direction `refd`: the innovation is
     /// the measured unit vector's components on two unit vectors E = [e₁ e₂] perpendicular to the
     /// predicted b̂ = A(q̂) r, H = [Eᵀ [b̂×], 0], R = σ² I₂.
     /// `port`: the inputs' stem (`sun`, `b`), `what`: the sensor named in a message.
-    fn vector_update(s: &mut Est, meas: &Vector3<f64>, refd: &Vector3<f64>, var: f64, port: &str, what: &str) -> ModelResult {
+    fn vector_update(s: &mut Est, meas: &Vector3<f64>, refd: &Vector3<f64>, var: f64, port: &str, what: &str) -> Result<Matrix6, String> {
         let bm = unit(&format!("{port}_meas"), meas)?;
         let r = unit(&format!("{port}_ref"), refd)?;
         let bh = attitude_matrix(&s.q) * r;
@@ -152,12 +164,50 @@ impl Mekf {
         Self::update(s, &h, &(SMatrix::<f64, 2, 2>::identity() * var), &nu, what)
     }
 
+    /// The zero-latency star-tracker update of sample k (a new usable q_meas, normalised): the first one
+    /// initialises the attitude with init_from_star_tracker = 1, the others update it.
+    fn star_update(&self, s: &mut Est, q_m: &Quaternion<f64>) -> ModelResult {
+        if self.d.init_from_st && !s.initialized {
+            // first measurement: the estimate is the measurement, its error covariance the noise's
+            s.q = if q_m.dot(&s.q) < 0.0 { -q_m } else { *q_m };
+            s.p.fixed_view_mut::<3, 6>(0, 0).fill(0.0);
+            s.p.fixed_view_mut::<6, 3>(0, 0).fill(0.0);
+            s.p.fixed_view_mut::<3, 3>(0, 0).copy_from(&self.d.r_st);
+        } else {
+            let nu = quat_log(&(s.q.conjugate() * q_m));
+            let mut h = SMatrix::<f64, 3, 6>::zeros();
+            h.fixed_view_mut::<3, 3>(0, 0).fill_with_identity();
+            Self::update(s, &h, &self.d.r_st, &nu, "star-tracker")?;
+            s.innovation = nu;
+        }
+        Ok(())
+    }
+
+    /// The delayed star-tracker update of sample k (`st_latency` > 0): the current sample is recorded in
+    /// the history with its transition `t`, a new measurement `q_m` (if any) updates the history's oldest
+    /// sample and the correction is carried to the current one (`mekf_delay`).
+    fn delayed_star_update(&self, s: &mut Est, t: Matrix6, q_m: Option<Quaternion<f64>>) -> ModelResult {
+        let d = &self.d;
+        let e = delay::Entry { k: s.k, q: s.q, b: s.b, p: s.p, t };
+        delay::record(&mut s.hist, d.delay, e);
+        if let Some(q_m) = q_m {
+            if d.init_from_st && !s.initialized {
+                s.initialized = delay::initialize(&mut s.hist, d.delay, &q_m, &d.r_st);
+            } else if let Some((nu, nis)) = delay::update(&mut s.hist, d.delay, &q_m, &d.r_st)? {
+                (s.innovation, s.nis, s.nis_dim) = (nu, s.nis + nis, s.nis_dim + 3);
+            }
+            let now = s.hist.back().expect("the current sample is recorded");
+            (s.q, s.b, s.p) = (now.q, now.b, now.p);
+        }
+        Ok(())
+    }
+
     /// The filter after sample k given the filter after sample k − 1 (first sample k0: the initial estimate).
-    fn next(&self, prev: &Est, k: i64, v: &MekfVars) -> Result<Est, String> {
+    fn next(&self, mut s: Est, k: i64, v: &MekfVars) -> Result<Est, String> {
         let d = &self.d;
         finite("w_meas", v.w_meas.as_slice())?;
-        let mut s = prev.clone();
         s.k = k;
+        let mut t = Matrix6::identity();
         if k == d.k0 {
             (s.q, s.b, s.p) = (d.q0, d.b0, d.p0);
         } else {
@@ -165,8 +215,8 @@ impl Mekf {
             // rule: exact for a rate linear over the step, as the plant's under a held torque)
             let w = (s.w + v.w_meas) * 0.5 - s.b;
             s.q = (s.q * quat_exp(&(w * d.period))).normalize();
-            let phi = error_transition(&w, d.period);
-            let p = phi * s.p * phi.transpose() + d.q_proc;
+            t = error_transition(&w, d.period);
+            let p = t * s.p * t.transpose() + d.q_proc;
             s.p = (p + p.transpose()) * 0.5;
         }
         (s.innovation, s.nis, s.nis_dim) = (Vector3::zeros(), 0.0, 0);
@@ -181,22 +231,14 @@ impl Mekf {
                 return Err(format!("input quaternion q_meas has norm {n}, expected 1 (is it connected?)"));
             }
         }
-        if d.use_st && v.st_valid >= 0.5 && qm != s.last_q {
-            let q_m = v.q_meas / v.q_meas.norm();
-            if d.init_from_st && !s.initialized {
-                // first measurement: the estimate is the measurement, its error covariance the noise's
-                s.q = if q_m.dot(&s.q) < 0.0 { -q_m } else { q_m };
-                s.p.fixed_view_mut::<3, 6>(0, 0).fill(0.0);
-                s.p.fixed_view_mut::<6, 3>(0, 0).fill(0.0);
-                s.p.fixed_view_mut::<3, 3>(0, 0).copy_from(&d.r_st);
-            } else {
-                let nu = quat_log(&(s.q.conjugate() * q_m));
-                let mut h = SMatrix::<f64, 3, 6>::zeros();
-                h.fixed_view_mut::<3, 3>(0, 0).fill_with_identity();
-                Self::update(&mut s, &h, &d.r_st, &nu, "star-tracker")?;
-                s.innovation = nu;
-            }
+        // a new usable star-tracker measurement is used once: now (no latency) or after the vector
+        // updates, as an update of the sample it was measured at
+        let q_new = (d.use_st && v.st_valid >= 0.5 && qm != s.last_q).then(|| v.q_meas / v.q_meas.norm());
+        if let (Some(q_m), 0) = (q_new, d.delay) {
+            self.star_update(&mut s, &q_m)?;
             s.initialized = true;
+        }
+        if q_new.is_some() {
             s.last_q = qm;
         }
         let sm = [v.sun_meas.x, v.sun_meas.y, v.sun_meas.z];
@@ -205,7 +247,7 @@ impl Mekf {
             unit("sun_ref", &v.sun_ref)?;
         }
         if d.use_sun && v.sun_valid >= 0.5 && sm != s.last_sun {
-            Self::vector_update(&mut s, &v.sun_meas, &v.sun_ref, d.sun_var, "sun", "sun-sensor")?;
+            t = Self::vector_update(&mut s, &v.sun_meas, &v.sun_ref, d.sun_var, "sun", "sun-sensor")? * t;
             s.last_sun = sm;
         }
         let mm = [v.b_meas.x, v.b_meas.y, v.b_meas.z];
@@ -214,8 +256,11 @@ impl Mekf {
             unit("b_ref", &v.b_ref)?;
         }
         if d.use_mag && mm != s.last_mag {
-            Self::vector_update(&mut s, &v.b_meas, &v.b_ref, d.mag_var, "b", "magnetometer")?;
+            t = Self::vector_update(&mut s, &v.b_meas, &v.b_ref, d.mag_var, "b", "magnetometer")? * t;
             s.last_mag = mm;
+        }
+        if d.delay > 0 {
+            self.delayed_star_update(&mut s, t, q_new)?;
         }
         s.w = v.w_meas;
         if !(s.q.coords.iter().all(|x| x.is_finite()) && s.p.iter().all(|x| x.is_finite())) {
@@ -231,7 +276,7 @@ impl Mekf {
         }
         let mut s = s.clone();
         for j in s.k + 1..=k {
-            s = self.next(&s, j, v)?;
+            s = self.next(s, j, v)?;
         }
         Ok(s)
     }
@@ -303,6 +348,7 @@ estimation error squared and the NIS follow chi-square distributions of 6 and ni
             use_st: v.use_star_tracker == 1,
             use_sun: v.use_sun == 1,
             use_mag: v.use_mag == 1,
+            delay: delay::delay_samples(v.st_latency, t)?,
         };
         let s = Est {
             k: k0 - 1,
@@ -317,6 +363,7 @@ estimation error squared and the NIS follow chi-square distributions of 6 and ni
             innovation: Vector3::zeros(),
             nis: 0.0,
             nis_dim: 0,
+            hist: VecDeque::new(),
         };
         Ok(Mekf { d, s })
     }
@@ -357,7 +404,7 @@ estimation error squared and the NIS follow chi-square distributions of 6 and ni
         if (s.p - s.p.transpose()).abs().max() > 0.0 || s.p.cholesky().is_none() {
             return Err("restored state: covariance is not symmetric positive definite".into());
         }
-        Ok(())
+        delay::check(&s.hist, self.d.delay, s.k)
     }
 }
 
