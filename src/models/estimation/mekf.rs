@@ -1,7 +1,8 @@
 //! `Mekf`: the multiplicative extended Kalman filter of spacecraft attitude — error state of three
 //! small-angle attitude errors and three gyro biases, a unit reference quaternion kept unit by the
 //! multiplicative reset, propagation with the gyro, Joseph-form updates from star-tracker quaternions
-//! and from body-frame unit vectors (sun sensor, magnetometer) with their reference directions.
+//! and from body-frame unit vectors (sun sensor, magnetometer) with their reference directions; a star
+//! tracker's latency (`st_latency`) is compensated by a delayed update (`mekf_delay.rs`).
 
 use std::collections::VecDeque;
 
@@ -287,7 +288,7 @@ impl Model for Mekf {
     const EVOLVING: &'static [&'static str] = &["s"];
     const INFO: ModelInfo = ModelInfo {
         name: "Mekf",
-        description: "Multiplicative extended Kalman filter of attitude and gyro bias: gyro propagation, star-tracker and sun/magnetometer vector updates (Joseph form), covariance, innovation and NIS outputs",
+        description: "Multiplicative extended Kalman filter of attitude and gyro bias: gyro propagation, star-tracker (with latency compensation) and sun/magnetometer vector updates (Joseph form), covariance, innovation and NIS outputs",
         source: "multiplicative EKF of [Lefferts-Markley-Shuster-1982] in the discrete form of [Markley-Crassidis-2014] Ch. 6 (state transition and process noise of a gyro with angle and rate random walk); vector measurement on the tangent plane of the predicted direction and measurement-once rule: project choice",
         equations_html: concat!("<pre>state: q_hat (unit), b_hat; error state x = (dtheta, db), q = q_hat (x) exp(dtheta/2), covariance P (6x6)\n\
 samples at t_k = k T; at the first sample k0: q_hat = q_init, b_hat = bias_init, P = diag(sigma_att_init^2 I, sigma_bias_init^2 I)\n\
@@ -306,13 +307,26 @@ each update (sequential: star tracker, sun, magnetometer), Joseph form:\n\
   S = H P H^T + R,  K = P H^T S^-1,  dx = K nu,  P <- (I - K H) P (I - K H)^T + K R K^T  (symmetrised)\n\
   reset: q_hat <- q_hat (x) exp(dtheta/2) (normalised),  b_hat <- b_hat + db\n\
   nis += nu^T S^-1 nu,  nis_dim += dim(nu)\n\
+star-tracker latency (st_latency = d T > 0): q_meas arriving at sample k was measured at sample s = k - d;\n\
+  kept: q_hat_j, b_hat_j, P_j and T_j = (I - K H of sample j's vector updates) Phi_j for j = s..k\n\
+  update of sample s (after the vector updates of sample k): nu = log(q_hat_s* (x) q_meas), S = P_s,att + R,\n\
+    K = P_s H^T S^-1, dx_s = K nu, P_s+ (Joseph);  nis += nu^T S^-1 nu, nis_dim += 3\n\
+  carried over the delay (Larsen): M_j = T_j ... T_s+1, for j = s+1..k:\n\
+    dx_j = M_j dx_s (reset of q_hat_j, b_hat_j),  P_j <- P_j - M_j (P_s - P_s+) M_j^T\n\
+  first measurement (init_from_star_tracker = 1): q_hat_j <- q_meas (x) q_hat_s* (x) q_hat_j, P_s,att = R\n\
 outputs (held until the next sample): q_est = q_hat, w_est = w_meas,k - b_hat, bias_est = b_hat,\n\
-  p_att, p_bias = diag(P), innovation = star-tracker nu of sample k, nis, nis_dim of sample k</pre>\n\
+  p_att, p_bias = diag(P), innovation = star-tracker nu used at sample k, nis, nis_dim of sample k</pre>\n\
 <p>A measurement is used once: an update happens only when the measurement differs from the last one used \
 (sensors hold their output between their samples, so a held sample is not used again). With \
 init_from_star_tracker = 1 the first usable star-tracker measurement sets the attitude estimate and its \
-covariance (the star tracker's noise) instead of updating it. The filter treats measurements as taken at \
-the filter's sample instant: a star tracker's latency should be zero or compensated. The discrete ARW model \
+covariance (the star tracker's noise) instead of updating it. With st_latency = 0 a quaternion is taken \
+as measured at its arrival; st_latency (a whole number d of sample periods, at most 1000, else refused at \
+initialization) compensates a star tracker's latency: the innovation is formed against the estimate of the \
+measurement's sample and the correction is carried to the current sample through the stored transitions \
+(Larsen's method over the whole kept history, so that the next delayed measurement sees the earlier ones; \
+exact for a linear system when the star tracker is the only measurement, the vector updates inside the \
+delay use gains without the delayed information; a measurement taken before the first sample is not used). \
+Sun and magnetometer directions are taken as measured at their arrival. The discrete ARW model \
 assumes one gyro sample per filter sample (filter period = gyro period). A sample strictly inside a \
 communication step sees the inputs held at the step's start. With the true noise densities the normalized \
 estimation error squared and the NIS follow chi-square distributions of 6 and nis_dim degrees of freedom.</p>", crate::sample_grid_note!()),
