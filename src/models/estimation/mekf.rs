@@ -38,7 +38,7 @@ declare_variables! {
         47 => bias_est: Vec3 = [0.0; 3], Output, "rad/s", "Estimated gyro bias";
         50 => p_att: Vec3 = [0.0; 3], Output, "rad2", "Covariance diagonal of the attitude error (body axes)";
         53 => p_bias: Vec3 = [0.0; 3], Output, "rad2/s2", "Covariance diagonal of the bias error";
-        56 => innovation: Vec3 = [0.0; 3], Output, "rad", "Star-tracker innovation of the current sample: rotation vector from the predicted to the measured attitude (0 without a star-tracker update)";
+        56 => innovation: Vec3 = [0.0; 3], Output, "rad", "Star-tracker innovation of the current sample: rotation vector from the predicted attitude (with st_latency > 0: the estimate of the measurement's sample) to the measured one (0 without a star-tracker update)";
         59 => nis: Real = 0.0, Output, "", "Normalized innovation squared of the current sample's updates, summed over them (0 without updates)";
         60 => nis_dim: Integer = 0, Output, "", "Innovation dimension of the current sample: 3 per star-tracker update + 2 per vector update (0 = no update)";
         100 => sample_period: Real = 0.01, Parameter, "s", "Sample period T of the filter (equal to the gyro's, so that each gyro sample is used once)", Range(1e-6, 1e4);
