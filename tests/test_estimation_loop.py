@@ -11,7 +11,8 @@
   last third of paper 000's large slew) the RMS difference of the Euler-axis error α between the loop fed
   by the estimator and the same loop fed the truth is at most 3 σ, σ the RMS over that phase of the
   filter's own attitude sigma sqrt(tr P_att) — and the same test fails with the sensing loop's 0.1 s
-  star-tracker latency, which the filter does not compensate;
+  star-tracker latency, which the variant's filter does not compensate (``st_latency`` = 0; compensated in
+  tests/test_mekf_latency.py);
 * the error of that uncompensated latency is the rate times the latency: one gyro sample of star-tracker
   latency makes the estimate's RMS error over the slew |ω| τ (the plant's true rate).
 """
@@ -200,7 +201,7 @@ def test_benchmark_with_estimator_column(tmp_path):
 
 
 def test_a_latency_of_one_gyro_sample_lags_the_estimate_by_rate_times_latency():
-    """The Mekf assumes zero latency (docs/estimation.md): a star tracker τ late makes the estimate lag by about
+    """The Mekf with ``st_latency`` = 0 (default) assumes zero latency (docs/estimation.md): a star tracker τ late makes the estimate lag by about
     |ω| τ. Over the slew of paper 000's large manoeuvre (1 s to 10 s, the plant's true rate ~10 °/s RMS), with
     τ = one gyro sample (0.01 s) the RMS estimate error is |ω| τ (RMS of the true rate times τ) within
     -30 %/+50 %, and without latency it is under a tenth of that."""

@@ -94,6 +94,17 @@ pub fn joseph_update<const M: usize>(
     r: &SMatrix<f64, M, M>,
     nu: &SVector<f64, M>,
 ) -> Option<(SVector<f64, 6>, Matrix6, f64)> {
+    joseph_update_with_gain(p, h, r, nu).map(|(dx, pp, nis, _)| (dx, pp, nis))
+}
+
+/// [`joseph_update`] that also returns the gain K (6 × M): the error-state transition of the update is
+/// I − K H (used to carry a delayed correction across the updates after the measurement's instant).
+pub fn joseph_update_with_gain<const M: usize>(
+    p: &Matrix6,
+    h: &SMatrix<f64, M, 6>,
+    r: &SMatrix<f64, M, M>,
+    nu: &SVector<f64, M>,
+) -> Option<(SVector<f64, 6>, Matrix6, f64, SMatrix<f64, 6, M>)> {
     let s = h * p * h.transpose() + r;
     let s = (s + s.transpose()) * 0.5;
     let chol = s.cholesky()?;
@@ -101,7 +112,7 @@ pub fn joseph_update<const M: usize>(
     let nis = nu.dot(&chol.solve(nu));
     let ikh = Matrix6::identity() - k * h;
     let pp = ikh * p * ikh.transpose() + k * r * k.transpose();
-    Some((k * nu, (pp + pp.transpose()) * 0.5, nis))
+    Some((k * nu, (pp + pp.transpose()) * 0.5, nis, k))
 }
 
 #[cfg(test)]

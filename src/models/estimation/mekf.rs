@@ -1,16 +1,22 @@
 //! `Mekf`: the multiplicative extended Kalman filter of spacecraft attitude — error state of three
 //! small-angle attitude errors and three gyro biases, a unit reference quaternion kept unit by the
 //! multiplicative reset, propagation with the gyro, Joseph-form updates from star-tracker quaternions
-//! and from body-frame unit vectors (sun sensor, magnetometer) with their reference directions.
+//! and from body-frame unit vectors (sun sensor, magnetometer) with their reference directions; a star
+//! tracker's latency (`st_latency`) is compensated by a delayed update (`mekf_delay.rs`).
+
+use std::collections::VecDeque;
 
 use nalgebra::{Matrix3, Quaternion, Rotation3, SMatrix, SVector, Vector3};
 use serde::{Deserialize, Serialize};
 
 use crate::declare_variables;
 use crate::math::attitude::{attitude_matrix, skew};
-use crate::math::attitude_kalman::{error_transition, gyro_process_noise, joseph_update, quat_exp, quat_log, Matrix6};
+use crate::math::attitude_kalman::{error_transition, gyro_process_noise, joseph_update_with_gain, quat_exp, quat_log, Matrix6};
 use crate::math::sample_grid;
 use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult};
+
+#[path = "mekf_delay.rs"]
+mod delay;
 
 /// At most this many filter samples per doStep (bounded work: a longer step is refused before any work).
 pub const MAX_SAMPLES_PER_CALL: i64 = 1_000_000;
@@ -32,7 +38,7 @@ declare_variables! {
         47 => bias_est: Vec3 = [0.0; 3], Output, "rad/s", "Estimated gyro bias";
         50 => p_att: Vec3 = [0.0; 3], Output, "rad2", "Covariance diagonal of the attitude error (body axes)";
         53 => p_bias: Vec3 = [0.0; 3], Output, "rad2/s2", "Covariance diagonal of the bias error";
-        56 => innovation: Vec3 = [0.0; 3], Output, "rad", "Star-tracker innovation of the current sample: rotation vector from the predicted to the measured attitude (0 without a star-tracker update)";
+        56 => innovation: Vec3 = [0.0; 3], Output, "rad", "Star-tracker innovation of the current sample: rotation vector from the predicted attitude (with st_latency > 0: the estimate of the measurement's sample) to the measured one (0 without a star-tracker update)";
         59 => nis: Real = 0.0, Output, "", "Normalized innovation squared of the current sample's updates, summed over them (0 without updates)";
         60 => nis_dim: Integer = 0, Output, "", "Innovation dimension of the current sample: 3 per star-tracker update + 2 per vector update (0 = no update)";
         100 => sample_period: Real = 0.01, Parameter, "s", "Sample period T of the filter (equal to the gyro's, so that each gyro sample is used once)", Range(1e-6, 1e4);
@@ -51,6 +57,7 @@ declare_variables! {
         124 => use_star_tracker: Integer = 1, Parameter, "", "1 = update with q_meas when st_valid >= 0.5 and q_meas is new", Choice(SWITCH);
         125 => use_sun: Integer = 0, Parameter, "", "1 = update with sun_meas when sun_valid >= 0.5 and sun_meas is new", Choice(SWITCH);
         126 => use_mag: Integer = 0, Parameter, "", "1 = update with b_meas whenever it is new", Choice(SWITCH);
+        127 => st_latency: Real = 0.0, Parameter, "s", "Star-tracker latency compensated by the filter (as the StarTracker's latency): a quaternion arriving at sample k was measured at sample k - st_latency/sample_period (a whole number, at most 1000)", Range(0.0, 10.0);
     }
 }
 
@@ -73,6 +80,8 @@ struct Derived {
     use_st: bool,
     use_sun: bool,
     use_mag: bool,
+    /// Star-tracker latency in samples (0: no compensation, the history stays empty).
+    delay: usize,
 }
 
 /// The filter after sample k: estimate, covariance, the gyro rate to propagate with, the last used
@@ -91,6 +100,9 @@ struct Est {
     innovation: Vector3<f64>,
     nis: f64,
     nis_dim: i32,
+    /// With a star-tracker latency: the filter after each of the last `delay` + 1 samples (the newest is
+    /// this one), for the delayed update (`mekf_delay`).
+    hist: VecDeque<delay::Entry>,
 }
 
 #[derive(Clone, Serialize, Deserialize)]
@@ -124,20 +136,21 @@ impl Mekf {
         s.b += dx.fixed_rows::<3>(3);
     }
 
-    fn update<const M: usize>(s: &mut Est, h: &SMatrix<f64, M, 6>, r: &SMatrix<f64, M, M>, nu: &SVector<f64, M>, what: &str) -> ModelResult {
-        let (dx, p, nis) = joseph_update(&s.p, h, r, nu).ok_or_else(|| format!("{what} update: innovation covariance is not positive definite"))?;
+    /// Joseph-form update of the current sample; returns its error-state transition I − K H.
+    fn update<const M: usize>(s: &mut Est, h: &SMatrix<f64, M, 6>, r: &SMatrix<f64, M, M>, nu: &SVector<f64, M>, what: &str) -> Result<Matrix6, String> {
+        let (dx, p, nis, k) = joseph_update_with_gain(&s.p, h, r, nu).ok_or_else(|| format!("{what} update: innovation covariance is not positive definite"))?;
         s.p = p;
         Self::reset(s, &dx);
         s.nis += nis;
         s.nis_dim += M as i32;
-        Ok(())
+        Ok(Matrix6::identity() - k * h)
     }
 
     /// Update with a measured body direction `meas` of the reference direction `refd`: the innovation is
     /// the measured unit vector's components on two unit vectors E = [e₁ e₂] perpendicular to the
     /// predicted b̂ = A(q̂) r, H = [Eᵀ [b̂×], 0], R = σ² I₂.
     /// `port`: the inputs' stem (`sun`, `b`), `what`: the sensor named in a message.
-    fn vector_update(s: &mut Est, meas: &Vector3<f64>, refd: &Vector3<f64>, var: f64, port: &str, what: &str) -> ModelResult {
+    fn vector_update(s: &mut Est, meas: &Vector3<f64>, refd: &Vector3<f64>, var: f64, port: &str, what: &str) -> Result<Matrix6, String> {
         let bm = unit(&format!("{port}_meas"), meas)?;
         let r = unit(&format!("{port}_ref"), refd)?;
         let bh = attitude_matrix(&s.q) * r;
@@ -152,12 +165,50 @@ impl Mekf {
         Self::update(s, &h, &(SMatrix::<f64, 2, 2>::identity() * var), &nu, what)
     }
 
+    /// The zero-latency star-tracker update of sample k (a new usable q_meas, normalised): the first one
+    /// initialises the attitude with init_from_star_tracker = 1, the others update it.
+    fn star_update(&self, s: &mut Est, q_m: &Quaternion<f64>) -> ModelResult {
+        if self.d.init_from_st && !s.initialized {
+            // first measurement: the estimate is the measurement, its error covariance the noise's
+            s.q = if q_m.dot(&s.q) < 0.0 { -q_m } else { *q_m };
+            s.p.fixed_view_mut::<3, 6>(0, 0).fill(0.0);
+            s.p.fixed_view_mut::<6, 3>(0, 0).fill(0.0);
+            s.p.fixed_view_mut::<3, 3>(0, 0).copy_from(&self.d.r_st);
+        } else {
+            let nu = quat_log(&(s.q.conjugate() * q_m));
+            let mut h = SMatrix::<f64, 3, 6>::zeros();
+            h.fixed_view_mut::<3, 3>(0, 0).fill_with_identity();
+            Self::update(s, &h, &self.d.r_st, &nu, "star-tracker")?;
+            s.innovation = nu;
+        }
+        Ok(())
+    }
+
+    /// The delayed star-tracker update of sample k (`st_latency` > 0): the current sample is recorded in
+    /// the history with its transition `t`, a new measurement `q_m` (if any) updates the history's oldest
+    /// sample and the correction is carried to the current one (`mekf_delay`).
+    fn delayed_star_update(&self, s: &mut Est, t: Matrix6, q_m: Option<Quaternion<f64>>) -> ModelResult {
+        let d = &self.d;
+        let e = delay::Entry { k: s.k, q: s.q, b: s.b, p: s.p, t };
+        delay::record(&mut s.hist, d.delay, e);
+        if let Some(q_m) = q_m {
+            if d.init_from_st && !s.initialized {
+                s.initialized = delay::initialize(&mut s.hist, d.delay, &q_m, &d.r_st);
+            } else if let Some((nu, nis)) = delay::update(&mut s.hist, d.delay, &q_m, &d.r_st)? {
+                (s.innovation, s.nis, s.nis_dim) = (nu, s.nis + nis, s.nis_dim + 3);
+            }
+            let now = s.hist.back().expect("the current sample is recorded");
+            (s.q, s.b, s.p) = (now.q, now.b, now.p);
+        }
+        Ok(())
+    }
+
     /// The filter after sample k given the filter after sample k − 1 (first sample k0: the initial estimate).
-    fn next(&self, prev: &Est, k: i64, v: &MekfVars) -> Result<Est, String> {
+    fn next(&self, mut s: Est, k: i64, v: &MekfVars) -> Result<Est, String> {
         let d = &self.d;
         finite("w_meas", v.w_meas.as_slice())?;
-        let mut s = prev.clone();
         s.k = k;
+        let mut t = Matrix6::identity();
         if k == d.k0 {
             (s.q, s.b, s.p) = (d.q0, d.b0, d.p0);
         } else {
@@ -165,8 +216,8 @@ impl Mekf {
             // rule: exact for a rate linear over the step, as the plant's under a held torque)
             let w = (s.w + v.w_meas) * 0.5 - s.b;
             s.q = (s.q * quat_exp(&(w * d.period))).normalize();
-            let phi = error_transition(&w, d.period);
-            let p = phi * s.p * phi.transpose() + d.q_proc;
+            t = error_transition(&w, d.period);
+            let p = t * s.p * t.transpose() + d.q_proc;
             s.p = (p + p.transpose()) * 0.5;
         }
         (s.innovation, s.nis, s.nis_dim) = (Vector3::zeros(), 0.0, 0);
@@ -181,22 +232,14 @@ impl Mekf {
                 return Err(format!("input quaternion q_meas has norm {n}, expected 1 (is it connected?)"));
             }
         }
-        if d.use_st && v.st_valid >= 0.5 && qm != s.last_q {
-            let q_m = v.q_meas / v.q_meas.norm();
-            if d.init_from_st && !s.initialized {
-                // first measurement: the estimate is the measurement, its error covariance the noise's
-                s.q = if q_m.dot(&s.q) < 0.0 { -q_m } else { q_m };
-                s.p.fixed_view_mut::<3, 6>(0, 0).fill(0.0);
-                s.p.fixed_view_mut::<6, 3>(0, 0).fill(0.0);
-                s.p.fixed_view_mut::<3, 3>(0, 0).copy_from(&d.r_st);
-            } else {
-                let nu = quat_log(&(s.q.conjugate() * q_m));
-                let mut h = SMatrix::<f64, 3, 6>::zeros();
-                h.fixed_view_mut::<3, 3>(0, 0).fill_with_identity();
-                Self::update(&mut s, &h, &d.r_st, &nu, "star-tracker")?;
-                s.innovation = nu;
-            }
+        // a new usable star-tracker measurement is used once: now (no latency) or after the vector
+        // updates, as an update of the sample it was measured at
+        let q_new = (d.use_st && v.st_valid >= 0.5 && qm != s.last_q).then(|| v.q_meas / v.q_meas.norm());
+        if let (Some(q_m), 0) = (q_new, d.delay) {
+            self.star_update(&mut s, &q_m)?;
             s.initialized = true;
+        }
+        if q_new.is_some() {
             s.last_q = qm;
         }
         let sm = [v.sun_meas.x, v.sun_meas.y, v.sun_meas.z];
@@ -205,7 +248,7 @@ impl Mekf {
             unit("sun_ref", &v.sun_ref)?;
         }
         if d.use_sun && v.sun_valid >= 0.5 && sm != s.last_sun {
-            Self::vector_update(&mut s, &v.sun_meas, &v.sun_ref, d.sun_var, "sun", "sun-sensor")?;
+            t = Self::vector_update(&mut s, &v.sun_meas, &v.sun_ref, d.sun_var, "sun", "sun-sensor")? * t;
             s.last_sun = sm;
         }
         let mm = [v.b_meas.x, v.b_meas.y, v.b_meas.z];
@@ -214,8 +257,11 @@ impl Mekf {
             unit("b_ref", &v.b_ref)?;
         }
         if d.use_mag && mm != s.last_mag {
-            Self::vector_update(&mut s, &v.b_meas, &v.b_ref, d.mag_var, "b", "magnetometer")?;
+            t = Self::vector_update(&mut s, &v.b_meas, &v.b_ref, d.mag_var, "b", "magnetometer")? * t;
             s.last_mag = mm;
+        }
+        if d.delay > 0 {
+            self.delayed_star_update(&mut s, t, q_new)?;
         }
         s.w = v.w_meas;
         if !(s.q.coords.iter().all(|x| x.is_finite()) && s.p.iter().all(|x| x.is_finite())) {
@@ -231,7 +277,7 @@ impl Mekf {
         }
         let mut s = s.clone();
         for j in s.k + 1..=k {
-            s = self.next(&s, j, v)?;
+            s = self.next(s, j, v)?;
         }
         Ok(s)
     }
@@ -242,7 +288,7 @@ impl Model for Mekf {
     const EVOLVING: &'static [&'static str] = &["s"];
     const INFO: ModelInfo = ModelInfo {
         name: "Mekf",
-        description: "Multiplicative extended Kalman filter of attitude and gyro bias: gyro propagation, star-tracker and sun/magnetometer vector updates (Joseph form), covariance, innovation and NIS outputs",
+        description: "Multiplicative extended Kalman filter of attitude and gyro bias: gyro propagation, star-tracker (with latency compensation) and sun/magnetometer vector updates (Joseph form), covariance, innovation and NIS outputs",
         source: "multiplicative EKF of [Lefferts-Markley-Shuster-1982] in the discrete form of [Markley-Crassidis-2014] Ch. 6 (state transition and process noise of a gyro with angle and rate random walk); vector measurement on the tangent plane of the predicted direction and measurement-once rule: project choice",
         equations_html: concat!("<pre>state: q_hat (unit), b_hat; error state x = (dtheta, db), q = q_hat (x) exp(dtheta/2), covariance P (6x6)\n\
 samples at t_k = k T; at the first sample k0: q_hat = q_init, b_hat = bias_init, P = diag(sigma_att_init^2 I, sigma_bias_init^2 I)\n\
@@ -261,13 +307,26 @@ each update (sequential: star tracker, sun, magnetometer), Joseph form:\n\
   S = H P H^T + R,  K = P H^T S^-1,  dx = K nu,  P <- (I - K H) P (I - K H)^T + K R K^T  (symmetrised)\n\
   reset: q_hat <- q_hat (x) exp(dtheta/2) (normalised),  b_hat <- b_hat + db\n\
   nis += nu^T S^-1 nu,  nis_dim += dim(nu)\n\
+star-tracker latency (st_latency = d T > 0): q_meas arriving at sample k was measured at sample s = k - d;\n\
+  kept: q_hat_j, b_hat_j, P_j and T_j = (I - K H of sample j's vector updates) Phi_j for j = s..k\n\
+  update of sample s (after the vector updates of sample k): nu = log(q_hat_s* (x) q_meas), S = P_s,att + R,\n\
+    K = P_s H^T S^-1, dx_s = K nu, P_s+ (Joseph);  nis += nu^T S^-1 nu, nis_dim += 3\n\
+  carried over the delay (Larsen): M_j = T_j ... T_s+1, for j = s+1..k:\n\
+    dx_j = M_j dx_s (reset of q_hat_j, b_hat_j),  P_j <- P_j - M_j (P_s - P_s+) M_j^T\n\
+  first measurement (init_from_star_tracker = 1): q_hat_j <- q_meas (x) q_hat_s* (x) q_hat_j, P_s,att = R\n\
 outputs (held until the next sample): q_est = q_hat, w_est = w_meas,k - b_hat, bias_est = b_hat,\n\
-  p_att, p_bias = diag(P), innovation = star-tracker nu of sample k, nis, nis_dim of sample k</pre>\n\
+  p_att, p_bias = diag(P), innovation = star-tracker nu used at sample k, nis, nis_dim of sample k</pre>\n\
 <p>A measurement is used once: an update happens only when the measurement differs from the last one used \
 (sensors hold their output between their samples, so a held sample is not used again). With \
 init_from_star_tracker = 1 the first usable star-tracker measurement sets the attitude estimate and its \
-covariance (the star tracker's noise) instead of updating it. The filter treats measurements as taken at \
-the filter's sample instant: a star tracker's latency should be zero or compensated. The discrete ARW model \
+covariance (the star tracker's noise) instead of updating it. With st_latency = 0 a quaternion is taken \
+as measured at its arrival; st_latency (a whole number d of sample periods, at most 1000, else refused at \
+initialization) compensates a star tracker's latency: the innovation is formed against the estimate of the \
+measurement's sample and the correction is carried to the current sample through the stored transitions \
+(Larsen's method over the whole kept history, so that the next delayed measurement sees the earlier ones; \
+exact for a linear system when the star tracker is the only measurement, the vector updates inside the \
+delay use gains without the delayed information; a measurement taken before the first sample is not used). \
+Sun and magnetometer directions are taken as measured at their arrival. The discrete ARW model \
 assumes one gyro sample per filter sample (filter period = gyro period). A sample strictly inside a \
 communication step sees the inputs held at the step's start. With the true noise densities the normalized \
 estimation error squared and the NIS follow chi-square distributions of 6 and nis_dim degrees of freedom.</p>", crate::sample_grid_note!()),
@@ -303,6 +362,7 @@ estimation error squared and the NIS follow chi-square distributions of 6 and ni
             use_st: v.use_star_tracker == 1,
             use_sun: v.use_sun == 1,
             use_mag: v.use_mag == 1,
+            delay: delay::delay_samples(v.st_latency, t)?,
         };
         let s = Est {
             k: k0 - 1,
@@ -317,6 +377,7 @@ estimation error squared and the NIS follow chi-square distributions of 6 and ni
             innovation: Vector3::zeros(),
             nis: 0.0,
             nis_dim: 0,
+            hist: VecDeque::new(),
         };
         Ok(Mekf { d, s })
     }
@@ -357,7 +418,7 @@ estimation error squared and the NIS follow chi-square distributions of 6 and ni
         if (s.p - s.p.transpose()).abs().max() > 0.0 || s.p.cholesky().is_none() {
             return Err("restored state: covariance is not symmetric positive definite".into());
         }
-        Ok(())
+        delay::check(&s.hist, self.d.delay, s.k)
     }
 }
 

@@ -55,10 +55,13 @@ def drive(f: Fmu, k0: int, k1: int) -> np.ndarray:
     return np.array(out)
 
 
+@pytest.mark.parametrize("st_latency", [0.0, 0.1])
 @pytest.mark.parametrize("fmi", [2, 3])
-def test_fmu_state_restore_mid_run_is_bit_identical(fmi):
+def test_fmu_state_restore_mid_run_is_bit_identical(fmi, st_latency):
+    """With st_latency = 0.1 s the state carries the delay history of 11 samples (estimates, covariances,
+    transitions): restored, the delayed updates continue bit for bit."""
     path = fmu_path("Mekf") if fmi == 2 else fmu_path("Mekf").parent / "fmi3" / "Mekf.fmu"
-    f = Fmu("Mekf", {"sigma_bias_init": 1e-4}, path=path)
+    f = Fmu("Mekf", {"sigma_bias_init": 1e-4, "st_latency": st_latency}, path=path)
     try:
         drive(f, 0, 300)
         s = f.slave
@@ -82,7 +85,7 @@ def test_fmu_state_restore_mid_run_is_bit_identical(fmi):
     # the state carries a converged covariance: far below the initial (0.1 rad)^2, the bias near the truth
     assert a[-1, 4:7].max() < 1e-8
     assert np.all(np.abs(a[-1, 7:10] - BIAS) < 5e-5)
-    print(f"\nMekf FMI {fmi}: restore after 300 steps, 200 steps bit-identical (get/set and {len(blob)}-byte "
+    print(f"\nMekf FMI {fmi}, st_latency {st_latency} s: restore after 300 steps, 200 steps bit-identical (get/set and {len(blob)}-byte "
           f"serialized); p_att {a[-1, 4:7]}, bias error {a[-1, 7:10] - BIAS}")
 
 
@@ -104,7 +107,8 @@ def test_bad_inputs_and_parameters_are_refused_with_the_reason():
         assert "q_meas has norm 0" in " ".join(m[2] for m in f.messages)
     finally:
         f.close()
-    for bad in ({"st_noise_cross": 0.0}, {"arw_psd_x": -1e-9}, {"use_sun": 2}):
+    for bad in ({"st_noise_cross": 0.0}, {"arw_psd_x": -1e-9}, {"use_sun": 2}, {"st_latency": 0.105},
+                {"st_latency": 11.0}, {"st_latency": 1.0, "sample_period": 1e-4}):
         with pytest.raises(Exception) as e:
             Fmu("Mekf", bad, logging_on=True)
         assert next(iter(bad)) in str(e.value), (bad, str(e.value))
