@@ -173,10 +173,11 @@ def with_estimation(sc: Scenario, name: str | None = None, mekf: dict | None = N
     decides, sample by sample) and the magnetometer's field (``b_meas_*``), each with its reference direction
     from the Ephemeris (``sun_ref_*``, ``b_ref_*``). The plant's orbit parameters go to every environment-reading unit, so
     sensors, ephemeris and plant see one environment. ``mekf``: parameters over :func:`mekf_params`.
-    ``star_tracker``: parameters over :data:`STAR_TRACKER_EST` (no latency: the Mekf takes a quaternion as
-    measured at its arrival and does not compensate a delay; a latency τ makes its estimate lag by about
-    |ω| τ: with τ = 0.1 s, an RMS error of ~1.2° during paper 000's large slew and ~0.08° over its pointing
-    phase, against a filter sigma of ~0.005°; docs/estimation.md)."""
+    ``star_tracker``: parameters over :data:`STAR_TRACKER_EST` (no latency, and the Mekf's ``st_latency`` left
+    at 0: a quaternion is taken as measured at its arrival. With a latency τ and no compensation the estimate
+    lags by about |ω| τ: with τ = 0.1 s, an RMS error of ~1.2° during paper 000's large slew and ~0.08° over
+    its pointing phase, against a filter sigma of ~0.005°. To model a late star tracker, give it ``latency``
+    and the filter the same ``st_latency``, a whole number of its sample periods: docs/estimation.md)."""
     s = copy.deepcopy(sc) if any(c.name == "gyro" for c in sc.components) else with_sensors(sc, name=sc.name)
     if any(c.name == "estimator" for c in s.components):
         raise KeyError(f"with_estimation: scenario {sc.name!r} already has an estimator")
