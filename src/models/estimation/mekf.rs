@@ -129,11 +129,36 @@ fn unit(name: &str, x: &Vector3<f64>) -> Result<Vector3<f64>, String> {
     Ok(x / n)
 }
 
+/// Multiplicative reset of an estimate (q̂, b̂) by an error-state correction: q̂ ← q̂ ⊗ exp(δθ/2)
+/// (renormalised), b̂ ← b̂ + δb (also the delayed update's, `mekf_delay`).
+fn apply_correction(q: &mut Quaternion<f64>, b: &mut Vector3<f64>, dx: &SVector<f64, 6>) {
+    *q = (*q * quat_exp(&dx.fixed_rows::<3>(0).into_owned())).normalize();
+    *b += dx.fixed_rows::<3>(3);
+}
+
+/// A star-tracker quaternion update's innovation against the prediction q̂ (rotation vector from q̂ to
+/// q_meas) and its H = [I 0]: the attitude error is observed directly, the bias not.
+fn star_innovation(q: &Quaternion<f64>, q_m: &Quaternion<f64>) -> (Vector3<f64>, SMatrix<f64, 3, 6>) {
+    let mut h = SMatrix::<f64, 3, 6>::zeros();
+    h.fixed_view_mut::<3, 3>(0, 0).fill_with_identity();
+    (quat_log(&(q.conjugate() * q_m)), h)
+}
+
+/// Initialisation from a first star-tracker quaternion: the measurement on the estimate's hemisphere
+/// (the same rotation) and the covariance whose attitude block is the star tracker's noise, uncorrelated
+/// with the bias.
+fn star_initialization(q: &Quaternion<f64>, p: &Matrix6, q_m: &Quaternion<f64>, r_st: &Matrix3<f64>) -> (Quaternion<f64>, Matrix6) {
+    let mut p = *p;
+    p.fixed_view_mut::<3, 6>(0, 0).fill(0.0);
+    p.fixed_view_mut::<6, 3>(0, 0).fill(0.0);
+    p.fixed_view_mut::<3, 3>(0, 0).copy_from(r_st);
+    (if q_m.dot(q) < 0.0 { -q_m } else { *q_m }, p)
+}
+
 impl Mekf {
-    /// Multiplicative reset: q ← q ⊗ exp(δθ/2) (renormalised), b ← b + δb, δx ← 0.
+    /// Multiplicative reset of the current estimate, δx ← 0.
     fn reset(s: &mut Est, dx: &SVector<f64, 6>) {
-        s.q = (s.q * quat_exp(&dx.fixed_rows::<3>(0).into_owned())).normalize();
-        s.b += dx.fixed_rows::<3>(3);
+        apply_correction(&mut s.q, &mut s.b, dx);
     }
 
     /// Joseph-form update of the current sample; returns its error-state transition I − K H.
@@ -170,14 +195,9 @@ impl Mekf {
     fn star_update(&self, s: &mut Est, q_m: &Quaternion<f64>) -> ModelResult {
         if self.d.init_from_st && !s.initialized {
             // first measurement: the estimate is the measurement, its error covariance the noise's
-            s.q = if q_m.dot(&s.q) < 0.0 { -q_m } else { *q_m };
-            s.p.fixed_view_mut::<3, 6>(0, 0).fill(0.0);
-            s.p.fixed_view_mut::<6, 3>(0, 0).fill(0.0);
-            s.p.fixed_view_mut::<3, 3>(0, 0).copy_from(&self.d.r_st);
+            (s.q, s.p) = star_initialization(&s.q, &s.p, q_m, &self.d.r_st);
         } else {
-            let nu = quat_log(&(s.q.conjugate() * q_m));
-            let mut h = SMatrix::<f64, 3, 6>::zeros();
-            h.fixed_view_mut::<3, 3>(0, 0).fill_with_identity();
+            let (nu, h) = star_innovation(&s.q, q_m);
             Self::update(s, &h, &self.d.r_st, &nu, "star-tracker")?;
             s.innovation = nu;
         }

@@ -17,10 +17,10 @@
 
 use std::collections::VecDeque;
 
-use nalgebra::{Matrix3, Quaternion, SMatrix, Vector3};
+use nalgebra::{Matrix3, Quaternion, Vector3};
 use serde::{Deserialize, Serialize};
 
-use crate::math::attitude_kalman::{joseph_update_with_gain, quat_exp, quat_log, Matrix6};
+use crate::math::attitude_kalman::{joseph_update_with_gain, Matrix6};
 
 /// At most this many filter samples of star-tracker latency (the history holds one more entry).
 pub const MAX_DELAY_SAMPLES: usize = 1000;
@@ -94,16 +94,10 @@ pub fn update(hist: &mut VecDeque<Entry>, d: usize, q_m: &Quaternion<f64>, r_st:
     if hist.len() < d + 1 {
         return Ok(None);
     }
-    let nu = quat_log(&(hist[0].q.conjugate() * q_m));
-    let mut h = SMatrix::<f64, 3, 6>::zeros();
-    h.fixed_view_mut::<3, 3>(0, 0).fill_with_identity();
+    let (nu, h) = super::star_innovation(&hist[0].q, q_m);
     let (dx, p_plus, nis, _) =
         joseph_update_with_gain(&hist[0].p, &h, r_st, &nu).ok_or("star-tracker update (delayed): innovation covariance is not positive definite")?;
-    carry(hist, &p_plus, |e, m| {
-        let c = m * dx;
-        e.q = (e.q * quat_exp(&c.fixed_rows::<3>(0).into_owned())).normalize();
-        e.b += c.fixed_rows::<3>(3);
-    });
+    carry(hist, &p_plus, |e, m| super::apply_correction(&mut e.q, &mut e.b, &(m * dx)));
     Ok(Some((nu, nis)))
 }
 
@@ -116,11 +110,7 @@ pub fn initialize(hist: &mut VecDeque<Entry>, d: usize, q_m: &Quaternion<f64>, r
         return false;
     }
     let qs = hist[0].q;
-    let q_m = if q_m.dot(&qs) < 0.0 { -q_m } else { *q_m };
-    let mut p_new = hist[0].p;
-    p_new.fixed_view_mut::<3, 6>(0, 0).fill(0.0);
-    p_new.fixed_view_mut::<6, 3>(0, 0).fill(0.0);
-    p_new.fixed_view_mut::<3, 3>(0, 0).copy_from(r_st);
+    let (q_m, p_new) = super::star_initialization(&qs, &hist[0].p, q_m, r_st);
     carry(hist, &p_new, |e, _| e.q = (q_m * qs.conjugate() * e.q).normalize());
     true
 }
