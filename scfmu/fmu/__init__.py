@@ -114,11 +114,12 @@ def fmu_path(model: str) -> Path:
     return p
 
 
-def model_description(path: str | Path):
-    """fmpy's model description of an FMU file, after :func:`inspect_archive` (so that no oversized
-    ``modelDescription.xml`` is inflated in memory)."""
-    inspect_archive(path)
-    return read_model_description(str(path), validate=False)
+def file_key(path: str | Path) -> tuple:
+    """(resolved path, modification time, size) of a file: the key of the per-process caches of what is
+    read from an FMU file (a rebuilt file is read again)."""
+    path = Path(path).resolve()
+    st = path.stat()
+    return str(path), st.st_mtime_ns, st.st_size
 
 
 _DESCRIBED: dict = {}
@@ -128,14 +129,13 @@ _UNPACKED: dict = {}
 def described(path: str | Path):
     """fmpy's model description of an FMU file (validated against the schema), read from the archive after
     :func:`inspect_archive`, without unpacking anything; cached per process by path, modification time and
-    size. Planning, resolving and recording a run need no more than this."""
-    path = Path(path).resolve()
-    st = path.stat()
-    key = (str(path), st.st_mtime_ns, st.st_size)
+    size (:func:`file_key`); an oversized ``modelDescription.xml`` is never inflated in memory. Planning,
+    resolving and recording a run need no more than this."""
+    key = file_key(path)
     hit = _DESCRIBED.get(key)
     if hit is None:
-        inspect_archive(path)
-        hit = _DESCRIBED[key] = read_model_description(str(path))
+        inspect_archive(key[0])
+        hit = _DESCRIBED[key] = read_model_description(key[0])
     return hit
 
 
@@ -158,11 +158,9 @@ _DIGESTS: dict = {}
 def fmu_digest(path: Path) -> str:
     """SHA-256 of an FMU file (cached per process by path, modification time and size)."""
     import hashlib
-    path = Path(path).resolve()
-    st = path.stat()
-    key = (str(path), st.st_mtime_ns, st.st_size)
+    key = file_key(path)
     if key not in _DIGESTS:
-        _DIGESTS[key] = hashlib.sha256(path.read_bytes()).hexdigest()
+        _DIGESTS[key] = hashlib.sha256(Path(key[0]).read_bytes()).hexdigest()
     return _DIGESTS[key]
 
 

@@ -14,7 +14,7 @@ import copy
 import dataclasses
 from dataclasses import dataclass, field
 
-from ..fmu import described, fmu_path, is_path
+from ..fmu import described, file_key, fmu_path, is_path
 from .model import Component, Scenario
 from .profile import ProfileError, evaluate, names_in
 
@@ -25,8 +25,7 @@ _DECLARED: dict = {}
 def declared(model: str) -> dict:
     """``{name: ScalarVariable}`` of a model's FMU (the model description is read once per process)."""
     p = fmu_path(model)
-    st = p.stat()
-    key = (str(p), st.st_mtime_ns, st.st_size)
+    key = file_key(p)
     hit = _DECLARED.get(key)
     if hit is None:
         md = described(p)
