@@ -24,3 +24,12 @@ def q321(roll, pitch, yaw):
         q[axis] = math.sin(a / 2)
         return q
     return qmul(qmul(el(3, yaw), el(2, pitch)), el(1, roll))
+
+
+def estimate_error(r: dict) -> np.ndarray:
+    """Angle [rad] of the rotation from the true attitude (``q_*``) to the estimated one (``q_est_*``) of a
+    run's logged signals, sample by sample."""
+    qt = np.stack([r[f"q_{a}"] for a in "wxyz"], axis=1)
+    qe = np.stack([r[f"q_est_{a}"] for a in "wxyz"], axis=1)
+    dot = np.abs(np.sum(qt * qe, axis=1)) / np.linalg.norm(qt, axis=1) / np.linalg.norm(qe, axis=1)
+    return 2 * np.arccos(np.clip(dot, -1.0, 1.0))

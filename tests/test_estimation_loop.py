@@ -24,6 +24,7 @@ import math
 
 import numpy as np
 import pytest
+from quat_oracle import estimate_error
 
 from scfmu import scenario as scenarios
 from scfmu.engines import simulate
@@ -121,10 +122,7 @@ def test_every_engine_gives_the_same_run(name, t):
 
 def _quat_angle_deg(r: dict) -> np.ndarray:
     """Angle [deg] of the rotation from the true to the estimated attitude (numpy quaternion algebra)."""
-    qt = np.stack([r[f"q_{a}"] for a in "wxyz"], axis=1)
-    qe = np.stack([r[f"q_est_{a}"] for a in "wxyz"], axis=1)
-    dot = np.abs(np.sum(qt * qe, axis=1)) / np.linalg.norm(qt, axis=1) / np.linalg.norm(qe, axis=1)
-    return np.degrees(2 * np.arccos(np.clip(dot, -1.0, 1.0)))
+    return np.degrees(estimate_error(r))
 
 
 def perfect_knowledge(sc):

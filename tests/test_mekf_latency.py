@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from quat_oracle import estimate_error
 from scipy.stats import chi2
 
 from scfmu import scenario as scenarios
@@ -36,21 +37,13 @@ def _run(st_latency: float, fmi: int = 2) -> dict:
     return simulate(sc)
 
 
-def _angle(r: dict) -> np.ndarray:
-    """Angle [rad] of the rotation from the true to the estimated attitude."""
-    qt = np.stack([r[f"q_{a}"] for a in "wxyz"], axis=1)
-    qe = np.stack([r[f"q_est_{a}"] for a in "wxyz"], axis=1)
-    dot = np.abs(np.sum(qt * qe, axis=1)) / np.linalg.norm(qt, axis=1) / np.linalg.norm(qe, axis=1)
-    return 2 * np.arccos(np.clip(dot, -1.0, 1.0))
-
-
 def _checks(r: dict) -> dict:
     t = r["time"]
     assert np.allclose(np.diff(t), 0.01)  # every filter sample is logged: its nis and nis_dim are all seen
     ph = t >= t[-1] * 2 / 3
     nis, dof = float(np.sum(r["nis"][ph])), int(np.sum(r["nis_dim"][ph]))
     lo, hi = chi2.ppf([0.025, 0.975], dof) / dof
-    rms = float(np.sqrt(np.mean(_angle(r)[ph] ** 2)))
+    rms = float(np.sqrt(np.mean(estimate_error(r)[ph] ** 2)))
     sigma = float(np.sqrt(np.mean((r["p_att_x"] + r["p_att_y"] + r["p_att_z"])[ph])))
     return {"nis_dof": nis / dof, "dof": dof, "band": (float(lo), float(hi)), "rms_deg": np.degrees(rms),
             "sigma_deg": np.degrees(sigma), "nis_ok": lo <= nis / dof <= hi, "err_ok": rms <= 2 * sigma}
