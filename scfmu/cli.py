@@ -65,6 +65,9 @@ def _export(argv) -> int:
     ap.add_argument("kind", choices=KINDS)
     ap.add_argument("names", nargs="*", help="scenario names or files (default: the standard set)")
     ap.add_argument("--out", default=None, help="output folder (default fmus/ssp or fmus/loops)")
+    ap.add_argument("--platform", choices=("host", "all"), default="host",
+                    help="binaries the files carry: this machine's only (host, default: 4-10x smaller) or every "
+                         "platform the FMUs carry (all: a file for other machines)")
     ap.add_argument("--fmu", action="append", default=[], metavar="INSTANCE=PATH", help="use this FMU for INSTANCE")
     ap.add_argument("--map", action="append", default=[], metavar="INSTANCE.THEIRS=OURS", help="rename a unit's port")
     ap.add_argument("--set", action="append", default=[], metavar="INSTANCE.VAR=VALUE", help="parameter or input")
@@ -87,7 +90,7 @@ def _export(argv) -> int:
             print(f"scfmu export: {e.one_line()}", file=sys.stderr)
             return 2
     try:
-        export(a.kind, out, items)
+        export(a.kind, out, items, platform=a.platform)
     except (RuntimeError, KeyError, ValueError) as e:
         print(f"scfmu export: {e}", file=sys.stderr)
         return 1

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Builds the FMUs (scripts/build_fmus.sh, without the SSP files and loop FMUs: the wheel ships neither)
-# and writes platform wheels of the scfmu package into dist/: each carries the FMUs (scfmu/fmus/<Model>.fmu,
+# Builds the FMUs (scripts/build_fmus.sh with the reference results and the cross build of each platform
+# asked for, and nothing else: the wheel ships no SSP files or loop FMUs) and writes platform wheels of the scfmu package into dist/: each carries the FMUs (scfmu/fmus/<Model>.fmu,
 # FMI 2.0, and scfmu/fmus/fmi3/<Model>.fmu, FMI 3.0) with only its platform's binary, and the compiled
 # engine's loop library for that platform (scfmu/engines/native_loop/bin/<platform>/) and the Model Exchange
 # wrapper of Co-Simulation faces for that platform (scfmu/engines/me_cs/bin/<tuple>/). `pip install` of
@@ -8,11 +8,15 @@
 # pip picks the wheel of its platform by the tag. `scfmu export ssp|loop` writes the scenario files from
 # the installed package.
 #
-#   scripts/build_wheel.sh                       set-up, build the FMUs, write the wheel of this machine
+#   scripts/build_wheel.sh                       set-up, build the FMUs for this machine only (no cross build,
+#                                                no system package), write the wheel of this machine
 #                                                (linux-x86_64: dist/scfmu-<version>-py3-none-manylinux_2_N_x86_64.whl)
 #   scripts/build_wheel.sh --platform P          the wheel of platform P: linux-x86_64, linux-aarch64,
 #                                                win-amd64, macos-x86_64, macos-arm64, or all (every platform
-#                                                whose binaries the FMUs carry); repeatable
+#                                                whose cross toolchain is installed); repeatable. A platform
+#                                                other than this machine's is cross-built: its toolchain comes
+#                                                from `scripts/setup.sh --cross` (root, Debian 12), which this
+#                                                script never runs by itself
 #   scripts/build_wheel.sh --no-fmu-build        package the FMUs already in fmus/ (the test suite uses this)
 #   scripts/build_wheel.sh --out DIR             write the wheels into DIR instead of dist/
 # Prints one line per wheel written, the path last.
@@ -36,7 +40,14 @@ while [ $# -gt 0 ]; do
     shift
 done
 ALL=(linux-x86_64 linux-aarch64 win-amd64 macos-x86_64 macos-arm64)
-[ ${#platforms[@]} -gt 0 ] || platforms=(linux-x86_64)
+case "$(uname -s)-$(uname -m)" in
+    Linux-x86_64) host=linux-x86_64 ;;
+    *) host="" ;;  # the wheels are built on x86-64 Linux; elsewhere name the platform
+esac
+if [ ${#platforms[@]} -eq 0 ]; then
+    [ -n "$host" ] || { echo "build_wheel: this machine builds no wheel of its own: give --platform" >&2; exit 2; }
+    platforms=("$host")
+fi
 for p in "${platforms[@]}"; do
     case " all ${ALL[*]} " in
         *" $p "*) ;;
@@ -45,7 +56,17 @@ for p in "${platforms[@]}"; do
 done
 scripts/setup.sh >&2
 if [ "$build_fmus" = 1 ]; then
-    SCFMU_NO_SCENARIO_FILES=1 scripts/build_fmus.sh >&2
+    # the cross builds of the platforms asked for (build_fmus.sh names the one whose toolchain is missing)
+    cross=()
+    for p in "${platforms[@]}"; do
+        case "$p" in
+            all) cross+=(--all-platforms) ;;
+            "$host") ;;
+            macos-*) cross+=(--platform macos) ;;
+            *) cross+=(--platform "$p") ;;
+        esac
+    done
+    scripts/build_fmus.sh --reference-results "${cross[@]}" >&2
 fi
 shopt -s nullglob
 fmus=(fmus/*.fmu)

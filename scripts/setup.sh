@@ -2,9 +2,27 @@
 # One-time (idempotent) set-up on a fresh machine: checks the Rust toolchain and creates the Python
 # virtual environment .venv with the pinned packages of requirements.txt and this package (scfmu, editable,
 # with its `scfmu` command). Re-running is cheap: the venv is rebuilt only when requirements.txt or
-# pyproject.toml changes.
+# pyproject.toml changes. Without options it installs no system package (scripts/run.sh needs none: the
+# host build needs only cargo and the C linker the Rust toolchain already uses).
+#
+#   scripts/setup.sh                 the venv only (scripts/run.sh)
+#   scripts/setup.sh --test-tools    also rustfmt/clippy and the system tools the tests use: gcc, valgrind (apt)
+#   scripts/setup.sh --cross         also the cross toolchains of the other platforms' binaries and their
+#                                    emulators: MinGW-w64 + Debian's Rust + Wine (Windows), the aarch64 cross
+#                                    linker + qemu-user (Linux aarch64) (apt, as root on Debian 12)
+#   scripts/setup.sh --all           both (scripts/test.sh)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+test_tools=0
+cross=0
+for arg in "$@"; do
+    case "$arg" in
+        --test-tools) test_tools=1 ;;
+        --cross) cross=1 ;;
+        --all) test_tools=1; cross=1 ;;
+        *) echo "setup: unknown option '$arg' (allowed: --test-tools, --cross, --all)" >&2; exit 2 ;;
+    esac
+done
 
 if ! command -v cargo >/dev/null 2>&1; then
     echo "setup: cargo not found. Install the Rust toolchain (https://rustup.rs), then re-run." >&2
@@ -12,6 +30,7 @@ if ! command -v cargo >/dev/null 2>&1; then
 fi
 # The lint gates of scripts/lint.sh need rustfmt and clippy; a rustup toolchain adds them as components.
 for c in fmt:rustfmt clippy:clippy; do
+    [ "$test_tools" = 1 ] || break
     if ! cargo "${c%%:*}" --version >/dev/null 2>&1; then
         if command -v rustup >/dev/null 2>&1; then
             echo "setup: adding the ${c#*:} component"
@@ -30,8 +49,10 @@ apt_install() {
     DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "$@" >/dev/null
 }
 missing=()
-command -v gcc >/dev/null 2>&1 || missing+=(gcc libc6-dev)
-command -v valgrind >/dev/null 2>&1 || missing+=(valgrind)
+if [ "$test_tools" = 1 ]; then
+    command -v gcc >/dev/null 2>&1 || missing+=(gcc libc6-dev)
+    command -v valgrind >/dev/null 2>&1 || missing+=(valgrind)
+fi
 if [ ${#missing[@]} -gt 0 ]; then
     if can_apt; then
         echo "setup: installing ${missing[*]}"
@@ -46,7 +67,7 @@ fi
 # installed (not Debian 12, not root) the FMUs carry linux64 binaries only and scripts/build_fmus.sh
 # says so.
 win_missing=()
-if command -v dpkg-query >/dev/null 2>&1; then
+if [ "$cross" = 1 ] && command -v dpkg-query >/dev/null 2>&1; then
     for p in rustc-web cargo-web rust-web-src gcc-mingw-w64-x86-64 wine wine64; do
         dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "ok installed" || win_missing+=("$p")
     done
@@ -67,7 +88,7 @@ fi
 # scripts/build_fmus.sh says so. macOS binaries need no system package (Zig and cargo-zigbuild come from
 # requirements.txt).
 arm_missing=()
-if command -v dpkg-query >/dev/null 2>&1; then
+if [ "$cross" = 1 ] && command -v dpkg-query >/dev/null 2>&1; then
     for p in gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user libstd-rust-web-dev:arm64; do
         dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "ok installed" || arm_missing+=("$p")
     done

@@ -118,7 +118,7 @@ def universal_macho(slices: list[bytes]) -> bytes:
     return header.ljust(1 << align, b"\0") + body
 
 
-def _host() -> str:
+def host_tuple() -> str:
     """This machine's platform tuple."""
     cpu = "aarch64" if platform.machine().lower() in ("aarch64", "arm64") else "x86_64"
     osname = {"win32": "windows", "darwin": "darwin"}.get(sys.platform, "linux")
@@ -143,7 +143,7 @@ def wrapper_libraries() -> dict[str, Path]:
     out = {}
     for tup, (built, _, cross) in _BUILDS.items():
         shipped = pkg / "engines" / "me_cs" / "bin" / tup / built
-        local = root / ("target/release" if tup == _host() else cross or "-") / built
+        local = root / ("target/release" if tup == host_tuple() else cross or "-") / built
         if shipped.is_file():
             out[tup] = shipped
         elif checkout and local.is_file():
@@ -153,7 +153,7 @@ def wrapper_libraries() -> dict[str, Path]:
 
 def wrapper_library() -> Path | None:
     """This machine's wrapper library (see :func:`wrapper_libraries`), else None."""
-    return wrapper_libraries().get(_host())
+    return wrapper_libraries().get(host_tuple())
 
 
 def wrapper_identity() -> tuple:

@@ -2,7 +2,9 @@
 
 :func:`export` writes either kind for the given scenario names (default: every scenario a plug-in marks as
 exported) and validates each file (SSP 1.0 schemas; ``fmpy.validate_fmu``); ``scfmu export ssp|loop``
-is its command line, called by ``scripts/build_fmus.sh``.
+is its command line, called by ``scripts/build_fmus.sh --scenario-files``. ``platform`` chooses the binaries
+the files carry: ``"host"`` (default) this machine's only, ``"all"`` every one the FMUs carry
+(:mod:`scfmu.export.platforms` says why and how).
 """
 
 from __future__ import annotations
@@ -13,15 +15,19 @@ from ..registry import REGISTRY
 from ..scenario import get
 from ..scenario.ssp import file_stem, identifier, validate_ssp, write_ssp
 from .loops import write_loop_fmu
+from .platforms import PLATFORMS, keep_host_binaries
 
 KINDS = ("ssp", "loop")
 
 
-def export(kind: str, out: str | Path, names=None, log=print) -> list[Path]:
+def export(kind: str, out: str | Path, names=None, log=print, platform: str = "host") -> list[Path]:
     """Writes ``<out>/<name with / replaced by _>.ssp`` (kind "ssp") or ``.fmu`` (kind "loop") for each
-    scenario name (a registered name, or a scenario object) and validates it; returns the paths."""
+    scenario name (a registered name, or a scenario object) with the binaries of ``platform`` ("host" or
+    "all") and validates it; returns the paths."""
     if kind not in KINDS:
         raise ValueError(f"export kind {kind!r}: expected one of {KINDS}")
+    if platform not in PLATFORMS:
+        raise ValueError(f"export platform {platform!r}: expected one of {PLATFORMS}")
     out = Path(out)
     written = []
     ssd_names = {}
@@ -34,15 +40,19 @@ def export(kind: str, out: str | Path, names=None, log=print) -> list[Path]:
             if other != stem:
                 raise ValueError(f"scenarios {other} and {stem} get the same SSP system name {identifier(file_stem(sc.name))}")
             p = write_ssp(sc, out / f"{stem}.ssp")
+            if platform == "host":
+                keep_host_binaries(p)
             problems = validate_ssp(p)
             what = "not valid SSP 1.0"
         else:
             from fmpy.validation import validate_fmu
             p = write_loop_fmu(sc, out / f"{stem}.fmu")
+            if platform == "host":
+                keep_host_binaries(p)
             problems = validate_fmu(str(p))
             what = "fmpy validation failed"
         if problems:
             raise RuntimeError(f"{p}: {what}: {problems[:5]}")
-        log(f"wrote {p} ({p.stat().st_size // 1024} KiB)")
+        log(f"wrote {p} ({p.stat().st_size // 1024} KiB, binaries: {'this machine' if platform == 'host' else 'all'})")
         written.append(p)
     return written
