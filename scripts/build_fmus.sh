@@ -65,8 +65,10 @@ if [ "$engines" = 1 ]; then
 else
     cargo build --release --locked -p spacecraft_fmus_cdylib -p spacecraft_fmus_package
 fi
-# fmu-package's own `cargo build` of src/cdylib finds it built; the Windows DLL comes from cross_build below
-package_args=(--locked --win64 no)
+# the library just built, given to fmu-package (--crate with --lib): a cargo run of its own on src/cdylib alone
+# would unify the dependencies' features differently and compile the library a second time
+host_lib=$(ls target/release/libspacecraft_fmus_cdylib.so target/release/libspacecraft_fmus_cdylib.dylib 2>/dev/null || true)
+package_args=(--locked --crate src/cdylib --lib "$host_lib" --win64 no)
 skipped=()
 # cross_build NAME SKIP_VAR SCRIPT: 0 = built (its output in $cross_out), 1 = not built
 cross_build() {

@@ -1,12 +1,14 @@
 //! `fmu-package`: builds a model crate and packages every model it exports as an FMU.
 //!
 //! ```text
-//! fmu-package [--crate DIR | --lib PATH] [--out DIR] [--xml DIR] [--win64 auto|yes|no]
+//! fmu-package [--crate DIR] [--lib PATH] [--out DIR] [--xml DIR] [--win64 auto|yes|no]
 //!             [--add-lib PLATFORM=PATH]... [--locked] [--check]
 //! ```
 //! - `--crate DIR`: the model crate (a `cdylib` calling `spacecraft_fmus::export_fmus!`); it is built
 //!   with `cargo build --release --lib`. Default: this project's `src/cdylib` (all registered models).
-//! - `--lib PATH`: package an already built host library instead of building a crate.
+//! - `--lib PATH`: package an already built host library instead of building a crate; with `--crate`,
+//!   that crate's library as already built (no cargo run: `scripts/build_fmus.sh` passes the library its
+//!   own `cargo build` made, which a second cargo run with other unified features would compile again).
 //! - `--out DIR`: where `<Model>.fmu` go (default `DIR/fmus`; for the project, `fmus/`); the FMI 3.0
 //!   archives of the same models go to `DIR/fmi3/<Model>.fmu`.
 //! - `--xml DIR`: also write `<Model>.xml` there, and the FMI 3.0 ones in `DIR/fmi3/` (the project:
@@ -96,9 +98,6 @@ fn parse() -> Result<Args, String> {
             }
             other => return Err(format!("unknown argument {other} (see --help)")),
         }
-    }
-    if a.krate.is_some() && a.lib.is_some() {
-        return Err("give --crate or --lib, not both".into());
     }
     Ok(a)
 }
