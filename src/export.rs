@@ -225,9 +225,9 @@ pub fn project_catalogue() -> Catalogue {
     )
 }
 
-/// Generates the FMI 2.0 and FMI 3.0 entry points (Co-Simulation and Model Exchange) of a shared library for the given models, plus
-/// `spacecraft_fmus_catalogue` (the declarations, for the packaging tool). Use it once, at the root of a
-/// `cdylib` crate:
+/// Generates the FMI 2.0 and FMI 3.0 entry points (Co-Simulation and Model Exchange) of a shared library for
+/// the given models, plus `spacecraft_fmus_catalogue` (the declarations, for the packaging tool). Use it once,
+/// at the root of a `cdylib` crate:
 ///
 /// ```ignore
 /// spacecraft_fmus::export_fmus!(MyController, MyPlant);               // model types
