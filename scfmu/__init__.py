@@ -1,5 +1,6 @@
-"""scfmu: spacecraft guidance and control units as FMI 2.0 Co-Simulation FMUs, their closed-loop
-scenarios, engines, campaigns and the papers' experiments.
+"""scfmu: spacecraft guidance and control units as FMUs (FMI 2.0 and 3.0; Co-Simulation, and Model Exchange
+where a model is continuous or static), their closed-loop scenarios, engines, campaigns and the papers'
+experiments.
 
 The public API (imported lazily, so ``import scfmu`` stays cheap and pulls in no layer it does not need):
 

@@ -1,10 +1,11 @@
 //! The export API: everything a crate needs to turn its own models into FMUs through this project's
 //! FMI layer, in one place. The project's own models use exactly this path (`src/cdylib` calls
-//! [`export_fmus!`](crate::export_fmus) with the registry), so every build of the 24 FMUs exercises it.
+//! [`export_fmus!`](crate::export_fmus) with the registry), so every build of the project's FMUs exercises it.
 //!
 //! A model crate is a `cdylib` that depends on `spacecraft_fmus`, declares each model's variables with
-//! [`declare_variables!`](crate::declare_variables), implements [`Model`], and exports the FMI 2.0
-//! Co-Simulation functions for its models with one line:
+//! [`declare_variables!`](crate::declare_variables), implements [`Model`], and exports the FMI 2.0 and
+//! FMI 3.0 functions for its models (Co-Simulation, and Model Exchange for a model that declares its
+//! continuous states) with one line:
 //!
 //! ```
 //! use spacecraft_fmus::export::*;
@@ -42,7 +43,7 @@
 //!     }
 //! }
 //!
-//! // the FMI 2.0 entry points of this shared library, for these models
+//! // the FMI 2.0 and FMI 3.0 entry points of this shared library, for these models
 //! export_fmus!(SatGain);
 //!
 //! // a model is tested as plain Rust, without the C layer:
@@ -224,9 +225,9 @@ pub fn project_catalogue() -> Catalogue {
     )
 }
 
-/// Generates the FMI 2.0 and FMI 3.0 Co-Simulation entry points of a shared library for the given models, plus
-/// `spacecraft_fmus_catalogue` (the declarations, for the packaging tool). Use it once, at the root of a
-/// `cdylib` crate:
+/// Generates the FMI 2.0 and FMI 3.0 entry points (Co-Simulation and Model Exchange) of a shared library for
+/// the given models, plus `spacecraft_fmus_catalogue` (the declarations, for the packaging tool). Use it once,
+/// at the root of a `cdylib` crate:
 ///
 /// ```ignore
 /// spacecraft_fmus::export_fmus!(MyController, MyPlant);               // model types

@@ -1,8 +1,9 @@
 """The command-line options that choose and change a scenario, shared by ``scfmu run`` and ``scfmu campaign``:
 
   SCENARIO                     a registered name, or a scenario file (.toml / .json)
-  --fmu INSTANCE=PATH          put any FMI 2.0 Co-Simulation FMU (or another model name) in that place;
-                               the old model's parameters are dropped (one notice lists them)
+  --fmu INSTANCE=PATH          put any FMI 2.0 or 3.0 FMU, Co-Simulation or Model Exchange (or another model
+                               name) in that place; the old model's parameters are dropped (one notice
+                               lists them)
   --map INSTANCE.THEIRS=OURS   the unit's port THEIRS plays the scenario's port OURS; a vector stem renames
                                every element (--map controller.omega=w); a parameter THEIRS takes the
                                place's slot value OURS (--map controller.J1=inertia_xx)
@@ -78,7 +79,8 @@ def fmu_file(option: str, text: str) -> str:
 def add_arguments(ap) -> None:
     ap.add_argument("scenario", help="scenario name (`scfmu scenarios` lists them) or a .toml/.json scenario file")
     ap.add_argument("--fmu", action="append", default=[], metavar="INSTANCE=PATH",
-                    help="use this FMU (a path to any FMI 2.0 CS FMU, or a model name) for INSTANCE (repeatable)")
+                    help="use this FMU (a path to any FMI 2.0 or 3.0 FMU, Co-Simulation or Model Exchange, or a model "
+                         "name) for INSTANCE (repeatable)")
     ap.add_argument("--map", action="append", default=[], metavar="INSTANCE.THEIRS=OURS",
                     help="the unit's port (or vector stem) THEIRS plays the scenario's port OURS; a parameter "
                          "THEIRS takes the place's slot value OURS (repeatable)")
