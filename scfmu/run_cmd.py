@@ -55,6 +55,7 @@ def plot(r: dict, path: Path, title: str, units: dict | None = None) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import FuncFormatter, NullFormatter
     units = units or {}
     groups = _groups([k for k in r if k != "time"])
     prefer = ["321 angles", "alpha_deg", "w", "torque_applied", "theta", "pos", "torque_cmd", "force", "u",
@@ -75,6 +76,9 @@ def plot(r: dict, path: Path, title: str, units: dict | None = None) -> None:
             ax.plot(t, y, ls=":" if k.endswith("_ref") else "-", label=k)
         if name == "alpha_deg":
             ax.set_yscale("log")
+            # plain tick labels ("1e-05"): the default ones are mathtext, whose parser costs ~0.3 s CPU to build
+            ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _pos: f"{v:.0e}"))
+            ax.yaxis.set_minor_formatter(NullFormatter())
         label = _LABELS.get(name, name)
         ax.set_ylabel(f"{label} [{unit}]" if unit else f"{label} [-]", fontsize=9)
         ax.grid(True, alpha=0.3, which="both")

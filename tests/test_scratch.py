@@ -1,4 +1,5 @@
-"""Temporary folders: every unit scfmu unpacks lives in its process's scratch folder (scfmu.fmu.scratch),
+"""Temporary folders: every private folder scfmu makes (a container's work folder, an isolated run, every unit
+with SCFMU_UNIT_CACHE=off) lives in its process's scratch folder (scfmu.fmu.scratch),
 which goes with the process however it ends. Each test runs Python processes with a temporary folder of
 their own (TMPDIR) and lists what is left in it."""
 
@@ -18,8 +19,8 @@ from scfmu.fmu import fmu_path, scratch
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def python(code: str, tmp: Path, **kw) -> subprocess.Popen:
-    env = dict(os.environ, TMPDIR=str(tmp), PYTHONPATH=str(ROOT))
+def python(code: str, tmp: Path, env: dict | None = None, **kw) -> subprocess.Popen:
+    env = dict(os.environ, TMPDIR=str(tmp), PYTHONPATH=str(ROOT), **(env or {}))
     return subprocess.Popen([sys.executable, "-c", textwrap.dedent(code)], env=env, cwd=str(ROOT),
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **kw)
 
@@ -59,7 +60,7 @@ def test_the_folder_of_a_killed_process_goes_with_the_next_process(tmp_path):
         md, d = unpacked({unit!r})
         print(scratch.process_folder(), d, flush=True)
         time.sleep(300)
-    """, tmp)
+    """, tmp, env={"SCFMU_UNIT_CACHE": "off"})  # units unpacked into the scratch folder (not the unit cache)
     try:
         folder, unzipped = a.stdout.readline().split()
         assert Path(unzipped, "modelDescription.xml").is_file() and Path(unzipped).parent == Path(folder)
@@ -133,10 +134,11 @@ def test_libcosim_that_cannot_unpack_a_unit_is_an_error_not_a_crash(tmp_path):
     assert "error: libcosim cannot load command" in out and "temp_directory_path" in out, out
 
 
-def test_copies_of_a_unit_share_one_folder_and_a_description_unpacks_nothing(tmp_path, monkeypatch):
+@pytest.mark.parametrize("cache", ["units", "off"])
+def test_copies_of_a_unit_share_one_folder_and_a_description_unpacks_nothing(tmp_path, monkeypatch, cache):
     """A test session or a notebook meets the same FMU at many paths (copies, rebuilt identical files):
-    unpacked once per content, not per path; and reading a model description (planning, resolving,
-    recording a run) unpacks nothing at all."""
+    unpacked once per content, not per path (in the unit cache, and in the scratch folder with the cache
+    off); and reading a model description (planning, resolving, recording a run) unpacks nothing at all."""
     import shutil
     import tempfile
 
@@ -144,6 +146,7 @@ def test_copies_of_a_unit_share_one_folder_and_a_description_unpacks_nothing(tmp
     tmp = tmp_path / "tmp"
     tmp.mkdir()
     monkeypatch.setattr(tempfile, "tempdir", str(tmp))
+    monkeypatch.setenv("SCFMU_UNIT_CACHE", "off" if cache == "off" else str(tmp_path / cache))
     src = fmu_path("PdController")
     copies = []
     for i in range(3):
@@ -152,7 +155,7 @@ def test_copies_of_a_unit_share_one_folder_and_a_description_unpacks_nothing(tmp
         shutil.copy(src, copies[-1])
     mds = [fmu_mod.described(p) for p in copies]
     assert all(md.modelName == "PdController" for md in mds)
-    assert not tmp.exists() or [p for p in tmp.rglob("modelDescription.xml")] == []
+    assert [p for p in tmp_path.rglob("modelDescription.xml")] == []
     dirs = {fmu_mod.unpacked(p)[1] for p in copies}
     assert len(dirs) == 1 and Path(next(iter(dirs)), "modelDescription.xml").is_file()
     other = fmu_path("PdController").parent / "fmi3" / "PdController.fmu"  # another file: its own folder

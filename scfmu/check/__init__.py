@@ -74,20 +74,17 @@ class Report:
 
 
 def _extract(path: Path):
-    """(model description, folder) through the package's FMU extraction (scfmu.fmu.unpacked); the folder is
-    removed again by :func:`_release` when this call created it."""
+    """(model description, folder, created) of the FMU under check: a whole extraction of its own (every
+    platform, so that the binaries row can name the platforms present) into the process's scratch folder,
+    never the shared unit cache (scfmu.fmu.units): the unit's library runs in child processes that may
+    write into it. :func:`_release` removes it."""
     from .. import fmu as fmu_mod
-    before = set(getattr(fmu_mod, "_UNPACKED", {}).keys())
-    md, d = fmu_mod.unpacked(path)
-    created = [k for k in getattr(fmu_mod, "_UNPACKED", {}) if k not in before]
-    return md, Path(d), created
+    md = fmu_mod.described(path)
+    d = fmu_mod.safe_extract(path)
+    return md, Path(d), [d]
 
 
 def _release(d: Path, created: list) -> None:
-    from .. import fmu as fmu_mod
-    cache = getattr(fmu_mod, "_UNPACKED", {})
-    for k in created:
-        cache.pop(k, None)
     if created:
         shutil.rmtree(d, ignore_errors=True)
 

@@ -2,7 +2,8 @@
 interface that the child's dynamic checks work from.
 
 - ``schema``: modelDescription.xml against the standard's XML schema (the XSD files fmpy ships);
-- ``archive`` (in scfmu.check): the FMU unpacks through the package's extraction (scfmu.fmu.unpacked);
+- ``archive`` (in scfmu.check): the FMU unpacks whole, into a private folder, through the package's extraction
+  (scfmu.fmu.safe_extract: the archive limits);
 - ``units``, ``start_values``, ``model_structure``, ``value_references``, ``variables``: the standard's
   rules beyond the schema, as fmpy's validation states them (units defined, required start values and
   none where forbidden, ModelStructure complete and consistent, unique value references in FMI 3.0,

@@ -13,7 +13,11 @@ A component's model may also be a path to any ``.fmu`` file (:func:`fmu_path`).
 
 Every FMU this package unpacks (ours, a user's, one shipped to a Dask worker, the units nested in a loop
 FMU) goes through :func:`safe_extract`, which inspects the whole archive before it writes anything (the
-limits: scfmu.fmu.archive). The Model Exchange integration of :class:`Fmu` is in scfmu.fmu.model_exchange.
+limits: scfmu.fmu.archive). A unit that runs is unpacked once per content, with the running platform's
+binaries only, into the unit cache that every scfmu process of the user shares (:func:`unpacked`,
+scfmu.fmu.units); what must stay private or writable (a container's work folder, an isolated run, a unit
+under ``scfmu check``) is unpacked whole into the process's scratch folder (scfmu.fmu.scratch). The Model
+Exchange integration of :class:`Fmu` is in scfmu.fmu.model_exchange.
 """
 
 from __future__ import annotations
@@ -140,16 +144,23 @@ def described(path: str | Path):
 
 
 def unpacked(path: Path) -> tuple:
-    """(model description, unzip directory) of an FMU, extracted once per process and kept until exit
-    (for runs that instantiate the same FMUs many times, e.g. campaigns). Copies of one file at other paths
-    share one folder (the cache is keyed by the file's SHA-256). The folder is in the process's scratch
-    folder (scfmu.fmu.scratch), removed at exit or, after a killed process, by the next one."""
+    """(model description, unzip directory) of an FMU: its entry in the unit cache shared by processes
+    (scfmu.fmu.units: the running platform's binaries only, unpacked once per content, then found by every
+    later call of any process), or, with ``SCFMU_UNIT_CACHE=off``, a whole extraction into the process's
+    scratch folder (scfmu.fmu.scratch), kept until the process ends. Copies of one file at other paths share
+    one folder (keyed by the file's SHA-256). Nothing may write into the folder: it is shared."""
+    from . import units
     md = described(path)
     digest = fmu_digest(path)
-    d = _UNPACKED.get(digest)
+    key = (digest, str(units.cache_root()))
+    d = _UNPACKED.get(key)
     if d is None or not os.path.isdir(d):
-        d = _UNPACKED[digest] = safe_extract(path)
+        d = _UNPACKED[key] = units.unpack(path, digest)
     return md, d
+
+
+def _cached(path: Path) -> tuple:
+    return unpacked(path)  # (Fmu's argument of the same name hides this function there)
 
 
 _DIGESTS: dict = {}
@@ -232,12 +243,16 @@ class Fmu(ModelExchange):
                  me_rtol: float = 1e-10, me_atol: float = 1e-12, me_max_step: float = 0.0):
         self.model = model
         self.path = Path(path) if path else fmu_path(model)
-        if unpacked is None:  # (model description, unzip directory) shared by instances; kept on close
-            self.unzipdir = safe_extract(self.path)
-            self._owns_dir = True
-        else:
+        self._owns_dir = False
+        if unpacked is None:  # the unit cache's entry (shared, kept), else a folder of this instance's own
+            from . import units
+            if units.cache_root() is None:
+                self.unzipdir = safe_extract(self.path)
+                self._owns_dir = True
+            else:
+                unpacked = _cached(self.path)
+        if unpacked is not None:
             self.md, self.unzipdir = unpacked
-            self._owns_dir = False
         self.slave = None
         try:
             self._open(model, unpacked, params, name, start_time, stop_time, tolerance, initialize, logging_on,

@@ -144,12 +144,18 @@ def inspect_archive(path: str | Path, limits: ArchiveLimits | None = None) -> li
     return infos
 
 
-def safe_extract(path: str | Path, dest: str | Path | None = None, limits: ArchiveLimits | None = None) -> str:
+def safe_extract(path: str | Path, dest: str | Path | None = None, limits: ArchiveLimits | None = None,
+                 keep=None) -> str:
     """Extracts a zip archive (an FMU or SSP) into ``dest`` (a new temporary folder by default; created when
-    absent) after :func:`inspect_archive`; returns the folder. On any failure the folder is removed (when this
-    call created it) and :class:`ArchiveError` is raised."""
+    absent) after :func:`inspect_archive`; returns the folder. ``keep(names)``, when given, receives every
+    entry name of the (inspected) archive and returns a predicate on a name: only the entries it accepts are
+    written (the unit cache writes one platform's binaries; scfmu.fmu.units). On any failure the folder is
+    removed (when this call created it) and :class:`ArchiveError` is raised."""
     limits = limits or archive_limits()
-    infos = inspect_archive(path, limits)
+    infos = inspect_archive(path, limits)  # the whole archive, whatever is then written
+    if keep is not None:
+        accept = keep([i.filename for i in infos])
+        infos = [i for i in infos if accept(i.filename)]
     if dest is None:
         from .scratch import mkdtemp  # inside the process's scratch folder: removed however the process ends
         root = Path(mkdtemp(prefix="scfmu_fmu_"))

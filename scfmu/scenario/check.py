@@ -19,7 +19,7 @@ from pathlib import Path
 
 from fmpy import read_model_description
 
-from ..fmu import ArchiveError, fmu_path, inspect_archive
+from ..fmu import ArchiveError, described, fmu_path, inspect_archive
 from .model import Scenario
 from .plan import Unit, link_problem
 from .resolve import resolve
@@ -87,8 +87,11 @@ def check_unit(model: str, instantiate: bool = True, interface: str = "") -> tup
             inspect_archive(path)  # archive limits before anything is inflated
     except ArchiveError as e:
         return None, [str(e)]
-    try:
-        md = read_model_description(str(path), validate=False)
+    try:  # the process's cached, schema-validated description; read unvalidated when it fails the schema
+        try:
+            md = described(path)
+        except Exception:
+            md = read_model_description(str(path), validate=False)
     except Exception as e:  # not a zip, no modelDescription.xml, XML errors
         return None, [f"{model}: cannot read its modelDescription.xml: {e}"]
     errs = []

@@ -23,8 +23,6 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.interpolate import CubicSpline
-from scipy.optimize import minimize
 
 from ...engines.lean import OpenLoop
 from ...engines.reference import CoSimulation
@@ -79,6 +77,7 @@ def full_nodes(x: np.ndarray) -> np.ndarray:
 
 def spline_basis(times: np.ndarray) -> np.ndarray:
     """B with u(times) = B @ node_values (the spline is linear in the node values); 0 after t_f."""
+    from scipy.interpolate import CubicSpline  # here, not at import: loading the plug-ins (every scfmu command)
     b = CubicSpline(NODE_TIMES, np.eye(N_NODES), bc_type="not-a-knot")(times)
     b[np.asarray(times) > NODE_TIMES[-1]] = 0.0
     return b
@@ -236,6 +235,7 @@ class SplineProblem:
         def count(_zk):
             iters[0] += 1
 
+        from scipy.optimize import minimize  # here, not at import (see spline_basis)
         success, budget_hit = False, False
         try:
             res = minimize(lambda z: self.objective(xz(z)), r @ x0, jac=lambda z: r_inv.T @ self.objective_grad(xz(z)),
