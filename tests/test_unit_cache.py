@@ -409,3 +409,36 @@ def test_campaign_workers_share_the_cache(cache, tmp_path):
     assert len(inv) >= 4 and not [k for k in inv if k.startswith(".")]
     run("b")
     assert inventory(cache) == inv
+
+
+def once_per_process_copy(dst: Path, src: str = "PdController") -> Path:
+    """A copy of ``src`` whose description declares canBeInstantiatedOnlyOncePerProcess="true"."""
+    with zipfile.ZipFile(fmu_path(src)) as z, zipfile.ZipFile(dst, "w", zipfile.ZIP_DEFLATED) as out:
+        for info in z.infolist():
+            data = z.read(info)
+            if info.filename == "modelDescription.xml":
+                text = data.decode()
+                flag = 'canBeInstantiatedOnlyOncePerProcess="false"'
+                assert text.count(flag) >= 1
+                text = text.replace(flag, flag.replace("false", "true"))
+                data = text.encode()
+            out.writestr(info, data)
+    return dst
+
+
+def test_a_once_per_process_unit_gets_a_library_file_per_instance(cache, tmp_path):
+    """Two instances of one file share its cached entry (one library, loaded once); a unit that declares it can
+    be instantiated only once per process gets a private extraction per instance, so each instance loads a
+    library file of its own (a second dlopen of one file would share the library's globals)."""
+    shared = [fmu_mod.Fmu("PdController", name=f"s{i}") for i in range(2)]
+    once = once_per_process_copy(tmp_path / "Once.fmu")
+    private = [fmu_mod.Fmu(str(once), name=f"p{i}") for i in range(2)]
+    try:
+        assert shared[0].unzipdir == shared[1].unzipdir and str(cache) in str(shared[0].unzipdir)
+        assert private[0].unzipdir != private[1].unzipdir
+        assert not any(str(cache) in str(f.unzipdir) for f in private)
+        for f in private:
+            f.do_step(0.0, 0.01)
+    finally:
+        for f in shared + private:
+            f.close()

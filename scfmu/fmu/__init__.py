@@ -159,6 +159,12 @@ def unpacked(path: Path) -> tuple:
     return md, d
 
 
+def once_per_process(md) -> bool:
+    """True when a model description declares canBeInstantiatedOnlyOncePerProcess for an interface it has."""
+    return any(getattr(i, "canBeInstantiatedOnlyOncePerProcess", False)
+               for i in (getattr(md, "coSimulation", None), getattr(md, "modelExchange", None)) if i is not None)
+
+
 def _cached(path: Path) -> tuple:
     return unpacked(path)  # (Fmu's argument of the same name hides this function there)
 
@@ -246,7 +252,9 @@ class Fmu(ModelExchange):
         self._owns_dir = False
         if unpacked is None:  # the unit cache's entry (shared, kept), else a folder of this instance's own
             from . import units
-            if units.cache_root() is None:
+            # a unit that may be instantiated only once per process gets a library file of its own per
+            # instance (a second dlopen of the same file would share its globals), as before the cache
+            if units.cache_root() is None or once_per_process(described(self.path)):
                 self.unzipdir = safe_extract(self.path)
                 self._owns_dir = True
             else:
