@@ -66,7 +66,7 @@ def _export(argv) -> int:
     ap.add_argument("names", nargs="*", help="scenario names or files (default: the standard set)")
     ap.add_argument("--out", default=None, help="output folder (default fmus/ssp or fmus/loops)")
     ap.add_argument("--platform", choices=("host", "all"), default="host",
-                    help="binaries the files carry: this machine's only (host, default: 4-10x smaller) or every "
+                    help="binaries the files carry: this machine's only (host, default: about 4x smaller) or every "
                          "platform the FMUs carry (all: a file for other machines)")
     ap.add_argument("--fmu", action="append", default=[], metavar="INSTANCE=PATH", help="use this FMU for INSTANCE")
     ap.add_argument("--map", action="append", default=[], metavar="INSTANCE.THEIRS=OURS", help="rename a unit's port")

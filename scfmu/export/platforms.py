@@ -3,8 +3,8 @@
 ``all`` keeps every binary the FMUs carry (in a checkout built with ``scripts/build_fmus.sh --all``: Linux x86-64
 and aarch64, Windows x86-64, macOS), so the file runs on any of those machines; an SSP file of the default
 scenario is then about 40 MB and a loop FMU 15–34 MB. ``host`` (the default) keeps only the binaries of the
-machine that writes the file: a file to run here, in this machine's fmpy, libcosim or OMSimulator, is 4–10
-times smaller. From an installed wheel the two are the same (a wheel's FMUs carry its platform only).
+machine that writes the file: a file to run here, in this machine's fmpy, libcosim or OMSimulator, is about
+4 times smaller (docs/tools.md, sizes). From an installed wheel the two are the same (a wheel's FMUs carry its platform only).
 
 A binary's platform is read from its header (ELF, PE or Mach-O: :func:`scfmu.engines.cs_face.binary_tuples`),
 not from its folder's name: the aarch64 wheel's FMUs carry their aarch64 build in the FMI 2.0 folder
