@@ -1,6 +1,6 @@
 //! The export API: everything a crate needs to turn its own models into FMUs through this project's
 //! FMI layer, in one place. The project's own models use exactly this path (`src/cdylib` calls
-//! [`export_fmus!`](crate::export_fmus) with the registry), so every build of the 24 FMUs exercises it.
+//! [`export_fmus!`](crate::export_fmus) with the registry), so every build of the project's FMUs exercises it.
 //!
 //! A model crate is a `cdylib` that depends on `spacecraft_fmus`, declares each model's variables with
 //! [`declare_variables!`](crate::declare_variables), implements [`Model`], and exports the FMI 2.0
