@@ -91,7 +91,10 @@ def _export(argv) -> int:
             return 2
     try:
         export(a.kind, out, items, platform=a.platform)
-    except (RuntimeError, KeyError, ValueError) as e:
+    except KeyError as e:  # an unknown scenario name or prefix (the message names the known ones)
+        print(f"scfmu export: {e.args[0] if e.args else e}", file=sys.stderr)
+        return 2
+    except (RuntimeError, ValueError) as e:
         print(f"scfmu export: {e}", file=sys.stderr)
         return 1
     return 0
@@ -131,9 +134,15 @@ LOCAL = {"scenarios": ("list the registered scenarios with descriptions", _scena
 ORDER = ("run", "scenarios", "campaign", "benchmark", "export", "report", "paper", "check", "verify")
 
 
-# the optional extras (pyproject.toml) and the modules that tell whether each is installed
-EXTRAS = {"campaigns": ("pyarrow", "dask", "distributed"), "papers": ("pyswarms", "pygad"), "libcosim": ("libcosim",)}
-NEEDS = {"campaign": "campaigns", "benchmark": "campaigns", "report": "campaigns"}
+# the optional extras (pyproject.toml) and the modules they provide (tests/test_first_hour.py holds each to
+# the extra's requirements in pyproject.toml)
+EXTRAS = {"campaigns": ("pyarrow", "dask", "distributed", "control"), "papers": ("pyswarms", "pygad"),
+          "libcosim": ("libcosim",)}
+# the extra a command needs and the modules of it the command imports (checked before it starts; not for --help)
+NEEDS = {"campaign": ("campaigns", ("pyarrow", "dask", "distributed")),
+         # python-control: the benchmark's stability margins (scfmu.benchmark.margins)
+         "benchmark": ("campaigns", ("pyarrow", "dask", "distributed", "control")),
+         "report": ("campaigns", ("pyarrow", "dask", "distributed"))}
 RESUME = {"run": "nothing was written; run the same command again to start over",
           "campaign": "the workers were stopped and the runs finished so far are kept; run the same command "
                       "again to resume",
@@ -150,11 +159,11 @@ def _extra_of(module: str | None) -> str | None:
 
 def _missing_extra(command: str) -> str | None:
     """The one line for a command whose extra is not installed (None when it is)."""
-    extra = NEEDS.get(command)
-    if extra is None:
+    if command not in NEEDS:
         return None
+    extra, modules = NEEDS[command]
     import importlib
-    for mod in EXTRAS[extra]:
+    for mod in modules:
         try:
             importlib.import_module(mod)
         except ImportError:
@@ -163,14 +172,33 @@ def _missing_extra(command: str) -> str | None:
     return None
 
 
+def _wants_help(rest: list) -> bool:
+    """``-h``/``--help`` among a subcommand's options (before a ``--``): its help needs no extra."""
+    opts = rest[:rest.index("--")] if "--" in rest else rest
+    return "-h" in opts or "--help" in opts
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised in the main thread as Ctrl-C is, so that a command ends the same way: its ``finally``
+    blocks stop its workers and kill its child processes, then one line (exit 143)."""
+
+
+def _on_sigterm(signum, frame):
+    raise Terminated()
+
+
 def _run_command(command: str, rest: list) -> int:
-    """Runs a subcommand; a user's mistake, a refused archive, an FMU's error, a missing extra or Ctrl-C
-    end in one line on stderr (exit 2, 2, 1, 2, 130), never in a traceback."""
-    from .fmu import ArchiveError
+    """Runs a subcommand; a user's mistake, a refused archive or unknown model name, an FMU's error, a missing
+    extra or Ctrl-C (or SIGTERM) end in one line on stderr (exit 2, 2, 1, 2, 130), never in a traceback."""
+    from .fmu import ArchiveError, UnknownModel
     from .scenario.values import UsageError
     from fmpy.fmi1 import FMICallException
+    import signal
+    import threading
+    if threading.current_thread() is threading.main_thread() and signal.getsignal(signal.SIGTERM) == signal.SIG_DFL:
+        signal.signal(signal.SIGTERM, _on_sigterm)
     try:
-        missing = _missing_extra(command)
+        missing = None if _wants_help(rest) else _missing_extra(command)
         if missing:
             print(missing, file=sys.stderr)
             return 2
@@ -180,11 +208,12 @@ def _run_command(command: str, rest: list) -> int:
     except UsageError as e:
         print(f"scfmu {command}: {e.message}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print(f"\nscfmu {command}: interrupted (Ctrl-C); {RESUME.get(command, 'run the same command again')}",
+    except KeyboardInterrupt as e:
+        how, code = ("SIGTERM", 143) if isinstance(e, Terminated) else ("Ctrl-C", 130)
+        print(f"\nscfmu {command}: interrupted ({how}); {RESUME.get(command, 'run the same command again')}",
               file=sys.stderr)
-        return 130
-    except ArchiveError as e:
+        return code
+    except (ArchiveError, UnknownModel) as e:  # a refused archive, a misspelled model name
         print(f"scfmu {command}: {e}", file=sys.stderr)
         return 2
     except FMICallException as e:
@@ -207,7 +236,25 @@ def _run_command(command: str, rest: list) -> int:
         return 1
 
 
+def _one_line_error(self, message):
+    """argparse's refusal of an option as one line (its usage is one ``--help`` away), exit status 2."""
+    self.exit(2, f"{self.prog}: {message} (`{self.prog} --help` lists the options)\n")
+
+
 def main(argv=None) -> int:
+    import argparse
+    error, argparse.ArgumentParser.error = argparse.ArgumentParser.error, _one_line_error
+    try:
+        return _main(argv)
+    except KeyboardInterrupt as e:  # before a command started (imports, parsing): nothing to stop yet
+        how, code = ("SIGTERM", 143) if isinstance(e, Terminated) else ("Ctrl-C", 130)
+        print(f"\nscfmu: interrupted ({how}) while starting; nothing was done", file=sys.stderr)
+        return code
+    finally:
+        argparse.ArgumentParser.error = error
+
+
+def _main(argv=None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     first = next((a for a in argv if not a.startswith("-")), None)
     if first is not None and first not in ORDER and not (argv.index(first) > 0 and argv[argv.index(first) - 1] == "--fmus"):

@@ -113,6 +113,8 @@ def run(unit: str | None, family: str, out: str | Path, label: str | None = None
     every pair on its scenario's ``sensing+estimation/`` variant (:mod:`.estimator`) and show the primary
     metric with the estimator in the loop in a column (about twice the runs)."""
     cases, ctrls, profile, unit_label = _select(unit, family, label, controllers, cases, profile)
+    if family == "attitude":  # its stability margins need python-control (the campaigns extra): say so first
+        engineering.require_margins()
     if unit is not None and strict:
         _refuse_unbound(cases, str(unit), unit_label, unit_params, port_map, profile)
     out = Path(out)
@@ -163,14 +165,21 @@ def run(unit: str | None, family: str, out: str | Path, label: str | None = None
     return entries
 
 
-def _select(unit, family: str, label, controllers, only, profile):
-    """(cases, [(label, model, BuiltinController or None)], profile, unit label) of a benchmark call."""
+def selected_cases(family: str, only: list[str] | None = None) -> list:
+    """The benchmark cases of ``family`` (those whose scenario name is in ``only`` or whose label contains an
+    item of it); a KeyError when none is."""
     REGISTRY.load()
     cases = [c for c in REGISTRY.benchmark_cases if c.family == family
              and (only is None or any(x == c.scenario or x in c.label for x in only))]
     if not cases:
         raise KeyError(f"no benchmark scenario for family {family!r}{' matching ' + str(only) if only else ''}; "
                        f"families: {', '.join(REGISTRY.families())}")
+    return cases
+
+
+def _select(unit, family: str, label, controllers, only, profile):
+    """(cases, [(label, model, BuiltinController or None)], profile, unit label) of a benchmark call."""
+    cases = selected_cases(family, only)
     if isinstance(profile, (str, Path)):
         profile = profiles.load(profile)
     builtins = [b for b in REGISTRY.controllers if b.family == family

@@ -12,10 +12,13 @@ import argparse
 import sys
 from pathlib import Path
 
+from ..fmu import described, fmu_path
 from ..registry import REGISTRY
 from ..scenario import profile as profiles
-from ..scenario.options import pairs, value
-from . import StrictRefusal, run
+from ..scenario.options import fmu_file, pairs, value
+from ..scenario.values import UsageError, did_you_mean
+from . import StrictRefusal, run, selected_cases
+from .options import unit_options
 
 
 def main(argv=None) -> int:
@@ -25,10 +28,13 @@ def main(argv=None) -> int:
                                             "(omit it to benchmark the built-in controllers only)")
     ap.add_argument("--family", default="attitude", help="attitude, single_axis or formation")
     ap.add_argument("--label", help="name of the unit in the tables (default: its file name)")
-    ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help="a parameter of the unit")
-    ap.add_argument("--map", action="append", default=[], metavar="THEIRS=OURS",
+    ap.add_argument("--set", action="append", default=[], metavar="[controller.]NAME=VALUE",
+                    help="a parameter of the unit (NAME or controller.NAME)")
+    ap.add_argument("--map", action="append", default=[], metavar="[controller.]THEIRS=OURS",
                     help="the unit's port (or vector stem: omega=w) THEIRS plays the scenario's port OURS; a "
-                         "parameter THEIRS takes the place's slot value OURS (J1=inertia_xx) in every scenario")
+                         "parameter THEIRS takes the place's slot value OURS (controller.J1=inertia_xx, or "
+                         "J1=inertia_xx) in every scenario; a name the unit lacks or a map that binds nothing is "
+                         "refused")
     ap.add_argument("--profile", metavar="FILE", help="the unit's profile (TOML: [params] J1 = \"inertia_xx\", "
                                                       "[ports], unused = [...]), applied in every scenario")
     ap.add_argument("--strict", action="store_true",
@@ -47,28 +53,55 @@ def main(argv=None) -> int:
     if a.family not in REGISTRY.families():
         print(f"scfmu benchmark: no family {a.family!r}; known: {', '.join(REGISTRY.families())}", file=sys.stderr)
         return 2
+    only = [x.strip() for x in a.cases.split(",")] if a.cases else None
+    try:
+        cases = selected_cases(a.family, only)
+    except KeyError:
+        known = [c.scenario for c in selected_cases(a.family)]
+        raise UsageError(f"--cases {a.cases}: no benchmark scenario of family {a.family!r} matches"
+                         f"{did_you_mean(only[0], known)}; allowed: scenario names or parts of their titles "
+                         f"({', '.join(known)})") from None
+    controllers = [x.strip() for x in a.controllers.split(",")] if a.controllers else None
+    builtins = [b for b in REGISTRY.controllers if b.family == a.family]
+    for c in controllers or []:
+        if not any(c in (b.model, b.label) for b in builtins):
+            names = sorted({b.model for b in builtins})
+            raise UsageError(f"--controllers {c}: no built-in controller of family {a.family!r} is called so"
+                             f"{did_you_mean(c, names)}; allowed: {', '.join(names)}")
+    if a.workers < 1 or a.workers > 1024:
+        raise UsageError(f"--workers {a.workers}: allowed: a whole number in [1, 1024]")
     unit = a.unit
-    if unit and (unit.endswith(".fmu") or "/" in unit):
-        p = Path(unit).expanduser()
-        if not p.is_file():
-            print(f"scfmu benchmark: {unit}: no such file", file=sys.stderr)
-            return 2
-        unit = str(p.resolve())
-        if a.check:
-            from ..check import check_quick
-            rep = check_quick(unit)
-            print(rep.text(), file=sys.stderr)
-            if not rep.ok:
-                print(f"scfmu benchmark: {unit} fails scfmu check ({', '.join(sorted(rep.failed_checks()))}); "
-                      "not benchmarked", file=sys.stderr)
-                return 1
+    if not unit:
+        given = [o for o, v in (("--set", a.set), ("--map", a.map), ("--profile", a.profile), ("--label", a.label),
+                                ("--strict", a.strict), ("--check", a.check)) if v]
+        if given:
+            raise UsageError(f"{given[0]} needs a unit under test (scfmu benchmark PATH.fmu|MODEL {given[0]} ...); "
+                             "without one only the built-in controllers run")
+    if unit and (unit.lower().endswith(".fmu") or "/" in unit):
+        unit = fmu_file("", unit)
+        try:
+            described(unit)
+        except Exception as e:
+            raise UsageError(f"{a.unit}: not a readable FMU ({str(e).splitlines()[0] if str(e) else type(e).__name__})"
+                             "; allowed: an FMI 2.0/3.0 .fmu file or a model name") from None
+    elif unit:
+        fmu_path(unit)  # an unknown model name: one line with the closest name (exit 2)
+    if unit and a.check:
+        from ..check import check_quick
+        rep = check_quick(str(fmu_path(unit)))
+        print(rep.text(), file=sys.stderr)
+        if not rep.ok:
+            print(f"scfmu benchmark: {unit} fails scfmu check ({', '.join(sorted(rep.failed_checks()))}); "
+                  "not benchmarked", file=sys.stderr)
+            return 1
     label = a.label or (Path(unit).stem if unit else None)
     out = Path(a.out or Path("out") / "benchmark" / a.family)
+    params = {k: value(v) for k, v in pairs(a.set, "--set").items()}
+    port_map = pairs(a.map, "--map")
+    if unit and (params or port_map):
+        params, port_map = unit_options(unit, cases, params, port_map)
     prof = None
     if a.profile:
-        if not unit:
-            print("scfmu benchmark: --profile needs a unit under test", file=sys.stderr)
-            return 2
         try:
             prof = profiles.load(a.profile)
         except profiles.ProfileError as e:
@@ -76,10 +109,8 @@ def main(argv=None) -> int:
             return 2
     print(f"benchmark {a.family}: {label or 'built-in controllers only'} → {out}")
     try:
-        entries = run(unit, a.family, out, label=label, unit_params={k: value(v) for k, v in pairs(a.set, "--set").items()},
-                      port_map=pairs(a.map, "--map"), quick=a.quick, workers=a.workers,
-                      controllers=[x.strip() for x in a.controllers.split(",")] if a.controllers else None,
-                      cases=[x.strip() for x in a.cases.split(",")] if a.cases else None, profile=prof, strict=a.strict,
+        entries = run(unit, a.family, out, label=label, unit_params=params, port_map=port_map, quick=a.quick, workers=a.workers,
+                      controllers=controllers, cases=only, profile=prof, strict=a.strict,
                       estimator=a.estimator)
     except StrictRefusal as e:
         print(f"scfmu benchmark: {e}", file=sys.stderr)

@@ -165,12 +165,28 @@ def pick(cases, scenarios: dict, with_units: bool) -> list:
     return [c for _, c in chosen.values()]
 
 
+MARGINS_EXTRA = "the stability margins need python-control: pip install 'scfmu[campaigns]'"
+
+
+def require_margins() -> None:
+    """python-control, which the margins need (the ``campaigns`` extra): a ModuleNotFoundError (``name``
+    "control", the line naming the extra) before any run, never a "not linearised" row per controller."""
+    try:
+        import control  # noqa: F401
+    except ImportError:
+        raise ModuleNotFoundError(MARGINS_EXTRA, name="control") from None
+
+
 def _margins_task(sc_dict: dict, fmu_dir: str | None):
     from .. import fmu as fmu_access
     from ..scenario.model import Scenario
     from .margins import loop_margins
     if fmu_dir:
         fmu_access.set_fmu_dir(fmu_dir)
+    try:
+        require_margins()  # a worker of a remote cluster without the extra: the row names it
+    except ModuleNotFoundError as err:
+        return f"{err} (on the Dask worker)"
     try:
         ms = loop_margins(Scenario.from_dict(sc_dict), horizon=20.0, n_freq=800, max_horizon=200.0)
         return [dict(axis=m.axis, gm_db=m.gm_db, gm_low_db=m.gm_low_db, pm_deg=m.pm_deg, wc=m.wc, wpc=m.wpc,

@@ -144,10 +144,14 @@ def _client(scheduler: str | None, n_workers: int | None):
     # The worker processes start with SIGINT ignored (a disposition they inherit and keep): Ctrl-C in a
     # terminal reaches the whole process group, and only this process should act on it, by closing the
     # cluster (run()'s finally) instead of each worker dying with its own traceback.
+    # This process ignores it too while the workers start, so a Ctrl-C then is seen by a watcher process
+    # (_CtrlCWatcher) in the same process group, and acted on as soon as the cluster stands.
     import signal
     import threading
     main = threading.current_thread() is threading.main_thread()
+    watcher = _CtrlCWatcher() if main and signal.getsignal(signal.SIGINT) is signal.default_int_handler else None
     old = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
+    cluster = None
     try:
         cluster = LocalCluster(n_workers=n_workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
                                dashboard_address=None, host="127.0.0.1",
@@ -155,7 +159,49 @@ def _client(scheduler: str | None, n_workers: int | None):
     finally:
         if main:
             signal.signal(signal.SIGINT, old)
+        if watcher is not None and watcher.interrupted() and cluster is not None:
+            cluster.close()  # Ctrl-C during the start: the workers stop, then the interrupt as if at once
+            raise KeyboardInterrupt
     return Client(cluster), cluster
+
+
+class _CtrlCWatcher:
+    """A forked process that waits, with SIGINT at its default action, until :meth:`interrupted` is asked:
+    it dies of a Ctrl-C sent to the process group in between (which the caller, ignoring SIGINT while the
+    workers start, cannot see), and :meth:`interrupted` tells whether it did. Nothing of it outlives the call
+    (killed with its parent on Linux)."""
+
+    def __init__(self):
+        import signal
+        self.pid = None
+        if not hasattr(os, "fork"):
+            return
+        r, self.w = os.pipe()
+        parent = os.getpid()
+        pid = os.fork()
+        if pid == 0:  # the watcher: no Python cleanup of the caller's, only a read until EOF or death by SIGINT
+            try:
+                os.close(self.w)
+                signal.signal(signal.SIGINT, signal.SIG_DFL)
+                if sys.platform.startswith("linux"):  # prctl(PR_SET_PDEATHSIG, SIGKILL)
+                    import ctypes
+                    ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGKILL), 0, 0, 0)
+                if os.getppid() == parent:
+                    os.read(r, 1)
+            finally:
+                os._exit(0)
+        os.close(r)
+        self.pid = pid
+
+    def interrupted(self) -> bool:
+        """Whether a SIGINT ended the watcher; ends it otherwise (and reaps it)."""
+        import signal
+        if self.pid is None:
+            return False
+        os.close(self.w)  # the watcher's read returns: it exits 0, unless SIGINT killed it before
+        _, status = os.waitpid(self.pid, 0)
+        self.pid = None
+        return os.WIFSIGNALED(status) and os.WTERMSIG(status) == signal.SIGINT
 
 
 def run(c: Campaign, out_dir: str | Path, scheduler: str | None = None, n_workers: int | None = None,

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import zipfile
 from pathlib import Path
 
 
@@ -14,7 +15,7 @@ def main(argv=None) -> int:
                                  "then its binary in isolated child processes (state machine, bad arguments, "
                                  "random call sequences, FMU states, memory, threads). Exit 0 = every check "
                                  "passed, 1 = a check failed, 2 = a usage mistake.")
-    ap.add_argument("fmu", help="the .fmu file")
+    ap.add_argument("fmu", help="the .fmu file, or the name of a model of the package (e.g. PidController)")
     ap.add_argument("--quick", action="store_true", help="fewer sequences, cycles and steps (about 5-20 s per interface)")
     ap.add_argument("--report", metavar="DIR", help="also write DIR/check.json and DIR/check.html")
     ap.add_argument("--seed", type=int, default=0, help="seed of the random sequences and inputs (default 0)")
@@ -29,12 +30,23 @@ def main(argv=None) -> int:
         a = ap.parse_args(argv)
     except SystemExit as e:
         return int(e.code or 0) and 2
-    p = Path(a.fmu)
+    p = Path(a.fmu).expanduser()
+    if not p.exists() and not a.fmu.lower().endswith(".fmu") and "/" not in a.fmu and "\\" not in a.fmu:
+        from ..fmu import UnknownModel, fmu_path
+        try:  # a model name, as `scfmu verify NAME` takes it
+            p = fmu_path(a.fmu)
+        except UnknownModel as e:
+            print(f"scfmu check: {e}", file=sys.stderr)
+            return 2
     if not p.exists():
-        print(f"scfmu check: FMU {a.fmu!r} not found", file=sys.stderr)
+        print(f"scfmu check: FMU {a.fmu!r} not found (give an .fmu file or a model name)", file=sys.stderr)
         return 2
     if not p.is_file():
         print(f"scfmu check: FMU {a.fmu!r} is not a file (give the .fmu archive)", file=sys.stderr)
+        return 2
+    if not zipfile.is_zipfile(p):
+        print(f"scfmu check: FMU {a.fmu!r} is not an FMU archive (not a zip file: truncated, or another kind of "
+              f"file); allowed: an .fmu file (a zip archive) or a model name", file=sys.stderr)
         return 2
     if a.sequences is not None and not 0 <= a.sequences <= 1_000_000:
         print(f"scfmu check: --sequences {a.sequences} is outside 0..1000000", file=sys.stderr)

@@ -40,71 +40,97 @@ def _one_child(spec, checks, options, timeout) -> dict:
             tempfile.TemporaryFile(dir=tmp) as err:
         env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
         env.pop("PYTHONFAULTHANDLER", None)  # the FMU's signal is reported from the exit status
+        env["SCFMU_CHECK_PARENT"] = str(os.getpid())  # the child ends with this process (scfmu.check.child)
         proc = subprocess.Popen([sys.executable, "-m", "scfmu.check.child"], stdin=subprocess.PIPE,
                                 stdout=subprocess.PIPE, stderr=err, cwd=tmp, env=env, start_new_session=True)
-        proc.stdin.write(job)
-        proc.stdin.close()
-        sel = selectors.DefaultSelector()
-        sel.register(proc.stdout, selectors.EVENT_READ)
-        current, lines, buf = None, [], b""
-        deadline = time.monotonic() + timeout + 60.0  # starting Python is not the FMU's time
-        hung = False
-        fd = proc.stdout.fileno()
-        while True:
-            left = deadline - time.monotonic()
-            if left <= 0:
-                hung = True
-                break
-            if not sel.select(timeout=min(left, 1.0)):
-                continue
-            chunk = os.read(fd, 1 << 16)
-            if not chunk:
-                break
-            buf += chunk
-            *complete, buf = buf.split(b"\n")
-            for raw in complete:
-                line = raw.decode(errors="replace")
-                tag, _, rest = line.partition(" ")
-                if tag == "B":
-                    current, lines = rest, []
-                    deadline = time.monotonic() + timeout
-                elif tag == "S":
-                    lines = []
-                elif tag == "C":
-                    lines.append(rest)
-                elif tag == "R" and lines:
-                    lines[-1] = rest
-                elif tag == "E" and current:
-                    results[current] = json.loads(rest)
-                    current = None
-        sel.close()
-        if hung:
-            try:
-                os.killpg(proc.pid, signal.SIGKILL)
-            except ProcessLookupError:
-                pass
         try:
-            rc = proc.wait(timeout=30)
-        except subprocess.TimeoutExpired:
+            return _watch(proc, job, err, checks, timeout, results)
+        except BaseException:  # Ctrl-C, SIGTERM (scfmu.cli), any error: no child outlives the check
+            _kill(proc)
+            raise
+
+
+def _kill(proc) -> None:
+    """Kills the child's process group (the child and anything it started) and waits for the child."""
+    try:
+        os.killpg(proc.pid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):
+        pass
+    try:
+        proc.wait(timeout=30)
+    except subprocess.TimeoutExpired:
+        pass
+
+
+def _watch(proc, job: bytes, err, checks, timeout, results: dict) -> dict:
+    """Feeds the child its job and reads its events until it ends or hangs; the results of its checks."""
+    proc.stdin.write(job)
+    proc.stdin.close()
+    sel = selectors.DefaultSelector()
+    sel.register(proc.stdout, selectors.EVENT_READ)
+    current, lines, buf = None, [], b""
+    deadline = time.monotonic() + timeout + 60.0  # starting Python is not the FMU's time
+    hung = False
+    fd = proc.stdout.fileno()
+    while True:
+        left = deadline - time.monotonic()
+        if left <= 0:
+            hung = True
+            break
+        if not sel.select(timeout=min(left, 1.0)):
+            continue
+        chunk = os.read(fd, 1 << 16)
+        if not chunk:
+            break
+        buf += chunk
+        *complete, buf = buf.split(b"\n")
+        for raw in complete:
+            line = raw.decode(errors="replace")
+            tag, _, rest = line.partition(" ")
+            if tag == "B":
+                current, lines = rest, []
+                deadline = time.monotonic() + timeout
+            elif tag == "S":
+                lines = []
+            elif tag == "C":
+                lines.append(rest)
+            elif tag == "R" and lines:
+                lines[-1] = rest
+            elif tag == "E" and current:
+                results[current] = json.loads(rest)
+                current = None
+    sel.close()
+    if hung:
+        try:
             os.killpg(proc.pid, signal.SIGKILL)
-            rc = proc.wait()
-        err.seek(0)
-        stderr = err.read()[-4000:].decode(errors="replace").strip()
-        if current is not None and current not in results:
-            last = lines[-1] if lines else "(no call yet)"
-            if hung:
-                results[current] = {"status": "fail", "kind": "hang",
-                                    "detail": f"no answer within {timeout:g} s; the call in progress: {last}",
-                                    "reproducer": lines}
-            else:
-                how = f"killed by {_signame(rc)}" if rc < 0 else f"exited with status {rc}"
-                tail = " | ".join(stderr.splitlines()[-3:])
-                results[current] = {"status": "fail", "kind": "crash",
-                                    "detail": f"the process was {how} during {last}" + (f" (stderr: {tail})" if tail else ""),
-                                    "reproducer": lines}
-        elif not results and rc != 0:  # the child died before its first check (e.g. cannot start)
+        except ProcessLookupError:
+            pass
+    try:
+        rc = proc.wait(timeout=30)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        rc = proc.wait()
+    try:  # what the FMU may have started in the child's group ends with it
+        os.killpg(proc.pid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):
+        pass
+    err.seek(0)
+    stderr = err.read()[-4000:].decode(errors="replace").strip()
+    if current is not None and current not in results:
+        last = lines[-1] if lines else "(no call yet)"
+        if hung:
+            results[current] = {"status": "fail", "kind": "hang",
+                                "detail": f"no answer within {timeout:g} s; the call in progress: {last}",
+                                "reproducer": lines}
+        else:
+            how = f"killed by {_signame(rc)}" if rc < 0 else f"exited with status {rc}"
             tail = " | ".join(stderr.splitlines()[-3:])
-            results[checks[0]] = {"status": "fail", "kind": "crash",
-                                  "detail": f"the check process exited with status {rc} before the check began: {tail}",
-                                  "reproducer": []}
+            results[current] = {"status": "fail", "kind": "crash",
+                                "detail": f"the process was {how} during {last}" + (f" (stderr: {tail})" if tail else ""),
+                                "reproducer": lines}
+    elif not results and rc != 0:  # the child died before its first check (e.g. cannot start)
+        tail = " | ".join(stderr.splitlines()[-3:])
+        results[checks[0]] = {"status": "fail", "kind": "crash",
+                              "detail": f"the check process exited with status {rc} before the check began: {tail}",
+                              "reproducer": []}
     return results

@@ -23,6 +23,7 @@ from pathlib import Path
 from importlib import resources
 
 from ..registry import REGISTRY, resolve
+from ..scenario.values import UsageError
 from .types import Context
 
 
@@ -79,7 +80,8 @@ def parse_papers(text: str | None) -> list[str]:
             out.append(p)
             continue
         if not (p.isdigit() and len(p) <= 3):
-            raise SystemExit(f"--papers: {p!r} is not a paper number (000 … 004) nor a study ({', '.join(studies_known())})")
+            raise UsageError(f"--papers {text}: {p!r} is not a paper number ({', '.join(papers_known())}) nor a study "
+                             f"({', '.join(studies_known())})")
         out.append(p.zfill(3))
     return out
 
@@ -92,15 +94,16 @@ def load_modules(papers: list[str]) -> dict:
         try:
             plugin = REGISTRY.paper_plugin(p)
         except KeyError as e:
-            raise SystemExit(str(e.args[0])) from None
+            raise UsageError(f"--papers: {e.args[0]}") from None
         if not plugin.report:
-            raise SystemExit(f"paper {p} ({plugin.plugin}) has no report section")
+            raise UsageError(f"--papers: paper {p} ({plugin.plugin}) has no report section")
         builders[p] = resolve(plugin.report)
     return builders
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argparse.ArgumentParser(prog="scfmu report", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true", help="reduced grids and run counts (CI)")
     ap.add_argument("--workers", type=int, default=2, help="Dask LocalCluster workers (default 2)")
     ap.add_argument("--papers", default=None, help="comma-separated paper numbers (default: every paper with a report section)")
@@ -109,6 +112,8 @@ def main(argv=None) -> int:
                     help="also rewrite the generated blocks of each DOCS/paperNNN.md (the 'paper vs ours' table from "
                          "numbers.csv, the claims and results tables from doc_tables.json)")
     args = ap.parse_args(argv)
+    if not 1 <= args.workers <= 1024:
+        raise UsageError(f"--workers {args.workers}: allowed: a whole number in [1, 1024]")
 
     papers = parse_papers(args.papers)
     mods = load_modules(papers)

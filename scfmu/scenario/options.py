@@ -21,6 +21,7 @@ import json
 import math
 import sys
 import tomllib
+import zipfile
 from pathlib import Path
 
 from . import files, profile
@@ -65,7 +66,7 @@ def scenario_by_name(name: str, **kw) -> Scenario:
 
 def fmu_file(option: str, text: str) -> str:
     """The resolved path of an FMU file given on the command line; a :class:`UsageError` when it is a
-    directory, missing, or not an ``.fmu`` file."""
+    directory, missing, not an ``.fmu`` file, or not a zip archive (truncated, another kind of file)."""
     p = Path(text).expanduser()
     if p.is_dir():
         raise UsageError(f"{option}{text}: a directory, not an FMU file (give the .fmu archive)")
@@ -73,6 +74,9 @@ def fmu_file(option: str, text: str) -> str:
         raise UsageError(f"{option}{text}: no such file")
     if p.suffix.lower() != ".fmu":
         raise UsageError(f"{option}{text}: not an .fmu file (give the FMU archive)")
+    if not zipfile.is_zipfile(p):
+        raise UsageError(f"{option}{text}: not an FMU archive (not a zip file: truncated, or another kind of file); "
+                         f"allowed: an FMI 2.0/3.0 .fmu file")
     return str(p.resolve())
 
 

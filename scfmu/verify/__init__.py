@@ -370,6 +370,31 @@ def verify(fmu: Path, importer: str = "fmpy") -> list[Deviation]:
     return devs
 
 
+def _fmu_problem(text: str) -> Path | str:
+    """The FMU file a command-line argument names (a path to an .fmu, or a model name of the package), or the
+    one line saying why it names none: no such file, a folder, an unknown model (with the closest name), or a
+    file that is not a readable zip archive (truncated, damaged, another kind of file)."""
+    from ..fmu import UnknownModel, fmu_path
+    p = Path(text).expanduser()
+    if not p.exists() and not text.lower().endswith(".fmu") and "/" not in text:
+        try:
+            p = fmu_path(text)
+        except UnknownModel as e:
+            return str(e)
+    if p.is_dir():
+        return f"FMU {text!r} is a directory; allowed: an .fmu file or a model name"
+    if not p.is_file():
+        return f"FMU {text!r}: no such file; allowed: an .fmu file or a model name"
+    try:
+        with zipfile.ZipFile(p) as z:
+            bad = z.testzip()
+    except (zipfile.BadZipFile, OSError, EOFError) as e:
+        return f"FMU {text!r} is not an FMU archive ({e}: truncated, or another kind of file)"
+    if bad is not None:
+        return f"FMU {text!r} is damaged: entry {bad!r} fails its CRC check (a truncated or corrupted copy)"
+    return p
+
+
 def main(argv=None) -> int:
     import argparse
     ap = argparse.ArgumentParser(prog="scfmu verify", description="Replay the reference results an FMU carries "
@@ -385,14 +410,13 @@ def main(argv=None) -> int:
     if a.importer not in IMPORTERS:
         print(f"scfmu verify: --importer {a.importer!r}: expected one of {', '.join(IMPORTERS)}", file=sys.stderr)
         return 2
-    from ..fmu import fmu_path
     paths = []
     for f in a.fmus:
-        p = Path(f) if f.endswith(".fmu") else fmu_path(f)
-        if not p.is_file():
-            print(f"scfmu verify: FMU {f!r}: no such file", file=sys.stderr)
+        problem = _fmu_problem(f)
+        if isinstance(problem, str):
+            print(f"scfmu verify: {problem}", file=sys.stderr)
             return 2
-        paths.append(p)
+        paths.append(problem)
     if a.write:
         write_references(paths, inputs=not a.no_inputs)
         return 0
