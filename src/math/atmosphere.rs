@@ -65,7 +65,11 @@ pub fn harris_priester_density(h: f64, cos_psi: f64, n: f64) -> Result<f64, Stri
         ));
     }
     let last = HARRIS_PRIESTER.len() - 1;
-    let i = HARRIS_PRIESTER.iter().rposition(|row| row.0 <= km).unwrap_or(0).min(last - 1);
+    let i = HARRIS_PRIESTER
+        .iter()
+        .rposition(|row| row.0 <= km)
+        .unwrap_or(0)
+        .min(last - 1);
     let (lo, hi) = (HARRIS_PRIESTER[i], HARRIS_PRIESTER[i + 1]);
     // exponential interpolation between the tabulated heights (continued above the top one)
     let f = (km - lo.0) / (hi.0 - lo.0);
@@ -92,7 +96,10 @@ mod tests {
         assert!((exponential_density(0.0) - 1.225).abs() < 1e-15);
         // [Vallado-2013] Example 8-4 style: 747.2 km = 700 km layer, ρ = 3.614e-14 exp(−47.2/88.667)
         let rho = exponential_density(747.2e3);
-        assert!((rho / (3.614e-14 * (-47.2f64 / 88.667).exp()) - 1.0).abs() < 1e-12, "{rho}");
+        assert!(
+            (rho / (3.614e-14 * (-47.2f64 / 88.667).exp()) - 1.0).abs() < 1e-12,
+            "{rho}"
+        );
         // the scale heights were chosen so that each layer ends at the next one's base density
         // (within the table's four digits, 0.2 %)
         for w in EXPONENTIAL.windows(2) {

@@ -36,7 +36,11 @@ fn first_degree_is_the_tilted_dipole() {
     c.g[1][1] = -1410.3;
     c.h[1][1] = 4545.5;
     let m = Vector3::new(c.g[1][1], c.h[1][1], c.g[1][0]);
-    for r in [Vector3::new(7e6, 0.0, 0.0), Vector3::new(1e6, -4e6, 5.5e6), Vector3::new(0.0, 0.0, -6.9e6)] {
+    for r in [
+        Vector3::new(7e6, 0.0, 0.0),
+        Vector3::new(1e6, -4e6, 5.5e6),
+        Vector3::new(0.0, 0.0, -6.9e6),
+    ] {
         let b = field_ecef(&c, &r);
         assert!((b - dipole(m, &r)).norm() < 1e-18, "{r}: {b} vs {}", dipole(m, &r));
     }
@@ -67,7 +71,11 @@ fn potential(year: f64, r: &Vector3<f64>) -> f64 {
     let mut v = 0.0;
     for n in 1..=N_MAX {
         for m in 0..=n {
-            let schmidt = if m == 0 { 1.0 } else { (2.0 * fact(n - m) / fact(n + m)).sqrt() };
+            let schmidt = if m == 0 {
+                1.0
+            } else {
+                (2.0 * fact(n - m) / fact(n + m)).sqrt()
+            };
             let (sm, cm) = (m as f64 * lam).sin_cos();
             v += (a / rn).powi(n as i32 + 1) * (c.g[n][m] * cm + c.h[n][m] * sm) * schmidt * p[n][m];
         }

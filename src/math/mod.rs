@@ -7,8 +7,8 @@
 //! with the PID / PI^λD^μ laws, and interval type-2 fuzzy inference (Karnik–Mendel type reduction).
 //! Each module carries its own unit tests against closed-form results.
 
-pub mod attitude;
 pub mod atmosphere;
+pub mod attitude;
 pub mod attitude_kalman;
 pub mod dopri_tableau;
 pub mod environment;

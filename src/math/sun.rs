@@ -76,19 +76,28 @@ mod tests {
         let d = julian_date(2025, 6, 21, 2.0 * 3600.0 + 42.0 * 60.0) - JD_J2000;
         let (s, _) = sun_position(d);
         let of_date = precession((d + TT_MINUS_UTC / DAY) / CENTURY) * s;
-        assert!((of_date.z.asin().to_degrees() - 23.436).abs() < 0.01, "{}", of_date.z.asin().to_degrees());
+        assert!(
+            (of_date.z.asin().to_degrees() - 23.436).abs() < 0.01,
+            "{}",
+            of_date.z.asin().to_degrees()
+        );
         // perihelion 2025-01-04 (0.98333 AU) and aphelion 2025-07-03 (1.01664 AU)
         let (_, rp) = sun_position(julian_date(2025, 1, 4, 13.0 * 3600.0) - JD_J2000);
         let (_, ra) = sun_position(julian_date(2025, 7, 3, 20.0 * 3600.0) - JD_J2000);
-        assert!((rp / AU - 0.983_33).abs() < 3e-4 && (ra / AU - 1.016_64).abs() < 3e-4, "{} {}", rp / AU, ra / AU);
+        assert!(
+            (rp / AU - 0.983_33).abs() < 3e-4 && (ra / AU - 1.016_64).abs() < 3e-4,
+            "{} {}",
+            rp / AU,
+            ra / AU
+        );
         assert!((s.norm() - 1.0).abs() < 1e-15);
     }
 
     #[test]
     fn shadow_factor_closed_forms() {
         let r = 6_878_137.0; // 500 km
-        // the sun 1 AU from the spacecraft along +x: its centre is seen at angle c from the Earth's centre
-        // when the spacecraft is at (−r cos c, r sin c, 0)
+                             // the sun 1 AU from the spacecraft along +x: its centre is seen at angle c from the Earth's centre
+                             // when the spacecraft is at (−r cos c, r sin c, 0)
         let at = |c: f64| {
             let p = Vector3::new(-r * c.cos(), r * c.sin(), 0.0);
             shadow_factor(&p, &(p + Vector3::new(AU, 0.0, 0.0)))

@@ -27,7 +27,11 @@ const ARCSEC: f64 = std::f64::consts::PI / (180.0 * 3600.0);
 
 /// Julian date of a Gregorian calendar date and time (UTC): the algorithm of [Meeus-1998] Ch. 7.
 pub fn julian_date(year: i32, month: u32, day: u32, seconds_of_day: f64) -> f64 {
-    let (y, m) = if month <= 2 { (year - 1, month + 12) } else { (year, month) };
+    let (y, m) = if month <= 2 {
+        (year - 1, month + 12)
+    } else {
+        (year, month)
+    };
     let a = y.div_euclid(100);
     let b = 2 - a + a.div_euclid(4);
     (365.25 * f64::from(y + 4716)).floor() + (30.6001 * f64::from(m + 1)).floor() + f64::from(day) + f64::from(b)

@@ -44,7 +44,11 @@ fn precession_moves_pole_and_equinox_at_published_rates() {
     // p_A = 5029.0966″ T (IAU 1976), so fixed stars gain longitude; the J2000 ecliptic: obliquity 23.4392911°
     let eps = 23.439_291_1f64.to_radians();
     let eq = p.transpose() * Vector3::x();
-    let ecl = Vector3::new(eq.x, eq.y * eps.cos() + eq.z * eps.sin(), -eq.y * eps.sin() + eq.z * eps.cos());
+    let ecl = Vector3::new(
+        eq.x,
+        eq.y * eps.cos() + eq.z * eps.sin(),
+        -eq.y * eps.sin() + eq.z * eps.cos(),
+    );
     let lon = ecl.y.atan2(ecl.x) / ARCSEC;
     assert!((lon + 5029.0966 * t).abs() < 1.0, "{lon}");
 }
@@ -52,12 +56,24 @@ fn precession_moves_pole_and_equinox_at_published_rates() {
 #[test]
 fn geodetic_round_trip_and_ned_axes() {
     let e2 = WGS84_F * (2.0 - WGS84_F);
-    for (lat_deg, lon_deg, h) in [(0.0, 0.0, 500e3), (45.0, 120.0, 300e3), (-89.9, -60.0, 2000e3), (90.0, 10.0, 1e3)] {
+    for (lat_deg, lon_deg, h) in [
+        (0.0, 0.0, 500e3),
+        (45.0, 120.0, 300e3),
+        (-89.9, -60.0, 2000e3),
+        (90.0, 10.0, 1e3),
+    ] {
         let (lat, lon) = (f64::to_radians(lat_deg), f64::to_radians(lon_deg));
         let n = WGS84_A / (1.0 - e2 * lat.sin().powi(2)).sqrt();
-        let r = Vector3::new((n + h) * lat.cos() * lon.cos(), (n + h) * lat.cos() * lon.sin(), (n * (1.0 - e2) + h) * lat.sin());
+        let r = Vector3::new(
+            (n + h) * lat.cos() * lon.cos(),
+            (n + h) * lat.cos() * lon.sin(),
+            (n * (1.0 - e2) + h) * lat.sin(),
+        );
         let (la, lo, hh) = geodetic(&r);
-        assert!((la - lat).abs() < 1e-12 && (hh - h).abs() < 1e-6, "{lat_deg} {lon_deg}: {la} {hh}");
+        assert!(
+            (la - lat).abs() < 1e-12 && (hh - h).abs() < 1e-6,
+            "{lat_deg} {lon_deg}: {la} {hh}"
+        );
         if lat_deg.abs() < 90.0 {
             assert!((lo - lon).abs() < 1e-12);
         }

@@ -21,9 +21,15 @@ impl EpochParams {
     pub fn days_from_j2000(&self) -> Result<f64, String> {
         let (y, m, d) = (self.epoch_year, self.epoch_month as u32, self.epoch_day as u32);
         let jd0 = julian_date(y, m, 1, 0.0);
-        let next = if m == 12 { julian_date(y + 1, 1, 1, 0.0) } else { julian_date(y, m + 1, 1, 0.0) };
+        let next = if m == 12 {
+            julian_date(y + 1, 1, 1, 0.0)
+        } else {
+            julian_date(y, m + 1, 1, 0.0)
+        };
         if f64::from(d) > next - jd0 {
-            return Err(format!("epoch: {y}-{m:02}-{d:02} is not a calendar date (epoch_year/epoch_month/epoch_day)"));
+            return Err(format!(
+                "epoch: {y}-{m:02}-{d:02} is not a calendar date (epoch_year/epoch_month/epoch_day)"
+            ));
         }
         let sod = f64::from(self.epoch_hour * 3600 + self.epoch_minute * 60) + self.epoch_second;
         Ok(julian_date(y, m, d, sod) - JD_J2000)
