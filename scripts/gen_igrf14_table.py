@@ -64,7 +64,7 @@ def main(argv: list[str]) -> int:
         "];",
         "",
         f"/// One row per coefficient, one column per epoch of [`EPOCHS`] (nT).\n#[rustfmt::skip]\n"
-        f"pub const COEFFS: [[f64; {len(epochs)}]; {len(order)}] = [",
+        f"pub static COEFFS: [[f64; {len(epochs)}]; {len(order)}] = [",
     ]
     for n, m in order:
         vals = rows[n, m]

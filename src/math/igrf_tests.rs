@@ -50,6 +50,7 @@ fn first_degree_is_the_tilted_dipole() {
 
 /// The potential (nT·m) by the spherical form with Schmidt functions from factorials, written
 /// independently of the Cartesian recursion.
+#[allow(clippy::needless_range_loop)] // degree and order index several tables and enter the formulas
 fn potential(year: f64, r: &Vector3<f64>) -> f64 {
     let c = schmidt_coefficients(year).unwrap();
     let a = REFERENCE_RADIUS;
