@@ -89,6 +89,15 @@ pub const UNITS: &[UnitRow] = &[
     ("N.m/A", u(1, 2, -2, -1, 0), &[]),
     ("T", u(1, 0, -2, -1, 0), &[]),
     ("T.m3", u(1, 3, -2, -1, 0), &[]),
+    ("kg/m3", u(1, -3, 0, 0, 0), &[]),
+    (
+        "d",
+        BaseUnit {
+            factor: 86_400.0,
+            ..u(0, 0, 1, 0, 0)
+        },
+        &[],
+    ),
 ];
 
 /// Whether `name` is "" (dimensionless) or a unit of the table; usable in constants (the declaration

@@ -19,6 +19,8 @@ from fmpy import extract, read_model_description, simulate_fmu
 from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE, \
     fmi2CallbackLoggerTYPE, fmi2StepFinishedTYPE
 
+from scfmu.verify import REF_INPUT_OFFSETS
+
 ROOT = Path(__file__).resolve().parents[1]
 OURS = sorted((ROOT / "fmus").glob("*.fmu"))
 LOOPS = sorted((ROOT / "fmus" / "loops").glob("*.fmu"))
@@ -61,7 +63,11 @@ class Slave:
         self.fmu.enterInitializationMode()
         self.fmu.exitInitializationMode()
         real = [v for v in self.md.modelVariables if v.type == "Real"]
-        self.inputs = [v.valueReference for v in real if v.causality == "input" and not v.name.split(".")[-1].startswith("q")]
+        ins = [v for v in real if v.causality == "input" and not v.name.split(".")[-1].startswith("q")]
+        self.inputs = [v.valueReference for v in ins]
+        # where a small signal alone is refused (a position inside the Earth), the reference experiment's offset
+        offsets = REF_INPUT_OFFSETS.get(self.md.coSimulation.modelIdentifier, {})
+        self.offsets = [offsets.get(v.name, 0.0) for v in ins]
         self.outputs = [v.valueReference for v in real if v.causality == "output"]
         self.h = float(self.md.defaultExperiment.stepSize)
         self.t = 0.0
@@ -70,7 +76,8 @@ class Slave:
         rows = []
         for k in range(n):
             if self.inputs:
-                self.fmu.setReal(self.inputs, [0.01 * np.sin(0.3 * (self.t + i)) for i in range(len(self.inputs))])
+                self.fmu.setReal(self.inputs, [0.01 * np.sin(0.3 * (self.t + i)) + self.offsets[i]
+                                               for i in range(len(self.inputs))])
             h = self.h if steps is None else steps[k % len(steps)]
             self.fmu.doStep(self.t, h)
             self.t += h

@@ -21,7 +21,9 @@ includes every controller, so their outputs move) are given at every communicati
 
 * each quaternion input group ``<p>_w, <p>_x, <p>_y, <p>_z``: the unit quaternion of a rotation by
   0.3 sin(0.2 t + 0.5 j) rad about (1, 2, 2)/3 (j = the group's index);
-* every other Real input number i (in modelDescription order): 0.1 sin((0.5 + 0.1 i) t + 0.3 i) + 0.01 i.
+* every other Real input number i (in modelDescription order): 0.1 sin((0.5 + 0.1 i) t + 0.3 i) + 0.01 i,
+  plus the unit's offset in ``REF_INPUT_OFFSETS`` where the signal alone is not a valid input (a position
+  that must lie outside the Earth).
 
 The rows of ``<Model>_in.csv`` are exactly those values at the communication points, so an importer that
 interpolates the table linearly applies them unchanged. Row k of ``<Model>_ref.csv`` holds the outputs at
@@ -64,6 +66,10 @@ REF_PARAMS = {
     "RelativePositionCommand": {"target_pos_x": 10.0, "target_pos_y": -5.0, "target_pos_z": 2.0, "step_time": 10.0},
     "ReferenceCorrector": {"mode": 1, "init_euler321_roll": 0.3, "init_w_x": 0.02, "node_x_1": 0.01, "node_y_2": -0.01, "node_x_4": 0.005},
     "SunSensor": {"fov": math.pi, "eclipse": 0},
+}
+# Constant offsets added to the documented input signals where those alone are refused by the unit
+REF_INPUT_OFFSETS = {
+    "Environment": {"r_x": 6_878_137.0},  # 500 km above the equator (|r| below the Earth's radius is refused)
 }
 REL_TOL = 1e-6
 ABS_TOL = 1e-12
@@ -133,8 +139,8 @@ def output_names(md) -> list[str]:
     return [v.name for v in md.modelVariables if v.causality == "output" and v.type == _real_type(md)]
 
 
-def input_signals(names: list[str], t: np.ndarray) -> np.ndarray:
-    """The documented input sequence (module docstring) at the times t: one column per input."""
+def input_signals(names: list[str], t: np.ndarray, model: str = "") -> np.ndarray:
+    """The documented input sequence (module docstring) of ``model`` at the times t: one column per input."""
     cols = {}
     groups = [n[:-2] for n in names if n.endswith("_w") and all(f"{n[:-2]}_{c}" in names for c in "xyz")]
     for j, g in enumerate(groups):
@@ -145,7 +151,7 @@ def input_signals(names: list[str], t: np.ndarray) -> np.ndarray:
     i = 0
     for n in names:
         if n not in cols:
-            cols[n] = 0.1 * np.sin((0.5 + 0.1 * i) * t + 0.3 * i) + 0.01 * i
+            cols[n] = 0.1 * np.sin((0.5 + 0.1 * i) * t + 0.3 * i) + 0.01 * i + REF_INPUT_OFFSETS.get(model, {}).get(n, 0.0)
             i += 1
     return np.column_stack([cols[n] for n in names]) if names else np.zeros((len(t), 0))
 
@@ -171,7 +177,7 @@ def _run_fmpy(fmu: Path, md, exp: Experiment, ins: list[str], outs: list[str]) -
     t = exp.points()
     kw = {}
     if ins:
-        u = input_signals(ins, t)
+        u = input_signals(ins, t, md.coSimulation.modelIdentifier)
         dtype = [("time", np.float64)] + [(n, np.float64) for n in ins]
         table = np.array([tuple([tk, *row]) for tk, row in zip(t, u)], dtype=dtype)
         kw["input"] = table
@@ -188,7 +194,7 @@ def _run_fmusim(fmu: Path, md, exp: Experiment, ins: list[str], outs: list[str],
                "--output-interval", repr(exp.step), "--output-file", str(work / "out.csv")]
         if ins:
             t = exp.points()
-            (work / "in.csv").write_text(_csv_text(["time", *ins], np.column_stack([t, input_signals(ins, t)])))
+            (work / "in.csv").write_text(_csv_text(["time", *ins], np.column_stack([t, input_signals(ins, t, md.coSimulation.modelIdentifier)])))
             cmd += ["--input-file", str(work / "in.csv")]
         for k, v in (exp.params or {}).items():
             cmd += ["--start-value", k, repr(v)]
@@ -258,7 +264,8 @@ def _doc(model: str, exp: Experiment, ins: list[str]) -> str:
     if ins:
         text += (f"Inputs ({model}_in.csv): given at every communication point and held over the step; quaternion "
                  "groups <p>_w.._z turn by 0.3 sin(0.2 t + 0.5 j) rad about (1, 2, 2)/3, every other input i is "
-                 "0.1 sin((0.5 + 0.1 i) t + 0.3 i) + 0.01 i.\n")
+                 "0.1 sin((0.5 + 0.1 i) t + 0.3 i) + 0.01 i"
+                 + "".join(f", {k} plus {v!r}" for k, v in REF_INPUT_OFFSETS.get(model, {}).items()) + ".\n")
     elif not exp.inputs:
         text += "Inputs: none given (the FMU runs as it is; a loop FMU runs its scenario).\n"
     text += (f"Results ({model}_ref.csv): the outputs at every communication point, row 0 after initialization, row k "
@@ -288,7 +295,7 @@ def reference_files(fmu: Path, inputs: bool = True) -> dict[str, bytes]:
         files[f"{REF_DIR}/{model}_ref.ssv"] = _ssv([(k, types[k], v) for k, v in exp.params.items()], f"{model}_ref")
     if ins:
         t = exp.points()
-        files[f"{REF_DIR}/{model}_in.csv"] = _csv_text(["time", *ins], np.column_stack([t, input_signals(ins, t)])).encode()
+        files[f"{REF_DIR}/{model}_in.csv"] = _csv_text(["time", *ins], np.column_stack([t, input_signals(ins, t, model)])).encode()
     return files
 
 

@@ -34,9 +34,12 @@
 //!   from 20 (`w_meas`, `q_meas` + `valid` 24, `sun_meas` + `valid` 23, `b_meas`; `SampleHold` `y_1…8`
 //!   20–27 from `u_1…8` 0–7), diagnostics from 30; `sample_period` 100, `seed` 140, the plant's orbit
 //!   parameters with the plant's references (`mu` 160 … `earth_dipole` 164), `sun_ecliptic_longitude` 165.
+//! - environment: epoch `epoch_year` … `epoch_second` 100–105 (`environment::epoch::EpochParams`);
+//!   `Environment`: position `r` 0–2, outputs 20–29, diagnostics 30–39, `hp_exponent` 106, `density_model` 120.
 //! - plants of every family: `integrator` is an Integer with codes 0 RK4, 1 Euler, 2 Dormand–Prince.
 
 pub mod attitude;
+pub mod environment;
 pub mod estimation;
 pub mod formation;
 pub mod ports;

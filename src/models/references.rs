@@ -101,6 +101,67 @@ pub const ALL: &[Reference] = &[
         used_for: "the multiplicative extended Kalman filter of attitude and gyro bias (error state of small-angle \
                    attitude errors and biases, multiplicative reset)",
     },
+    Reference {
+        key: "IGRF-14",
+        authors: "IAGA Division V, Working Group V-MOD",
+        title: "International Geomagnetic Reference Field, 14th generation (IGRF-14): coefficients 1900-2030",
+        venue: "IAGA release, Zenodo, doi:10.5281/zenodo.14012302, 2024",
+        subject: "",
+        used_for: "the Gauss coefficients of the geomagnetic main field to degree 13 and their secular variation",
+    },
+    Reference {
+        key: "Alken-2021",
+        authors: "P. Alken, E. Thebault, C. D. Beggan, et al.",
+        title: "International Geomagnetic Reference Field: the thirteenth generation",
+        venue: "Earth, Planets and Space 73, 49, 2021",
+        subject: "",
+        used_for: "the IGRF potential, reference radius, Schmidt normalisation and time interpolation rule",
+    },
+    Reference {
+        key: "Montenbruck-Gill-2000",
+        authors: "O. Montenbruck, E. Gill",
+        title: "Satellite Orbits: Models, Methods and Applications",
+        venue: "Springer, 2000",
+        subject: "",
+        used_for: "solid-harmonic recursions and gradient of a spherical-harmonic potential (Sec. 3.2); conical \
+                   Earth shadow by the overlap of the apparent disks (Sec. 3.4.2); modified Harris-Priester \
+                   density (Sec. 3.5.2, Table 3.8)",
+    },
+    Reference {
+        key: "Vallado-2013",
+        authors: "D. A. Vallado",
+        title: "Fundamentals of Astrodynamics and Applications",
+        venue: "4th ed., Microcosm Press, 2013",
+        subject: "",
+        used_for: "Greenwich mean sidereal time (IAU 1982, Eq. 3-45), IAU 1976 precession; the exponential \
+                   atmosphere (Table 8-4)",
+    },
+    Reference {
+        key: "AA-2024",
+        authors: "U.S. Naval Observatory, H.M. Nautical Almanac Office",
+        title: "The Astronomical Almanac",
+        venue: "Section C, low-precision formulas for the Sun (the same in every recent edition)",
+        subject: "",
+        used_for: "the sun's apparent ecliptic longitude, distance and the obliquity, accurate to 0.01 deg \
+                   from 1950 to 2050",
+    },
+    Reference {
+        key: "Lieske-1977",
+        authors: "J. H. Lieske, T. Lederle, W. Fricke, B. Morando",
+        title: "Expressions for the precession quantities based upon the IAU (1976) system of astronomical \
+                constants",
+        venue: "Astronomy and Astrophysics 58, 1-16, 1977",
+        subject: "",
+        used_for: "the precession angles zeta, z, theta from J2000 to the mean equator and equinox of date",
+    },
+    Reference {
+        key: "Meeus-1998",
+        authors: "J. Meeus",
+        title: "Astronomical Algorithms",
+        venue: "2nd ed., Willmann-Bell, 1998",
+        subject: "",
+        used_for: "Julian date of a calendar date and back (Ch. 7)",
+    },
 ];
 
 #[cfg(test)]
