@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The first result: sets up what this machine needs and runs the default scenario (paper 000's large-angle
 # slew, quaternion PD): prints EULERINT, settling times and control effort, writes out/default/default.{csv,png}.
-# Builds for this machine only: the FMUs' library and the packager (cargo), the Python venv (in parallel with
-# the build), then `scfmu run default`. Nothing else: no system package, no cross build, no reference results,
+# Builds for this machine only: the FMUs' library and the packager (cargo), the Python venv with what `scfmu run`
+# needs (scripts/setup.sh --run-only: requirements-run.txt; in parallel with the build), then `scfmu run default`. Nothing else: no system package, no cross build, no reference results,
 # SSP files or loop FMUs — those come with scripts/test.sh, scripts/build_fmus.sh --all (or --platform P,
 # --reference-results, --scenario-files), scripts/build_wheel.sh --platform P and scfmu export ssp|loop.
 # Arguments go to `scfmu run`: a scenario name and options, or options alone for the default scenario
@@ -12,7 +12,7 @@ cd "$(dirname "$0")/.."
 start=$(date +%s)
 log=$(mktemp)
 trap 'rm -f "$log"' EXIT
-scripts/setup.sh >"$log" 2>&1 &
+scripts/setup.sh --run-only >"$log" 2>&1 &
 setup_pid=$!
 scripts/build_fmus.sh --fmus-only
 if ! wait "$setup_pid"; then

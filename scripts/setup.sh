@@ -5,7 +5,8 @@
 # pyproject.toml changes. Without options it installs no system package (scripts/run.sh needs none: the
 # host build needs only cargo and the C linker the Rust toolchain already uses).
 #
-#   scripts/setup.sh                 the venv only (scripts/run.sh)
+#   scripts/setup.sh                 the venv with every pinned package of requirements.txt, no system package
+#   scripts/setup.sh --run-only      the venv with what `scfmu run` needs only (requirements-run.txt; scripts/run.sh)
 #   scripts/setup.sh --test-tools    also rustfmt/clippy and the system tools the tests use: gcc, valgrind (apt)
 #   scripts/setup.sh --cross         also the cross toolchains of the other platforms' binaries and their
 #                                    emulators: MinGW-w64 + Debian's Rust + Wine (Windows), the aarch64 cross
@@ -15,12 +16,14 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 test_tools=0
 cross=0
+run_only=0
 for arg in "$@"; do
     case "$arg" in
         --test-tools) test_tools=1 ;;
         --cross) cross=1 ;;
         --all) test_tools=1; cross=1 ;;
-        *) echo "setup: unknown option '$arg' (allowed: --test-tools, --cross, --all)" >&2; exit 2 ;;
+        --run-only) run_only=1 ;;
+        *) echo "setup: unknown option '$arg' (allowed: --run-only, --test-tools, --cross, --all)" >&2; exit 2 ;;
     esac
 done
 
@@ -111,13 +114,28 @@ if ! command -v "$PY" >/dev/null 2>&1; then
     echo "setup: $PY not found (Python >= 3.11 needed)." >&2
     exit 1
 fi
+# The stamp records what the venv holds: "full <sha256 of requirements.txt + requirements-run.txt>" (every
+# pinned package) or "run <sha256 of requirements-run.txt>" (--run-only: what `scfmu run` needs). A full venv
+# serves --run-only; a run-only venv is completed in place when the full set is asked for; a change of pins
+# rebuilds the venv.
 stamp=.venv/.requirements.sha256
-want=$(sha256sum requirements.txt | cut -d' ' -f1)
-if [ ! -x .venv/bin/python ] || [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
-    echo "setup: creating .venv with the pinned packages of requirements.txt"
+run_want="run $(cat requirements-run.txt | sha256sum | cut -d' ' -f1)"
+full_want="full $(cat requirements.txt requirements-run.txt | sha256sum | cut -d' ' -f1)"
+have=$(cat "$stamp" 2>/dev/null || true)
+if [ "$run_only" = 1 ]; then
+    want_set=requirements-run.txt want=$run_want
+else
+    want_set=requirements.txt want=$full_want
+fi
+if [ ! -x .venv/bin/python ] || { [ "$have" != "$want" ] && [ "$have" != "$full_want" ] && [ "$have" != "$run_want" ]; }; then
+    echo "setup: creating .venv with the pinned packages of $want_set"
     rm -rf .venv
     "$PY" -m venv .venv
     .venv/bin/python -m pip install --quiet --upgrade pip
+    .venv/bin/python -m pip install --quiet -r "$want_set"
+    echo "$want" > "$stamp"
+elif [ "$have" = "$run_want" ] && [ "$want" = "$full_want" ]; then
+    echo "setup: adding the test, extra and build packages of requirements.txt to .venv"
     .venv/bin/python -m pip install --quiet -r requirements.txt
     echo "$want" > "$stamp"
 fi
