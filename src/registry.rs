@@ -5,7 +5,7 @@
 use crate::export::Extras;
 pub use crate::export::Family;
 use crate::model::{concat, total_len, ModelEntry};
-use crate::models::{attitude, estimation, formation, sensors, single_axis};
+use crate::models::{attitude, environment, estimation, formation, sensors, single_axis};
 
 /// The families, each a folder under `src/models/` and a page `docs/models/<slug>.md` (title and overview
 /// go into the catalogue the library exports).
@@ -46,15 +46,22 @@ pub const FAMILIES: &[Family] = &[
         overview: include_str!("models/estimation/README.md"),
         fmus: estimation::FMUS,
     },
+    Family {
+        slug: "environment",
+        title: "Orbital environment: orbit, geomagnetic field, sun, eclipse and atmosphere",
+        overview: include_str!("models/environment/README.md"),
+        fmus: environment::FMUS,
+    },
 ];
 
-const LISTS: [&[ModelEntry]; 6] = [
+const LISTS: [&[ModelEntry]; 7] = [
     FAMILIES[0].fmus,
     FAMILIES[1].fmus,
     FAMILIES[2].fmus,
     FAMILIES[3].fmus,
     FAMILIES[4].fmus,
     FAMILIES[5].fmus,
+    FAMILIES[6].fmus,
 ];
 const _: () = assert!(FAMILIES.len() == LISTS.len(), "every family goes into the registry");
 

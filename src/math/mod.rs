@@ -12,6 +12,7 @@ pub mod environment;
 pub mod fractional;
 pub mod fuzzy;
 pub mod integrate;
+pub mod orbit;
 pub mod pole_placement;
 pub mod predictive_control;
 pub mod random;

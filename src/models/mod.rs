@@ -37,6 +37,7 @@
 //! - plants of every family: `integrator` is an Integer with codes 0 RK4, 1 Euler, 2 Dormand–Prince.
 
 pub mod attitude;
+pub mod environment;
 pub mod estimation;
 pub mod formation;
 pub mod ports;

@@ -101,6 +101,41 @@ pub const ALL: &[Reference] = &[
         used_for: "the multiplicative extended Kalman filter of attitude and gyro bias (error state of small-angle \
                    attitude errors and biases, multiplicative reset)",
     },
+    Reference {
+        key: "Vallado-2013",
+        authors: "D. A. Vallado",
+        title: "Fundamentals of Astrodynamics and Applications",
+        venue: "4th ed., Microcosm Press, 2013",
+        subject: "",
+        used_for: "classical orbital elements and the state vector, Kepler's equation, the zonal-harmonic \
+                   accelerations J2-J4 and atmospheric drag of the Orbit unit",
+    },
+    Reference {
+        key: "Montenbruck-Gill-2000",
+        authors: "O. Montenbruck, E. Gill",
+        title: "Satellite Orbits: Models, Methods and Applications",
+        venue: "Springer, 2000",
+        subject: "",
+        used_for: "numerical orbit propagation: force model (geopotential, drag relative to a co-rotating \
+                   atmosphere), adaptive Runge-Kutta integration and its tolerances",
+    },
+    Reference {
+        key: "Hoots-Roehrich-1980",
+        authors: "F. R. Hoots, R. L. Roehrich",
+        title: "Spacetrack Report No. 3: Models for Propagation of NORAD Element Sets",
+        venue: "Aerospace Defense Command, 1980",
+        subject: "",
+        used_for: "the SGP4 analytical propagator of two-line element sets",
+    },
+    Reference {
+        key: "Vallado-2006",
+        authors: "D. A. Vallado, P. Crawford, R. Hujsak, T. S. Kelso",
+        title: "Revisiting Spacetrack Report #3",
+        venue: "AIAA/AAS Astrodynamics Specialist Conference, AIAA 2006-6753, 2006",
+        subject: "",
+        used_for: "the reference SGP4 implementation, its verification element sets (SGP4-VER.TLE) and the TEME \
+                   frame of its output",
+    },
 ];
 
 #[cfg(test)]
