@@ -184,3 +184,28 @@ fn restored_sgp4_state_rebuilds_the_propagator() {
     q.step(60.0, 60.0).unwrap();
     assert_eq!(p.model().x, q.model().x);
 }
+
+/// Cost of one communication step (step + outputs), numerical mode with J2 and drag, and SGP4 mode:
+/// `cargo test --release --lib orbit::tests::step_cost -- --ignored --nocapture`.
+#[test]
+#[ignore = "timing, not a check"]
+fn step_cost() {
+    for h in [0.1, 10.0] {
+        for mode in ["numerical J2 + drag", "numerical J4 + drag", "SGP4"] {
+            let mut p = match mode {
+                "SGP4" => sgp4_orbit(),
+                "numerical J4 + drag" => orbit(|v| v.zonal_degree = 4),
+                _ => orbit(|_| {}),
+            };
+            p.v.rho = 1e-12;
+            let n = (20_000.0 / h).min(200_000.0) as usize;
+            let t0 = std::time::Instant::now();
+            for k in 0..n {
+                p.step(k as f64 * h, h).unwrap();
+                p.outputs((k + 1) as f64 * h).unwrap();
+            }
+            let us = t0.elapsed().as_secs_f64() * 1e6 / n as f64;
+            println!("{mode}, step {h} s: {us:.2} us per communication step ({n} steps)");
+        }
+    }
+}

@@ -40,13 +40,18 @@ pub fn propagator(t: &Tle) -> Result<sgp4::Constants, String> {
         .map_err(|e| format!("SGP4 cannot start from these elements (eccentricity {})", e.0))
 }
 
-/// Position (m) and velocity (m/s) in TEME `dt` seconds after the TLE epoch (negative: before it).
+/// Position (m) and velocity (m/s) in TEME `dt` seconds after the TLE epoch (negative: before it);
+/// refused where SGP4 fails or the satellite is below the WGS-72 equatorial radius (decayed).
 pub fn propagate(c: &sgp4::Constants, dt: f64) -> Result<(Vector3<f64>, Vector3<f64>), String> {
     let p = c
         .propagate(sgp4::MinutesSinceEpoch(dt / 60.0))
         .map_err(|e| format!("SGP4 fails {dt} s after the TLE epoch: {e}"))?;
     let r = Vector3::from(p.position) * 1e3;
     let v = Vector3::from(p.velocity) * 1e3;
+    // the reference implementation's error 6: the satellite is under the surface
+    if r.norm() < WGS72_RADIUS {
+        return Err(format!("the satellite has decayed {dt} s after the TLE epoch (|r| = {} m)", r.norm()));
+    }
     Ok((r, v))
 }
 
