@@ -190,7 +190,7 @@ fn restored_sgp4_state_rebuilds_the_propagator() {
 #[test]
 #[ignore = "timing, not a check"]
 fn step_cost() {
-    for h in [0.1, 10.0] {
+    for h in [0.1f64, 10.0] {
         for mode in ["numerical J2 + drag", "numerical J4 + drag", "SGP4"] {
             let mut p = match mode {
                 "SGP4" => sgp4_orbit(),
