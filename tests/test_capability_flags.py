@@ -62,6 +62,8 @@ class Slave:
         self.fmu.exitInitializationMode()
         real = [v for v in self.md.modelVariables if v.type == "Real"]
         self.inputs = [v.valueReference for v in real if v.causality == "input" and not v.name.split(".")[-1].startswith("q")]
+        # an atmospheric density (Orbit's rho) is non-negative and thin in orbit (0.01 kg/m3 brings it down)
+        self.density = [v.valueReference for v in real if v.causality == "input" and v.unit == "kg/m3"]
         self.outputs = [v.valueReference for v in real if v.causality == "output"]
         self.h = float(self.md.defaultExperiment.stepSize)
         self.t = 0.0
@@ -70,7 +72,8 @@ class Slave:
         rows = []
         for k in range(n):
             if self.inputs:
-                self.fmu.setReal(self.inputs, [0.01 * np.sin(0.3 * (self.t + i)) for i in range(len(self.inputs))])
+                self.fmu.setReal(self.inputs, [1e-12 * (1 + np.sin(0.3 * (self.t + i))) if vr in self.density
+                                               else 0.01 * np.sin(0.3 * (self.t + i)) for i, vr in enumerate(self.inputs)])
             h = self.h if steps is None else steps[k % len(steps)]
             self.fmu.doStep(self.t, h)
             self.t += h
