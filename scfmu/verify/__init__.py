@@ -21,7 +21,9 @@ includes every controller, so their outputs move) are given at every communicati
 
 * each quaternion input group ``<p>_w, <p>_x, <p>_y, <p>_z``: the unit quaternion of a rotation by
   0.3 sin(0.2 t + 0.5 j) rad about (1, 2, 2)/3 (j = the group's index);
-* every other Real input number i (in modelDescription order): 0.1 sin((0.5 + 0.1 i) t + 0.3 i) + 0.01 i.
+* every other Real input number i (in modelDescription order): 0.1 sin((0.5 + 0.1 i) t + 0.3 i) + 0.01 i,
+  except an atmospheric density ``rho`` (kg/m3, the Orbit unit's), which is thin and non-negative:
+  1e-12 (1.1 + sin((0.5 + 0.1 i) t + 0.3 i)).
 
 The rows of ``<Model>_in.csv`` are exactly those values at the communication points, so an importer that
 interpolates the table linearly applies them unchanged. Row k of ``<Model>_ref.csv`` holds the outputs at
@@ -65,6 +67,8 @@ REF_PARAMS = {
     "ReferenceCorrector": {"mode": 1, "init_euler321_roll": 0.3, "init_w_x": 0.02, "node_x_1": 0.01, "node_y_2": -0.01, "node_x_4": 0.005},
     "SunSensor": {"fov": math.pi, "eclipse": 0},
 }
+# an input of this name is an atmospheric density (kg/m3): the documented signal keeps it in orbit's range
+DENSITY_INPUT = "rho"
 REL_TOL = 1e-6
 ABS_TOL = 1e-12
 IMPORTERS = ("fmpy", "fmusim")
@@ -145,7 +149,8 @@ def input_signals(names: list[str], t: np.ndarray) -> np.ndarray:
     i = 0
     for n in names:
         if n not in cols:
-            cols[n] = 0.1 * np.sin((0.5 + 0.1 * i) * t + 0.3 * i) + 0.01 * i
+            wave = np.sin((0.5 + 0.1 * i) * t + 0.3 * i)
+            cols[n] = 1e-12 * (1.1 + wave) if n == DENSITY_INPUT else 0.1 * wave + 0.01 * i
             i += 1
     return np.column_stack([cols[n] for n in names]) if names else np.zeros((len(t), 0))
 
@@ -258,7 +263,9 @@ def _doc(model: str, exp: Experiment, ins: list[str]) -> str:
     if ins:
         text += (f"Inputs ({model}_in.csv): given at every communication point and held over the step; quaternion "
                  "groups <p>_w.._z turn by 0.3 sin(0.2 t + 0.5 j) rad about (1, 2, 2)/3, every other input i is "
-                 "0.1 sin((0.5 + 0.1 i) t + 0.3 i) + 0.01 i.\n")
+                 "0.1 sin((0.5 + 0.1 i) t + 0.3 i) + 0.01 i"
+                 + (f", except the density {DENSITY_INPUT}: 1e-12 (1.1 + sin((0.5 + 0.1 i) t + 0.3 i))" if DENSITY_INPUT in ins else "")
+                 + ".\n")
     elif not exp.inputs:
         text += "Inputs: none given (the FMU runs as it is; a loop FMU runs its scenario).\n"
     text += (f"Results ({model}_ref.csv): the outputs at every communication point, row 0 after initialization, row k "
