@@ -48,7 +48,7 @@ pub const FAMILIES: &[Family] = &[
     },
     Family {
         slug: "environment",
-        title: "Orbital environment",
+        title: "Orbital environment: orbit, geomagnetic field, sun, eclipse and atmosphere",
         overview: include_str!("models/environment/README.md"),
         fmus: environment::FMUS,
     },

@@ -68,6 +68,8 @@ class Slave:
         # where a small signal alone is refused (a position inside the Earth), the reference experiment's offset
         offsets = REF_INPUT_OFFSETS.get(self.md.coSimulation.modelIdentifier, {})
         self.offsets = [offsets.get(v.name, 0.0) for v in ins]
+        # an atmospheric density (Orbit's rho) is non-negative and thin in orbit (0.01 kg/m3 brings it down)
+        self.density = [v.valueReference for v in ins if v.unit == "kg/m3"]
         self.outputs = [v.valueReference for v in real if v.causality == "output"]
         self.h = float(self.md.defaultExperiment.stepSize)
         self.t = 0.0
@@ -76,8 +78,9 @@ class Slave:
         rows = []
         for k in range(n):
             if self.inputs:
-                self.fmu.setReal(self.inputs, [0.01 * np.sin(0.3 * (self.t + i)) + self.offsets[i]
-                                               for i in range(len(self.inputs))])
+                self.fmu.setReal(self.inputs, [1e-12 * (1 + np.sin(0.3 * (self.t + i))) if vr in self.density
+                                               else 0.01 * np.sin(0.3 * (self.t + i)) + self.offsets[i]
+                                               for i, vr in enumerate(self.inputs)])
             h = self.h if steps is None else steps[k % len(steps)]
             self.fmu.doStep(self.t, h)
             self.t += h

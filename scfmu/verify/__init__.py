@@ -23,7 +23,8 @@ includes every controller, so their outputs move) are given at every communicati
   0.3 sin(0.2 t + 0.5 j) rad about (1, 2, 2)/3 (j = the group's index);
 * every other Real input number i (in modelDescription order): 0.1 sin((0.5 + 0.1 i) t + 0.3 i) + 0.01 i,
   plus the unit's offset in ``REF_INPUT_OFFSETS`` where the signal alone is not a valid input (a position
-  that must lie outside the Earth).
+  that must lie outside the Earth), except an atmospheric density ``rho`` (kg/m3, the Orbit unit's), which is
+  thin and non-negative: 1e-12 (1.1 + sin((0.5 + 0.1 i) t + 0.3 i)).
 
 The rows of ``<Model>_in.csv`` are exactly those values at the communication points, so an importer that
 interpolates the table linearly applies them unchanged. Row k of ``<Model>_ref.csv`` holds the outputs at
@@ -68,6 +69,8 @@ REF_PARAMS = {
     "SunSensor": {"fov": math.pi, "eclipse": 0},
 }
 # Constant offsets added to the documented input signals where those alone are refused by the unit
+# an input of this name is an atmospheric density (kg/m3): the documented signal keeps it in orbit's range
+DENSITY_INPUT = "rho"
 REF_INPUT_OFFSETS = {
     "Environment": {"r_x": 6_878_137.0},  # 500 km above the equator (|r| below the Earth's radius is refused)
 }
@@ -151,7 +154,9 @@ def input_signals(names: list[str], t: np.ndarray, model: str = "") -> np.ndarra
     i = 0
     for n in names:
         if n not in cols:
-            cols[n] = 0.1 * np.sin((0.5 + 0.1 * i) * t + 0.3 * i) + 0.01 * i + REF_INPUT_OFFSETS.get(model, {}).get(n, 0.0)
+            wave = np.sin((0.5 + 0.1 * i) * t + 0.3 * i)
+            cols[n] = (1e-12 * (1.1 + wave) if n == DENSITY_INPUT
+                       else 0.1 * wave + 0.01 * i + REF_INPUT_OFFSETS.get(model, {}).get(n, 0.0))
             i += 1
     return np.column_stack([cols[n] for n in names]) if names else np.zeros((len(t), 0))
 
@@ -265,7 +270,9 @@ def _doc(model: str, exp: Experiment, ins: list[str]) -> str:
         text += (f"Inputs ({model}_in.csv): given at every communication point and held over the step; quaternion "
                  "groups <p>_w.._z turn by 0.3 sin(0.2 t + 0.5 j) rad about (1, 2, 2)/3, every other input i is "
                  "0.1 sin((0.5 + 0.1 i) t + 0.3 i) + 0.01 i"
-                 + "".join(f", {k} plus {v!r}" for k, v in REF_INPUT_OFFSETS.get(model, {}).items()) + ".\n")
+                 + "".join(f", {k} plus {v!r}" for k, v in REF_INPUT_OFFSETS.get(model, {}).items())
+                 + (f", except the density {DENSITY_INPUT}: 1e-12 (1.1 + sin((0.5 + 0.1 i) t + 0.3 i))" if DENSITY_INPUT in ins else "")
+                 + ".\n")
     elif not exp.inputs:
         text += "Inputs: none given (the FMU runs as it is; a loop FMU runs its scenario).\n"
     text += (f"Results ({model}_ref.csv): the outputs at every communication point, row 0 after initialization, row k "

@@ -17,6 +17,7 @@ pub mod fuzzy;
 pub mod igrf;
 mod igrf14_coefficients;
 pub mod integrate;
+pub mod orbit;
 pub mod pole_placement;
 pub mod predictive_control;
 pub mod random;

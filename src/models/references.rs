@@ -125,7 +125,8 @@ pub const ALL: &[Reference] = &[
         subject: "",
         used_for: "solid-harmonic recursions and gradient of a spherical-harmonic potential (Sec. 3.2); conical \
                    Earth shadow by the overlap of the apparent disks (Sec. 3.4.2); modified Harris-Priester \
-                   density (Sec. 3.5.2, Table 3.8)",
+                   density (Sec. 3.5.2, Table 3.8); numerical orbit propagation: force model (geopotential, drag \
+                   relative to a co-rotating atmosphere), adaptive Runge-Kutta integration and its tolerances",
     },
     Reference {
         key: "Vallado-2013",
@@ -134,7 +135,8 @@ pub const ALL: &[Reference] = &[
         venue: "4th ed., Microcosm Press, 2013",
         subject: "",
         used_for: "Greenwich mean sidereal time (IAU 1982, Eq. 3-45), IAU 1976 precession; the exponential \
-                   atmosphere (Table 8-4)",
+                   atmosphere (Table 8-4); classical orbital elements and the state vector, Kepler's equation, \
+                   the zonal-harmonic accelerations J2-J4 and atmospheric drag of the Orbit unit",
     },
     Reference {
         key: "AA-2024",
@@ -161,6 +163,23 @@ pub const ALL: &[Reference] = &[
         venue: "2nd ed., Willmann-Bell, 1998",
         subject: "",
         used_for: "Julian date of a calendar date and back (Ch. 7)",
+    },
+    Reference {
+        key: "Hoots-Roehrich-1980",
+        authors: "F. R. Hoots, R. L. Roehrich",
+        title: "Spacetrack Report No. 3: Models for Propagation of NORAD Element Sets",
+        venue: "Aerospace Defense Command, 1980",
+        subject: "",
+        used_for: "the SGP4 analytical propagator of two-line element sets",
+    },
+    Reference {
+        key: "Vallado-2006",
+        authors: "D. A. Vallado, P. Crawford, R. Hujsak, T. S. Kelso",
+        title: "Revisiting Spacetrack Report #3",
+        venue: "AIAA/AAS Astrodynamics Specialist Conference, AIAA 2006-6753, 2006",
+        subject: "",
+        used_for: "the reference SGP4 implementation, its verification element sets (SGP4-VER.TLE) and the TEME \
+                   frame of its output",
     },
 ];
 
