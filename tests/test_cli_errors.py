@@ -25,22 +25,9 @@ import pytest
 from scfmu.scenario import files, get
 from scfmu.scenario.values import INT32, parse_cli, timing_problems, value_problem
 
+from cli_run import refused, scfmu  # tests/ is on the path (pyproject.toml)
+
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def scfmu(*args, env=None, cwd=None, timeout=300):
-    e = dict(os.environ, **(env or {}))
-    return subprocess.run([sys.executable, "-m", "scfmu", *map(str, args)], capture_output=True, text=True,
-                          timeout=timeout, env=e, cwd=cwd)
-
-
-def refused(r) -> str:
-    """The one error line of a refused command: exit 2, one line (notices of a swap aside), no traceback."""
-    assert "Traceback" not in r.stderr, r.stderr
-    assert r.returncode == 2, (r.returncode, r.stderr)
-    lines = [x for x in r.stderr.splitlines() if x.strip() and not x.startswith(("notice:", "warning:"))]
-    assert len(lines) == 1, r.stderr
-    return lines[0]
 
 
 @pytest.fixture(scope="module")

@@ -33,22 +33,9 @@ import pytest
 from scfmu import cli
 from scfmu.fmu import fmu_dir
 
+from cli_run import refused, scfmu  # tests/ is on the path (pyproject.toml)
+
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def scfmu(*args, env=None, cwd=None, timeout=300):
-    e = dict(os.environ, **(env or {}))
-    return subprocess.run([sys.executable, "-m", "scfmu", *map(str, args)], capture_output=True, text=True,
-                          timeout=timeout, env=e, cwd=cwd)
-
-
-def refused(r) -> str:
-    """The one line of a refused command: exit 2, one line (notices and warnings aside), no traceback."""
-    assert "Traceback" not in r.stderr, r.stderr
-    assert r.returncode == 2, (r.returncode, r.stdout[-1000:], r.stderr[-2000:])
-    lines = [x for x in r.stderr.splitlines() if x.strip() and not x.startswith(("notice:", "warning:", "BLOCKED IMPORT"))]
-    assert len(lines) == 1, r.stderr
-    return lines[0]
 
 
 BLOCKER = '''

@@ -15,20 +15,15 @@ import os
 import time
 from pathlib import Path
 
+from ..fmu.units import megabytes_setting
+
 CACHE = Path(os.environ.get("SCFMU_CONTAINER_DIR", Path.home() / ".cache" / "scfmu" / "containers"))
 IN_USE_S = 600.0
 
 
 def budget_bytes() -> int:
-    """The cache's size bound from ``$SCFMU_CONTAINER_CACHE_MB`` (a number of megabytes, > 0)."""
-    raw = os.environ.get("SCFMU_CONTAINER_CACHE_MB", "4096")
-    try:
-        mb = float(raw)
-    except ValueError:
-        mb = float("nan")
-    if not mb > 0 or mb == float("inf"):
-        raise ValueError(f"SCFMU_CONTAINER_CACHE_MB = {raw!r}: a number of megabytes > 0 is allowed")
-    return int(mb * 1e6)
+    """The cache's size bound from ``$SCFMU_CONTAINER_CACHE_MB`` (a number of megabytes, > 0; default 4096)."""
+    return megabytes_setting("SCFMU_CONTAINER_CACHE_MB", 4096)
 
 
 def used(path: Path) -> Path:

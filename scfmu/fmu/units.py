@@ -81,18 +81,24 @@ def cache_root() -> Path | None:
     return base / "scfmu" / "units"
 
 
-def budget_bytes() -> int:
-    """The cache's size bound from ``$SCFMU_UNIT_CACHE_MB`` (megabytes of 10^6 bytes, > 0; default 2048)."""
-    raw = os.environ.get(ENV_MB)
+def megabytes_setting(name: str, default_mb: float) -> int:
+    """A size bound in bytes from the environment variable ``name`` (megabytes of 10^6 bytes, > 0; unset or
+    empty: ``default_mb``); anything else is refused with a ValueError naming the variable."""
+    raw = os.environ.get(name)
     if raw is None or not raw.strip():
-        return DEFAULT_MB * 10**6
+        return int(default_mb * 10**6)
     try:
         mb = float(raw)
     except ValueError:
         mb = float("nan")
     if not mb > 0 or mb == float("inf"):
-        raise ValueError(f"{ENV_MB} = {raw!r}: a number of megabytes > 0 is allowed")
+        raise ValueError(f"{name} = {raw!r}: a number of megabytes > 0 is allowed")
     return int(mb * 10**6)
+
+
+def budget_bytes() -> int:
+    """The cache's size bound from ``$SCFMU_UNIT_CACHE_MB`` (megabytes of 10^6 bytes, > 0; default 2048)."""
+    return megabytes_setting(ENV_MB, DEFAULT_MB)
 
 
 def host_folders() -> frozenset[str]:
