@@ -123,11 +123,23 @@ class ModelExchange:
                 continue
             if self.nx:
                 from scipy.integrate import solve_ivp  # imported here: SciPy costs ~1 s at start-up
-                sol = solve_ivp(self._rhs, (t, t_stop), self._states(), method=self.me_method,
+                x0 = self._states()
+                sol = solve_ivp(self._rhs, (t, t_stop), x0, method=self.me_method,
                                 rtol=self.me_rtol, atol=self.me_atol, events=events)
                 if not sol.success:
                     raise RuntimeError(f"{self.model}: solve_ivp failed from t = {t} to {t_stop}: {sol.message}")
-                if sol.status == 1:  # an event indicator changed sign: stop there
+                if sol.status == 1 and float(sol.t[-1]) <= t + eps:
+                    # a root at the interval's start: the indicator is (to rounding) 0 at t, which solve_ivp
+                    # takes as a sign change at once, and the unit saw none at t. Step just past t without
+                    # event functions and hand the event to the unit there, where the sign has changed;
+                    # never stop at t again (that looped for ever)
+                    t_stop = min(t_stop, t + 1000.0 * eps)
+                    sol = solve_ivp(self._rhs, (t, t_stop), x0, method=self.me_method,
+                                    rtol=self.me_rtol, atol=self.me_atol)
+                    if not sol.success:
+                        raise RuntimeError(f"{self.model}: solve_ivp failed from t = {t} to {t_stop}: {sol.message}")
+                    state_event = True
+                elif sol.status == 1:  # an event indicator changed sign: stop there
                     state_event, t_stop = True, float(sol.t[-1])
                 self._rhs(t_stop, sol.y[:, -1])  # leaves the unit at (t_stop, x(t_stop))
             else:
