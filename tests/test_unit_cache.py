@@ -63,7 +63,7 @@ def cache(tmp_path, monkeypatch) -> Path:
 
 def multi_platform(dst: Path, src: str = "PdController") -> Path:
     """A copy of one of our FMUs that also carries fake binaries of every other platform, documentation,
-    sources, a resource, and a nested FMU (as a container carries its units) with binaries of its own."""
+    sources, layered-standard files under extra/, a resource, and a nested FMU (as a container carries its units) with binaries of its own."""
     lib = {"linux64": "so", "x86_64-linux": "so", "aarch64-linux": "so", "win64": "dll", "x86_64-windows": "dll",
            "darwin64": "dylib", "aarch64-darwin": "dylib"}
     with zipfile.ZipFile(fmu_path(src)) as zin, zipfile.ZipFile(dst, "w", zipfile.ZIP_DEFLATED) as zout:
@@ -80,6 +80,9 @@ def multi_platform(dst: Path, src: str = "PdController") -> Path:
         zout.writestr("resources/table.txt", "4 5 6\n")
         zout.writestr("sources/model.c", "int x;\n")
         zout.writestr("documentation/extra.html", "<p/>")
+        if "extra/org.fmi-standard.fmi-ls-ref/fmi-ls-manifest.xml" not in names:  # as a built FMU carries
+            zout.writestr("extra/org.fmi-standard.fmi-ls-ref/fmi-ls-manifest.xml", "<fmiReferences/>")
+        zout.writestr("resources/Inner/extra/org.example/notes.txt", "x\n")
     return dst
 
 

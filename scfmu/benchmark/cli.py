@@ -21,7 +21,7 @@ from . import StrictRefusal, run, selected_cases
 from .options import unit_options
 
 
-def main(argv=None) -> int:
+def _parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="scfmu benchmark", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("unit", nargs="?", help="the controller under test: a path to an .fmu or a model name "
@@ -49,7 +49,33 @@ def main(argv=None) -> int:
     ap.add_argument("--out", default=None, help="output folder (default out/benchmark/<family>)")
     ap.add_argument("--check", action="store_true", help="first run `scfmu check --quick` on the unit (an .fmu); "
                     "stop with exit status 1 if a check fails")
-    a = ap.parse_args(argv)
+    return ap
+
+
+def _unit(a) -> str | None:
+    """The unit under test: a checked .fmu path or a known model name (None: built-ins only); a usage error
+    names what is wrong (an option that needs a unit, an unreadable file, an unknown name)."""
+    unit = a.unit
+    if not unit:
+        given = [o for o, v in (("--set", a.set), ("--map", a.map), ("--profile", a.profile), ("--label", a.label),
+                                ("--strict", a.strict), ("--check", a.check)) if v]
+        if given:
+            raise UsageError(f"{given[0]} needs a unit under test (scfmu benchmark PATH.fmu|MODEL {given[0]} ...); "
+                             "without one only the built-in controllers run")
+    if unit and (unit.lower().endswith(".fmu") or "/" in unit):
+        unit = fmu_file("", unit)
+        try:
+            described(unit)
+        except Exception as e:
+            raise UsageError(f"{a.unit}: not a readable FMU ({str(e).splitlines()[0] if str(e) else type(e).__name__})"
+                             "; allowed: an FMI 2.0/3.0 .fmu file or a model name") from None
+    elif unit:
+        fmu_path(unit)  # an unknown model name: one line with the closest name (exit 2)
+    return unit
+
+
+def main(argv=None) -> int:
+    a = _parser().parse_args(argv)
     if a.family not in REGISTRY.families():
         print(f"scfmu benchmark: no family {a.family!r}; known: {', '.join(REGISTRY.families())}", file=sys.stderr)
         return 2
@@ -70,22 +96,7 @@ def main(argv=None) -> int:
                              f"{did_you_mean(c, names)}; allowed: {', '.join(names)}")
     if a.workers < 1 or a.workers > 1024:
         raise UsageError(f"--workers {a.workers}: allowed: a whole number in [1, 1024]")
-    unit = a.unit
-    if not unit:
-        given = [o for o, v in (("--set", a.set), ("--map", a.map), ("--profile", a.profile), ("--label", a.label),
-                                ("--strict", a.strict), ("--check", a.check)) if v]
-        if given:
-            raise UsageError(f"{given[0]} needs a unit under test (scfmu benchmark PATH.fmu|MODEL {given[0]} ...); "
-                             "without one only the built-in controllers run")
-    if unit and (unit.lower().endswith(".fmu") or "/" in unit):
-        unit = fmu_file("", unit)
-        try:
-            described(unit)
-        except Exception as e:
-            raise UsageError(f"{a.unit}: not a readable FMU ({str(e).splitlines()[0] if str(e) else type(e).__name__})"
-                             "; allowed: an FMI 2.0/3.0 .fmu file or a model name") from None
-    elif unit:
-        fmu_path(unit)  # an unknown model name: one line with the closest name (exit 2)
+    unit = _unit(a)
     if unit and a.check:
         from ..check import check_quick
         rep = check_quick(str(fmu_path(unit)))

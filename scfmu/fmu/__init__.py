@@ -2,7 +2,7 @@
 name-based access: FMI 2.0 or FMI 3.0, Co-Simulation (fmpy's FMU2Slave / FMU3Slave underneath) or Model
 Exchange (FMU2Model / FMU3Model, integrated by SciPy's solve_ivp between communication points).
 
-Where the FMUs are is decided here and nowhere else (:func:`fmu_dir`), first match wins:
+Where the FMUs are is decided in scfmu.fmu.locate and nowhere else (:func:`fmu_dir`), first match wins:
 
 1. the environment variable ``SCFMU_FMU_DIR``;
 2. a folder set by the program (:func:`set_fmu_dir`, the ``--fmus`` option of the ``scfmu`` command);
@@ -22,10 +22,8 @@ Exchange integration of :class:`Fmu` is in scfmu.fmu.model_exchange.
 
 from __future__ import annotations
 
-import functools
 import os
 import shutil
-from importlib import resources
 from pathlib import Path
 
 from fmpy import read_model_description
@@ -33,89 +31,14 @@ from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Model, FMU2Slave, defaultCallbacks, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
 from fmpy.fmi3 import FMU3Model, FMU3Slave
 
+from .locate import UnknownModel, fmu_dir, fmu_path, is_path, models, set_fmu_dir
 from .archive import ArchiveError, ArchiveLimits, archive_limits, inspect_archive, safe_extract, set_archive_limits
 from .model_exchange import ModelExchange
 
-__all__ = ["ArchiveError", "ArchiveLimits", "archive_limits", "inspect_archive", "safe_extract", "set_archive_limits"]
+__all__ = ["ArchiveError", "ArchiveLimits", "archive_limits", "inspect_archive", "safe_extract", "set_archive_limits",
+           "UnknownModel", "fmu_dir", "fmu_path", "is_path", "models", "set_fmu_dir"]
 
-_FMU_DIR_OVERRIDE: Path | None = None
 INT32 = (-(2 ** 31), 2 ** 31 - 1)  # the range of an FMI 2.0 Integer (fmi2Integer is a C int)
-
-
-def set_fmu_dir(path: str | Path | None) -> None:
-    """Uses ``path`` as the FMU folder (unless ``SCFMU_FMU_DIR`` is set); None restores the default."""
-    global _FMU_DIR_OVERRIDE
-    _FMU_DIR_OVERRIDE = None if path is None else Path(path).resolve()
-
-
-@functools.cache  # where the installed package lies does not change while it runs
-def _package_fmus() -> Path | None:
-    d = resources.files("scfmu") / "fmus"
-    if d.is_dir() and any(p.name.endswith(".fmu") for p in d.iterdir()):
-        return Path(str(d))
-    return None
-
-
-@functools.cache
-def _checkout_fmus() -> Path | None:
-    """``fmus/`` of the source checkout that holds this package (editable install), if it is one."""
-    pkg = Path(str(resources.files("scfmu")))
-    root = pkg.parent
-    if (root / "Cargo.toml").is_file() and (root / "fmus").is_dir():
-        return root / "fmus"
-    return None
-
-
-def fmu_dir() -> Path:
-    """The folder holding ``<Model>.fmu`` (see the module docstring for the order)."""
-    env = os.environ.get("SCFMU_FMU_DIR")
-    if env:
-        return Path(env)
-    if _FMU_DIR_OVERRIDE is not None:
-        return _FMU_DIR_OVERRIDE
-    for d in (_package_fmus(), _checkout_fmus()):
-        if d is not None:
-            return d
-    raise FileNotFoundError("no FMU folder: set SCFMU_FMU_DIR or pass --fmus DIR (this installation ships no "
-                            "FMUs and is not a source checkout with fmus/)")
-
-
-def is_path(model: str) -> bool:
-    """True when a component's model is given as a path to an FMU file rather than a model name."""
-    return str(model).endswith(".fmu") or "/" in str(model) or os.sep in str(model)
-
-
-class UnknownModel(FileNotFoundError):
-    """A model name that names no FMU of the FMU folder (the message suggests the closest names)."""
-
-
-def models() -> list[str]:
-    """The model names of the FMU folder (``<name>.fmu``), sorted."""
-    try:
-        return sorted(p.stem for p in fmu_dir().glob("*.fmu"))
-    except OSError:
-        return []
-
-
-def fmu_path(model: str) -> Path:
-    """The FMU file of ``model``: a path to an ``.fmu`` file as given, else ``<fmu_dir()>/<model>.fmu``."""
-    if is_path(model):
-        p = Path(model).expanduser()
-        if p.is_dir():
-            raise FileNotFoundError(f"FMU {p} is a directory, not an FMU file (give the .fmu archive)")
-        if not p.is_file():
-            raise FileNotFoundError(f"FMU {p} not found")
-        return p.resolve()
-    p = fmu_dir() / f"{model}.fmu"
-    if not p.is_file():
-        import difflib
-        close = difflib.get_close_matches(str(model), models(), n=1)
-        if close:
-            raise UnknownModel(f"unknown model {model!r}; did you mean {close[0]!r}? (the models are the .fmu files "
-                               f"of {fmu_dir()})")
-        raise UnknownModel(f"{p} not found: build the FMUs (scripts/build_fmus.sh in a checkout), set "
-                           f"SCFMU_FMU_DIR or pass --fmus DIR")
-    return p
 
 
 def file_key(path: str | Path) -> tuple:

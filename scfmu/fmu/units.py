@@ -56,7 +56,9 @@ UNIT = "unit"  # the unzip directory inside an entry
 MARK = "complete"  # written last: an entry without it is never used
 TMP = ".tmp-"  # an entry being made (its maker holds scratch.LOCK)
 TRASH = ".trash-"  # an evicted entry being deleted
-DROPPED = ("documentation", "sources")  # top-level folders of an FMU that running it never reads
+DROPPED = ("documentation", "sources", "extra")  # top-level folders of an FMU that running it never reads
+# (``extra/`` holds layered-standard files such as fmi-ls-ref reference results: tools read them from the
+# archive; a unit sees only its resources folder)
 _DIGEST = re.compile(r"^[0-9a-f]{64}$")
 
 _HELD: dict = {}  # (root, digest) -> open descriptor of the entry's lock (shared lock until the process ends)
@@ -109,7 +111,7 @@ def host_folders() -> frozenset[str]:
 
 
 def platform_filter(names: list[str], folders=None):
-    """A predicate on the entry names of an FMU: False for ``documentation/``, ``sources/`` and the
+    """A predicate on the entry names of an FMU: False for ``documentation/``, ``sources/``, ``extra/`` and the
     ``binaries/<folder>/`` of other platforms than ``folders`` (default :func:`host_folders`), at the top
     and inside every nested FMU (``resources/<name>/`` with its own ``modelDescription.xml``)."""
     folders = host_folders() if folders is None else frozenset(folders)
