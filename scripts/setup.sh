@@ -11,19 +11,23 @@
 #   scripts/setup.sh --cross         also the cross toolchains of the other platforms' binaries and their
 #                                    emulators: MinGW-w64 + Debian's Rust + Wine (Windows), the aarch64 cross
 #                                    linker + qemu-user (Linux aarch64) (apt, as root on Debian 12)
-#   scripts/setup.sh --all           both (scripts/test.sh)
+#   scripts/setup.sh --basilisk      also Basilisk (requirements-bsk.txt) in its own venv .venv-bsk: the
+#                                    independent simulator the drag/solar-pressure test compares against
+#   scripts/setup.sh --all           all of them (scripts/test.sh)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 test_tools=0
 cross=0
 run_only=0
+basilisk=0
 for arg in "$@"; do
     case "$arg" in
         --test-tools) test_tools=1 ;;
         --cross) cross=1 ;;
-        --all) test_tools=1; cross=1 ;;
+        --basilisk) basilisk=1 ;;
+        --all) test_tools=1; cross=1; basilisk=1 ;;
         --run-only) run_only=1 ;;
-        *) echo "setup: unknown option '$arg' (allowed: --run-only, --test-tools, --cross, --all)" >&2; exit 2 ;;
+        *) echo "setup: unknown option '$arg' (allowed: --run-only, --test-tools, --cross, --basilisk, --all)" >&2; exit 2 ;;
     esac
 done
 
@@ -147,4 +151,16 @@ if [ "$(cat "$pstamp" 2>/dev/null)" != "$pwant" ] || [ ! -x .venv/bin/scfmu ]; t
     echo "setup: installing the scfmu package (editable) into .venv"
     .venv/bin/python -m pip install --quiet --no-deps --no-build-isolation -e .
     echo "$pwant" > "$pstamp"
+fi
+# Basilisk in its own venv (its pins conflict with ours), rebuilt when requirements-bsk.txt changes.
+if [ "$basilisk" = 1 ]; then
+    bstamp=.venv-bsk/.requirements.sha256
+    bwant=$(sha256sum requirements-bsk.txt | cut -d' ' -f1)
+    if [ "$(cat "$bstamp" 2>/dev/null)" != "$bwant" ] || [ ! -x .venv-bsk/bin/python ]; then
+        echo "setup: creating .venv-bsk with Basilisk (requirements-bsk.txt)"
+        rm -rf .venv-bsk
+        "$PY" -m venv .venv-bsk
+        .venv-bsk/bin/python -m pip install --quiet -r requirements-bsk.txt
+        echo "$bwant" > "$bstamp"
+    fi
 fi

@@ -31,7 +31,11 @@ class Stall(RuntimeError):
 
 
 class MeLoop:
-    def __init__(self, scenario, path_of=None, tolerance=None):
+    def __init__(self, scenario, path_of=None, tolerance=None, connector_defaults=False, callbacks=None):
+        """``connector_defaults``: initialise the way OMSimulator initialises a subsystem: every connected
+        input first gets its connector's default 0 and every unit's outputs are read in Initialization Mode
+        before the values flow (a quaternion input then reads [0, 0, 0, 0]); ``callbacks(name)`` gives each
+        unit's fmi2CallbackFunctions (to record its log)."""
         self.sc = resolve(scenario)
         path_of = path_of or fmu_path
         self.units, self.dirs, self.vr, self.nx, self.outs = {}, [], {}, {}, {}
@@ -42,7 +46,7 @@ class MeLoop:
             d = extract(p)
             self.dirs.append(d)
             u = FMU2Model(guid=md.guid, unzipDirectory=d, modelIdentifier=md.modelExchange.modelIdentifier, instanceName=c.name)
-            u.instantiate()
+            u.instantiate(callbacks=callbacks(c.name) if callbacks else None, loggingOn=callbacks is not None)
             u.setupExperiment(tolerance=tolerance, startTime=self.sc.start_time, stopTime=self.sc.stop_time)
             u.enterInitializationMode()
             vr = {v.name: v for v in md.modelVariables}
@@ -55,6 +59,10 @@ class MeLoop:
                              [v.name for v in md.modelVariables if v.causality == "output"])
             self.outs[c.name] = [v.valueReference for v in md.modelVariables if v.causality == "output" and v.type == "Real"]
         self.links = [(d, self.vr[d][di].valueReference, s, self.vr[s][so].valueReference) for d, di, s, so in self.sc.wiring(ports)]
+        if connector_defaults:
+            for d, dvr, _, _ in self.links:
+                self.units[d].setReal([dvr], [0.0])
+            self.initial_outputs = {n: self.units[n].getReal(vrs) for n, vrs in self.outs.items() if vrs}
         for q, value in self.sc.inputs.items():
             inst, _, var = q.partition(".")
             self.units[inst].setReal([self.vr[inst][var].valueReference], [float(value)])

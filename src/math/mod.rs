@@ -3,7 +3,7 @@
 //! gains, counter-based random numbers, the sample grid of the sampled units (a master's rounded
 //! time taken as the grid instant), the orbit environment (the attitude plant's simple one; the true one of
 //! the environment family: time scales and Earth orientation, IGRF-14, the sun and its shadow, atmospheric
-//! density), Grünwald–Letnikov fractional calculus
+//! density; the drag and solar-pressure forces on a facet model), Grünwald–Letnikov fractional calculus
 //! with the PID / PI^λD^μ laws, and interval type-2 fuzzy inference (Karnik–Mendel type reduction).
 //! Each module carries its own unit tests against closed-form results.
 
@@ -26,6 +26,7 @@ pub mod riccati;
 pub mod sample_grid;
 pub mod spline;
 pub mod sun;
+pub mod surface_forces;
 pub mod time_scales;
 pub mod type2_fuzzy;
 pub mod wahba;

@@ -242,14 +242,22 @@ impl Instance {
         self.model.initialize(&self.run.exp).map_err(Fail::error)?;
         self.run.params_dirty = false;
         self.run.outputs_dirty = true;
-        self.ensure_outputs()?;
+        // inputs not yet consistent: a warning here (a Co-Simulation master may still set them before the
+        // first step); outputs read after this call, or a step, with the same inputs are refused
+        let warning = match self.ensure_outputs_or_keep() {
+            Err(f) if f.status == Status::Warning => Some(f),
+            other => {
+                other?;
+                None
+            }
+        };
         self.run.fsm = if self.model_exchange {
             FsmState::EventMode
         } else {
             FsmState::StepComplete
         };
         self.run.event_time = self.run.time;
-        Ok(())
+        warning.map_or(Ok(()), Err)
     }
 
     pub fn do_step(&mut self, t: f64, h: f64) -> CallResult {

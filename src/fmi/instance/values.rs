@@ -4,7 +4,7 @@
 //! to set.
 
 use super::{CallResult, Fail, Instance, LayerVar};
-use crate::fmi::types::FsmState;
+use crate::fmi::types::{FsmState, Status};
 use crate::model::{
     Causality, SlotMut, Value, VarDecl, VarKind, Variability, DERIVATIVE_VR_BASE, RESERVED_VR_START, STATE_VR_BASE,
 };
@@ -139,10 +139,66 @@ impl Instance {
         Ok(())
     }
 
+    /// [`Self::ensure_outputs`], except in Initialization Mode: there the inputs a master has set so far
+    /// need not be consistent yet (a master hands an unconnected input its default before the unit that
+    /// feeds it is initialized: OMSimulator gives a quaternion `[0, 0, 0, 0]`). Outputs the model refuses
+    /// to compute from them keep their previous values (the start values) and the call reports a warning
+    /// with the model's reason; they are computed again at the next read, and outside Initialization Mode
+    /// the same inputs are refused with an error (a step never runs on them).
+    pub fn ensure_outputs_or_keep(&mut self) -> CallResult {
+        if self.run.fsm != FsmState::InitializationMode {
+            return self.ensure_outputs();
+        }
+        self.ensure_initialized()?;
+        if !self.run.outputs_dirty {
+            return Ok(());
+        }
+        let computed: Vec<usize> = (self.entry.decls.iter().enumerate())
+            .filter(|(_, d)| matches!(d.causality, Causality::Output | Causality::Local))
+            .map(|(i, _)| i)
+            .collect();
+        let kept: Vec<(usize, Value)> = computed
+            .iter()
+            .filter_map(|&i| self.model.value(i).map(|v| (i, v)))
+            .collect();
+        match self.model.update_outputs(self.run.time) {
+            Ok(()) => {
+                self.run.outputs_dirty = false;
+                Ok(())
+            }
+            Err(reason) => {
+                for (i, v) in kept {
+                    match (self.model.slot(i), v) {
+                        (Some(SlotMut::Real(s)), Value::Real(x)) => *s = x,
+                        (Some(SlotMut::Integer(s)), Value::Integer(x)) => *s = x,
+                        (Some(SlotMut::Boolean(s)), Value::Boolean(x)) => *s = x,
+                        _ => {}
+                    }
+                }
+                Err(Fail {
+                    status: Status::Warning,
+                    reason: format!(
+                        "outputs not computed in Initialization Mode from the inputs set so far ({reason}); \
+                         they keep their previous values until the inputs are consistent, and a step with these \
+                         inputs is refused"
+                    ),
+                })
+            }
+        }
+    }
+
     /// Reads values of one kind; `write(i, v)` receives the value of `vrs[i]`. Outputs are computed
-    /// lazily here; a non-finite output puts the instance into the error state.
+    /// lazily here; a non-finite output puts the instance into the error state. In Initialization Mode,
+    /// outputs that inconsistent inputs do not yet allow are read as kept, with a warning
+    /// ([`Self::ensure_outputs_or_keep`]).
     pub fn get_values(&mut self, kind: VarKind, vrs: &[u32], mut write: impl FnMut(usize, Value)) -> CallResult {
-        self.ensure_outputs()?;
+        let warning = match self.ensure_outputs_or_keep() {
+            Err(f) if f.status == Status::Warning => Some(f),
+            other => {
+                other?;
+                None
+            }
+        };
         for (i, vr) in vrs.iter().enumerate() {
             if kind == VarKind::Real && *vr >= RESERVED_VR_START {
                 if let Some(var) = self.layer_var(*vr) {
@@ -166,7 +222,7 @@ impl Instance {
             }
             write(i, v);
         }
-        Ok(())
+        warning.map_or(Ok(()), Err)
     }
 }
 

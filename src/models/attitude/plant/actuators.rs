@@ -52,7 +52,7 @@ impl AttitudePlant {
     /// Commanded dipole (each axis clamped at the dipole limit) and its torque m × B (mtq_mode 1).
     fn external_dipole(&self, v: &AttitudePlantVars, t: f64, a: &Matrix3<f64>) -> (Vector3<f64>, Vector3<f64>) {
         let m = clamp3(v.m_cmd, Vector3::repeat(self.d.dipole_max));
-        (m, m.cross(&self.field_body(t, a)))
+        (m, m.cross(&self.field_body(v, t, a)))
     }
 
     /// Actuators for state x at time t.
@@ -72,7 +72,7 @@ impl AttitudePlant {
         let mut dipole = Vector3::zeros();
         let mut tau_mtq = Vector3::zeros();
         if Self::mtq(v) {
-            let b = self.field_body(t, a);
+            let b = self.field_body(v, t, a);
             let b2 = b.norm_squared();
             if b2.sqrt() >= 1e-12 {
                 let raw = hw.cross(&b) * (v.mtq_k_dump / b2);

@@ -1,11 +1,13 @@
 //! The plant's environment: disturbance generator (constant, sinusoid, seeded zero-order-held white
-//! noise), gravity gradient and the geomagnetic field on a circular orbit, and the events (fault
+//! noise), gravity gradient and the geomagnetic field on a circular orbit or from the environment inputs,
+//! drag and solar pressure on the facets, the residual dipole's torque, and the events (fault
 //! onset, noise-hold boundaries) at which a communication step is cut.
 
 use nalgebra::{Matrix3, Vector3};
 
 use super::{AttitudePlant, AttitudePlantVars};
-use crate::math::environment::gravity_gradient;
+use crate::math::environment::{gravity_gradient, EARTH_RADIUS};
+use crate::math::surface_forces::{drag, radiation_pressure, solar_pressure, Wrench};
 use crate::math::random::{hold_index, normal};
 
 /// What is constant over one internal step (steps are cut at fault_time and at noise-hold boundaries).
@@ -54,21 +56,107 @@ pub fn breakpoints(v: &AttitudePlantVars, t: f64, h: f64) -> Result<Vec<f64>, St
     Ok(b)
 }
 
+/// The external torques beyond the generator and the input (body axes): the disturbance budget.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Budget {
+    pub gg: Vector3<f64>,
+    pub aero: Wrench,
+    pub srp: Wrench,
+    pub residual: Vector3<f64>,
+}
+
+impl Budget {
+    pub fn torque(&self) -> Vector3<f64> {
+        self.gg + self.aero.torque + self.srp.torque + self.residual
+    }
+}
+
+/// The environment inputs (environment_inputs = 1) checked before they are used: a position outside the
+/// Earth, a unit sun vector when facets feel the sun, an eclipse factor in [0, 1], a density ≥ 0.
+pub fn check_world(v: &AttitudePlantVars, facets: bool) -> Result<(), String> {
+    if v.environment_inputs != 1 {
+        return Ok(());
+    }
+    let r = v.r.norm();
+    if !(r >= EARTH_RADIUS) {
+        return Err(format!(
+            "input r = {:?} m has norm {r} m, below the Earth's radius {EARTH_RADIUS} m (is it connected?)",
+            v.r.as_slice()
+        ));
+    }
+    if !(v.rho >= 0.0) {
+        return Err(format!("input rho = {} kg/m3: a density >= 0 is allowed", v.rho));
+    }
+    if !(0.0..=1.0).contains(&v.eclipse) {
+        return Err(format!("input eclipse = {}: a visible fraction in [0, 1] is allowed", v.eclipse));
+    }
+    if facets {
+        let n = v.sun_eci.norm();
+        if (n - 1.0).abs() > 1e-3 {
+            return Err(format!("input sun_eci has norm {n}, expected 1 (is it connected?)"));
+        }
+        if !(v.sun_distance > r) {
+            return Err(format!("input sun_distance = {} m: a distance beyond the spacecraft's |r| = {r} m is allowed", v.sun_distance));
+        }
+    }
+    Ok(())
+}
+
 impl AttitudePlant {
-    /// Geomagnetic field in body axes, B_b = A B_R(t).
-    pub(super) fn field_body(&self, t: f64, a: &Matrix3<f64>) -> Vector3<f64> {
+    /// Geomagnetic field in body axes, B_b = A B_R: the dipole of the circular orbit at t, or the input
+    /// b_eci (environment_inputs = 1).
+    pub(super) fn field_body(&self, v: &AttitudePlantVars, t: f64, a: &Matrix3<f64>) -> Vector3<f64> {
+        if v.environment_inputs == 1 {
+            return a * v.b_eci;
+        }
         a * self.d.orbit.field_ref(t)
     }
 
-    /// Disturbance generator + gravity gradient + input: τ_ext.
+    /// Whether the external torque needs the attitude matrix.
+    pub(super) fn budget_needs_attitude(&self, v: &AttitudePlantVars) -> bool {
+        v.gg_enable == 1 || v.environment_inputs == 1 || v.residual_dipole != Vector3::zeros()
+    }
+
+    /// Gravity gradient (gg_enable), residual dipole, and with the environment inputs drag and solar
+    /// pressure on the facets.
+    pub(super) fn budget(&self, v: &AttitudePlantVars, t: f64, a: &Matrix3<f64>) -> Budget {
+        let mut b = Budget::default();
+        let world = v.environment_inputs == 1;
+        if v.gg_enable == 1 {
+            b.gg = if world {
+                let r = v.r.norm();
+                gravity_gradient(v.mu / (r * r * r), &(a * (v.r / r)), &self.inertia)
+            } else {
+                gravity_gradient(self.d.n2, &(a * self.d.orbit.r_hat(t)), &self.inertia)
+            };
+        }
+        if v.residual_dipole != Vector3::zeros() {
+            b.residual = v.residual_dipole.cross(&self.field_body(v, t, a));
+        }
+        if world && self.d.has_facets {
+            let v_rel = v.v - Vector3::z().cross(&v.r) * v.earth_rotation_rate;
+            b.aero = drag(&self.d.facets, v.rho, &(a * v_rel));
+            let to_sun = v.sun_eci * v.sun_distance - v.r;
+            let d = to_sun.norm();
+            let seen = if v.eclipse_shadows_srp == 1 { v.eclipse } else { 1.0 };
+            let p = radiation_pressure(v.solar_flux, d, seen);
+            b.srp = solar_pressure(&self.d.facets, p, &(a * (to_sun / d)));
+        }
+        b
+    }
+
+    /// Disturbance generator + input + the budget: τ_ext.
     pub(super) fn external(&self, v: &AttitudePlantVars, t: f64, a: &Matrix3<f64>, seg: &Segment) -> Vector3<f64> {
         let mut tau = v.torque_dist + v.dist_const + seg.noise;
         if v.dist_sin_amp != Vector3::zeros() {
             let wt = v.dist_sin_freq * t;
             tau += Vector3::from_fn(|i, _| v.dist_sin_amp[i] * (wt + v.dist_sin_phase[i]).sin());
         }
-        if v.gg_enable == 1 {
+        if v.gg_enable == 1 && v.environment_inputs == 0 && v.residual_dipole == Vector3::zeros() {
+            // the papers' plant: the same operations as before the budget existed (bit for bit)
             tau += gravity_gradient(self.d.n2, &(a * self.d.orbit.r_hat(t)), &self.inertia);
+        } else if self.budget_needs_attitude(v) {
+            tau += self.budget(v, t, a).torque();
         }
         tau
     }

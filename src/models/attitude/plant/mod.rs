@@ -20,13 +20,14 @@ use nalgebra::Matrix3;
 use serde::{Deserialize, Serialize};
 
 pub use kinematics::Kinematics;
-pub use variables::AttitudePlantVars;
+pub use variables::{AttitudePlantVars, FACETS};
 
-use self::environment::{breakpoints, segment_at, segment_of_piece, Segment};
+use self::environment::{breakpoints, check_world, segment_at, segment_of_piece, Segment};
 use self::kinematics::{attitude_rates, initial_attitude, post_step, v3, State, ATT, HW, TW, W};
 use crate::math::attitude::{euler321_from_dcm, euler321_from_quat, wxyz};
 use crate::math::environment::CircularOrbit;
 use crate::math::integrate::Stepper;
+use crate::math::surface_forces::Facet;
 use crate::model::{check_derived, check_finite_state, Experiment, Feedthrough, Model, ModelInfo, ModelResult, ParamEnum, StateDecl};
 
 /// Parameters derived at initialization.
@@ -42,6 +43,9 @@ struct Derived {
     /// Model Exchange: drift of |q| (‖AᵀA − I‖) that asks for a projection event after a solver step
     /// (`exchange::projection_threshold`).
     projection_threshold: f64,
+    /// The facets (normals normalised) and whether any has an area.
+    facets: [Facet; FACETS],
+    has_facets: bool,
 }
 
 #[derive(Clone, Serialize, Deserialize)]
@@ -62,7 +66,7 @@ impl AttitudePlant {
     /// ẋ with the inputs held.
     fn derivative(&self, v: &AttitudePlantVars, t: f64, x: &State, seg: &Segment) -> State {
         let w = v3(x, W);
-        let needs_a = v.gg_enable == 1 || Self::mtq(v) || Self::mtq_external(v);
+        let needs_a = self.budget_needs_attitude(v) || Self::mtq(v) || Self::mtq_external(v);
         let a = if needs_a { self.attitude(x) } else { Matrix3::identity() };
         let act = self.actuate(v, t, x, &a, seg);
         let tau = act.torque + self.external(v, t, &a, seg);
@@ -96,16 +100,24 @@ impl Model for AttitudePlant {
         feedthrough: Feedthrough::Some(&[
             // every axis on every command: τ_applied = M sat(u) (mode 0) or M sat(K_w (u − τ_mtq)) + τ_mtq (mode 1),
             // M = R(δ) diag(k) couples the axes when the actuators are misaligned
-            ("torque_applied_x", &["torque_cmd_x", "torque_cmd_y", "torque_cmd_z", "m_cmd_x", "m_cmd_y", "m_cmd_z"]),
-            ("torque_applied_y", &["torque_cmd_x", "torque_cmd_y", "torque_cmd_z", "m_cmd_x", "m_cmd_y", "m_cmd_z"]),
-            ("torque_applied_z", &["torque_cmd_x", "torque_cmd_y", "torque_cmd_z", "m_cmd_x", "m_cmd_y", "m_cmd_z"]),
-            // mtq_mode 1: τ_applied includes sat(m_cmd) × B, the dipole output is sat(m_cmd)
-            ("dipole_x", &["m_cmd_x"]),
-            ("dipole_y", &["m_cmd_y"]),
-            ("dipole_z", &["m_cmd_z"]),
-            ("torque_ext_x", &["torque_dist_x"]),
-            ("torque_ext_y", &["torque_dist_y"]),
-            ("torque_ext_z", &["torque_dist_z"]),
+            // (with the environment inputs, the magnetorquers' torque m × B also depends on b_eci)
+            ("torque_applied", &["torque_cmd", "m_cmd", "b_eci"]),
+            // mtq_mode 1: τ_applied includes sat(m_cmd) × B, the dipole output is sat(m_cmd); with the
+            // internal dumping law the dipole depends on the field
+            ("dipole_x", &["m_cmd_x", "b_eci"]),
+            ("dipole_y", &["m_cmd_y", "b_eci"]),
+            ("dipole_z", &["m_cmd_z", "b_eci"]),
+            ("torque_ext_x", &["torque_dist_x", "r", "v", "b_eci", "sun_eci", "eclipse", "rho", "sun_distance"]),
+            ("torque_ext_y", &["torque_dist_y", "r", "v", "b_eci", "sun_eci", "eclipse", "rho", "sun_distance"]),
+            ("torque_ext_z", &["torque_dist_z", "r", "v", "b_eci", "sun_eci", "eclipse", "rho", "sun_distance"]),
+            // the budget (environment_inputs = 1)
+            ("b_body", &["b_eci"]),
+            ("torque_residual", &["b_eci"]),
+            ("torque_gg", &["r"]),
+            ("torque_aero", &["r", "v", "rho"]),
+            ("force_aero", &["r", "v", "rho"]),
+            ("torque_srp", &["r", "sun_eci", "eclipse", "sun_distance"]),
+            ("force_srp", &["r", "sun_eci", "eclipse", "sun_distance"]),
         ]),
         ..ModelInfo::DEFAULT
     };
@@ -128,6 +140,8 @@ impl Model for AttitudePlant {
             dipole_max: v.mtq_turns * v.mtq_coil_area * v.mtq_max_current,
             actuator_map: nalgebra::Rotation3::new(v.actuator_misalignment).into_inner() * Matrix3::from_diagonal(&v.actuator_scale),
             projection_threshold: exchange::projection_threshold(exp),
+            facets: v.facets()?,
+            has_facets: v.facets()?.iter().any(|f| f.area > 0.0),
         };
         let angles = (v.init_euler321_roll, v.init_euler321_pitch, v.init_euler321_yaw);
         let mut x = State::zeros();
@@ -145,6 +159,7 @@ impl Model for AttitudePlant {
     }
 
     fn outputs(&self, v: &mut AttitudePlantVars, t: f64) -> ModelResult {
+        check_world(v, self.d.has_facets)?;
         let x = self.x;
         let q = self.quaternion(&x);
         let a = self.attitude(&x);
@@ -158,7 +173,10 @@ impl Model for AttitudePlant {
         let seg = segment_at(v, t);
         let act = self.actuate(v, t, &x, &a, &seg);
         let ext = self.external(v, t, &a, &seg);
-        v.b_body = self.field_body(t, &a);
+        let budget = self.budget(v, t, &a);
+        (v.torque_gg, v.torque_aero, v.torque_srp, v.torque_residual) = (budget.gg, budget.aero.torque, budget.srp.torque, budget.residual);
+        (v.force_aero, v.force_srp) = (budget.aero.force, budget.srp.force);
+        v.b_body = self.field_body(v, t, &a);
         v.h_total_ref = a.transpose() * (self.inertia * w + hw);
         v.wheel_speed = hw / v.wheel_inertia;
         v.q = q;
@@ -173,6 +191,7 @@ impl Model for AttitudePlant {
     }
 
     fn step(&mut self, v: &AttitudePlantVars, t: f64, h: f64) -> ModelResult {
+        check_world(v, self.d.has_facets)?;
         let (kin, ortho) = (self.kin, v.dcm_orthonormalize == 1);
         let (mut stepper, mut x, mut q_dcm) = (self.stepper, self.x, self.q_dcm);
         let this = &*self;
@@ -216,6 +235,7 @@ impl Model for AttitudePlant {
     }
     fn derivatives(&self, v: &AttitudePlantVars, t: f64, dx: &mut [f64]) -> ModelResult {
         self.check_chart(t)?;
+        check_world(v, self.d.has_facets)?;
         dx.copy_from_slice(self.derivative(v, t, &self.x, &segment_at(v, t)).as_slice());
         Ok(())
     }

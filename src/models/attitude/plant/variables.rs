@@ -1,8 +1,10 @@
-//! The declared variables of `AttitudePlant` (ports 0–46, parameters 100–190, calculated 200–203).
+//! The declared variables of `AttitudePlant` (ports 0–79, parameters 100–197, calculated 200–203, facets
+//! 210–269).
 
 use super::kinematics::Kinematics;
 use crate::declare_variables;
 use crate::math::integrate::Method;
+use crate::math::surface_forces::Facet;
 use crate::model::{ParamEnum, SWITCH};
 
 declare_variables! {
@@ -28,6 +30,21 @@ declare_variables! {
         41 => b_body: Vec3 = [0.0; 3], Output, "T", "Geomagnetic field in body axes";
         // appended (issue 37): external magnetorquer command
         44 => m_cmd: Vec3 = [0.0; 3], Input, "A.m2", "Magnetorquer dipole command, body axes (mtq_mode = 1; e.g. from BDot)";
+        // appended (issue 43): the environment as inputs (environment_inputs = 1), by the Environment/Orbit port names
+        47 => r: Vec3 = [0.0; 3], Input, "m", "Spacecraft position, Earth-centred inertial axes (environment_inputs = 1; R is then that frame)";
+        50 => v: Vec3 = [0.0; 3], Input, "m/s", "Spacecraft velocity, inertial axes (environment_inputs = 1)";
+        53 => b_eci: Vec3 = [0.0; 3], Input, "T", "Geomagnetic field at the spacecraft, inertial axes (environment_inputs = 1)";
+        56 => sun_eci: Vec3 = [1.0, 0.0, 0.0], Input, "", "Unit vector Earth to sun, inertial axes (environment_inputs = 1)";
+        59 => eclipse: Real = 1.0, Input, "", "Visible fraction of the solar disk, 0 (umbra) to 1 (full sun) (environment_inputs = 1)";
+        60 => rho: Real = 0.0, Input, "kg/m3", "Atmospheric density at the spacecraft (environment_inputs = 1)";
+        61 => sun_distance: Real = 149_597_870_700.0, Input, "m", "Distance Earth to sun (environment_inputs = 1)";
+        // appended (issue 43): the disturbance budget, each torque on its own
+        62 => torque_gg: Vec3 = [0.0; 3], Output, "N.m", "Gravity-gradient torque, body axes";
+        65 => torque_aero: Vec3 = [0.0; 3], Output, "N.m", "Aerodynamic torque of the facets, body axes";
+        68 => torque_srp: Vec3 = [0.0; 3], Output, "N.m", "Solar-radiation-pressure torque of the facets, body axes";
+        71 => torque_residual: Vec3 = [0.0; 3], Output, "N.m", "Torque of the residual magnetic dipole m_res x B, body axes";
+        74 => force_aero: Vec3 = [0.0; 3], Output, "N", "Aerodynamic force on the facets, body axes";
+        77 => force_srp: Vec3 = [0.0; 3], Output, "N", "Solar-radiation-pressure force on the facets, body axes";
         // parameters: body
         100 => inertia: Diag3 = [1000.0, 500.0, 700.0], Parameter, "kg.m2", "Inertia matrix diagonal entry ([Navabi-2019] default)", Positive;
         103 => inertia_xy: Real = 0.0, Parameter, "kg.m2", "Inertia matrix entry xy (matrix entry, not product of inertia)";
@@ -87,6 +104,49 @@ declare_variables! {
         187 => actuator_misalignment: Vec3 = [0.0; 3], Parameter, "rad", "Actuator-triad misalignment: rotation vector delta of the actuator axes relative to the body axes (R(delta) = exp([delta x]))";
         // appended (issue 37): source of the magnetorquer dipole
         190 => mtq_mode: Integer = 0, Parameter, "", "Magnetorquer dipole: 0 = internal momentum dumping (actuator_mode 1 with mtq_enable 1; otherwise none); 1 = the input m_cmd, each axis clamped at mtq_dipole_max, in either actuator mode (the internal dumping law is off)", Choice(SWITCH);
+        // appended (issue 43): the environment's source and the disturbance model's constants (project choices)
+        191 => environment_inputs: Integer = 0, Parameter, "", "0 = the circular orbit and dipole field above (the papers' plant); 1 = position, velocity, field, sun, eclipse and density from the inputs (gravity gradient from r; drag, solar pressure and residual dipole)", Choice(SWITCH);
+        192 => residual_dipole: Vec3 = [0.0; 3], Parameter, "A.m2", "Residual magnetic dipole m_res of the spacecraft, body axes (both sources of the field)";
+        195 => earth_rotation_rate: Real = 7.292115e-5, Parameter, "rad/s", "Earth rotation rate: the air co-rotates, v_rel = v - w_E z x r";
+        196 => solar_flux: Real = 1361.0, Parameter, "W/m2", "Solar flux at one astronomical unit (pressure = flux / c, scaled with (1 au / d)^2)", NonNegative;
+        197 => eclipse_shadows_srp: Integer = 1, Parameter, "", "1 = the solar pressure is multiplied by the input eclipse (visible fraction), 0 = ignore it", Choice(SWITCH);
+        // appended (issue 43): up to six flat facets (a box, or a box and panels) for drag and solar pressure
+        210 => facet1_area: Real = 0.0, Parameter, "m2", "Facet 1: area (0 = no facet)", NonNegative;
+        211 => facet1_normal: Vec3 = [0.0; 3], Parameter, "", "Facet 1: outward normal, body axes (normalised)";
+        214 => facet1_centre: Vec3 = [0.0; 3], Parameter, "m", "Facet 1: centre of pressure relative to the centre of mass, body axes";
+        217 => facet1_drag_coeff: Real = 2.2, Parameter, "", "Facet 1: drag coefficient C_D", NonNegative;
+        218 => facet1_specular: Real = 0.0, Parameter, "", "Facet 1: specular reflection coefficient C_s", Range(0.0, 1.0);
+        219 => facet1_diffuse: Real = 0.0, Parameter, "", "Facet 1: diffuse reflection coefficient C_d (C_s + C_d <= 1; the rest is absorbed)", Range(0.0, 1.0);
+        220 => facet2_area: Real = 0.0, Parameter, "m2", "Facet 2: area (0 = no facet)", NonNegative;
+        221 => facet2_normal: Vec3 = [0.0; 3], Parameter, "", "Facet 2: outward normal, body axes (normalised)";
+        224 => facet2_centre: Vec3 = [0.0; 3], Parameter, "m", "Facet 2: centre of pressure relative to the centre of mass, body axes";
+        227 => facet2_drag_coeff: Real = 2.2, Parameter, "", "Facet 2: drag coefficient C_D", NonNegative;
+        228 => facet2_specular: Real = 0.0, Parameter, "", "Facet 2: specular reflection coefficient C_s", Range(0.0, 1.0);
+        229 => facet2_diffuse: Real = 0.0, Parameter, "", "Facet 2: diffuse reflection coefficient C_d (C_s + C_d <= 1; the rest is absorbed)", Range(0.0, 1.0);
+        230 => facet3_area: Real = 0.0, Parameter, "m2", "Facet 3: area (0 = no facet)", NonNegative;
+        231 => facet3_normal: Vec3 = [0.0; 3], Parameter, "", "Facet 3: outward normal, body axes (normalised)";
+        234 => facet3_centre: Vec3 = [0.0; 3], Parameter, "m", "Facet 3: centre of pressure relative to the centre of mass, body axes";
+        237 => facet3_drag_coeff: Real = 2.2, Parameter, "", "Facet 3: drag coefficient C_D", NonNegative;
+        238 => facet3_specular: Real = 0.0, Parameter, "", "Facet 3: specular reflection coefficient C_s", Range(0.0, 1.0);
+        239 => facet3_diffuse: Real = 0.0, Parameter, "", "Facet 3: diffuse reflection coefficient C_d (C_s + C_d <= 1; the rest is absorbed)", Range(0.0, 1.0);
+        240 => facet4_area: Real = 0.0, Parameter, "m2", "Facet 4: area (0 = no facet)", NonNegative;
+        241 => facet4_normal: Vec3 = [0.0; 3], Parameter, "", "Facet 4: outward normal, body axes (normalised)";
+        244 => facet4_centre: Vec3 = [0.0; 3], Parameter, "m", "Facet 4: centre of pressure relative to the centre of mass, body axes";
+        247 => facet4_drag_coeff: Real = 2.2, Parameter, "", "Facet 4: drag coefficient C_D", NonNegative;
+        248 => facet4_specular: Real = 0.0, Parameter, "", "Facet 4: specular reflection coefficient C_s", Range(0.0, 1.0);
+        249 => facet4_diffuse: Real = 0.0, Parameter, "", "Facet 4: diffuse reflection coefficient C_d (C_s + C_d <= 1; the rest is absorbed)", Range(0.0, 1.0);
+        250 => facet5_area: Real = 0.0, Parameter, "m2", "Facet 5: area (0 = no facet)", NonNegative;
+        251 => facet5_normal: Vec3 = [0.0; 3], Parameter, "", "Facet 5: outward normal, body axes (normalised)";
+        254 => facet5_centre: Vec3 = [0.0; 3], Parameter, "m", "Facet 5: centre of pressure relative to the centre of mass, body axes";
+        257 => facet5_drag_coeff: Real = 2.2, Parameter, "", "Facet 5: drag coefficient C_D", NonNegative;
+        258 => facet5_specular: Real = 0.0, Parameter, "", "Facet 5: specular reflection coefficient C_s", Range(0.0, 1.0);
+        259 => facet5_diffuse: Real = 0.0, Parameter, "", "Facet 5: diffuse reflection coefficient C_d (C_s + C_d <= 1; the rest is absorbed)", Range(0.0, 1.0);
+        260 => facet6_area: Real = 0.0, Parameter, "m2", "Facet 6: area (0 = no facet)", NonNegative;
+        261 => facet6_normal: Vec3 = [0.0; 3], Parameter, "", "Facet 6: outward normal, body axes (normalised)";
+        264 => facet6_centre: Vec3 = [0.0; 3], Parameter, "m", "Facet 6: centre of pressure relative to the centre of mass, body axes";
+        267 => facet6_drag_coeff: Real = 2.2, Parameter, "", "Facet 6: drag coefficient C_D", NonNegative;
+        268 => facet6_specular: Real = 0.0, Parameter, "", "Facet 6: specular reflection coefficient C_s", Range(0.0, 1.0);
+        269 => facet6_diffuse: Real = 0.0, Parameter, "", "Facet 6: diffuse reflection coefficient C_d (C_s + C_d <= 1; the rest is absorbed)", Range(0.0, 1.0);
         // calculated parameters
         200 => wheel_torque_max: Real = 0.05, CalculatedParameter, "N.m", "Wheel torque limit k_t i_max before faults";
         201 => wheel_momentum_max: Real = 0.504, CalculatedParameter, "N.m.s", "Wheel momentum limit J_w Omega_max";
@@ -95,7 +155,23 @@ declare_variables! {
     }
 }
 
+/// Facets of the facet model.
+pub const FACETS: usize = 6;
+
 impl AttitudePlantVars {
+    /// The facets as declared, checked (see [`Facet::new`]).
+    pub fn facets(&self) -> Result<[Facet; FACETS], String> {
+        let f = |n: &str, a, nrm, c, cd, cs, cdf| Facet::new(n, a, nrm, c, [cd, cs, cdf]);
+        Ok([
+            f("facet1", self.facet1_area, self.facet1_normal, self.facet1_centre, self.facet1_drag_coeff, self.facet1_specular, self.facet1_diffuse)?,
+            f("facet2", self.facet2_area, self.facet2_normal, self.facet2_centre, self.facet2_drag_coeff, self.facet2_specular, self.facet2_diffuse)?,
+            f("facet3", self.facet3_area, self.facet3_normal, self.facet3_centre, self.facet3_drag_coeff, self.facet3_specular, self.facet3_diffuse)?,
+            f("facet4", self.facet4_area, self.facet4_normal, self.facet4_centre, self.facet4_drag_coeff, self.facet4_specular, self.facet4_diffuse)?,
+            f("facet5", self.facet5_area, self.facet5_normal, self.facet5_centre, self.facet5_drag_coeff, self.facet5_specular, self.facet5_diffuse)?,
+            f("facet6", self.facet6_area, self.facet6_normal, self.facet6_centre, self.facet6_drag_coeff, self.facet6_specular, self.facet6_diffuse)?,
+        ])
+    }
+
     /// The stuck flags as booleans.
     pub fn stuck(&self) -> [bool; 3] {
         [self.fault_stuck_x == 1, self.fault_stuck_y == 1, self.fault_stuck_z == 1]

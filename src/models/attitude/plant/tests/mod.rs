@@ -13,6 +13,7 @@ type P = Fmu<AttitudePlant>;
 
 mod actuators;
 mod robustness;
+mod world;
 
 pub(super) fn plant(setup: impl FnOnce(&mut AttitudePlantVars)) -> P {
     let mut p = Fmu::<AttitudePlant>::default();
