@@ -129,7 +129,8 @@ def ours(cs):
             reals = [k for k in p if k not in ints]
             u.setReal([vr[k] for k in reals], [float(p[k]) for k in reals])
             inputs = {f"{n}_{ax}": c[n][i] for n in ("r", "v", "sun_eci") for i, ax in enumerate("xyz")}
-            inputs |= {"rho": c["rho"], "eclipse": c["eclipse"], "sun_distance": c["sun_distance"]}
+            inputs |= {"rho": c["rho"], "eclipse": c["eclipse"], "sun_distance": c["sun_distance"],
+                       "b_eci_x": 0.0, "b_eci_y": 0.0, "b_eci_z": 3e-5}  # a field (no dipole here: no torque)
             u.setReal([vr[k] for k in inputs], list(inputs.values()))
             u.exitInitializationMode()
             res.append({o: u.getReal([vr[f"{o}_{ax}"] for ax in "xyz"]) for o in OUTS})

@@ -4,10 +4,12 @@ reference master's reading of ``x_*`` as covering the scalar port ``x`` (SingleA
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import pytest
 
 from scfmu.engines.reference import CoSimulation
-from scfmu.scenario import DEFAULT_UNCONNECTED, Scenario, matches_input
+from scfmu.scenario import DEFAULT_UNCONNECTED, Component, Scenario, matches_input
 
 
 @pytest.mark.parametrize("port, stems, expected", [
@@ -51,5 +53,21 @@ def test_scenario_and_reference_master_read_the_lists_through_the_matcher():
     assert sc._is_unconnected("plant", "torque_dist_y") and sc._is_unconnected("plant", "torque_cmd_x")
     assert not sc._is_unconnected("ctrl", "torque_cmd_x")
     assert not sc._is_unconnected("plant", "torque_dist")
-    assert not CoSimulation._required("torque_dist") and not CoSimulation._required("torque_dist_x")
-    assert CoSimulation._required("torque_cmd") and CoSimulation._required("torque_distx")
+    unit = SimpleNamespace(model="PdController")
+    assert not CoSimulation._required(unit, "torque_dist") and not CoSimulation._required(unit, "torque_dist_x")
+    assert CoSimulation._required(unit, "torque_cmd") and CoSimulation._required(unit, "torque_distx")
+
+
+def test_model_qualified_patterns_name_the_inputs_of_one_model():
+    """AttitudePlant's environment position may stay open (read with environment_inputs = 1 only);
+    Environment's r, the same port name, must be wired: "AttitudePlant:r_*" names the first only."""
+    pats = ["AttitudePlant:r_*"]
+    assert matches_input("r_x", pats, model="AttitudePlant")
+    assert matches_input("r_x", pats, model="/some/where/AttitudePlant.fmu")
+    assert not matches_input("r_x", pats, model="Environment")
+    assert not matches_input("r_x", pats)  # no model: names none
+    sc = Scenario(name="t", components=[Component("plant", "AttitudePlant"), Component("env", "Environment")],
+                  stop_time=1.0, step=0.1)
+    assert sc._is_unconnected("plant", "r_y") and not sc._is_unconnected("env", "r_y")
+    assert not CoSimulation._required(SimpleNamespace(model="AttitudePlant"), "v_z")
+    assert CoSimulation._required(SimpleNamespace(model="Environment"), "r_x")

@@ -112,5 +112,7 @@ def test_plant_state_outputs_do_not_depend_on_torque_inputs():
     for n in ("q_w", "q_x", "w_x", "w_z"):
         assert deps[index[n]] & inputs == set(), n
     # every command: the actuator misalignment (actuator_misalignment_*) couples the axes; the magnetorquer
-    # dipole command (mtq_mode = 1) acts through m x B on every axis
-    assert deps[index["torque_applied_x"]] & inputs == {index[f"{p}_{a}"] for p in ("torque_cmd", "m_cmd") for a in "xyz"}
+    # dipole command (mtq_mode = 1) acts through m x B on every axis, B from the input b_eci with the
+    # environment inputs (environment_inputs = 1)
+    assert deps[index["torque_applied_x"]] & inputs == {index[f"{p}_{a}"] for p in ("torque_cmd", "m_cmd", "b_eci")
+                                                        for a in "xyz"}

@@ -44,7 +44,7 @@ class CoSimulation:
                 if len(sources) > 1:
                     raise ValueError(f"input {dst.model}.{name} has several sources: {[s.model for s in sources]}")
                 if not sources:
-                    if name in self.unconnected or not self._required(name):
+                    if name in self.unconnected or not self._required(dst, name):
                         continue
                     raise ValueError(f"input {dst.model}.{name} has no source; list it in unconnected=")
                 src = sources[0]
@@ -54,11 +54,11 @@ class CoSimulation:
             self.links.extend(by_src.values())
 
     @staticmethod
-    def _required(name: str) -> bool:
+    def _required(dst: Fmu, name: str) -> bool:
         # The optional inputs (disturbances, wheel momenta, reference derivatives, the magnetorquer dipole
         # command, ...) may stay at their start value: the scenarios' one list of them.
         # A pattern "x_*" also covers the scalar port "x" (SingleAxisPlant's torque_dist).
-        return not matches_input(name, DEFAULT_UNCONNECTED, stems=True)
+        return not matches_input(name, DEFAULT_UNCONNECTED, stems=True, model=dst.model)
 
     def propagate(self) -> None:
         for dst in self.fmus:

@@ -34,20 +34,31 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 DEFAULT_UNCONNECTED = ("torque_dist_*", "dist_*", "h_wheel*", "q_ref_dot*", "q_ref_ddot*", "leader_true_anomaly",
-                       "m_cmd_*")
+                       "m_cmd_*",
+                       # the environment inputs of AttitudePlant, read with environment_inputs = 1 only (which
+                       # refuses an unwired r, b_eci or sun_eci), and Orbit's density (0 = no drag); r and v by
+                       # model, as Environment's r must stay wired
+                       "AttitudePlant:r_*", "AttitudePlant:v_*", "b_eci_*", "sun_eci_*", "eclipse", "rho",
+                       "sun_distance")
 
 
-def matches_input(port: str, patterns, instance: str | None = None, *, stems: bool = False) -> bool:
+def matches_input(port: str, patterns, instance: str | None = None, *, stems: bool = False,
+                  model: str | None = None) -> bool:
     """Whether input ``port`` (of ``instance``, when given) matches one of the glob ``patterns`` (``fnmatch``,
     case-sensitive): the one matcher of the ``unconnected`` lists.
 
     A bare pattern (``"torque_dist_*"``) names that port of any instance; a qualified one
-    (``"plant.torque_dist_*"``) names it in one instance and matches only when ``instance`` is given. With
+    (``"plant.torque_dist_*"``) names it in one instance and matches only when ``instance`` is given; a
+    model-qualified one (``"AttitudePlant:r_*"``) names it in every instance of that model (the file name
+    without ``.fmu`` of a path) and matches only when ``model`` is given. With
     ``stems``, a pattern ``"x_*"`` also covers the scalar port ``"x"`` (SingleAxisPlant's ``torque_dist``
     against ``"torque_dist_*"``): the reference master's reading of the optional inputs; a scenario's own
     ``unconnected`` list names such a port as it is (paper002 lists ``"torque_dist"``)."""
     for pat in patterns:
-        if "." in pat:
+        if ":" in pat:
+            if model is not None and fnmatch.fnmatchcase(f"{Path(str(model)).name.removesuffix('.fmu')}:{port}", pat):
+                return True
+        elif "." in pat:
             if instance is not None and fnmatch.fnmatchcase(f"{instance}.{port}", pat):
                 return True
         elif fnmatch.fnmatchcase(port, pat) or (stems and port == pat.removesuffix("_*")):
@@ -302,7 +313,8 @@ class Scenario:
         return out
 
     def _is_unconnected(self, inst: str, port: str) -> bool:
-        return matches_input(port, self.unconnected, inst)
+        model = next((c.model for c in self.components if c.name == inst), None)
+        return matches_input(port, self.unconnected, inst, model=model)
 
     def log_items(self) -> list[tuple[str, str, str]]:
         """(key, instance, variable) of every logged signal."""

@@ -121,7 +121,7 @@ rho = rho0 exp(-(h - h0)/H)   or   rho_m(h) + (rho_M(h) - rho_m(h)) cos^n(psi/2)
         let r = v.r;
         if r.norm() < EARTH_RADIUS {
             return Err(format!(
-                "input r = ({}, {}, {}) m: |r| = {:.1} m is below the Earth's radius {EARTH_RADIUS} m",
+                "input r = ({}, {}, {}) m: |r| = {:.1} m is below the Earth's radius {EARTH_RADIUS} m (is it connected?)",
                 r.x,
                 r.y,
                 r.z,

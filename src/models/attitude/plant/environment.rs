@@ -84,6 +84,9 @@ pub fn check_world(v: &AttitudePlantVars, facets: bool) -> Result<(), String> {
             v.r.as_slice()
         ));
     }
+    if v.b_eci == Vector3::zeros() {
+        return Err("input b_eci is zero: a geomagnetic field is expected (is it connected?)".into());
+    }
     if !(v.rho >= 0.0) {
         return Err(format!("input rho = {} kg/m3: a density >= 0 is allowed", v.rho));
     }

@@ -33,10 +33,10 @@ declare_variables! {
         // appended (issue 43): the environment as inputs (environment_inputs = 1), by the Environment/Orbit port names
         47 => r: Vec3 = [0.0; 3], Input, "m", "Spacecraft position, Earth-centred inertial axes (environment_inputs = 1; R is then that frame)";
         50 => v: Vec3 = [0.0; 3], Input, "m/s", "Spacecraft velocity, inertial axes (environment_inputs = 1)";
-        53 => b_eci: Vec3 = [0.0; 3], Input, "T", "Geomagnetic field at the spacecraft, inertial axes (environment_inputs = 1)";
-        56 => sun_eci: Vec3 = [1.0, 0.0, 0.0], Input, "", "Unit vector Earth to sun, inertial axes (environment_inputs = 1)";
-        59 => eclipse: Real = 1.0, Input, "", "Visible fraction of the solar disk, 0 (umbra) to 1 (full sun) (environment_inputs = 1)";
-        60 => rho: Real = 0.0, Input, "kg/m3", "Atmospheric density at the spacecraft (environment_inputs = 1)";
+        53 => b_eci: Vec3 = [0.0; 3], Input, "T", "Geomagnetic field at the spacecraft, inertial axes (environment_inputs = 1; the start value 0 is refused)";
+        56 => sun_eci: Vec3 = [0.0; 3], Input, "", "Unit vector Earth to sun, inertial axes (environment_inputs = 1 with facets; the start value 0 is refused)";
+        59 => eclipse: Real = 1.0, Input, "", "Visible fraction of the solar disk, 0 (umbra) to 1 (full sun) (environment_inputs = 1; unwired: always full sun)";
+        60 => rho: Real = 0.0, Input, "kg/m3", "Atmospheric density at the spacecraft (environment_inputs = 1; unwired: no air)";
         61 => sun_distance: Real = 149_597_870_700.0, Input, "m", "Distance Earth to sun (environment_inputs = 1)";
         // appended (issue 43): the disturbance budget, each torque on its own
         62 => torque_gg: Vec3 = [0.0; 3], Output, "N.m", "Gravity-gradient torque, body axes";

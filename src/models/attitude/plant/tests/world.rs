@@ -35,6 +35,8 @@ fn six_u(v: &mut AttitudePlantVars) {
     v.environment_inputs = 1;
     v.r = Vector3::new(6_878_137.0, 0.0, 0.0);
     v.v = Vector3::new(0.0, 5383.0, 5383.0);
+    v.b_eci = Vector3::new(1e-5, 0.0, 3e-5);
+    v.sun_eci = Vector3::x();
 }
 
 fn rel_err(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
@@ -134,6 +136,7 @@ fn gravity_gradient_from_the_input_position_equals_the_circular_orbits() {
         setup(v);
         v.environment_inputs = 1;
         v.r = Vector3::new(7078137.0, 0.0, 0.0);
+        v.b_eci = Vector3::new(0.0, 0.0, 2e-5);
     });
     let v = &textbook.v;
     let orbit = CircularOrbit { mu: v.mu, radius: v.orbit_radius, inclination: v.orbit_inclination, arg_lat0: v.orbit_arg_lat0, dipole: v.earth_dipole };
@@ -161,6 +164,19 @@ fn residual_dipole_torque_is_m_cross_b_in_body_axes() {
     assert!(rel_err(&p.v.torque_residual, &expect) < 1e-15 && expect.norm() > 1e-7);
     assert!((p.v.b_body.norm() - b_eci.norm()).abs() < 1e-18);
     assert_eq!(p.v.torque_ext, expect);
+}
+
+#[test]
+fn an_unconnected_field_or_sun_is_refused_with_the_reason() {
+    let mut p: P = plant(six_u);
+    p.v.b_eci = Vector3::zeros();
+    assert!(p.outputs(0.0).unwrap_err().contains("b_eci"));
+    p.v.b_eci = Vector3::z() * 1e-5;
+    p.v.sun_eci = Vector3::zeros();
+    assert!(p.outputs(0.0).unwrap_err().contains("sun_eci"));
+    p.v.sun_eci = Vector3::x();
+    p.v.eclipse = 1.5;
+    assert!(p.outputs(0.0).unwrap_err().contains("eclipse"));
 }
 
 #[test]
