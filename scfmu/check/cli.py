@@ -23,6 +23,11 @@ def main(argv=None) -> int:
                     help="number of random call sequences (default 200, 20 with --quick)")
     ap.add_argument("--timeout", type=float, default=None, metavar="S",
                     help="time limit of each dynamic check in seconds (default 120, 30 with --quick)")
+    ap.add_argument("--call-timeout", type=float, default=None, metavar="S",
+                    help="time limit of one FMI call in seconds: a call still running is a hang (default 5; 2 once "
+                         "the unit has hung)")
+    ap.add_argument("--check", action="append", default=None, metavar="NAME", dest="checks",
+                    help="run only this dynamic check (repeatable; default: every one)")
     ap.add_argument("--interface", choices=("cs", "me"), action="append", default=None,
                     help="check only this interface (repeatable; default: every interface the FMU offers)")
     ap.add_argument("--json", action="store_true", help="print the JSON result instead of the table")
@@ -54,11 +59,20 @@ def main(argv=None) -> int:
     if a.timeout is not None and not 0 < a.timeout <= 86400:
         print(f"scfmu check: --timeout {a.timeout} must be > 0 and at most 86400 s", file=sys.stderr)
         return 2
+    if a.call_timeout is not None and not 0 < a.call_timeout <= 86400:
+        print(f"scfmu check: --call-timeout {a.call_timeout} must be > 0 and at most 86400 s", file=sys.stderr)
+        return 2
+    from . import DYNAMIC_CHECKS
+    for c in a.checks or []:
+        if c not in DYNAMIC_CHECKS:
+            print(f"scfmu check: --check {c!r} is not a check; allowed: {', '.join(DYNAMIC_CHECKS)}", file=sys.stderr)
+            return 2
     if not -(2 ** 63) <= a.seed < 2 ** 63:
         print(f"scfmu check: --seed {a.seed} is outside the 64-bit range", file=sys.stderr)
         return 2
     from . import check
     rep = check(p, quick=a.quick, seed=a.seed, sequences=a.sequences, timeout=a.timeout, interfaces=a.interface,
+                checks=a.checks, call_timeout=a.call_timeout,
                 progress=lambda t: print(f"scfmu check: {t} ...", file=sys.stderr))
     if a.json:
         import json

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import random
 import threading
+import time
 
 from .fmi import OK, WARNING, Lib
 from .hostile import stale_handles, start_times, state_nan
@@ -26,11 +27,13 @@ def nominal_run(u: Unit, o: dict) -> dict:
     h = _need(u, u.new(), "instantiate")
     _expect_ok(u, u.start(h), "initialization")
     n = max(1, min(o["steps"], int(round((u.spec["stop_time"] - u.start_time) / u.dt)) or o["steps"]))
-    t, _ = _steps(u, h, u.start_time, n, _inputs_fn(u, o["seed"]))
+    t, outs = _steps(u, h, u.start_time, n, _inputs_fn(u, o["seed"]))
+    ended = u.ended.get(h)
     _expect_ok(u, u.terminate(h), "terminate")
     u.free(h)
-    return {"detail": f"{n} steps of {u.dt:g} s from t = {u.start_time:g}: every call OK, outputs finite",
-            "metrics": {"steps": n}}
+    return {"detail": f"{len(outs)} steps of {u.dt:g} s from t = {u.start_time:g} to {t:g}: every call OK, outputs "
+                      "finite" + (f"; the unit ended the simulation ({ended})" if ended else ""),
+            "metrics": {"steps": len(outs), "ended": bool(ended)}}
 
 
 def _cs_forbidden(u: Unit):
@@ -332,6 +335,24 @@ def memory(u: Unit, o: dict) -> dict:
                         "loads": loads, "load_growth_bytes": load_growth}}
 
 
+def _join_announcing(u: Unit, ts: list, traces: list) -> None:
+    """Waits for the threads, announcing their progress (the calls their traces record) as a call that
+    returns whenever a call of any thread has returned: the parent's per-call time bound then sees a thread
+    that hangs as a call that does not return."""
+    line = f"(the calls of {len(ts)} threads)"
+    done = -1
+    while any(th.is_alive() for th in ts):
+        n = sum(len(t.lines) for t in traces)
+        if n != done:
+            if done >= 0:
+                u.trace.done(line)
+            u.trace.add(line + " ...")
+            done = n
+        time.sleep(0.05)
+    if done >= 0:
+        u.trace.done(line)
+
+
 def threads(u: Unit, o: dict) -> dict:
     """The same inputs on N threads at once (one instance each): every thread's outputs bit-identical to
     a run on the main thread."""
@@ -382,8 +403,7 @@ def threads(u: Unit, o: dict) -> dict:
     ts = [threading.Thread(target=work, args=(i,)) for i in range(nt)]
     for th in ts:
         th.start()
-    for th in ts:
-        th.join()
+    _join_announcing(u, ts, [w.trace for w in tu])
     bad = [i for i, r in enumerate(results) if r != ref_bits]
     if bad:
         r = results[bad[0]]
