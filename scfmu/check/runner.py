@@ -127,6 +127,12 @@ def _watch(proc, job: bytes, err, checks, limits, results: dict, seen: dict) -> 
                 results[current] = json.loads(rest)
                 current = None
     sel.close()
+    return _finish(proc, err, checks, results, seen, (current, lines, hung, timeout, call_timeout))
+
+
+def _finish(proc, err, checks, results: dict, seen: dict, where: tuple) -> dict:
+    """Ends the child and turns a check it left unfinished into a hang or crash result."""
+    current, lines, hung, timeout, call_timeout = where
     if hung:
         try:
             os.killpg(proc.pid, signal.SIGKILL)
