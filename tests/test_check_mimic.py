@@ -103,6 +103,14 @@ def test_the_reference_fmus_real_defects_are_still_found(mimic):
     text = rep.text()
     assert "Violations of the FMI standard: 1" in text
     assert "Failures of this project's robustness rules (the standard does not require these): 2" in text
+    d = rep.to_dict()
+    assert d["findings"] == {"standard": ["state_machine (me)"],
+                             "robustness": ["bad_arguments (cs)", "bad_arguments (me)"]}, d["findings"]
+    from scfmu.check.report import to_html
+    page = to_html(rep)
+    std, rob = page.index("<h2>Violations of the FMI standard</h2>"), page.index("<h2>Failures of this project")
+    assert std < page.index("event update in Continuous-Time Mode", std) < rob
+    assert page.index("fmi3SetTime to start time + nan", rob) > rob
 
 
 def test_extreme_start_times_return_or_are_refused(mimic):
