@@ -1,5 +1,5 @@
-"""``scfmu check FMU [--quick] [--report DIR] [--seed N] [--sequences N]``: exit 0 when every check passes,
-1 when a check fails, 2 for a usage mistake."""
+"""``scfmu check FMU [--quick] [--report DIR] [--seed N] [--sequences N] [--check NAME] [--call-timeout S]``:
+exit 0 when every check passes, 1 when a check fails, 2 for a usage mistake."""
 
 from __future__ import annotations
 
@@ -13,8 +13,10 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="scfmu check", description="Check any FMI 2.0 or 3.0 FMU (Co-Simulation and/or "
                                  "Model Exchange): its modelDescription against the standard's schema and rules, "
                                  "then its binary in isolated child processes (state machine, bad arguments, "
-                                 "random call sequences, FMU states, memory, threads). Exit 0 = every check "
-                                 "passed, 1 = a check failed, 2 = a usage mistake.")
+                                 "random call sequences, FMU states, memory, threads, extreme start times, stale "
+                                 "handles, NaN in a state). Each failure is marked STD (violates the FMI "
+                                 "standard) or ROB (fails a robustness rule of this project). Exit 0 = every "
+                                 "check passed, 1 = a check failed, 2 = a usage mistake.")
     ap.add_argument("fmu", help="the .fmu file, or the name of a model of the package (e.g. PidController)")
     ap.add_argument("--quick", action="store_true", help="fewer sequences, cycles and steps (about 5-20 s per interface)")
     ap.add_argument("--report", metavar="DIR", help="also write DIR/check.json and DIR/check.html")
