@@ -23,7 +23,8 @@ MIMICS = {"discrete_input": (1, ("me",), 'startTime="0" stopTime="2" stepSize="0
           "stiff_no_step": (5, ("cs", "me"), 'startTime="0" stopTime="1e8"'),
           "nan_through": (6, ("cs",), 'startTime="0" stopTime="2" stepSize="0.01"'),
           "ref_defects": (7, ("cs", "me"), 'startTime="0" stopTime="2" stepSize="0.01"'),
-          "quiet_error": (8, ("cs",), 'startTime="0" stopTime="2" stepSize="0.1"')}
+          "quiet_error": (8, ("cs",), 'startTime="0" stopTime="2" stepSize="0.1"'),
+          "state_copy": (9, ("cs",), 'startTime="0" stopTime="2" stepSize="0.01"')}
 
 
 def token(name: str) -> str:
@@ -34,7 +35,7 @@ def _variables(name: str) -> tuple[list[str], list[str]]:
     """(variable elements, ModelStructure elements) of a Mimic3 unit (value references of mimic3.c)."""
     v = ['<Float64 name="time" valueReference="0" causality="independent" variability="continuous"/>']
     s: list[str] = []
-    if name in ("discrete_input", "nan_through", "ref_defects", "quiet_error"):
+    if name in ("discrete_input", "nan_through", "ref_defects", "quiet_error", "state_copy"):
         v += ['<Float64 name="u" valueReference="1" causality="input" start="0"/>',
               '<Float64 name="y" valueReference="3" causality="output"/>']
         s += ['<Output valueReference="3"/>', '<InitialUnknown valueReference="3"/>']
@@ -72,8 +73,9 @@ def model_description(name: str) -> str:
     if "me" in itfs:
         parts.append(f'<ModelExchange modelIdentifier="{model}" canBeInstantiatedOnlyOncePerProcess="false"/>')
     if "cs" in itfs:
+        state = ' canGetAndSetFMUState="true" canSerializeFMUState="true"' if name == "state_copy" else ""
         parts.append(f'<CoSimulation modelIdentifier="{model}" canHandleVariableCommunicationStepSize="true" '
-                     f'canBeInstantiatedOnlyOncePerProcess="false"/>')
+                     f'canBeInstantiatedOnlyOncePerProcess="false"{state}/>')
     if not itfs:
         parts.append(f'<ScheduledExecution modelIdentifier="{model}"/>')
     variables, structure = _variables(name)

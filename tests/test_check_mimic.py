@@ -131,3 +131,16 @@ def test_stale_instance_handles_are_refused_by_a_unit_with_tokens(mimic):
     rep = check(mimic["terminate"], quick=True, checks=["stale_handles"])
     assert rep.ok, rep.text()
     assert "refused (fmi3Error)" in rep.row("stale_handles", "cs")["detail"]
+
+
+def test_a_nan_written_into_a_plain_copy_state_and_a_reused_state_handle_are_found(mimic):
+    # the state is a copy of {int mode; double time, u, ...}: u is the third 8-byte word (byte 16) and y = x
+    # integrates it, so a NaN there reaches y after one step; word 0 (the mode) makes every call refused,
+    # word 1 (the time) is not read. A freed state's address is the next state's (malloc), and it is set.
+    rep = check(mimic["state_copy"], quick=True, checks=["state_nan", "stale_handles"])
+    sn = rep.row("state_nan", "cs")
+    assert sn["status"] == "fail" and sn["kind"] == "nonfinite" and sn["class"] == "robustness", sn
+    assert sn["detail"].startswith("a state with NaN at byte 16 was accepted, then output y = nan"), sn["detail"]
+    sh = rep.row("stale_handles", "cs")
+    assert sh["status"] == "fail" and sh["rule"].startswith("R5"), sh
+    assert sh["detail"] == "setting a freed FMU state returned fmi3OK (its address was reused by a new state)"

@@ -16,6 +16,10 @@
  *   MIMIC 6  NaN passed through (like Feedthrough, CS): y = u, a NaN input gives a NaN output with fmi3OK.
  *   MIMIC 8  a quiet error (CS): fmi3ExitInitializationMode logs an information message; fmi3DoStep from
  *            t >= 0.5 returns fmi3Error and logs nothing (the checker must not quote the earlier message).
+ *   MIMIC 9  an FMU state that is a plain copy of the instance's values (like every Reference-FMU, CS): x' = u,
+ *            y = x; fmi3GetFMUState allocates a copy, fmi3SerializeFMUState writes its bytes, deserializing
+ *            checks only the size: a NaN written into a state is restored, and a freed state whose address
+ *            the next state got is set as that state.
  *   MIMIC 7  the Reference-FMUs' real defects (CS and ME): a step of NaN loops for ever (CS); fmi3SetTime(NaN)
  *            returns fmi3OK (ME); fmi3UpdateDiscreteStates is accepted in Continuous-Time Mode (ME).
  *
@@ -116,7 +120,7 @@ EXPORT fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String toke
 EXPORT fmi3Instance fmi3InstantiateModelExchange(fmi3String name, fmi3String token, fmi3String res, fmi3Boolean vis,
         fmi3Boolean log_on, fmi3InstanceEnvironment env, fmi3LogMessageCallback log) {
     (void)res; (void)vis; (void)log_on;
-    if (MIMIC == 6 || MIMIC == 8) return NULL;  /* Co-Simulation only */
+    if (MIMIC == 6 || MIMIC == 8 || MIMIC == 9) return NULL;  /* Co-Simulation only */
     return make(name, token, true, env, log);
 }
 
@@ -167,7 +171,7 @@ static double value(Instance *c, fmi3ValueReference vr, bool *ok) {
     switch (vr) {
     case 1: return c->u;
     case 2: return c->d;
-    case 3: return (MIMIC == 4 || MIMIC == 5) ? c->x[0] : c->u;
+    case 3: return (MIMIC == 4 || MIMIC == 5 || MIMIC == 9) ? c->x[0] : c->u;
     case 4: return c->d;
     case 7: return c->x[0];
     default: *ok = false; return 0.0;
@@ -197,7 +201,7 @@ EXPORT fmi3Status fmi3SetFloat64(fmi3Instance h, const fmi3ValueReference vr[], 
     if (!in(c, INST | INIT | STEP | EVENT | CONT | TERM, "fmi3SetFloat64")) return fmi3Error;
     if ((n && (!vr || !v)) || nv < n) { say(c, fmi3Error, "fmi3SetFloat64: NULL array"); return fmi3Error; }
     for (size_t i = 0; i < n; i++) {
-        if (vr[i] == 1 && (MIMIC == 1 || MIMIC == 6 || MIMIC == 7 || MIMIC == 8)) c->u = v[i];
+        if (vr[i] == 1 && (MIMIC == 1 || MIMIC == 6 || MIMIC == 7 || MIMIC == 8 || MIMIC == 9)) c->u = v[i];
         else if (vr[i] == 2 && MIMIC == 1) {
             if (c->state & CONT) {
                 say(c, fmi3Error, "Variable d can only be set after instantiation, in Initialization Mode and in Event Mode.");
@@ -250,6 +254,8 @@ EXPORT fmi3Status fmi3DoStep(fmi3Instance h, fmi3Float64 t, fmi3Float64 dt, fmi3
     double x = c->x[0];
     for (double tk = t; tk < t1; tk += hs) x += hs * (-1000.0 * (x - 1.0));
     c->x[0] = x;
+#elif MIMIC == 9
+    c->x[0] += c->u * dt;
 #elif MIMIC == 2
     while (c->next_tick <= t1 + 1e-9 && !c->ended) {
         c->counter++;
@@ -346,3 +352,64 @@ EXPORT fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance h, fmi3Float64 
     derivatives(c, dx);
     return fmi3OK;
 }
+
+#if MIMIC == 9
+typedef struct {
+    int state;
+    double time, u, d, x[3], next_tick;
+    int counter;
+    bool ended;
+} Snap;
+
+static void to_snap(const Instance *c, Snap *p) {
+    p->state = c->state; p->time = c->time; p->u = c->u; p->d = c->d; memcpy(p->x, c->x, sizeof p->x);
+    p->next_tick = c->next_tick; p->counter = c->counter; p->ended = c->ended;
+}
+
+EXPORT fmi3Status fmi3GetFMUState(fmi3Instance h, fmi3FMUState *s) {
+    Instance *c = get(h);
+    if (!c || !s) return fmi3Error;
+    Snap *p = *s ? (Snap *)*s : malloc(sizeof(Snap));
+    if (!p) return fmi3Error;
+    to_snap(c, p);
+    *s = p;
+    return fmi3OK;
+}
+
+EXPORT fmi3Status fmi3SetFMUState(fmi3Instance h, fmi3FMUState s) {
+    Instance *c = get(h);
+    if (!c || !s) { say(c, fmi3Error, "fmi3SetFMUState: NULL state"); return fmi3Error; }
+    const Snap *p = s;
+    c->state = p->state; c->time = p->time; c->u = p->u; c->d = p->d; memcpy(c->x, p->x, sizeof c->x);
+    c->next_tick = p->next_tick; c->counter = p->counter; c->ended = p->ended;
+    return fmi3OK;
+}
+
+EXPORT fmi3Status fmi3FreeFMUState(fmi3Instance h, fmi3FMUState *s) {
+    if (!get(h) || !s) return fmi3Error;
+    free(*s);
+    *s = NULL;
+    return fmi3OK;
+}
+
+EXPORT fmi3Status fmi3SerializedFMUStateSize(fmi3Instance h, fmi3FMUState s, size_t *size) {
+    if (!get(h) || !s || !size) return fmi3Error;
+    *size = sizeof(Snap);
+    return fmi3OK;
+}
+
+EXPORT fmi3Status fmi3SerializeFMUState(fmi3Instance h, fmi3FMUState s, fmi3Byte buf[], size_t size) {
+    if (!get(h) || !s || !buf || size < sizeof(Snap)) return fmi3Error;
+    memcpy(buf, s, sizeof(Snap));
+    return fmi3OK;
+}
+
+EXPORT fmi3Status fmi3DeserializeFMUState(fmi3Instance h, const fmi3Byte buf[], size_t size, fmi3FMUState *s) {
+    if (!get(h) || !buf || !s || size != sizeof(Snap)) return fmi3Error;
+    Snap *p = malloc(sizeof(Snap));
+    if (!p) return fmi3Error;
+    memcpy(p, buf, sizeof(Snap));
+    *s = p;
+    return fmi3OK;
+}
+#endif
