@@ -66,7 +66,7 @@ BY_KIND = {"hang": "returns", "crash": "no_crash", "nonfinite": "finite_outputs"
            "memory": "memory", "wrong_state": "state_machine", "error_status": "runs",
            "invalid_status": "status_value", "nondeterministic": "determinism", "wrong_status": "invalid_argument",
            "missing_function": "load", "load": "load", "checker_error": "checker", "stale_handle": "stale_handle",
-           "model_description": "model_description", "no_binary": "load"}
+           "no_binary": "load"}
 
 
 def rule_text(key: str, version: int) -> str:
