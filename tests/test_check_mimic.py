@@ -144,3 +144,33 @@ def test_a_nan_written_into_a_plain_copy_state_and_a_reused_state_handle_are_fou
     sh = rep.row("stale_handles", "cs")
     assert sh["status"] == "fail" and sh["rule"].startswith("R5"), sh
     assert sh["detail"] == "setting a freed FMU state returned fmi3OK (its address was reused by a new state)"
+
+
+def test_the_table_script_makes_the_unit_by_check_table(mimic, tmp_path):
+    """scripts/check_table.py (docs/check.md's Reference-FMU table): one row per unit, a cell per check."""
+    import json
+    import shutil
+    import subprocess
+    import sys
+    from pathlib import Path
+    d = tmp_path / "units"
+    d.mkdir()
+    for name in ("scheduled", "ref_defects"):
+        shutil.copy(mimic[name], d)
+    script = Path(__file__).resolve().parents[1] / "scripts" / "check_table.py"
+    p = subprocess.run([sys.executable, str(script), str(d), "--quick"], capture_output=True, text=True, timeout=600)
+    assert p.returncode == 0, p.stderr
+    table, counts = p.stdout.strip().split("\n\n")
+    rows = {line.split(" | ")[0].strip("| "): line.split(" | ") for line in table.splitlines()[2:]}
+    header = table.splitlines()[0].split(" | ")
+    col = {h.strip("`| "): i for i, h in enumerate(header)}
+    assert set(rows) == {"Mimic_scheduled", "Mimic_ref_defects"}
+    assert rows["Mimic_scheduled"][col["binaries"]] == "n/a"
+    assert rows["Mimic_ref_defects"][col["state_machine"]] == "STD ME"
+    assert rows["Mimic_ref_defects"][col["bad_arguments"]] == "ROB"
+    assert rows["Mimic_ref_defects"][col["nominal_run"]] == "pass"
+    c = json.loads(counts)
+    assert c["units"] == 2 and c["units_failing"] == 1 and c["units_with_standard"] == 1 and c["standard"] == 1
+    p = subprocess.run([sys.executable, str(script), str(tmp_path / "nothere")], capture_output=True, text=True)
+    assert p.returncode == 2 and "Traceback" not in p.stderr and len(p.stderr.strip().splitlines()) == 1, p.stderr
+    assert "'" + str(tmp_path / "nothere") + "' does not exist" in p.stderr
