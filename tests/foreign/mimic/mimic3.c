@@ -1,6 +1,6 @@
 /* Mimic3: small FMI 3.0 units written by hand for tests/test_check_mimic.py. Each variant behaves, in the one
- * respect named, the way a Modelica Reference-FMU does (learnt from their documentation and behaviour, not
- * their code), so that the checker's verdict on such behaviour is tested on a unit of ours:
+ * respect named, the way a Modelica Reference-FMU does (its behaviour observed, and read in their source; none
+ * of their code is used here), so that the checker's verdict on such behaviour is tested on a unit of ours:
  *
  *   MIMIC 1  discrete input (like Feedthrough, ME): a discrete Float64 input `d` may be set only in
  *            Instantiated, Initialization and Event Mode; fmi3SetFloat64 on it in Continuous-Time Mode is
