@@ -17,10 +17,10 @@ from pathlib import Path
 import pytest
 
 from foreign_units import fmi_headers_dir
-from scfmu.check import check
+from scfmu.check import CLASSIC_CHECKS, check
 
 BROKEN_DIR = Path(__file__).resolve().parent / "foreign" / "broken"
-VARIANTS = {"ok": 0, "crash": 1, "hang": 2, "nan": 3, "lax": 4, "leak": 5}
+VARIANTS = {"ok": 0, "crash": 1, "hang": 2, "nan": 3, "lax": 4, "leak": 5, "ends": 6}
 
 
 def build_broken(dest: Path, variant: str) -> Path:
@@ -51,7 +51,14 @@ def failed(rep) -> dict:
 
 def test_the_healthy_build_passes_every_check(broken):
     rep = check(broken["ok"], quick=True, seed=3)
-    assert rep.ok, rep.text()
+    # its instance handle is the pointer calloc gave: a freed handle whose address a new instance got is that
+    # instance's handle (a robustness finding, which the standard does not require); everything else passes
+    f = {r["check"]: r for r in rep.failures()}
+    assert set(f) == {"stale_handles"}, rep.text()
+    assert f["stale_handles"]["class"] == "robustness" and f["stale_handles"]["rule"].startswith("R5")
+    assert "its address was given to a new instance" in f["stale_handles"]["detail"]
+    assert rep.row("start_times", "cs")["metrics"]["accepted"] == 20
+    assert rep.row("state_nan", "cs")["status"] == "n/a"
     assert rep.row("fmu_state", "cs")["status"] == "n/a"  # canGetAndSetFMUstate="false"
     assert rep.row("state_machine", "cs")["metrics"]["forbidden_calls"] >= 9
 
@@ -69,13 +76,34 @@ def test_a_crash_in_do_step_is_caught_by_nominal_run(broken):
 
 
 def test_a_hang_in_do_step_is_caught_by_nominal_run_within_the_time_limit(broken):
-    rep = check(broken["hang"], quick=True, timeout=3, checks=["nominal_run", "bad_arguments"])
+    rep = check(broken["hang"], quick=True, call_timeout=3, checks=["nominal_run", "bad_arguments"])
     f = failed(rep)
     assert set(f) == {"nominal_run"}, rep.text()
-    assert f["nominal_run"]["kind"] == "hang"
-    assert "no answer within 3 s" in f["nominal_run"]["detail"]
+    assert f["nominal_run"]["kind"] == "hang" and f["nominal_run"]["class"] == "robustness"
+    assert "a call did not return within 3 s" in f["nominal_run"]["detail"]
     assert f["nominal_run"]["reproducer"][-1].startswith("fmi2DoStep(c1, 0.05")
     assert rep.seconds < 60
+
+
+def test_a_full_check_of_a_unit_that_hangs_everywhere_takes_under_a_minute(broken):
+    """Every step from t = 0.05 never returns: the first hang takes the call bound (5 s), every later one
+    AFTER_HANG_CALL (2 s); the full gauntlet (not --quick) ends within 60 s with every stepping check a hang."""
+    rep = check(broken["hang"])
+    assert rep.seconds < 60, rep.seconds
+    hangs = {r["check"] for r in rep.failures() if r["kind"] == "hang"}
+    assert {"nominal_run", "random_sequences", "threads", "start_times"} <= hangs, rep.text()  # memory: 3 steps
+    assert all(r["class"] == "robustness" for r in rep.failures()), rep.text()
+    print(f"full check of a unit that hangs: {rep.seconds:.1f} s, {len(hangs)} checks hang")
+
+
+def test_a_unit_that_ends_its_run_with_discard_passes(broken):
+    """Like Stair (FMI 2.0 Co-Simulation): the step from t = 0.05 returns fmi2Discard and any later step
+    fmi2Error; a master stops at the Discard, and so does the checker (5 steps of 0.01 s, then the end)."""
+    rep = check(broken["ends"], quick=True, checks=["nominal_run", "threads", "state_machine"])
+    assert rep.ok, rep.text()
+    row = rep.row("nominal_run", "cs")
+    assert row["metrics"]["steps"] == 5 and row["metrics"]["ended"], row
+    assert "fmi2Discard" in row["detail"], row["detail"]
 
 
 def test_nan_returned_with_ok_is_caught_by_nominal_run(broken):
@@ -101,7 +129,7 @@ def test_a_lax_state_machine_is_caught_by_state_machine(broken):
 
 
 def test_a_leak_per_instance_is_caught_by_memory(broken):
-    rep = check(broken["leak"], quick=True)
+    rep = check(broken["leak"], quick=True, checks=list(CLASSIC_CHECKS))
     f = failed(rep)
     assert set(f) == {"memory"}, rep.text()
     assert f["memory"]["kind"] == "leak"
@@ -113,7 +141,7 @@ def test_the_command_line_exit_codes_and_reports(broken, tmp_path):
     def run(*args):
         return subprocess.run([sys.executable, "-m", "scfmu", "check", *map(str, args)], capture_output=True,
                               text=True, timeout=600)
-    p = run(broken["ok"], "--quick", "--report", tmp_path / "ok")
+    p = run(broken["ok"], "--quick", "--report", tmp_path / "ok", *[a for c in CLASSIC_CHECKS for a in ("--check", c)])
     assert p.returncode == 0, p.stdout + p.stderr
     assert "the FMU passes" in p.stdout
     assert (tmp_path / "ok" / "check.html").is_file() and (tmp_path / "ok" / "check.json").is_file()
@@ -126,7 +154,9 @@ def test_the_command_line_exit_codes_and_reports(broken, tmp_path):
     assert "fmi2DoStep" in (tmp_path / "lax" / "check.html").read_text()
     for args, needle in [(["/no/such.fmu"], "not found"), ([tmp_path], "is not a file"),
                          ([broken["ok"], "--seed", "x"], "invalid int value"),
-                         ([broken["ok"], "--sequences", "-1"], "--sequences -1")]:
+                         ([broken["ok"], "--sequences", "-1"], "--sequences -1"),
+                         ([broken["ok"], "--check", "memroy"], "--check 'memroy' is not a check; allowed: nominal_run"),
+                         ([broken["ok"], "--call-timeout", "0"], "--call-timeout 0")]:
         p = run(*args)
         assert p.returncode == 2, (args, p.stdout, p.stderr)
         assert needle in p.stderr and "Traceback" not in p.stderr, p.stderr

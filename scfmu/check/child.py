@@ -76,6 +76,8 @@ def main() -> int:
             res["status"] = "pass"
         except Fail as e:
             res = {"status": "fail", "kind": e.kind, "detail": e.detail, "reproducer": list(trace.lines)}
+            if e.rule:
+                res["rule"] = e.rule
         except NotApplicable as e:
             res = {"status": "n/a", "detail": str(e)}
         except AttributeError as e:  # a function the standard requires is not exported

@@ -172,7 +172,8 @@ class Lib:
         self.status_names = STATUS2 if version == 2 else STATUS3
         self._fns: dict = {}
         self.names: dict = {}  # instance pointer -> c1, c2, ...
-        self.log: list[tuple[int, str]] = []
+        self.log: list[tuple[int, str]] = []  # the unit's log messages (filled by scfmu.check.unit's logger)
+        self.mark = 0  # len(self.log) when the last call began
         self._keep = []
 
     def has(self, name: str) -> bool:
@@ -202,6 +203,7 @@ class Lib:
         if shown is None:
             shown = [self.handle_name(args[0]) if i == 0 else fmt(a) for i, a in enumerate(args)]
         text = f"{name}({', '.join(shown)})"
+        self.mark = len(self.log)
         self.trace.add(text + " ...")  # written before the call: a crash or a hang leaves the call in the trace
         r = f(*args)
         if f.restype is None:

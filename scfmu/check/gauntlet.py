@@ -11,8 +11,10 @@ from __future__ import annotations
 
 import random
 import threading
+import time
 
 from .fmi import OK, WARNING, Lib
+from .hostile import stale_handles, start_times, state_nan
 from .misuse import bad_arguments, random_sequences
 from .unit import Unit, s_name
 from .verdict import (Fail, NotApplicable, _bits, _check_status_valid, _expect_ok, _expect_refused, _inputs_fn,
@@ -25,11 +27,13 @@ def nominal_run(u: Unit, o: dict) -> dict:
     h = _need(u, u.new(), "instantiate")
     _expect_ok(u, u.start(h), "initialization")
     n = max(1, min(o["steps"], int(round((u.spec["stop_time"] - u.start_time) / u.dt)) or o["steps"]))
-    t, _ = _steps(u, h, u.start_time, n, _inputs_fn(u, o["seed"]))
+    t, outs = _steps(u, h, u.start_time, n, _inputs_fn(u, o["seed"]))
+    ended = u.ended.get(h)
     _expect_ok(u, u.terminate(h), "terminate")
     u.free(h)
-    return {"detail": f"{n} steps of {u.dt:g} s from t = {u.start_time:g}: every call OK, outputs finite",
-            "metrics": {"steps": n}}
+    return {"detail": f"{len(outs)} steps of {u.dt:g} s from t = {u.start_time:g} to {t:g}: every call OK, outputs "
+                      "finite" + (f"; the unit ended the simulation ({ended})" if ended else ""),
+            "metrics": {"steps": len(outs), "ended": bool(ended)}}
 
 
 def _cs_forbidden(u: Unit):
@@ -60,7 +64,7 @@ def _cs_forbidden(u: Unit):
         items.append(("fmi2Terminate after terminate", term, lambda h: u.terminate(h)))
         if u.outputs:
             items.append(("reading the outputs in Instantiated", None, lambda h: u.get(h, u.outputs[:1])[0]))
-    if inp:
+    if inp and u.v == 2:  # FMI 3.0 allows setting variables in Terminated (as the Reference-FMUs do)
         items.append((f"setting input {inp[0]['name']} after terminate", term,
                       lambda h: u.set(h, inp, [inp[0].get("start") or 0.0])))
     if u.me:
@@ -121,7 +125,7 @@ def state_machine(u: Unit, o: dict) -> dict:
             s = reach(h)
             if s > WARNING:
                 raise Fail("error_status", f"reaching the state for '{title}' failed: "
-                                           f"{u.trace.lines[-1] if u.trace.lines else ''}")
+                                           f"{u.trace.lines[-1] if u.trace.lines else ''}", "allowed_call")
         s = call(h)
         n_calls += 1
         _check_status_valid(u, s, title)
@@ -133,25 +137,25 @@ def state_machine(u: Unit, o: dict) -> dict:
     # allowed calls
     u.trace.start("state machine: allowed calls")
     h = _need(u, u.new(), "instantiate")
-    _expect_ok(u, u.enter_init(h), "initialization")
+    _expect_ok(u, u.enter_init(h), "initialization", rule="allowed_call")
     if u.outputs:
-        _expect_ok(u, u.outputs_ok(h)[0], "reading the outputs in Initialization Mode")
-    _expect_ok(u, u.exit_init(h), "exit initialization")
+        _expect_ok(u, u.outputs_ok(h)[0], "reading the outputs in Initialization Mode", rule="allowed_call")
+    _expect_ok(u, u.exit_init(h), "exit initialization", rule="allowed_call")
     u.free(h)
     for where in ("after a step", "after terminate", "after an error"):
         u.trace.start(f"state machine: Reset {where}")
         h = _need(u, u.new(), "instantiate")
-        _expect_ok(u, u.start(h), "initialization")
-        _expect_ok(u, u.step(h, u.start_time, u.dt), "a step")
+        _expect_ok(u, u.start(h), "initialization", rule="allowed_call")
+        _expect_ok(u, u.step(h, u.start_time, u.dt), "a step", rule="allowed_call")
         if where == "after terminate":
-            _expect_ok(u, u.terminate(h), "terminate")
+            _expect_ok(u, u.terminate(h), "terminate", rule="allowed_call")
             if u.outputs:
                 s, _, problem = u.outputs_ok(h)
-                _expect_ok(u, s, "reading the outputs after terminate")
+                _expect_ok(u, s, "reading the outputs after terminate", rule="allowed_call")
         if where == "after an error":
             u.lib.call(f"{u.p}ExitInitializationMode", h)  # forbidden here: an error (checked above)
-        _expect_ok(u, u.reset(h), f"{u.p}Reset {where}")
-        _expect_ok(u, u.start(h), f"initialization after {u.p}Reset")
+        _expect_ok(u, u.reset(h), f"{u.p}Reset {where}", rule="allowed_call")
+        _expect_ok(u, u.start(h), f"initialization after {u.p}Reset", rule="allowed_call")
         _steps(u, h, u.start_time, 3)
         u.free(h)
     u.trace.start("state machine: free in every state")
@@ -200,7 +204,7 @@ def _corrupted_states(u: Unit, o: dict, data: bytes, t: float) -> tuple[int, int
             continue
         s = u.set_state(h3, st3)
         if s <= WARNING:
-            u.x.pop(h3, None)
+            u.forget(h3)
             s = u.step(h3, t, u.dt)
             if s <= WARNING:
                 _, _, problem = u.outputs_ok(h3)
@@ -230,12 +234,13 @@ def fmu_state(u: Unit, o: dict) -> dict:
     t, _ = _steps(u, h, u.start_time, 5, inputs)
     s, st = u.get_state(h)
     _expect_ok(u, s, "getting the FMU state")
-    x_saved = list(u.x.get(h, []))
+    x_saved, te_saved = list(u.x.get(h, [])), u.next_event.get(h)
     n = 10
     _, y1 = _steps(u, h, t, n, lambda k: inputs(k + 5))
     _expect_ok(u, u.set_state(h, st), "setting the FMU state")
-    if u.me:
-        u.x[h] = list(x_saved)
+    u.forget(h)
+    if u.me:  # the checker's own integrator state goes back with the unit's
+        u.x[h], u.next_event[h] = list(x_saved), te_saved
     _, y2 = _steps(u, h, t, n, lambda k: inputs(k + 5))
     if _bits(y1) != _bits(y2):
         raise Fail("nondeterministic", "the steps after restoring the FMU state differ from the first ones")
@@ -252,8 +257,9 @@ def fmu_state(u: Unit, o: dict) -> dict:
         s, st2 = u.deserialize(h2, data)
         _expect_ok(u, s, "deserializing the FMU state")
         _expect_ok(u, u.set_state(h2, st2), "setting the deserialized FMU state")
+        u.forget(h2)
         if u.me:
-            u.x[h2] = list(x_saved)
+            u.x[h2], u.next_event[h2] = list(x_saved), te_saved
         _, y3 = _steps(u, h2, t, n, lambda k: inputs(k + 5))
         if _bits(y1) != _bits(y3):
             raise Fail("nondeterministic", "a second instance restored from the serialized state steps differently")
@@ -264,7 +270,7 @@ def fmu_state(u: Unit, o: dict) -> dict:
                    f"{n_cases} corrupted states: {refused} refused, {usable} usable with finite outputs")
         metrics.update(serialized_bytes=len(data), corrupted=n_cases, refused=refused, usable=usable)
     u.trace.start("FMU state: set a NULL state")
-    _expect_refused(u, u.set_state(h, None), "setting a NULL FMU state")
+    _expect_refused(u, u.set_state(h, None), "setting a NULL FMU state", rule="invalid_argument")
     u.free_state(h, st)
     u.free(h)
     return {"detail": detail, "metrics": metrics}
@@ -329,6 +335,24 @@ def memory(u: Unit, o: dict) -> dict:
                         "loads": loads, "load_growth_bytes": load_growth}}
 
 
+def _join_announcing(u: Unit, ts: list, traces: list) -> None:
+    """Waits for the threads, announcing their progress (the calls their traces record) as a call that
+    returns whenever a call of any thread has returned: the parent's per-call time bound then sees a thread
+    that hangs as a call that does not return."""
+    line = f"(the calls of {len(ts)} threads)"
+    done = -1
+    while any(th.is_alive() for th in ts):
+        n = sum(len(t.lines) for t in traces)
+        if n != done:
+            if done >= 0:
+                u.trace.done(line)
+            u.trace.add(line + " ...")
+            done = n
+        time.sleep(0.05)
+    if done >= 0:
+        u.trace.done(line)
+
+
 def threads(u: Unit, o: dict) -> dict:
     """The same inputs on N threads at once (one instance each): every thread's outputs bit-identical to
     a run on the main thread."""
@@ -379,8 +403,7 @@ def threads(u: Unit, o: dict) -> dict:
     ts = [threading.Thread(target=work, args=(i,)) for i in range(nt)]
     for th in ts:
         th.start()
-    for th in ts:
-        th.join()
+    _join_announcing(u, ts, [w.trace for w in tu])
     bad = [i for i, r in enumerate(results) if r != ref_bits]
     if bad:
         r = results[bad[0]]
@@ -391,4 +414,5 @@ def threads(u: Unit, o: dict) -> dict:
 
 
 CHECKS = {"nominal_run": nominal_run, "state_machine": state_machine, "bad_arguments": bad_arguments,
-          "random_sequences": random_sequences, "fmu_state": fmu_state, "memory": memory, "threads": threads}
+          "random_sequences": random_sequences, "fmu_state": fmu_state, "memory": memory, "threads": threads,
+          "start_times": start_times, "stale_handles": stale_handles, "state_nan": state_nan}

@@ -1,6 +1,13 @@
 """Runs the dynamic checks of one FMU interface in isolated child processes (scfmu.check.child) with a
-time limit per check: a crash, an abort or a hang of the FMU ends only the child; the check that was
-running is failed with the call list it was making, and a fresh child continues with the next checks."""
+time limit per check and one per FMI call: a crash, an abort or a hang of the FMU ends only the child; the
+check that was running is failed with the call list it was making, and a fresh child continues with the
+next checks.
+
+A hang is a call that has not returned after ``call_timeout`` seconds (the child announces each call before
+making it; the threads check announces its threads' progress the same way), or a check still running after
+``timeout``. Once the unit has hung, a call of the later checks gets AFTER_HANG_CALL seconds at most: a unit
+that hangs in every check is reported in well under a minute instead of one full time limit per check,
+while a check that is long but progressing keeps its whole time limit."""
 
 from __future__ import annotations
 
@@ -23,17 +30,23 @@ def _signame(rc: int) -> str:
         return f"signal {-rc}"
 
 
-def run_checks(spec: dict, checks: list[str], options: dict, timeout: float) -> dict:
-    """{check name: result dict} for `checks` on the interface `spec`; each check gets `timeout` seconds."""
+AFTER_HANG_CALL = 2.0  # s a call may take once the unit has hung
+
+
+def run_checks(spec: dict, checks: list[str], options: dict, timeout: float, seen: dict | None = None) -> dict:
+    """{check name: result dict} for `checks` on the interface `spec`; each check gets `timeout` seconds and
+    each call options["call_timeout"] seconds. `seen` ({"hung": bool}) carries over from one interface to
+    the next whether the unit has hung."""
     results: dict = {}
     todo = list(checks)
+    seen = {"hung": False} if seen is None else seen
     while todo:
-        results.update(_one_child(spec, todo, options, timeout))
+        results.update(_one_child(spec, todo, options, timeout, seen))
         todo = [c for c in todo if c not in results]
     return results
 
 
-def _one_child(spec, checks, options, timeout) -> dict:
+def _one_child(spec, checks, options, timeout, seen) -> dict:
     job = json.dumps({"spec": spec, "checks": checks, "options": options}).encode()
     results: dict = {}
     with tempfile.TemporaryDirectory(prefix="scfmu_check_", dir=scratch.process_folder()) as tmp, \
@@ -44,7 +57,7 @@ def _one_child(spec, checks, options, timeout) -> dict:
         proc = subprocess.Popen([sys.executable, "-m", "scfmu.check.child"], stdin=subprocess.PIPE,
                                 stdout=subprocess.PIPE, stderr=err, cwd=tmp, env=env, start_new_session=True)
         try:
-            return _watch(proc, job, err, checks, timeout, results)
+            return _watch(proc, job, err, checks, (timeout, float(options.get("call_timeout", 5.0))), results, seen)
         except BaseException:  # Ctrl-C, SIGTERM (scfmu.cli), any error: no child outlives the check
             _kill(proc)
             raise
@@ -62,22 +75,33 @@ def _kill(proc) -> None:
         pass
 
 
-def _watch(proc, job: bytes, err, checks, timeout, results: dict) -> dict:
+def _bounds(limits, seen) -> tuple[float, float]:
+    check_t, call_t = limits
+    return check_t, (min(call_t, AFTER_HANG_CALL) if seen["hung"] else call_t)
+
+
+def _watch(proc, job: bytes, err, checks, limits, results: dict, seen: dict) -> dict:
     """Feeds the child its job and reads its events until it ends or hangs; the results of its checks."""
     proc.stdin.write(job)
     proc.stdin.close()
     sel = selectors.DefaultSelector()
     sel.register(proc.stdout, selectors.EVENT_READ)
     current, lines, buf = None, [], b""
-    deadline = time.monotonic() + timeout + 60.0  # starting Python is not the FMU's time
-    hung = False
+    deadline = time.monotonic() + limits[0] + 60.0  # starting Python is not the FMU's time
+    call_since = None  # when the call in progress began (None: no call in progress)
+    hung = None  # "check" or "call"
+    timeout, call_timeout = _bounds(limits, seen)
     fd = proc.stdout.fileno()
     while True:
-        left = deadline - time.monotonic()
-        if left <= 0:
-            hung = True
+        now = time.monotonic()
+        if deadline - now <= 0:
+            hung = "check"
             break
-        if not sel.select(timeout=min(left, 1.0)):
+        if call_since is not None and current is not None and now - call_since > call_timeout:
+            hung = "call"
+            break
+        wait = deadline - now if call_since is None else min(deadline - now, call_since + call_timeout - now)
+        if not sel.select(timeout=max(0.01, min(wait, 0.25))):
             continue
         chunk = os.read(fd, 1 << 16)
         if not chunk:
@@ -88,18 +112,27 @@ def _watch(proc, job: bytes, err, checks, timeout, results: dict) -> dict:
             line = raw.decode(errors="replace")
             tag, _, rest = line.partition(" ")
             if tag == "B":
-                current, lines = rest, []
+                current, lines, call_since = rest, [], None
+                timeout, call_timeout = _bounds(limits, seen)
                 deadline = time.monotonic() + timeout
             elif tag == "S":
                 lines = []
             elif tag == "C":
                 lines.append(rest)
+                call_since = None if rest.startswith("//") else time.monotonic()
             elif tag == "R" and lines:
                 lines[-1] = rest
+                call_since = None
             elif tag == "E" and current:
                 results[current] = json.loads(rest)
                 current = None
     sel.close()
+    return _finish(proc, err, checks, results, seen, (current, lines, hung, timeout, call_timeout))
+
+
+def _finish(proc, err, checks, results: dict, seen: dict, where: tuple) -> dict:
+    """Ends the child and turns a check it left unfinished into a hang or crash result."""
+    current, lines, hung, timeout, call_timeout = where
     if hung:
         try:
             os.killpg(proc.pid, signal.SIGKILL)
@@ -119,9 +152,11 @@ def _watch(proc, job: bytes, err, checks, timeout, results: dict) -> dict:
     if current is not None and current not in results:
         last = lines[-1] if lines else "(no call yet)"
         if hung:
+            seen["hung"] = True
+            what = f"a call did not return within {call_timeout:g} s" if hung == "call" else \
+                f"the check did not end within {timeout:g} s"
             results[current] = {"status": "fail", "kind": "hang",
-                                "detail": f"no answer within {timeout:g} s; the call in progress: {last}",
-                                "reproducer": lines}
+                                "detail": f"{what}; the call in progress: {last}", "reproducer": lines}
         else:
             how = f"killed by {_signame(rc)}" if rc < 0 else f"exited with status {rc}"
             tail = " | ".join(stderr.splitlines()[-3:])

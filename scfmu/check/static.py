@@ -143,6 +143,9 @@ def binaries_check(md, unzipdir: Path) -> tuple[dict, dict]:
         else:
             missing.append(f"{itf.upper()}: binaries/{folder}/{lib.name}")
     if md.coSimulation is None and md.modelExchange is None:
+        if getattr(md, "scheduledExecution", None) is not None:  # FMI 3.0: a legal kind this checker does not drive
+            return {"check": "binaries", "status": "n/a",
+                    "detail": "the FMU offers only Scheduled Execution, which scfmu check does not drive"}, libs
         return {"check": "binaries", "status": "fail", "kind": "model_description",
                 "detail": "the FMU declares neither Co-Simulation nor Model Exchange"}, libs
     if missing:
@@ -155,11 +158,33 @@ def binaries_check(md, unzipdir: Path) -> tuple[dict, dict]:
                                                                        sorted(set(libs.values())))}, libs
 
 
+DEFAULT_STEP = 0.01  # s: the checker's step when the default experiment gives no stepSize
+
+
 def _num(x):
     try:
         return float(x) if x is not None else None
     except (TypeError, ValueError):
         return None
+
+
+def _size(v) -> int:
+    """The number of scalars of variable v: the product of its dimensions (FMI 3.0 arrays; a dimension given
+    by a structural parameter takes that parameter's start value), 1 for a scalar."""
+    n = 1
+    for d in getattr(v, "dimensions", None) or []:
+        if d.start is not None and str(d.start).strip():
+            n *= int(d.start)
+        else:
+            ref = d.variable
+            n *= int(float(ref.start)) if ref is not None and ref.start is not None else 1
+    return n
+
+
+def n_states(md) -> int:
+    """The number of continuous states: one per scalar of every derivative (an array state counts its
+    elements)."""
+    return sum(_size(d.variable) for d in md.derivatives)
 
 
 def unit_spec(md, unzipdir: Path, interface: str, library: Path) -> dict:
@@ -178,6 +203,7 @@ def unit_spec(md, unzipdir: Path, interface: str, library: Path) -> dict:
             else:
                 start = _num(start)
         return {"name": v.name, "vr": int(v.valueReference), "type": v.type, "start": start,
+                "variability": v.variability or "continuous",
                 "min": _num(getattr(v, "min", None)), "max": _num(getattr(v, "max", None))}
 
     scalar = [v for v in md.modelVariables if v.type in numeric and not getattr(v, "dimensions", None)]
@@ -185,8 +211,9 @@ def unit_spec(md, unzipdir: Path, interface: str, library: Path) -> dict:
     t0 = _num(de.startTime) if de and de.startTime is not None else 0.0
     t1 = _num(de.stopTime) if de and de.stopTime is not None else t0 + 1.0
     step = _num(de.stepSize) if de and de.stepSize is not None else None
-    if not step or step <= 0:
-        step = (t1 - t0) / 100.0 if t1 > t0 else 0.01
+    if not step or step <= 0:  # no stepSize: a hundredth of the experiment, at most DEFAULT_STEP (a unit with
+        # its own fixed internal step, e.g. 1e-6 s, is not asked for 1e6 s in one call)
+        step = min((t1 - t0) / 100.0, DEFAULT_STEP) if t1 > t0 else DEFAULT_STEP
     res = Path(unzipdir) / "resources"
     resources = res.as_uri() if v2 else str(res) + os.sep
     if v2:
@@ -198,7 +225,7 @@ def unit_spec(md, unzipdir: Path, interface: str, library: Path) -> dict:
         "version": 2 if v2 else 3, "interface": interface, "library": str(library),
         "token": md.guid if v2 else (getattr(md, "instantiationToken", None) or md.guid),
         "resources": resources, "model": md.modelName, "identifier": elem.modelIdentifier,
-        "nx": len(md.derivatives) if interface == "me" else 0,
+        "nx": n_states(md) if interface == "me" else 0,
         "start_time": t0, "stop_time": t1, "step": step,
         "can_get_set_state": bool(can_state), "can_serialize_state": bool(can_ser and can_state),
         "only_once": bool(getattr(elem, "canBeInstantiatedOnlyOncePerProcess", False)),

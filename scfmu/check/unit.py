@@ -21,6 +21,9 @@ _libc.free.argtypes = [c_void_p]
 _libc.free.restype = None
 
 
+MAX_SUBSTEPS = 50  # Euler sub-steps per Model Exchange step of the checker
+
+
 class Unit:
     def __init__(self, spec: dict, trace: Trace, lib: Lib | None = None):
         self.spec = spec
@@ -30,12 +33,17 @@ class Unit:
         self.lib = lib or Lib(spec["library"], self.v, trace)
         self.p = "fmi2" if self.v == 2 else "fmi3"
         self.nx = int(spec.get("nx", 0))
-        self.inputs = [x for x in spec["inputs"] if x["type"] in self._types()]
+        inputs = [x for x in spec["inputs"] if x["type"] in self._types()]
+        # Model Exchange: only continuous inputs may be set in Continuous-Time Mode (FMI 2.0.4 §3.2.3, FMI 3.0
+        # Model Exchange state machine); the discrete ones keep their start values
+        self.inputs = [x for x in inputs if not self.me or x.get("variability", "continuous") == "continuous"]
         self.outputs = [x for x in spec["outputs"] if x["type"] in self._types()]
         self.real_inputs = [x for x in self.inputs if x["type"] in ("Real", "Float64")]
         self.real_params = [x for x in spec["parameters"] if x["type"] in ("Real", "Float64")]
-        self.messages: list[tuple[int, str]] = []
+        self.messages: list[tuple[int, str]] = self.lib.log  # Lib.mark: where the last call's messages begin
         self.x: dict = {}       # instance -> continuous states (Model Exchange)
+        self.now: dict = {}     # instance -> the time a Model Exchange step reached (Unit.me_step)
+        self.ended: dict = {}   # instance -> why the unit asked to end the simulation (terminateSimulation)
         self.next_event: dict = {}
         self._counter = 0
         self._make_callbacks()
@@ -96,7 +104,13 @@ class Unit:
 
     def free(self, h) -> None:
         self.lib.call(f"{self.p}FreeInstance", h)
+        self.forget(h)
+
+    def forget(self, h) -> None:
+        """Drops what the checker holds of instance h (after free, reset or a restored FMU state)."""
         self.x.pop(h, None)
+        self.now.pop(h, None)
+        self.ended.pop(h, None)
         self.next_event.pop(h, None)
 
     def enter_init(self, h, t0: float | None = None) -> int:
@@ -134,7 +148,7 @@ class Unit:
         return self.lib.call(f"{self.p}Terminate", h)
 
     def reset(self, h) -> int:
-        self.x.pop(h, None)
+        self.forget(h)
         return self.lib.call(f"{self.p}Reset", h)
 
     @property
@@ -153,6 +167,7 @@ class Unit:
                 ei = EventInfo2()
                 s = self.lib.call("fmi2NewDiscreteStates", h, byref(ei), shown=[self.lib.handle_name(h), "&eventInfo"])
                 needed, defined, t_next = ei.newDiscreteStatesNeeded, ei.nextEventTimeDefined, ei.nextEventTime
+                term = ei.terminateSimulation
             else:
                 b = [c_bool() for _ in range(5)]
                 tn = c_double()
@@ -160,8 +175,12 @@ class Unit:
                                   shown=[self.lib.handle_name(h), "&needUpdate", "&terminate", "&nominalsChanged",
                                          "&valuesChanged", "&nextEventTimeDefined", "&nextEventTime"])
                 needed, defined, t_next = b[0].value, b[4].value, tn.value
+                term = b[1].value
             worst = max(worst, s)
             if s > WARNING:
+                return worst
+            if term:
+                self.ended[h] = "terminateSimulation from the event update"
                 return worst
             if not needed:
                 self.next_event[h] = t_next if defined else None
@@ -170,37 +189,60 @@ class Unit:
         return ERROR
 
     def me_step(self, h, t: float, dt: float) -> int:
-        """One explicit Euler step from t to t + dt with the events the unit asks for."""
+        """Explicit Euler from t towards t + dt with the events the unit asks for, in sub-steps that change no
+        state by more than a tenth of its size (plus 1e-6): a stiff unit or one without a stepSize in its
+        default experiment is not driven into the checker's own divergence. At most MAX_SUBSTEPS sub-steps:
+        the time reached is left in self.now[h]."""
+        worst, t1, tk = OK, t + dt, t
+        for _ in range(MAX_SUBSTEPS):
+            s, tk = self._euler(h, tk, t1)
+            worst = max(worst, s)
+            if s > WARNING:
+                return worst
+            if tk >= t1 or h in self.ended:
+                break
+        self.now[h] = tk
+        return worst
+
+    def _euler(self, h, t: float, t_end: float) -> tuple[int, float]:
+        """One Euler sub-step from t (to t_end at most, and not past a time event); (status, time reached)."""
         worst = OK
         n = self.nx
         hn = self.lib.handle_name(h)
-        t1 = t + dt
+        t1 = t_end
+        te = self.next_event.get(h)
+        if te is not None and t < te < t1:
+            t1 = te
         if n:
             x = self.x.get(h)
             if x is None or len(x) != n:
                 xs = (c_double * n)()
                 s = self.lib.call(f"{self.p}GetContinuousStates", h, xs, n, shown=[hn, "x", str(n)])
                 if s > WARNING:
-                    return s
+                    return s, t
                 x = list(xs)
             dx = (c_double * n)()
             name = "fmi2GetDerivatives" if self.v == 2 else "fmi3GetContinuousStateDerivatives"
             s = self.lib.call(name, h, dx, n, shown=[hn, "dx", str(n)])
             worst = max(worst, s)
             if s > WARNING:
-                return worst
-            x = [a + dt * b for a, b in zip(x, dx)]
+                return worst, t
+            rate = max((abs(d) / (0.1 * abs(a) + 1e-6) for a, d in zip(x, dx) if math.isfinite(a) and
+                        math.isfinite(d)), default=0.0)
+            if rate * (t1 - t) > 1.0:
+                t1 = t + 1.0 / rate
+            x = [a + (t1 - t) * b for a, b in zip(x, dx)]
             self.x[h] = x
         s = self.lib.call(f"{self.p}SetTime", h, t1)
         worst = max(worst, s)
         if s > WARNING:
-            return worst
+            return worst, t
         if n:
             xs = (c_double * n)(*self.x[h])
             s = self.lib.call(f"{self.p}SetContinuousStates", h, xs, n, shown=[hn, fmt_list(self.x[h]), str(n)])
             worst = max(worst, s)
             if s > WARNING:
-                return worst
+                return worst, t1
         if self.v == 2:
             enter, term = c_int(), c_int()
             s = self.lib.call("fmi2CompletedIntegratorStep", h, 1, byref(enter), byref(term),
@@ -211,18 +253,19 @@ class Unit:
                               shown=[hn, "true", "&enterEventMode", "&terminateSimulation"])
         worst = max(worst, s)
         if s > WARNING:
-            return worst
-        te = self.next_event.get(h)
+            return worst, t1
+        if term.value:
+            self.ended[h] = f"terminateSimulation from CompletedIntegratorStep at t = {t1!r}"
+            return worst, t1
         if enter.value or (te is not None and t1 >= te - 1e-12 * max(1.0, abs(te))):
-            for fn in ("EnterEventMode",):
-                s = self.lib.call(f"{self.p}{fn}", h)
-                worst = max(worst, s)
-                if s > WARNING:
-                    return worst
-            s = self.event_iteration(h)
+            s = self.lib.call(f"{self.p}EnterEventMode", h)
             worst = max(worst, s)
             if s > WARNING:
-                return worst
+                return worst, t1
+            s = self.event_iteration(h)
+            worst = max(worst, s)
+            if s > WARNING or h in self.ended:
+                return worst, t1
             s = self.lib.call(f"{self.p}EnterContinuousTimeMode", h)
             worst = max(worst, s)
             if n and s <= WARNING:
@@ -230,7 +273,7 @@ class Unit:
                 s2 = self.lib.call(f"{self.p}GetContinuousStates", h, xs, n, shown=[hn, "x", str(n)])
                 worst = max(worst, s2)
                 self.x[h] = list(xs)
-        return worst
+        return worst, t1
 
     # ------------------------------------------------------------------ stepping
     def step(self, h, t: float, dt: float) -> int:
@@ -240,9 +283,12 @@ class Unit:
             return self.lib.call("fmi2DoStep", h, t, dt, 1)
         flags = [c_bool() for _ in range(3)]
         last = c_double()
-        return self.lib.call("fmi3DoStep", h, t, dt, True, *[byref(f) for f in flags], byref(last),
-                             shown=[self.lib.handle_name(h), fmt_num(t), fmt_num(dt), "true", "&eventHandlingNeeded",
-                                    "&terminateSimulation", "&earlyReturn", "&lastSuccessfulTime"])
+        s = self.lib.call("fmi3DoStep", h, t, dt, True, *[byref(f) for f in flags], byref(last),
+                          shown=[self.lib.handle_name(h), fmt_num(t), fmt_num(dt), "true", "&eventHandlingNeeded",
+                                 "&terminateSimulation", "&earlyReturn", "&lastSuccessfulTime"])
+        if s <= WARNING and flags[1].value:
+            self.ended[h] = f"terminateSimulation from the step from t = {t!r}"
+        return s
 
     # ------------------------------------------------------------------ values
     def get(self, h, variables: list) -> tuple[int, list]:

@@ -8,6 +8,8 @@
  *   BROKEN 3  nan:     y is NaN once t >= FAIL_TIME, every call still returns fmi2OK
  *   BROKEN 4  lax:     no state checks: every call is accepted in every state
  *   BROKEN 5  leak:    every instance allocates (and touches) LEAK_BYTES that fmi2FreeInstance never frees
+ *   BROKEN 6  ends:    not broken: the unit ends its simulation as Stair does: fmi2DoStep from t >= FAIL_TIME
+ *                      returns fmi2Discard, every later step fmi2Error (a master stops at the Discard)
  *
  * Value references: k = 0 (parameter, start 1), u = 1 (input, start 1), y = 2 (output, y(0) = 0).
  */
@@ -38,6 +40,7 @@ typedef struct {
     char *name;
     int state;
     double time, k, u, y;
+    int ended;
     void *junk;
 } Instance;
 
@@ -65,6 +68,7 @@ static void defaults(Instance *c) {
     c->k = 1.0;
     c->u = 1.0;
     c->y = 0.0;
+    c->ended = 0;
 }
 
 FMI2_Export const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
@@ -234,6 +238,16 @@ FMI2_Export fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real t, fmi2Real h, fm
     if (!(h > 0.0) || !isfinite(h) || !isfinite(t) || h > 1e6) {
         logerr(c, "fmi2DoStep: the step size must be finite and > 0, the time finite");
         return fmi2Error;
+    }
+#endif
+#if BROKEN == 6
+    if (c->ended) {
+        logerr(c, "fmi2DoStep: the simulation has ended");
+        return fmi2Error;
+    }
+    if (t >= FAIL_TIME - 1e-12) {
+        c->ended = 1;
+        return fmi2Discard;
     }
 #endif
 #if BROKEN == 1
