@@ -94,7 +94,7 @@ impl Model for AttitudePlant {
     const EVOLVING: &'static [&'static str] = &["x", "stepper.h_adapt", "q_dcm"];
     const INFO: ModelInfo = ModelInfo {
         name: "AttitudePlant",
-        description: "Three-axis rigid spacecraft (gyrostat) with full inertia, selectable kinematics, saturating fault-prone torque actuators or reaction wheels with magnetorquers, disturbance generator and gravity gradient",
+        description: "Three-axis rigid spacecraft (gyrostat) with full inertia, selectable kinematics, saturating fault-prone torque actuators or reaction wheels with magnetorquers, disturbance generator and gravity gradient; with the environment inputs, facet drag, solar pressure and residual dipole torques",
         source: "rigid-body attitude dynamics and kinematics of [Navabi-2019], [T2FSMC-LEO] and [Moradi-FTC]; reaction-wheel lag of [Khatoonabadi-FO]",
         equations_html: include_str!("docs.html"),
         feedthrough: Feedthrough::Some(&[
