@@ -200,7 +200,7 @@ impl<T> Handles<T> {
     pub fn get(&self, t: usize) -> Option<*mut T> {
         let (serial, index) = self.decode(t)?;
         if index == OVERFLOW {
-            return self.lock().overflow.get(&t).copied();
+            return self.get_overflow(t);
         }
         let slot = &self.slots[index];
         if slot.serial.load(Ordering::Acquire) != serial {
@@ -208,6 +208,13 @@ impl<T> Handles<T> {
         }
         let p = slot.ptr.load(Ordering::Acquire);
         (slot.serial.load(Ordering::Relaxed) == serial).then_some(p)
+    }
+
+    /// [`Handles::get`] past the fast slots (out of line: the fast path stays small).
+    #[cold]
+    #[inline(never)]
+    fn get_overflow(&self, t: usize) -> Option<*mut T> {
+        self.lock().overflow.get(&t).copied()
     }
 
     /// (serial, index) of a token of this table's kind, if it is one.
