@@ -1,6 +1,6 @@
-//! The C boundary both FMI versions stand on: the table of live instances (a pointer from the master
-//! is a token, never an address, mapped to an instance only while that instance lives), the panic guard (a panic inside a call
-//! becomes a logged fatal status, never an unwind across `extern "C"`), borrowing of C arrays and
+//! The C boundary both FMI versions stand on: the table of live instances (a handle from the master is
+//! a token, never an address, mapped to an instance only while that instance lives), the panic guard (a
+//! panic inside a call becomes a logged fatal status, never an unwind across `extern "C"`), borrowing of C arrays and
 //! out-pointers with the argument named in the error, the model lookup by GUID / instantiation token,
 //! and one instantiate for every interface (FMI 2.0 CS/ME, FMI 3.0 CS/ME). Nothing here knows an FMI
 //! function name beyond what the caller passes in.

@@ -3,9 +3,10 @@
 //! Every snapshot handed to the master is recorded in a process-wide table under a token that is never
 //! handed out twice (`live.rs` says why not its address: a freed state's address goes to the next one),
 //! with its owning instance, so a foreign, freed or corrupted `fmi2FMUstate` handle is refused with an
-//! error, also after its memory went to a new state; the master never holds an address of ours. Every read or write of a snapshot happens while that table's lock is held,
-//! so instances on different threads never touch a snapshot at the same time (FMI allows independent
-//! instances on independent threads).
+//! error, also after its memory went to a new state; the master never holds an address of ours. Every
+//! read or write of a snapshot happens while that table's lock is held, so instances on different
+//! threads never touch a snapshot at the same time (FMI allows independent instances on independent
+//! threads).
 //!
 //! Byte format (little endian): magic `SCFMUST\0` (8 bytes), format version u32, payload length u32,
 //! payload (postcard), CRC-32 of everything before it (u32).
