@@ -28,7 +28,7 @@ out = {{}}
 for name, sc in (("2 FMUs", two_fmu_scenario()), ("run 000-6", scenarios.get("default"))):
     for how, f in (("compiled loop", t_compiled), ("native, no Python per step", lambda s: t_native(s, 0))):
         f(sc)  # warm: extraction, first load
-        out[f"{{how}}, {{name}}"] = min(f(sc) for _ in range(3)) / sc.n_steps * 1e6
+        out[f"{{how}}, {{name}}"] = min(f(sc) for _ in range(5)) / sc.n_steps * 1e6
 print(json.dumps(out))
 """
 
