@@ -43,11 +43,12 @@ pub fn instance_of<'a>(c: Handle, fmi3: bool) -> Option<&'a mut Instance> {
 /// Registers a new instance under a new token (installing the panic hook with the first one).
 fn register(inst: Box<Instance>) -> Result<Handle, String> {
     let p = Box::into_raw(inst);
-    LIVE.insert(p, install_panic_hook).map(|t| t as Handle).map_err(|e| {
-        // SAFETY: not registered: still ours alone
-        drop(unsafe { Box::from_raw(p) });
-        e
-    })
+    LIVE.insert(p, install_panic_hook)
+        .map(|t| t as Handle)
+        .inspect_err(|_| {
+            // SAFETY: not registered: still ours alone
+            drop(unsafe { Box::from_raw(p) });
+        })
 }
 
 /// Frees an instance of the given FMI version (and its FMU states); anything else is ignored.
