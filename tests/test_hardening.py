@@ -126,16 +126,18 @@ def test_cycles_are_bit_identical_and_leak_nothing(masters, version):
 
 
 @pytest.mark.parametrize("version", [2, 3])
-@pytest.mark.parametrize("threads,rounds", [(1, 10_000), (8, 1_250)])
-def test_stale_handles_are_refused_after_their_memory_is_reused(masters, version, threads, rounds):
-    """10,000 rounds (alone, and 8 threads x 1,250): an instance and its FMU states freed, a new instance and
+@pytest.mark.parametrize("threads,rounds,held", [(1, 10_000, 0), (8, 1_250, 0), (8, 500, 1_100)])
+def test_stale_handles_are_refused_after_their_memory_is_reused(masters, version, threads, rounds, held):
+    """10,000 rounds (alone, 8 threads x 1,250, and 8 x 500 with 1,100 more instances alive, so that the
+    rounds' instances are past the 1,024 lock-free slots): an instance and its FMU states freed, a new instance and
     state created, which the allocator usually places where the freed ones were; every stale instance handle
     (the thread's first, its last 24, 8 of other threads') is refused with the version's error status and no
     message, every stale FMU-state handle given to the new instance with the error status and a message naming
     the function; the new instance's outputs do not move and its run ends where a fresh one ends. On the
     address-checked handles of before, the reused address made the stale call reach the new instance."""
-    p = run(unit(masters, version), "reuse", rounds, threads, timeout=300)
-    assert re.search(r"ok reuse \d+ threads x \d+ rounds: \d+ stale calls refused", p.stdout), p.stdout
+    p = run(unit(masters, version), "reuse", rounds, threads, held, timeout=300)
+    assert re.search(r"ok reuse \d+ threads x \d+ rounds \(\d+ other instances held\): \d+ stale calls refused",
+                     p.stdout), p.stdout
 
 
 def test_stale_handles_under_valgrind(masters):

@@ -11,10 +11,11 @@
  *   fmi_hostile LIB GUID hang            calls that used to run forever must return an error promptly
  *   fmi_hostile LIB GUID fuzz N SEED     serialized states with random bytes and a valid CRC
  *   fmi_hostile LIB GUID extreme         extreme parameters: errors, never infinite values with fmi2OK
- *   fmi_hostile LIB GUID reuse N [T]     T threads (default 1), N rounds each: an instance and its FMU states
+ *   fmi_hostile LIB GUID reuse N [T [H]] T threads (default 1), N rounds each: an instance and its FMU states
  *                                        freed, a new instance (and state) that usually gets their memory; every
- *                                        stale instance and state handle kept (the first, the last ones, others
- *                                        threads') refused with fmi2Error, the new instance untouched
+ *                                        stale instance and state handle kept (the first, the last ones, other
+ *                                        threads') refused with fmi2Error, the new instance untouched; with H,
+ *                                        H more instances live all the while (unchanged at the end)
  *   fmi_hostile LIB GUID race N          deliberate misuse: two threads call ONE instance at the same time
  *                                        (FMI forbids it); under ThreadSanitizer this must be reported, which
  *                                        shows the detector is live (results are not checked)
@@ -39,7 +40,7 @@
  *                                        a log message naming the function, and the instance recovers
  *   fmi_hostile -3 LIB TOKEN mixed       an FMI 2.0 and an FMI 3.0 instance of the same library side by side
  *                                        give identical results; neither API accepts the other's instance
- *   fmi_hostile -3 LIB TOKEN reuse N [T] the reuse mode with the FMI 3.0 functions (fmi3Error)
+ *   fmi_hostile -3 LIB TOKEN reuse N [T [H]] the reuse mode with the FMI 3.0 functions (fmi3Error)
  *   fmi_hostile -3 LIB TOKEN me          Model Exchange: NULL and foreign pointers on every ME entry point,
  *                                        wrong call order, wrong lengths, NaN states and times, Co-Simulation
  *                                        calls on an ME instance and FMU states across the two; then an
@@ -862,10 +863,12 @@ static void *reuse_worker2(void *arg) {
     return NULL;
 }
 
-/* reuse N T: T threads, N rounds each */
-static void reuse2(int n, int nt) {
+/* reuse N T HOLD: T threads, N rounds each, while HOLD other instances live (past the lock-free slots) */
+static void reuse2(int n, int nt, int hold) {
     Fmi f = load();
-    CHECK(nt > 0 && nt <= 64, "1 to 64 threads");
+    CHECK(nt > 0 && nt <= 64 && hold >= 0, "1 to 64 threads, HOLD >= 0");
+    C *held = malloc(sizeof(C) * (size_t)(hold + 1));
+    for (int i = 0; i < hold; i++) held[i] = ready(&f, 0);
     C c = ready(&f, 0);
     double t = 0;
     step_n(&f, c, &t, 10);
@@ -886,9 +889,15 @@ static void reuse2(int n, int nt) {
         same_addr += r[i].same_addr;
         same_state += r[i].same_state;
     }
+    for (int i = 0; i < hold; i++) {
+        CHECK(read_wx(&f, held[i]) == 0.05, "a held instance changed");
+        f.free_instance(held[i]);
+    }
+    free(held);
     dlclose(f.lib);
-    printf("ok reuse %d threads x %d rounds: %ld stale calls refused; the new instance had the freed one's handle "
-           "value in %d rounds, its state a freed state's in %d\n", nt, n, refused, same_addr, same_state);
+    printf("ok reuse %d threads x %d rounds (%d other instances held): %ld stale calls refused; the new instance had "
+           "the freed one's handle value in %d rounds, its state a freed state's in %d\n", nt, n, hold, refused,
+           same_addr, same_state);
 }
 
 static int main2(int argc, char **argv) {
@@ -928,7 +937,7 @@ static int main2(int argc, char **argv) {
         dlclose(f.lib);
         printf("ok threads %d x %d cycles, all bit-identical to the single-threaded run\n", nt, n);
     } else if (!strcmp(mode, "reuse")) {
-        reuse2(atoi(argv[4]), argc > 5 ? atoi(argv[5]) : 1);
+        reuse2(atoi(argv[4]), argc > 5 ? atoi(argv[5]) : 1, argc > 6 ? atoi(argv[6]) : 0);
     } else if (!strcmp(mode, "race")) {
         int n = atoi(argv[4]);
         Fmi f = load();
@@ -1837,8 +1846,10 @@ static void *reuse_worker3(void *arg) {
     return NULL;
 }
 
-static void reuse3(int n, int nt) {
-    CHECK(nt > 0 && nt <= 64, "1 to 64 threads");
+static void reuse3(int n, int nt, int hold) {
+    CHECK(nt > 0 && nt <= 64 && hold >= 0, "1 to 64 threads, HOLD >= 0");
+    I *held = malloc(sizeof(I) * (size_t)(hold + 1));
+    for (int i = 0; i < hold; i++) held[i] = ready3();
     I c = ready3();
     double t = 0;
     run3(c, &t, 10);
@@ -1859,8 +1870,14 @@ static void reuse3(int n, int nt) {
         same_addr += r[i].same_addr;
         same_state += r[i].same_state;
     }
-    printf("ok reuse %d threads x %d rounds: %ld stale calls refused; the new instance had the freed one's handle "
-           "value in %d rounds, its state a freed state's in %d\n", nt, n, refused, same_addr, same_state);
+    for (int i = 0; i < hold; i++) {
+        CHECK(w_x3(held[i]) == 0.05, "a held instance changed");
+        free_instance(held[i]);
+    }
+    free(held);
+    printf("ok reuse %d threads x %d rounds (%d other instances held): %ld stale calls refused; the new instance had "
+           "the freed one's handle value in %d rounds, its state a freed state's in %d\n", nt, n, hold, refused,
+           same_addr, same_state);
 }
 
 static int main3(int argc, char **argv) {
@@ -1883,7 +1900,7 @@ static int main3(int argc, char **argv) {
     } else if (!strcmp(mode, "mixed")) {
         mixed();
     } else if (!strcmp(mode, "reuse")) {
-        reuse3(atoi(argv[4]), argc > 5 ? atoi(argv[5]) : 1);
+        reuse3(atoi(argv[4]), argc > 5 ? atoi(argv[5]) : 1, argc > 6 ? atoi(argv[6]) : 0);
     } else if (!strcmp(mode, "me")) {
         me_abuse();
     } else {
