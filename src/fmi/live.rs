@@ -10,17 +10,19 @@
 //! its serial; whatever takes its place later carries a larger one, so the stale token matches nothing,
 //! after any number of reuses of the same memory or slot, on any thread.
 //!
-//! The token is not a usable pointer: the top bit is set (on x86-64 and on AArch64 without
-//! top-byte-ignore an address in the kernel's half, or not canonical, so a master dereferencing it faults
-//! instead of reading our memory), and it is never dereferenced by us: it is decoded and compared. NULL
-//! is never a token (`TAG` is set). `KIND` (the bit below the top) tells instance tokens from FMU-state
-//! tokens, so one is never accepted as the other even where their serials coincide.
+//! The token is not a usable pointer: its top bit is set, which on x86-64 (and on AArch64 where the top
+//! byte is not ignored) makes it an address in the kernel's half or not canonical, so a master that
+//! dereferences it faults instead of reading our memory. Where the top byte is ignored (AArch64 Linux user
+//! space), the remaining bits may name any address, but no instance is ever found through them: we never
+//! dereference a token, we decode and compare it, and a stale one is refused. NULL is never a token (`TAG`
+//! is set). `KIND` (the bit below the top) tells instance tokens from FMU-state tokens, so one is never
+//! accepted as the other even where their serials coincide.
 //!
 //! Instances ([`Handles`]) are looked up on every FMI call, so without a lock: `FAST` slots in static
 //! memory hold (serial, pointer) pairs; the serial is compared, the pointer read, the serial read again
 //! (a slot freed and given to a newer instance in between is noticed: [`Handles::get`] says why).
-//! Creation and freeing take the lock. Past `FAST` live instances, new ones get the index `OVERFLOW` and are found in
-//! a map under the lock, as addresses past the cache were before. FMU states are looked up under their
+//! Creation and freeing take the lock. Past `FAST` live instances, new ones get the index `OVERFLOW` and
+//! are found in a map under the lock, as addresses past the cache were before. FMU states are looked up under their
 //! own lock anyway (`state.rs`), so they only take their tokens from [`Serials`] here.
 
 use std::collections::HashMap;
