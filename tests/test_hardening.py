@@ -140,6 +140,17 @@ def test_stale_handles_are_refused_after_their_memory_is_reused(masters, version
                      p.stdout), p.stdout
 
 
+def test_another_librarys_handles_are_refused(hostile, tmp_path):
+    """Two copies of the library under two names are two loaded libraries with their own handle tables: 1,000
+    rounds, each one's instance and FMU-state handles are refused by the other (the serials of every loaded
+    library start at a random point of their range)."""
+    prog, lib, token, version = hostile
+    copy = tmp_path / "AttitudePlant.copy.so"
+    shutil.copy(lib, copy)
+    p = run(hostile, "cross", copy, 1000, timeout=120)
+    assert p.stdout.startswith("ok cross 1000 rounds"), p.stdout
+
+
 def test_stale_handles_under_valgrind(masters):
     """The reuse mode under valgrind (both versions, 2 threads): no invalid access, nothing lost."""
     for version in (2, 3):

@@ -6,7 +6,9 @@
 //! stale handle then reaches the new object (a freed instance steps its successor). A token is
 //! `TAG | KIND | serial << INDEX_BITS | index`: `serial` comes from a counter that only counts up (one
 //! per table, kept in static memory, never reset while the library is loaded, never wrapped: when it
-//! would, creation is refused), `index` says where to look the object up. A freed object's token keeps
+//! would, creation is refused; it starts at a random point of its range, different for every loaded
+//! library, so that another FMU's handles in the same process miss ours but by a chance of about n in
+//! 2^50 for n handles made), `index` says where to look the object up. A freed object's token keeps
 //! its serial; whatever takes its place later carries a larger one, so the stale token matches nothing,
 //! after any number of reuses of the same memory or slot, on any thread.
 //!
@@ -82,24 +84,54 @@ fn token(kind: usize, serial: usize, index: usize) -> usize {
 /// call gave.
 pub struct Serials {
     kind: usize,
-    last: AtomicUsize,
+    /// How many serials were handed out (never more than `MAX_SERIAL`).
+    count: AtomicUsize,
+    /// Where this library's serials start in their range (random, drawn at the first use; 0 = not yet).
+    base: AtomicUsize,
 }
 
 impl Serials {
     pub const fn new(kind: usize) -> Self {
         Serials {
             kind,
-            last: AtomicUsize::new(0),
+            count: AtomicUsize::new(0),
+            base: AtomicUsize::new(0),
         }
     }
 
+    /// The random start of this counter's serials: every loaded library (each has its own copy of these
+    /// statics and of std's per-thread random keys) starts somewhere else in the 2^51 serials, so that a
+    /// handle of one FMU's library is not, but by a tiny chance, a handle of another's in the same process.
+    fn base(&self) -> usize {
+        let b = self.base.load(Ordering::Relaxed);
+        if b != 0 {
+            return b;
+        }
+        let r = std::collections::hash_map::RandomState::new().hash_one((self as *const Self as usize, self.kind));
+        let r = (r as usize & MAX_SERIAL).max(1);
+        match self.base.compare_exchange(0, r, Ordering::Relaxed, Ordering::Relaxed) {
+            Ok(_) => r,
+            Err(first) => first,
+        }
+    }
+
+    /// The next serial: `base + count` modulo 2^51 for a count that only counts up, so no two calls
+    /// give the same serial; 0 (never a serial) is skipped.
     fn next(&self) -> Result<usize, String> {
-        self.last
-            .fetch_update(Ordering::Relaxed, Ordering::Relaxed, |s| {
-                (s < MAX_SERIAL).then_some(s + 1)
-            })
-            .map(|s| s + 1)
-            .map_err(|_| format!("all {MAX_SERIAL} handles of this library are used up (load it again)"))
+        let base = self.base();
+        loop {
+            let count = self
+                .count
+                .fetch_update(Ordering::Relaxed, Ordering::Relaxed, |c| {
+                    (c < MAX_SERIAL).then_some(c + 1)
+                })
+                .map_err(|_| format!("all {MAX_SERIAL} handles of this library are used up (load it again)"))?
+                + 1;
+            let serial = base.wrapping_add(count) & MAX_SERIAL;
+            if serial != 0 {
+                return Ok(serial);
+            }
+        }
     }
 
     /// A new token of this counter's kind with index 0.

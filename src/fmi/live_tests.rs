@@ -96,7 +96,17 @@ fn serials_count_up_and_stop_before_they_would_wrap() {
     let s = Serials::new(KIND_STATE);
     let (a, b) = (s.token().unwrap(), s.token().unwrap());
     assert!(a != b && a & KIND_STATE != 0 && a & TAG != 0);
-    s.last.store(MAX_SERIAL - 1, Ordering::Relaxed);
+    s.count.store(MAX_SERIAL - 1, Ordering::Relaxed);
     assert!(s.token().is_ok());
     assert!(s.token().unwrap_err().contains("used up"));
+}
+
+#[test]
+fn two_tables_start_their_serials_at_different_random_points() {
+    // as two loaded libraries would: each table's tokens miss the other's
+    let (a, b) = (Serials::new(KIND_INSTANCE), Serials::new(KIND_INSTANCE));
+    let (ta, tb) = (a.token().unwrap(), b.token().unwrap());
+    assert_ne!(ta, tb);
+    let serial = |t: usize| (t & !(TAG | KIND_STATE)) >> INDEX_BITS;
+    assert_eq!(serial(a.token().unwrap()), (serial(ta) + 1) & MAX_SERIAL);
 }

@@ -16,6 +16,8 @@
  *                                        stale instance and state handle kept (the first, the last ones, other
  *                                        threads') refused with fmi2Error, the new instance untouched; with H,
  *                                        H more instances live all the while (unchanged at the end)
+ *   fmi_hostile LIB GUID cross LIB2 N    LIB2 a copy of LIB under another name (a second loaded library): N rounds
+ *                                        of an instance and state in each, each library's handles refused by the other
  *   fmi_hostile LIB GUID race N          deliberate misuse: two threads call ONE instance at the same time
  *                                        (FMI forbids it); under ThreadSanitizer this must be reported, which
  *                                        shows the detector is live (results are not checked)
@@ -900,6 +902,32 @@ static void reuse2(int n, int nt, int hold) {
            same_addr, same_state);
 }
 
+/* cross mode: two copies of the library under two file names (two loaded libraries, each with its own
+   handle tables); each one's instance and FMU-state handles are refused by the other */
+static void cross2(const char *lib2, int n) {
+    Fmi a = load();
+    const char *lib1 = LIB;
+    LIB = lib2;
+    Fmi b = load();
+    LIB = lib1;
+    CHECK(a.lib != b.lib, "the second copy is a second library");
+    long refused = 0;
+    for (int i = 0; i < n; i++) {
+        C ca = ready(&a, 0), cb = ready(&b, 0);
+        void *sa = NULL, *sb = NULL;
+        CHECK(a.get_state(ca, &sa) == OK && b.get_state(cb, &sb) == OK, "get states");
+        stale_calls2(&b, cb, ca, sa, &refused); /* a's handles given to b's library */
+        stale_calls2(&a, ca, cb, sb, &refused);
+        CHECK(read_wx(&a, ca) == 0.05 && read_wx(&b, cb) == 0.05, "an instance changed");
+        CHECK(a.free_state(ca, &sa) == OK && b.free_state(cb, &sb) == OK, "free states");
+        a.free_instance(ca);
+        b.free_instance(cb);
+    }
+    dlclose(a.lib);
+    dlclose(b.lib);
+    printf("ok cross %d rounds: %ld calls with the other library's handles refused\n", n, refused);
+}
+
 static int main2(int argc, char **argv) {
     if (argc < 4) { fprintf(stderr, "usage: %s LIB GUID MODE ...\n", argv[0]); return 2; }
     LIB = argv[1]; GUID = argv[2];
@@ -938,6 +966,8 @@ static int main2(int argc, char **argv) {
         printf("ok threads %d x %d cycles, all bit-identical to the single-threaded run\n", nt, n);
     } else if (!strcmp(mode, "reuse")) {
         reuse2(atoi(argv[4]), argc > 5 ? atoi(argv[5]) : 1, argc > 6 ? atoi(argv[6]) : 0);
+    } else if (!strcmp(mode, "cross")) {
+        cross2(argv[4], atoi(argv[5]));
     } else if (!strcmp(mode, "race")) {
         int n = atoi(argv[4]);
         Fmi f = load();
