@@ -6,9 +6,9 @@
 //! stale handle then reaches the new object (a freed instance steps its successor). A token is
 //! `TAG | KIND | serial << INDEX_BITS | index`: `serial` comes from a counter that only counts up (one
 //! per table, kept in static memory, never reset while the library is loaded, never wrapped: when it
-//! would, creation is refused; it starts at a random point of its range, different for every loaded
-//! library, so that another FMU's handles in the same process miss ours but by a chance of about n in
-//! 2^50 for n handles made), `index` says where to look the object up. A freed object's token keeps
+//! would, creation is refused; it starts at a point of its range mixed from the address of the counter,
+//! different for every loaded library, so that another FMU's handles in the same process miss ours but
+//! by a chance of about n in 2^50 for n handles made), `index` says where to look the object up. A freed object's token keeps
 //! its serial; whatever takes its place later carries a larger one, so the stale token matches nothing,
 //! after any number of reuses of the same memory or slot, on any thread.
 //!
@@ -99,16 +99,19 @@ impl Serials {
         }
     }
 
-    /// The random start of this counter's serials: every loaded library (each has its own copy of these
-    /// statics and of std's per-thread random keys) starts somewhere else in the 2^51 serials, so that a
-    /// handle of one FMU's library is not, but by a tiny chance, a handle of another's in the same process.
+    /// The start of this counter's serials, from the address of this counter: every loaded library has
+    /// its own copy of these statics at its own address (a different one in every run, with address
+    /// space randomisation), and the address is mixed over the 2^51 serials, so that a handle of one FMU's
+    /// library is not, but by a tiny chance, a handle of another's in the same process.
     fn base(&self) -> usize {
         let b = self.base.load(Ordering::Relaxed);
         if b != 0 {
             return b;
         }
-        let r = std::collections::hash_map::RandomState::new().hash_one((self as *const Self as usize, self.kind));
-        let r = (r as usize & MAX_SERIAL).max(1);
+        let mut h = (self as *const Self as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+        h = (h ^ (h >> 29)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        h ^= h >> 32;
+        let r = (h as usize & MAX_SERIAL).max(1);
         match self.base.compare_exchange(0, r, Ordering::Relaxed, Ordering::Relaxed) {
             Ok(_) => r,
             Err(first) => first,
