@@ -8,7 +8,8 @@ Exchange (every FMI 2.0 ME entry point, on AttitudePlant with 18 continuous stat
 PdController with none). FMI 3.0: NULL and foreign pointers, wrong states, NaN, odd bool bytes, wrong counts,
 corrupted FMU states and every refused function give the prescribed status and a message naming the
 function, on the Co-Simulation and on the Model Exchange entry points; FMI 2.0 and 3.0 instances of one
-library coexist and agree bit for bit; no invalid access and nothing leaked per instance. Every mode runs
+library coexist and agree bit for bit; no invalid access and nothing leaked per instance. Both versions: stale
+instance and FMU-state handles are refused after their memory went to new ones (one thread and 8). Every mode runs
 under a timeout: a hang is a failure."""
 
 from __future__ import annotations
@@ -122,6 +123,38 @@ def test_cycles_are_bit_identical_and_leak_nothing(masters, version):
     clean(many, leaks=False)
     assert few.stdout.split()[-1] == many.stdout.split()[-1]  # same w_x bits
     assert lost_bytes(many.stderr)[0] == lost_bytes(few.stderr)[0]
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("threads,rounds,held", [(1, 10_000, 0), (8, 1_250, 0), (8, 500, 1_100)])
+def test_stale_handles_are_refused_after_their_memory_is_reused(masters, version, threads, rounds, held):
+    """10,000 rounds (alone, 8 threads x 1,250, and 8 x 500 with 1,100 more instances alive, so that the
+    rounds' instances are past the 1,024 lock-free slots): an instance and its FMU states freed, a new instance and
+    state created, which the allocator usually places where the freed ones were; every stale instance handle
+    (the thread's first, its last 24, 8 of other threads') is refused with the version's error status and no
+    message, every stale FMU-state handle given to the new instance with the error status and a message naming
+    the function; the new instance's outputs do not move and its run ends where a fresh one ends. On the
+    address-checked handles of before, the reused address made the stale call reach the new instance."""
+    p = run(unit(masters, version), "reuse", rounds, threads, held, timeout=300)
+    assert re.search(r"ok reuse \d+ threads x \d+ rounds \(\d+ other instances held\): \d+ stale calls refused",
+                     p.stdout), p.stdout
+
+
+def test_another_librarys_handles_are_refused(hostile, tmp_path):
+    """Two copies of the library under two names are two loaded libraries with their own handle tables: 1,000
+    rounds, each one's instance and FMU-state handles are refused by the other (the serials of every loaded
+    library start at a random point of their range)."""
+    prog, lib, token, version = hostile
+    copy = tmp_path / "AttitudePlant.copy.so"
+    shutil.copy(lib, copy)
+    p = run(hostile, "cross", copy, 1000, timeout=120)
+    assert p.stdout.startswith("ok cross 1000 rounds"), p.stdout
+
+
+def test_stale_handles_under_valgrind(masters):
+    """The reuse mode under valgrind (both versions, 2 threads): no invalid access, nothing lost."""
+    for version in (2, 3):
+        clean(run(unit(masters, version), "reuse", 100, 2, valgrind=True, timeout=600), leaks=version == 2)
 
 
 @pytest.mark.parametrize("version", [2, 3])

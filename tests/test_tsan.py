@@ -1,7 +1,8 @@
 """ThreadSanitizer on the FMU binary (issue 22): the library built with -Zsanitizer=thread through
 Debian's Rust toolchain (scripts/build_tsan.sh; no nightly needed) and the hostile C master built with
 ``gcc -fsanitize=thread``: the 8-thread determinism and instance-churn run gives 0 TSan warnings, and a
-deliberate misuse (two threads on one instance) gives warnings, so the detector is live. Skipped with the
+deliberate misuse (two threads on one instance) gives warnings, so the detector is live; 8 threads trying each
+other's stale handles (reuse mode) give none. Skipped with the
 reason only where the toolchain is absent outside CI; in CI (CI=true) its absence is a failure."""
 
 from __future__ import annotations
@@ -52,6 +53,16 @@ def test_eight_threads_with_instance_churn_have_no_race(tsan):
     print(f"threads 8 x 40: {warnings} ThreadSanitizer warnings")
     assert warnings == 0, p.stderr[-5000:]
     assert p.returncode == 0 and p.stdout.startswith("ok threads"), p.stdout + p.stderr[-3000:]
+
+
+def test_stale_handles_across_eight_threads_have_no_race(tsan):
+    """The reuse mode (issue 45): 8 threads free and create instances and FMU states and try each other's
+    stale handles; the lock-free token check gives 0 TSan warnings."""
+    p = run(tsan, "reuse", 150, 8)
+    warnings = p.stderr.count(WARNING)
+    print(f"reuse 8 x 150: {warnings} ThreadSanitizer warnings")
+    assert warnings == 0, p.stderr[-5000:]
+    assert p.returncode == 0 and p.stdout.startswith("ok reuse"), p.stdout + p.stderr[-3000:]
 
 
 def test_detector_is_live_on_a_deliberate_misuse(tsan):

@@ -1,6 +1,6 @@
-//! The C boundary both FMI versions stand on: the table of live instances (a pointer from the master
-//! is dereferenced only if it is one of ours and not freed), the panic guard (a panic inside a call
-//! becomes a logged fatal status, never an unwind across `extern "C"`), borrowing of C arrays and
+//! The C boundary both FMI versions stand on: the table of live instances (a handle from the master is
+//! a token, never an address, mapped to an instance only while that instance lives), the panic guard (a
+//! panic inside a call becomes a logged fatal status, never an unwind across `extern "C"`), borrowing of C arrays and
 //! out-pointers with the argument named in the error, the model lookup by GUID / instantiation token,
 //! and one instantiate for every interface (FMI 2.0 CS/ME, FMI 3.0 CS/ME). Nothing here knows an FMI
 //! function name beyond what the caller passes in.
@@ -11,7 +11,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use super::instance::{CallResult, Fail, Instance, Logger};
 use super::library_path::own_library_stem;
-use super::live::LiveSet;
+use super::live::{Handles, KIND_INSTANCE};
 use super::state::Snapshot;
 use super::types::Status;
 use crate::model::guid::guid;
@@ -22,54 +22,55 @@ pub type Handle = *mut c_void;
 
 // ----- live instances ----------------------------------------------------------------------------
 
-/// The live instances of this library (`live` describes the lock-free check in front of the set).
-static LIVE: LiveSet = LiveSet::new();
+/// The live instances of this library behind their tokens (`live` says why a handle is a token that is
+/// never handed out twice, and how it is checked without a lock).
+static LIVE: Handles<Instance> = Handles::new(KIND_INSTANCE);
 
-/// The instance behind a pointer if it is live and was created through the FMI version asked for
-/// (`fmi3`: by an `fmi3Instantiate*` function); an FMI 2.0 instance is foreign to the FMI 3.0
-/// functions and the other way round. A null, foreign or freed pointer gives None (and the call
-/// returns an error status: there is no logger to tell). The address is checked against the set of
-/// live instances before anything behind it is read; on every FMI call, so without a lock when the
-/// address is in the set's cache.
+/// The instance behind a handle if it is a live token of this library and was created through the
+/// FMI version asked for (`fmi3`: by an `fmi3Instantiate*` function); an FMI 2.0 instance is foreign to
+/// the FMI 3.0 functions and the other way round. A null, foreign or freed handle gives None, also
+/// after its memory or slot went to a new instance (and the call returns an error status: there is no
+/// logger to tell). Nothing is read behind a handle before the table has mapped it to a live instance;
+/// on every FMI call, so without a lock.
 pub fn instance_of<'a>(c: Handle, fmi3: bool) -> Option<&'a mut Instance> {
-    if c.is_null() || !LIVE.contains(c as usize) {
-        return None;
-    }
-    // SAFETY: the address is registered by `instantiate` and removed by `free_instance`.
-    let inst = unsafe { &mut *(c as *mut Instance) };
+    let p = LIVE.get(c as usize)?;
+    // SAFETY: the table maps a live token only to the instance registered under it by `register`,
+    // which `free_instance` takes out of the table before freeing it.
+    let inst = unsafe { &mut *p };
     (inst.fmi3 == fmi3).then_some(inst)
 }
 
-/// Registers a new instance (installing the panic hook with the first one).
-fn register(inst: Box<Instance>) -> Handle {
-    let p = Box::into_raw(inst) as Handle;
-    let mut live = LIVE.lock();
-    if live.is_empty() {
-        install_panic_hook();
-    }
-    LIVE.insert(&mut live, p as usize);
-    p
+/// Registers a new instance under a new token (installing the panic hook with the first one).
+fn register(inst: Box<Instance>) -> Result<Handle, String> {
+    let p = Box::into_raw(inst);
+    LIVE.insert(p, install_panic_hook)
+        .map(|t| t as Handle)
+        .inspect_err(|_| {
+            // SAFETY: not registered: still ours alone
+            drop(unsafe { Box::from_raw(p) });
+        })
 }
 
 /// Frees an instance of the given FMI version (and its FMU states); anything else is ignored.
 pub fn free_instance(c: Handle, fmi3: bool) {
-    if instance_of(c, fmi3).is_none() || !LIVE.remove(&mut LIVE.lock(), c as usize) {
-        return; // null, not ours or of the other FMI version: nothing to free, nothing to log to
+    if instance_of(c, fmi3).is_none() {
+        return; // null, not ours, freed or of the other FMI version: nothing to free, nothing to log to
     }
+    let Some(p) = LIVE.remove(c as usize) else {
+        return; // freed by another thread in between
+    };
     let _ = guarded(|| {
         Snapshot::free_all_of(c as usize);
         // SAFETY: it was registered (so it is a leaked Box<Instance>) and is now unregistered.
-        drop(unsafe { Box::from_raw(c as *mut Instance) });
+        drop(unsafe { Box::from_raw(p) });
     });
-    let mut live = LIVE.lock();
-    if live.is_empty() {
-        // the last instance: give the set's memory back and remove the panic hook (not while the
-        // calling thread unwinds: take_hook panics then, which would abort inside extern "C")
-        live.shrink_to_fit();
+    // the last instance: remove the panic hook (not while the calling thread unwinds: take_hook
+    // panics then, which would abort inside extern "C")
+    LIVE.when_empty(|| {
         if !std::thread::panicking() {
             drop(std::panic::take_hook());
         }
-    }
+    });
 }
 
 // ----- panics ------------------------------------------------------------------------------------
@@ -250,7 +251,7 @@ pub fn instantiate(req: Request) -> Handle {
                 entry.info.name
             )
         });
-        Ok(register(inst))
+        register(inst)
     });
     let msg = match result {
         Ok(Ok(p)) => return p,

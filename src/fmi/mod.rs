@@ -4,7 +4,7 @@
 //! | module | what |
 //! |---|---|
 //! | [`types`] | status codes, logger callback types, the states of the state machine, log categories |
-//! | [`live`] | sets of addresses handed to the master (instances, FMU states) |
+//! | [`live`] | the handles handed to the master (instances, FMU states): tokens that are never reused, looked up without a lock |
 //! | [`boundary`] | live instance table, panic guard, C arrays and out-pointers, one instantiate for every interface |
 //! | [`instance`] | one FMU instance: state machine, initialization, stepping (`logging`, `values`: value access, `me`: Model Exchange, `jacobian`: directional derivatives) |
 //! | [`state`], `state_calls` | FMU state snapshots, their byte format, and the call bodies both versions share |

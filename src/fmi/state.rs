@@ -1,10 +1,12 @@
 //! FMU state snapshots (`fmi2GetFMUstate` & co.) and their byte format.
 //!
-//! Every snapshot handed to the master is recorded in a process-wide table (address → owning
-//! instance), so a foreign, freed or corrupted `fmi2FMUstate` pointer is refused with an error instead
-//! of being dereferenced. Every read or write of a snapshot happens while that table's lock is held,
-//! so instances on different threads never touch a snapshot at the same time (FMI allows independent
-//! instances on independent threads).
+//! Every snapshot handed to the master is recorded in a process-wide table under a token that is never
+//! handed out twice (`live.rs` says why not its address: a freed state's address goes to the next one),
+//! with its owning instance, so a foreign, freed or corrupted `fmi2FMUstate` handle is refused with an
+//! error, also after its memory went to a new state; the master never holds an address of ours. Every
+//! read or write of a snapshot happens while that table's lock is held, so instances on different
+//! threads never touch a snapshot at the same time (FMI allows independent instances on independent
+//! threads).
 //!
 //! Byte format (little endian): magic `SCFMUST\0` (8 bytes), format version u32, payload length u32,
 //! payload (postcard), CRC-32 of everything before it (u32).
@@ -15,7 +17,7 @@ use std::sync::{Mutex, MutexGuard};
 use serde::{Deserialize, Serialize};
 
 use super::instance::{CallResult, Fail, Instance, Run};
-use super::live::BuildAddrHasher;
+use super::live::{BuildAddrHasher, Serials, KIND_STATE};
 use super::types::FsmState;
 use crate::model::DynModel;
 
@@ -40,12 +42,20 @@ struct Payload {
     model: Vec<u8>,
 }
 
-/// Live snapshots: address → address of the instance that created it (freed with that instance).
-type Table = HashMap<usize, usize, BuildAddrHasher>;
+/// Live snapshots: token → (snapshot, token of the instance that created it, freed with that instance).
+type Table = HashMap<usize, (*mut Snapshot, usize), BuildAddrHasher>;
+
+/// A raw pointer in a static: every access is under the table's lock.
+struct Locked(Mutex<Table>);
+// SAFETY: the snapshots behind the pointers are touched only with the lock held.
+unsafe impl Sync for Locked {}
+
+/// Tokens of FMU states (distinct from instance tokens by their kind bit).
+static SERIALS: Serials = Serials::new(KIND_STATE);
 
 fn live() -> MutexGuard<'static, Table> {
-    static LIVE: Mutex<Table> = Mutex::new(HashMap::with_hasher(BuildAddrHasher));
-    LIVE.lock().unwrap_or_else(|p| p.into_inner())
+    static LIVE: Locked = Locked(Mutex::new(HashMap::with_hasher(BuildAddrHasher)));
+    LIVE.0.lock().unwrap_or_else(|p| p.into_inner())
 }
 
 /// Gives the table's memory back once it is empty, so an unloaded library leaves nothing behind.
@@ -88,26 +98,26 @@ impl Snapshot {
         Ok(())
     }
 
-    /// Hands a snapshot of instance `owner` to the master as an opaque pointer.
-    pub fn into_handle(self, owner: usize) -> *mut Snapshot {
-        let p = Box::into_raw(Box::new(self));
-        live().insert(p as usize, owner);
-        p
+    /// Hands a snapshot of instance `owner` to the master as a new token.
+    pub fn into_handle(self, owner: usize) -> CallResult<usize> {
+        let t = SERIALS.token().map_err(Fail::error)?;
+        live().insert(t, (Box::into_raw(Box::new(self)), owner));
+        Ok(t)
     }
 
     /// Runs `f` on the snapshot behind a handle, if the handle is one we issued and have not freed,
     /// with the table locked for the whole access.
-    pub fn with_handle<T>(p: *mut Snapshot, f: impl FnOnce(&mut Snapshot) -> CallResult<T>) -> CallResult<T> {
-        if p.is_null() {
+    pub fn with_handle<T>(t: usize, f: impl FnOnce(&mut Snapshot) -> CallResult<T>) -> CallResult<T> {
+        if t == 0 {
             return Err(Fail::error("FMUstate is NULL"));
         }
         let table = live();
-        if !table.contains_key(&(p as usize)) {
+        let Some(&(p, _)) = table.get(&t) else {
             return Err(Fail::error(format!(
-                "FMUstate {p:p} was not created by this FMU or was already freed"
+                "FMUstate {t:#x} was not created by this FMU or was already freed"
             )));
-        }
-        // SAFETY: the address is in the table, so it came from Box::into_raw and is not freed; the
+        };
+        // SAFETY: the token is in the table, so p came from Box::into_raw and is not freed; the
         // lock held until the end of this function keeps every other thread away from it.
         let r = f(unsafe { &mut *p });
         drop(table);
@@ -115,13 +125,13 @@ impl Snapshot {
     }
 
     /// Frees a handle we issued; unknown handles are refused.
-    pub fn free_handle(p: *mut Snapshot) -> CallResult {
+    pub fn free_handle(t: usize) -> CallResult {
         let mut table = live();
-        if table.remove(&(p as usize)).is_none() {
+        let Some((p, _)) = table.remove(&t) else {
             return Err(Fail::error(format!(
-                "FMUstate {p:p} was not created by this FMU or was already freed"
+                "FMUstate {t:#x} was not created by this FMU or was already freed"
             )));
-        }
+        };
         release_if_empty(&mut table);
         // SAFETY: it was in the table, so it is a Box we leaked and nobody else frees it.
         drop(unsafe { Box::from_raw(p) });
@@ -131,11 +141,16 @@ impl Snapshot {
     /// Frees every snapshot created by the given instance (called by fmi2FreeInstance).
     pub fn free_all_of(owner: usize) {
         let mut table = live();
-        let mine: Vec<usize> = table.iter().filter(|(_, o)| **o == owner).map(|(p, _)| *p).collect();
-        for p in mine {
-            table.remove(&p);
-            // SAFETY: removed from the table just now; it was a leaked Box.
-            drop(unsafe { Box::from_raw(p as *mut Snapshot) });
+        let mine: Vec<usize> = table
+            .iter()
+            .filter(|(_, (_, o))| *o == owner)
+            .map(|(t, _)| *t)
+            .collect();
+        for t in mine {
+            if let Some((p, _)) = table.remove(&t) {
+                // SAFETY: removed from the table just now; it was a leaked Box.
+                drop(unsafe { Box::from_raw(p) });
+            }
         }
         release_if_empty(&mut table);
     }

@@ -12,10 +12,10 @@ use crate::model::guid::guid;
 /// state the slot already holds is overwritten (reuse of a handed-out state is allowed by both standards).
 fn store(snap: Snapshot, slot: &mut *mut c_void, owner: usize) -> CallResult {
     if slot.is_null() {
-        *slot = snap.into_handle(owner) as *mut c_void;
+        *slot = snap.into_handle(owner)? as *mut c_void;
         Ok(())
     } else {
-        Snapshot::with_handle(*slot as *mut Snapshot, |s| {
+        Snapshot::with_handle(*slot as usize, |s| {
             *s = snap;
             Ok(())
         })
@@ -29,7 +29,7 @@ pub(crate) fn get(inst: &Instance, slot: &mut *mut c_void, owner: usize) -> Call
 
 /// `fmi2SetFMUstate` / `fmi3SetFMUState`.
 pub(crate) fn set(inst: &mut Instance, state: *mut c_void) -> CallResult {
-    Snapshot::with_handle(state as *mut Snapshot, |snap| snap.restore_into(inst))
+    Snapshot::with_handle(state as usize, |snap| snap.restore_into(inst))
 }
 
 /// `fmi2FreeFMUstate` / `fmi3FreeFMUState`: freeing NULL is a no-op.
@@ -37,7 +37,7 @@ pub(crate) fn free(slot: &mut *mut c_void) -> CallResult {
     if slot.is_null() {
         return Ok(());
     }
-    Snapshot::free_handle(*slot as *mut Snapshot)?;
+    Snapshot::free_handle(*slot as usize)?;
     *slot = std::ptr::null_mut();
     Ok(())
 }
@@ -45,7 +45,7 @@ pub(crate) fn free(slot: &mut *mut c_void) -> CallResult {
 /// `fmi2SerializedFMUstateSize` / `fmi3SerializedFMUStateSize`: serializes once and keeps the bytes
 /// for the serialize call that follows.
 pub(crate) fn serialized_size(inst: &Instance, state: *mut c_void, out: &mut usize) -> CallResult {
-    Snapshot::with_handle(state as *mut Snapshot, |snap| {
+    Snapshot::with_handle(state as usize, |snap| {
         let bytes = snap.to_bytes(&guid(inst.entry))?;
         *out = bytes.len();
         snap.serialized = Some(bytes);
@@ -62,7 +62,7 @@ pub(crate) fn serialize<'a>(
     size_function: &str,
     buffer: impl FnOnce() -> CallResult<&'a mut [u8]>,
 ) -> CallResult {
-    Snapshot::with_handle(state as *mut Snapshot, |snap| {
+    Snapshot::with_handle(state as usize, |snap| {
         let bytes = match snap.serialized.take() {
             Some(b) => b,
             None => snap.to_bytes(&guid(inst.entry))?,

@@ -11,6 +11,13 @@
  *   fmi_hostile LIB GUID hang            calls that used to run forever must return an error promptly
  *   fmi_hostile LIB GUID fuzz N SEED     serialized states with random bytes and a valid CRC
  *   fmi_hostile LIB GUID extreme         extreme parameters: errors, never infinite values with fmi2OK
+ *   fmi_hostile LIB GUID reuse N [T [H]] T threads (default 1), N rounds each: an instance and its FMU states
+ *                                        freed, a new instance (and state) that usually gets their memory; every
+ *                                        stale instance and state handle kept (the first, the last ones, other
+ *                                        threads') refused with fmi2Error, the new instance untouched; with H,
+ *                                        H more instances live all the while (unchanged at the end)
+ *   fmi_hostile LIB GUID cross LIB2 N    LIB2 a copy of LIB under another name (a second loaded library): N rounds
+ *                                        of an instance and state in each, each library's handles refused by the other
  *   fmi_hostile LIB GUID race N          deliberate misuse: two threads call ONE instance at the same time
  *                                        (FMI forbids it); under ThreadSanitizer this must be reported, which
  *                                        shows the detector is live (results are not checked)
@@ -35,6 +42,7 @@
  *                                        a log message naming the function, and the instance recovers
  *   fmi_hostile -3 LIB TOKEN mixed       an FMI 2.0 and an FMI 3.0 instance of the same library side by side
  *                                        give identical results; neither API accepts the other's instance
+ *   fmi_hostile -3 LIB TOKEN reuse N [T [H]] the reuse mode with the FMI 3.0 functions (fmi3Error)
  *   fmi_hostile -3 LIB TOKEN me          Model Exchange: NULL and foreign pointers on every ME entry point,
  *                                        wrong call order, wrong lengths, NaN states and times, Co-Simulation
  *                                        calls on an ME instance and FMU states across the two; then an
@@ -757,6 +765,169 @@ static C me_reload_instance(const Fmi *f, double *x) {
     return c;
 }
 
+/* ----- reuse mode: stale instance and FMU-state handles after their memory or slot went to a new one -----
+ * Each round: instance a (stepped, two FMU states: s1 kept until a is freed, s2 freed on its own), a freed;
+ * then instance b and its state sb, which an allocator gives a's and s1's/s2's memory most of the time. Every
+ * stale handle kept so far (the thread's first ones, its last STALE_KEEP, and a pool shared by all threads)
+ * must be refused with fmi2Error: instance calls with no message (no instance to log to), state calls on b
+ * with a message naming the function; b's outputs must not move and its run must end where a fresh one ends. */
+enum { STALE_KEEP = 24, STALE_POOL = 64 };
+typedef struct { C c[STALE_POOL]; void *s[2 * STALE_POOL]; unsigned nc, ns; pthread_mutex_t lock; } StalePool;
+static StalePool pool2 = {.lock = PTHREAD_MUTEX_INITIALIZER};
+typedef struct {
+    int n, same_addr, same_state;
+    long refused;
+    double ref;
+    C first_c, c[STALE_KEEP];
+    void *first_s, *s[2 * STALE_KEEP];
+    unsigned nc, ns;
+    const Fmi *f;
+} Reuse2;
+
+static void stale_refused(St got, const char *call, const char *fn, long *refused) {
+    if (got == ERROR && (!fn || strstr(last_msg, fn))) { (*refused)++; return; }
+    printf("FAIL %s with a stale handle returned %d (expected fmi2Error%s%s; last message: %s)\n", call, got,
+           fn ? " and a message naming " : "", fn ? fn : "", last_msg);
+    fflush(stdout);
+    exit(1);
+}
+
+/* every call a stale instance handle could reach b through, and the stale states given to b */
+static void stale_calls2(const Fmi *f, C b, C stale, void *s, long *refused) {
+    unsigned in = VR_TORQUE_CMD_X, out = VR_W_X;
+    double u = 1e3, w;
+    if (stale) {
+        stale_refused(f->do_step(stale, 0.05, 0.01, 1), "fmi2DoStep", NULL, refused);
+        stale_refused(f->set_real(stale, &in, 1, &u), "fmi2SetReal", NULL, refused);
+        stale_refused(f->get_real(stale, &out, 1, &w), "fmi2GetReal", NULL, refused);
+        void *sx = NULL;
+        stale_refused(f->get_state(stale, &sx), "fmi2GetFMUstate", NULL, refused);
+        stale_refused(f->reset(stale), "fmi2Reset", NULL, refused);
+        f->free_instance(stale); /* must be ignored */
+    }
+    if (s) {
+        size_t n;
+        void *copy = s;
+        stale_refused(f->set_state(b, s), "fmi2SetFMUstate", "fmi2SetFMUstate", refused);
+        stale_refused(f->ser_size(b, s, &n), "fmi2SerializedFMUstateSize", "fmi2SerializedFMUstateSize", refused);
+        stale_refused(f->free_state(b, &copy), "fmi2FreeFMUstate", "fmi2FreeFMUstate", refused);
+    }
+}
+
+static void reuse_round2(Reuse2 *r) {
+    const Fmi *f = r->f;
+    C a = ready(f, 0);
+    double t = 0;
+    step_n(f, a, &t, 3);
+    void *s1 = NULL, *s2 = NULL;
+    CHECK(f->get_state(a, &s1) == OK && f->get_state(a, &s2) == OK, "get states of a");
+    void *s2_stale = s2;
+    CHECK(f->free_state(a, &s2) == OK && !s2, "free state s2");
+    f->free_instance(a); /* frees s1 with it */
+    C b = ready(f, 0);
+    void *sb = NULL;
+    CHECK(f->get_state(b, &sb) == OK, "get state of b");
+    r->same_addr += b == a;
+    r->same_state += sb == s1 || sb == s2_stale;
+    t = 0;
+    step_n(f, b, &t, 5);
+    double w = read_wx(f, b);
+    if (!r->first_c) { r->first_c = a; r->first_s = s1; }
+    r->c[r->nc++ % STALE_KEEP] = a;
+    r->s[r->ns++ % (2 * STALE_KEEP)] = s1;
+    r->s[r->ns++ % (2 * STALE_KEEP)] = s2_stale;
+    pthread_mutex_lock(&pool2.lock);
+    pool2.c[pool2.nc++ % STALE_POOL] = a;
+    pool2.s[pool2.ns++ % (2 * STALE_POOL)] = s1;
+    C shared_c[8];
+    void *shared_s[8];
+    int k_shared = pool2.nc < 8 ? (int)pool2.nc : 8;
+    for (int k = 0; k < k_shared; k++) {
+        shared_c[k] = pool2.c[(unsigned)next() % (pool2.nc < STALE_POOL ? pool2.nc : STALE_POOL)];
+        shared_s[k] = pool2.s[(unsigned)next() % (pool2.ns < 2 * STALE_POOL ? pool2.ns : 2 * STALE_POOL)];
+    }
+    pthread_mutex_unlock(&pool2.lock);
+    stale_calls2(f, b, r->first_c, r->first_s, &r->refused);
+    for (unsigned k = 0; k < r->nc && k < STALE_KEEP; k++) stale_calls2(f, b, r->c[k], NULL, &r->refused);
+    for (unsigned k = 0; k < r->ns && k < 2 * STALE_KEEP; k++) stale_calls2(f, b, NULL, r->s[k], &r->refused);
+    for (int k = 0; k < k_shared; k++) stale_calls2(f, b, shared_c[k], shared_s[k], &r->refused);
+    /* b untouched: the same output, and the rest of its run ends where a fresh run ends */
+    CHECK(read_wx(f, b) == w, "a stale handle changed the new instance's output");
+    step_n(f, b, &t, 5);
+    CHECK(read_wx(f, b) == r->ref, "the new instance's run differs from a fresh one");
+    CHECK(f->free_state(b, &sb) == OK, "free state of b");
+    f->free_instance(b);
+}
+
+static void *reuse_worker2(void *arg) {
+    Reuse2 *r = (Reuse2 *)arg;
+    for (int i = 0; i < r->n; i++) reuse_round2(r);
+    return NULL;
+}
+
+/* reuse N T HOLD: T threads, N rounds each, while HOLD other instances live (past the lock-free slots) */
+static void reuse2(int n, int nt, int hold) {
+    Fmi f = load();
+    CHECK(nt > 0 && nt <= 64 && hold >= 0, "1 to 64 threads, HOLD >= 0");
+    C *held = malloc(sizeof(C) * (size_t)(hold + 1));
+    for (int i = 0; i < hold; i++) held[i] = ready(&f, 0);
+    C c = ready(&f, 0);
+    double t = 0;
+    step_n(&f, c, &t, 10);
+    double ref = read_wx(&f, c);
+    f.free_instance(c);
+    rng = 20261129;
+    static Reuse2 r[64];
+    pthread_t th[64];
+    for (int i = 0; i < nt; i++) {
+        r[i] = (Reuse2){.n = n, .ref = ref, .f = &f};
+        CHECK(pthread_create(&th[i], NULL, reuse_worker2, &r[i]) == 0, "pthread_create");
+    }
+    long refused = 0;
+    int same_addr = 0, same_state = 0;
+    for (int i = 0; i < nt; i++) {
+        pthread_join(th[i], NULL);
+        refused += r[i].refused;
+        same_addr += r[i].same_addr;
+        same_state += r[i].same_state;
+    }
+    for (int i = 0; i < hold; i++) {
+        CHECK(read_wx(&f, held[i]) == 0.05, "a held instance changed");
+        f.free_instance(held[i]);
+    }
+    free(held);
+    dlclose(f.lib);
+    printf("ok reuse %d threads x %d rounds (%d other instances held): %ld stale calls refused; the new instance had "
+           "the freed one's handle value in %d rounds, its state a freed state's in %d\n", nt, n, hold, refused,
+           same_addr, same_state);
+}
+
+/* cross mode: two copies of the library under two file names (two loaded libraries, each with its own
+   handle tables); each one's instance and FMU-state handles are refused by the other */
+static void cross2(const char *lib2, int n) {
+    Fmi a = load();
+    const char *lib1 = LIB;
+    LIB = lib2;
+    Fmi b = load();
+    LIB = lib1;
+    CHECK(a.lib != b.lib, "the second copy is a second library");
+    long refused = 0;
+    for (int i = 0; i < n; i++) {
+        C ca = ready(&a, 0), cb = ready(&b, 0);
+        void *sa = NULL, *sb = NULL;
+        CHECK(a.get_state(ca, &sa) == OK && b.get_state(cb, &sb) == OK, "get states");
+        stale_calls2(&b, cb, ca, sa, &refused); /* a's handles given to b's library */
+        stale_calls2(&a, ca, cb, sb, &refused);
+        CHECK(read_wx(&a, ca) == 0.05 && read_wx(&b, cb) == 0.05, "an instance changed");
+        CHECK(a.free_state(ca, &sa) == OK && b.free_state(cb, &sb) == OK, "free states");
+        a.free_instance(ca);
+        b.free_instance(cb);
+    }
+    dlclose(a.lib);
+    dlclose(b.lib);
+    printf("ok cross %d rounds: %ld calls with the other library's handles refused\n", n, refused);
+}
+
 static int main2(int argc, char **argv) {
     if (argc < 4) { fprintf(stderr, "usage: %s LIB GUID MODE ...\n", argv[0]); return 2; }
     LIB = argv[1]; GUID = argv[2];
@@ -793,6 +964,10 @@ static int main2(int argc, char **argv) {
         for (int i = 0; i < nt; i++) CHECK(w[i].bad == 0, "a thread's result differs from the single-threaded run");
         dlclose(f.lib);
         printf("ok threads %d x %d cycles, all bit-identical to the single-threaded run\n", nt, n);
+    } else if (!strcmp(mode, "reuse")) {
+        reuse2(atoi(argv[4]), argc > 5 ? atoi(argv[5]) : 1, argc > 6 ? atoi(argv[6]) : 0);
+    } else if (!strcmp(mode, "cross")) {
+        cross2(argv[4], atoi(argv[5]));
     } else if (!strcmp(mode, "race")) {
         int n = atoi(argv[4]);
         Fmi f = load();
@@ -1592,6 +1767,149 @@ static void mixed(void) {
     printf("ok mixed w_x=%.17g\n", w3);
 }
 
+/* reuse mode (FMI 3.0), as reuse_round2: stale instance handles first (b must then run on to the reference),
+   then the stale states given to b (each fmi3Error puts b into Terminated, where its outputs stay readable) */
+static StalePool pool3 = {.lock = PTHREAD_MUTEX_INITIALIZER};
+typedef struct {
+    int n, same_addr, same_state;
+    long refused;
+    double ref;
+    I first_c, c[STALE_KEEP];
+    void *first_s, *s[2 * STALE_KEEP];
+    unsigned nc, ns;
+} Reuse3;
+
+static void stale_refused3(St got, const char *call, const char *fn, long *refused) {
+    if (got == ERROR && (!fn || strstr(last_msg, fn))) { (*refused)++; return; }
+    printf("FAIL %s with a stale handle returned %d (expected fmi3Error%s%s; last message: %s)\n", call, got,
+           fn ? " and a message naming " : "", fn ? fn : "", last_msg);
+    fflush(stdout);
+    exit(1);
+}
+
+static void stale_instance3(I stale, long *refused) {
+    unsigned in = VR_TORQUE_CMD_X, out = VR_W_X;
+    double u = 1e3, w, last;
+    bool ev, term, early;
+    void *sx = NULL;
+    stale_refused3(do_step(stale, 0.5, 0.1, false, &ev, &term, &early, &last), "fmi3DoStep", NULL, refused);
+    stale_refused3(set_f64(stale, &in, 1, &u, 1), "fmi3SetFloat64", NULL, refused);
+    stale_refused3(get_f64(stale, &out, 1, &w, 1), "fmi3GetFloat64", NULL, refused);
+    stale_refused3(get_state(stale, &sx), "fmi3GetFMUState", NULL, refused);
+    stale_refused3(reset(stale), "fmi3Reset", NULL, refused);
+    free_instance(stale); /* must be ignored */
+}
+
+static void stale_state3(I b, void *s, long *refused) {
+    size_t n;
+    void *copy = s;
+    stale_refused3(set_state(b, s), "fmi3SetFMUState", "fmi3SetFMUState", refused);
+    stale_refused3(ser_size(b, s, &n), "fmi3SerializedFMUStateSize", "fmi3SerializedFMUStateSize", refused);
+    stale_refused3(free_state(b, &copy), "fmi3FreeFMUState", "fmi3FreeFMUState", refused);
+}
+
+static double w_x3(I c) {
+    unsigned out = VR_W_X;
+    double w = NAN;
+    CHECK(get_f64(c, &out, 1, &w, 1) == OK, "get w_x");
+    return w;
+}
+
+/* init_w_x 0.05, torque 0.5, n steps of 0.1 from *t */
+static void run3(I c, double *t, int n) {
+    unsigned vr = VR_TORQUE_CMD_X;
+    double tq = 0.5;
+    CHECK(set_f64(c, &vr, 1, &tq, 1) == OK, "set torque");
+    for (int k = 0; k < n; k++, *t += 0.1) CHECK(step3(c, *t, 0.1) == OK, "step3");
+}
+
+static void reuse_round3(Reuse3 *r) {
+    I a = ready3();
+    double t = 0;
+    run3(a, &t, 3);
+    void *s1 = NULL, *s2 = NULL;
+    CHECK(get_state(a, &s1) == OK && get_state(a, &s2) == OK, "get states of a");
+    void *s2_stale = s2;
+    CHECK(free_state(a, &s2) == OK && !s2, "free state s2");
+    free_instance(a); /* frees s1 with it */
+    I b = ready3();
+    void *sb = NULL;
+    CHECK(get_state(b, &sb) == OK, "get state of b");
+    r->same_addr += b == a;
+    r->same_state += sb == s1 || sb == s2_stale;
+    t = 0;
+    run3(b, &t, 5);
+    double w = w_x3(b);
+    if (!r->first_c) { r->first_c = a; r->first_s = s1; }
+    r->c[r->nc++ % STALE_KEEP] = a;
+    r->s[r->ns++ % (2 * STALE_KEEP)] = s1;
+    r->s[r->ns++ % (2 * STALE_KEEP)] = s2_stale;
+    pthread_mutex_lock(&pool3.lock);
+    pool3.c[pool3.nc++ % STALE_POOL] = a;
+    pool3.s[pool3.ns++ % (2 * STALE_POOL)] = s1;
+    I shared_c[8];
+    void *shared_s[8];
+    int k_shared = pool3.nc < 8 ? (int)pool3.nc : 8;
+    for (int k = 0; k < k_shared; k++) {
+        shared_c[k] = pool3.c[(unsigned)next() % (pool3.nc < STALE_POOL ? pool3.nc : STALE_POOL)];
+        shared_s[k] = pool3.s[(unsigned)next() % (pool3.ns < 2 * STALE_POOL ? pool3.ns : 2 * STALE_POOL)];
+    }
+    pthread_mutex_unlock(&pool3.lock);
+    stale_instance3(r->first_c, &r->refused);
+    for (unsigned k = 0; k < r->nc && k < STALE_KEEP; k++) stale_instance3(r->c[k], &r->refused);
+    for (int k = 0; k < k_shared; k++) stale_instance3(shared_c[k], &r->refused);
+    CHECK(w_x3(b) == w, "a stale handle changed the new instance's output");
+    run3(b, &t, 5);
+    double w_end = w_x3(b);
+    CHECK(w_end == r->ref, "the new instance's run differs from a fresh one");
+    stale_state3(b, r->first_s, &r->refused);
+    for (unsigned k = 0; k < r->ns && k < 2 * STALE_KEEP; k++) stale_state3(b, r->s[k], &r->refused);
+    for (int k = 0; k < k_shared; k++) stale_state3(b, shared_s[k], &r->refused);
+    CHECK(w_x3(b) == w_end, "a stale FMU state changed the new instance");
+    CHECK(free_state(b, &sb) == OK, "free state of b");
+    free_instance(b);
+}
+
+static void *reuse_worker3(void *arg) {
+    Reuse3 *r = (Reuse3 *)arg;
+    for (int i = 0; i < r->n; i++) reuse_round3(r);
+    return NULL;
+}
+
+static void reuse3(int n, int nt, int hold) {
+    CHECK(nt > 0 && nt <= 64 && hold >= 0, "1 to 64 threads, HOLD >= 0");
+    I *held = malloc(sizeof(I) * (size_t)(hold + 1));
+    for (int i = 0; i < hold; i++) held[i] = ready3();
+    I c = ready3();
+    double t = 0;
+    run3(c, &t, 10);
+    double ref = w_x3(c);
+    free_instance(c);
+    rng = 20261129;
+    static Reuse3 r[64];
+    pthread_t th[64];
+    for (int i = 0; i < nt; i++) {
+        r[i] = (Reuse3){.n = n, .ref = ref};
+        CHECK(pthread_create(&th[i], NULL, reuse_worker3, &r[i]) == 0, "pthread_create");
+    }
+    long refused = 0;
+    int same_addr = 0, same_state = 0;
+    for (int i = 0; i < nt; i++) {
+        pthread_join(th[i], NULL);
+        refused += r[i].refused;
+        same_addr += r[i].same_addr;
+        same_state += r[i].same_state;
+    }
+    for (int i = 0; i < hold; i++) {
+        CHECK(w_x3(held[i]) == 0.05, "a held instance changed");
+        free_instance(held[i]);
+    }
+    free(held);
+    printf("ok reuse %d threads x %d rounds (%d other instances held): %ld stale calls refused; the new instance had "
+           "the freed one's handle value in %d rounds, its state a freed state's in %d\n", nt, n, hold, refused,
+           same_addr, same_state);
+}
+
 static int main3(int argc, char **argv) {
     if (argc < 4) { fprintf(stderr, "usage: %s LIB GUID MODE [ARGS]\n", argv[0]); return 2; }
     LIB = argv[1];
@@ -1611,6 +1929,8 @@ static int main3(int argc, char **argv) {
         abuse();
     } else if (!strcmp(mode, "mixed")) {
         mixed();
+    } else if (!strcmp(mode, "reuse")) {
+        reuse3(atoi(argv[4]), argc > 5 ? atoi(argv[5]) : 1, argc > 6 ? atoi(argv[6]) : 0);
     } else if (!strcmp(mode, "me")) {
         me_abuse();
     } else {
