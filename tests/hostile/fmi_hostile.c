@@ -54,6 +54,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <signal.h>
+#include <sys/time.h>
+#include <unistd.h>
 
 typedef void *C;
 typedef int St;
@@ -757,11 +760,76 @@ static C me_reload_instance(const Fmi *f, double *x) {
     return c;
 }
 
+/* ----- epoch: start times far from 0 (issue 45) -----------------------------------------------------
+ * Every call must return within a second (a watchdog timer ends the program naming the call) and either
+ * work or be refused with Error and a message naming the function (and, for the time bound, "2^53"). */
+static const double EPOCHS[] = {1e6, -1e6, 1e10, -1e10, 1e15, -1e15, 1e18, -1e18, 1e20, -1e20,
+                                1e100, -1e100, 1e300, -1e300};
+enum { N_EPOCHS = sizeof EPOCHS / sizeof EPOCHS[0] };
+static const char *volatile watched = "";
+static double watched_t;
+static void watchdog(int sig) {
+    (void)sig;
+    char b[256];
+    int n = snprintf(b, sizeof b, "FAIL %s at startTime %g did not return within 1 s\n", watched, watched_t);
+    if (write(1, b, (size_t)n) < 0) _exit(3);
+    _exit(1);
+}
+static void watch(const char *fn, double t0) {
+    struct itimerval it = {{0, 0}, {1, 0}};
+    watched = fn;
+    watched_t = t0;
+    signal(SIGALRM, watchdog);
+    setitimer(ITIMER_REAL, &it, NULL);
+}
+static void unwatch(void) {
+    struct itimerval it = {{0, 0}, {0, 0}};
+    setitimer(ITIMER_REAL, &it, NULL);
+}
+static int n_epoch_calls, n_epoch_refused, n_epoch_bound;
+/* one timed call: OK, or Error with a message naming fn; returns the status */
+static St epoch_call(St st, const char *fn, double t0) {
+    unwatch();
+    n_epoch_calls++;
+    if (st == OK || st == WARNING) return OK;
+    if (st != ERROR || !strstr(last_msg, fn)) {
+        printf("FAIL %s at startTime %g returned %d with message \"%s\" (expected OK, or Error naming it)\n", fn, t0,
+               st, last_msg);
+        fflush(stdout);
+        exit(1);
+    }
+    n_epoch_refused++;
+    if (strstr(last_msg, "2^53")) n_epoch_bound++;
+    return ERROR;
+}
+#define TIMED(fn, t0, call) (last_msg[0] = 0, watch(fn, t0), epoch_call((call), fn, t0))
+
+static void epoch2(const Fmi *f, double h) {
+    for (int i = 0; i < N_EPOCHS; i++) {
+        double t0 = EPOCHS[i];
+        C c = f->instantiate("epoch", 1, GUID, NULL, &CB, 0, 0);
+        CHECK(c, "instantiate");
+        if (TIMED("fmi2SetupExperiment", t0, f->setup(c, 0, 0.0, t0, 0, 0.0)) == OK &&
+            TIMED("fmi2EnterInitializationMode", t0, f->enter_init(c)) == OK &&
+            TIMED("fmi2ExitInitializationMode", t0, f->exit_init(c)) == OK &&
+            TIMED("fmi2DoStep", t0, f->do_step(c, t0, h, 1)) == OK) {
+            TIMED("fmi2DoStep", t0, f->do_step(c, t0 + h, h, 1));
+        }
+        f->free_instance(c);
+    }
+}
+
 static int main2(int argc, char **argv) {
     if (argc < 4) { fprintf(stderr, "usage: %s LIB GUID MODE ...\n", argv[0]); return 2; }
     LIB = argv[1]; GUID = argv[2];
     const char *mode = argv[3];
-    if (!strcmp(mode, "cycles")) {
+    if (!strcmp(mode, "epoch")) {
+        Fmi f = load();
+        epoch2(&f, argc > 4 ? atof(argv[4]) : 0.1);
+        dlclose(f.lib);
+        printf("ok epoch: %d calls returned within 1 s, %d refused with Error naming the function (%d naming the 2^53 bound)\n",
+               n_epoch_calls, n_epoch_refused, n_epoch_bound);
+    } else if (!strcmp(mode, "cycles")) {
         int n = atoi(argv[4]);
         Fmi f = load();
         double w0 = cycle(&f, 0);
@@ -1592,6 +1660,22 @@ static void mixed(void) {
     printf("ok mixed w_x=%.17g\n", w3);
 }
 
+static void epoch3(double h) {
+    for (int i = 0; i < N_EPOCHS; i++) {
+        double t0 = EPOCHS[i];
+        I c = instantiate("epoch3", GUID, NULL, false, false, false, false, NULL, 0, NULL, log3, NULL);
+        CHECK(c, "fmi3InstantiateCoSimulation");
+        if (TIMED("fmi3EnterInitializationMode", t0, enter_init(c, false, 0.0, t0, false, 0.0)) == OK &&
+            TIMED("fmi3ExitInitializationMode", t0, exit_init(c)) == OK) {
+            bool ev, term, early;
+            double last;
+            if (TIMED("fmi3DoStep", t0, do_step(c, t0, h, false, &ev, &term, &early, &last)) == OK)
+                TIMED("fmi3DoStep", t0, do_step(c, t0 + h, h, false, &ev, &term, &early, &last));
+        }
+        free_instance(c);
+    }
+}
+
 static int main3(int argc, char **argv) {
     if (argc < 4) { fprintf(stderr, "usage: %s LIB GUID MODE [ARGS]\n", argv[0]); return 2; }
     LIB = argv[1];
@@ -1607,6 +1691,10 @@ static int main3(int argc, char **argv) {
             CHECK(memcmp(&w, &ref, sizeof w) == 0, "cycle3 gave different bits");
         }
         printf("ok cycles %d w_x=%.17g\n", n, ref);
+    } else if (!strcmp(mode, "epoch")) {
+        epoch3(argc > 4 ? atof(argv[4]) : 0.1);
+        printf("ok epoch: %d calls returned within 1 s, %d refused with Error naming the function (%d naming the 2^53 bound)\n",
+               n_epoch_calls, n_epoch_refused, n_epoch_bound);
     } else if (!strcmp(mode, "abuse")) {
         abuse();
     } else if (!strcmp(mode, "mixed")) {
