@@ -1655,9 +1655,20 @@ static void mixed(void) {
         CHECK(get2(a, &out, 1, &w2) == OK && get_f64(c, &out, 1, &w3, 1) == OK, "get both");
         CHECK(memcmp(&w2, &w3, sizeof w2) == 0, "FMI 2.0 and FMI 3.0 instances differ");
     }
+    /* an FMU state belongs to the FMI version of the instance that took it (issue 45) */
+    St (*get_state2)(I, void **) = sym3("fmi2GetFMUstate");
+    St (*set_state2)(I, void *) = sym3("fmi2SetFMUstate");
+    St (*free_state2)(I, void **) = sym3("fmi2FreeFMUstate");
+    void *s2 = NULL, *s3 = NULL;
+    CHECK(get_state2(a, &s2) == OK && get_state(c, &s3) == OK, "get an FMU state through each version");
+    CHECK(set_state2(a, s3) == ERROR, "fmi2SetFMUstate accepted a state taken through FMI 3.0");
+    EXPECT(set_state(c, s2), ERROR, "fmi3SetFMUState");
+    CHECK(strstr(last_msg, "taken by an FMI 2.0 instance"), "fmi3SetFMUState: message does not name the version");
+    CHECK(set_state2(a, s2) == OK && set_state(c, s3) == OK, "a state restored through its own version");
+    CHECK(free_state2(a, &s2) == OK && free_state(c, &s3) == OK, "free states");
     free2(a);
     free_instance(c);
-    printf("ok mixed w_x=%.17g\n", w3);
+    printf("ok mixed w_x=%.17g (FMU states refused across versions)\n", w3);
 }
 
 static void epoch3(double h) {

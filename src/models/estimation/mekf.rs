@@ -5,7 +5,6 @@
 //! tracker's latency (`st_latency`) is compensated by a delayed update (`mekf_delay.rs`).
 
 use std::collections::VecDeque;
-
 use nalgebra::{Matrix3, Quaternion, Rotation3, SMatrix, SVector, Vector3};
 use serde::{Deserialize, Serialize};
 
