@@ -73,6 +73,23 @@ fn check_version(state_fmi3: bool, inst_fmi3: bool, what: &str) -> CallResult {
     )))
 }
 
+/// A state taken in a Model Exchange mode is refused by a Co-Simulation instance and the reverse (at
+/// restore and already at deserialize, so that an accepted serialized state can always be set).
+fn check_kind(run: &Run, inst: &Instance) -> CallResult {
+    let me_state = matches!(run.fsm, FsmState::EventMode | FsmState::ContinuousTimeMode);
+    if (me_state && !inst.model_exchange)
+        || (inst.model_exchange && matches!(run.fsm, FsmState::StepComplete | FsmState::StepFailed))
+    {
+        let kind = |me: bool| if me { "Model Exchange" } else { "Co-Simulation" };
+        return Err(Fail::error(format!(
+            "FMU state was taken from a {} instance; this instance runs {}",
+            kind(me_state),
+            kind(inst.model_exchange)
+        )));
+    }
+    Ok(())
+}
+
 impl Snapshot {
     pub fn capture(inst: &Instance) -> Snapshot {
         Snapshot {
@@ -92,17 +109,7 @@ impl Snapshot {
             )));
         }
         check_version(self.fmi3, inst.fmi3, "FMU state")?;
-        let me_state = matches!(self.run.fsm, FsmState::EventMode | FsmState::ContinuousTimeMode);
-        if (me_state && !inst.model_exchange)
-            || (inst.model_exchange && matches!(self.run.fsm, FsmState::StepComplete | FsmState::StepFailed))
-        {
-            let kind = |me: bool| if me { "Model Exchange" } else { "Co-Simulation" };
-            return Err(Fail::error(format!(
-                "FMU state was taken from a {} instance; this instance runs {}",
-                kind(me_state),
-                kind(inst.model_exchange)
-            )));
-        }
+        check_kind(&self.run, inst)?;
         inst.model = self.model.clone_box();
         inst.run = self.run;
         Ok(())
@@ -240,6 +247,7 @@ impl Snapshot {
         p.run
             .validate()
             .map_err(|e| Fail::error(format!("serialized state is invalid: {e}")))?;
+        check_kind(&p.run, inst)?;
         if !model.is_initialized() && !matches!(p.run.fsm, FsmState::Instantiated | FsmState::InitializationMode) {
             return Err(Fail::error(format!(
                 "serialized state is invalid: state machine state {:?} without applied parameters",
