@@ -509,7 +509,7 @@ def test_an_fmu_state_keeps_the_model_exchange_states_and_refuses_a_co_simulatio
         with pytest.raises(Exception):
             cs.slave.deserializeFMUState(blob)  # refused already here: an accepted state can always be set
         taken = "FMU state was taken from a Model Exchange instance"
-        assert any("eserializeFMU" in m[2] and taken in m[2] for m in cs.messages), cs.messages
+        assert any("erializeFMU" in m[2] and taken in m[2] for m in cs.messages), cs.messages
     finally:
         me.close()
         cs.close()
