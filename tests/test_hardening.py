@@ -241,3 +241,44 @@ def test_fmi3_abuse_gives_prescribed_statuses_and_messages(hostile3):
 
 def test_fmi2_and_fmi3_instances_coexist_and_agree(hostile3):
     run(hostile3, "mixed")
+
+
+# ----- issue 45: start times far from 0 (epoch-based masters) ----------------------------------------------
+
+def _units(version: int) -> list[tuple[str, float, bool]]:
+    """Every unit packaged for `version`: (model, default step, sampled), read from its model description.
+    A unit is sampled when it declares a sample period parameter (`sample_period`, or a parameter whose
+    description starts with "Sample time"): its sample index is bounded by 2^53 periods."""
+    _, fmus, _, _ = VERSIONS[version]
+    out = []
+    for fmu in sorted(fmus.glob("*.fmu")):
+        with zipfile.ZipFile(fmu) as z:
+            md = z.read("modelDescription.xml").decode()
+        step = re.search(r'<DefaultExperiment[^>]*stepSize="([^"]+)"', md)
+        sampled = bool(re.search(r'name="sample_period"', md)
+                       or re.search(r'causality="parameter"[^>]*description="Sample time|description="Sample time[^"]*"[^>]*causality="parameter"', md)
+                       or re.search(r'name="step"[^>]*description="Sample time', md))
+        out.append((fmu.stem, float(step.group(1)) if step else 0.1, sampled))
+    return out
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_start_times_far_from_zero_return_within_a_second(masters, version):
+    """Every unit, started at ±1e6, ±1e10, ±1e15, ±1e18, ±1e20, ±1e100 and ±1e300 s: setup, initialization
+    and two steps each return within a second (the master's watchdog names a call that does not) and
+    either work or are refused with Error and a message naming the function. A sampled unit refuses the
+    start times beyond 2^53 of its sample periods (at least ±1e18 … ±1e300) with a message naming the bound.
+    Before the fix, BDot, Magnetometer, SampleHold, StarTracker and SunSensor never returned from the first
+    step at -1e20 s."""
+    units = _units(version)
+    assert len(units) >= 29, [u for u, _, _ in units]
+    sampled = [u for u, _, s in units if s]
+    assert {"BDot", "Magnetometer", "SampleHold", "StarTracker", "SunSensor", "PidController"} <= set(sampled), sampled
+    for model, step, is_sampled in units:
+        target = unit(masters, version, model)
+        p = run(target, "epoch", repr(step), timeout=120)
+        assert p.returncode == 0 and "ok epoch" in p.stdout, f"{model}: {p.stdout}{p.stderr[-2000:]}"
+        calls, refused, bound = map(int, re.search(r"(\d+) calls .* (\d+) refused .*\((\d+) naming", p.stdout).groups())
+        assert calls >= 14, f"{model}: {p.stdout}"
+        if is_sampled:
+            assert bound >= 8, f"{model}: sampled, but only {bound} refusals name the 2^53 bound: {p.stdout}"

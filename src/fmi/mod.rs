@@ -36,6 +36,8 @@ mod library_path;
 pub mod live;
 pub mod state;
 mod state_calls;
+#[cfg(test)]
+mod state_nan_tests;
 pub mod types;
 
 pub use types::{FsmState, Status, LOG_CATEGORIES};

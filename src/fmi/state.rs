@@ -22,12 +22,16 @@ use super::types::FsmState;
 use crate::model::DynModel;
 
 const MAGIC: &[u8; 8] = b"SCFMUST\0";
-const FORMAT_VERSION: u32 = 2; // 2: the run carries the time of the last event (Model Exchange)
+// 2: the run carries the time of the last event (Model Exchange); 3: the FMI version of the instance
+const FORMAT_VERSION: u32 = 3;
 const HEADER: usize = 16;
 const TRAILER: usize = 4;
 
 pub struct Snapshot {
     pub model_name: &'static str,
+    /// Taken by an FMI 3.0 instance (restored only into one: a state belongs to the interface version
+    /// that made it, see `docs/hardening.md`).
+    pub fmi3: bool,
     pub run: Run,
     pub model: Box<dyn DynModel>,
     /// Bytes computed by `fmi2SerializedFMUstateSize`, reused by `fmi2SerializeFMUstate`.
@@ -37,6 +41,7 @@ pub struct Snapshot {
 #[derive(Serialize, Deserialize)]
 struct Payload {
     model_name: String,
+    fmi3: bool,
     guid: String,
     run: Run,
     model: Vec<u8>,
@@ -65,10 +70,41 @@ fn release_if_empty(table: &mut Table) {
     }
 }
 
+/// A state taken through one FMI version is refused by the other version's calls.
+fn check_version(state_fmi3: bool, inst_fmi3: bool, what: &str) -> CallResult {
+    if state_fmi3 == inst_fmi3 {
+        return Ok(());
+    }
+    let v = |fmi3: bool| if fmi3 { "FMI 3.0" } else { "FMI 2.0" };
+    Err(Fail::error(format!(
+        "{what} was taken by an {} instance; this instance runs {} (a state is restored only through the interface version that took it)",
+        v(state_fmi3),
+        v(inst_fmi3)
+    )))
+}
+
+/// A state taken in a Model Exchange mode is refused by a Co-Simulation instance and the reverse (at
+/// restore and already at deserialize, so that an accepted serialized state can always be set).
+fn check_kind(run: &Run, inst: &Instance) -> CallResult {
+    let me_state = matches!(run.fsm, FsmState::EventMode | FsmState::ContinuousTimeMode);
+    if (me_state && !inst.model_exchange)
+        || (inst.model_exchange && matches!(run.fsm, FsmState::StepComplete | FsmState::StepFailed))
+    {
+        let kind = |me: bool| if me { "Model Exchange" } else { "Co-Simulation" };
+        return Err(Fail::error(format!(
+            "FMU state was taken from a {} instance; this instance runs {}",
+            kind(me_state),
+            kind(inst.model_exchange)
+        )));
+    }
+    Ok(())
+}
+
 impl Snapshot {
     pub fn capture(inst: &Instance) -> Snapshot {
         Snapshot {
             model_name: inst.entry.info.name,
+            fmi3: inst.fmi3,
             run: inst.run,
             model: inst.model.clone_box(),
             serialized: None,
@@ -82,17 +118,8 @@ impl Snapshot {
                 self.model_name, inst.entry.info.name
             )));
         }
-        let me_state = matches!(self.run.fsm, FsmState::EventMode | FsmState::ContinuousTimeMode);
-        if (me_state && !inst.model_exchange)
-            || (inst.model_exchange && matches!(self.run.fsm, FsmState::StepComplete | FsmState::StepFailed))
-        {
-            let kind = |me: bool| if me { "Model Exchange" } else { "Co-Simulation" };
-            return Err(Fail::error(format!(
-                "FMU state was taken from a {} instance; this instance runs {}",
-                kind(me_state),
-                kind(inst.model_exchange)
-            )));
-        }
+        check_version(self.fmi3, inst.fmi3, "FMU state")?;
+        check_kind(&self.run, inst)?;
         inst.model = self.model.clone_box();
         inst.run = self.run;
         Ok(())
@@ -158,6 +185,7 @@ impl Snapshot {
     pub fn to_bytes(&self, guid: &str) -> CallResult<Vec<u8>> {
         let payload = Payload {
             model_name: self.model_name.to_string(),
+            fmi3: self.fmi3,
             guid: guid.to_string(),
             run: self.run,
             model: self
@@ -222,6 +250,7 @@ impl Snapshot {
                 p.model_name, inst.entry.info.name
             )));
         }
+        check_version(p.fmi3, inst.fmi3, "serialized state")?;
         if p.guid != guid {
             return Err(Fail::error(format!(
                 "serialized state was written by a different version of {} (GUID {})",
@@ -233,6 +262,7 @@ impl Snapshot {
         p.run
             .validate()
             .map_err(|e| Fail::error(format!("serialized state is invalid: {e}")))?;
+        check_kind(&p.run, inst)?;
         if !model.is_initialized() && !matches!(p.run.fsm, FsmState::Instantiated | FsmState::InitializationMode) {
             return Err(Fail::error(format!(
                 "serialized state is invalid: state machine state {:?} without applied parameters",
@@ -244,6 +274,7 @@ impl Snapshot {
             .map_err(|e| Fail::error(format!("serialized state is invalid: {e}")))?;
         Ok(Snapshot {
             model_name: inst.entry.info.name,
+            fmi3: p.fmi3,
             run: p.run,
             model,
             serialized: None,

@@ -35,9 +35,10 @@ pub fn normal(seed: i64, k: i64, i: u64) -> f64 {
 }
 
 /// Index k of the hold interval [k T, (k+1) T) containing t; a t within 1e-9 T below a boundary
-/// counts as on it (communication points such as 0.3 = 3 · 0.1 are not exact in binary).
-pub fn hold_index(t: f64, hold: f64) -> i64 {
-    (t / hold + 1e-9).floor() as i64
+/// counts as on it (communication points such as 0.3 = 3 · 0.1 are not exact in binary). `None` beyond
+/// 2^53 intervals from 0 (`sample_grid::MAX_INDEX`: the index would not be exact), never a saturated cast.
+pub fn hold_index(t: f64, hold: f64) -> Option<i64> {
+    crate::math::sample_grid::exact_index((t / hold + 1e-9).floor())
 }
 
 #[cfg(test)]
@@ -80,8 +81,9 @@ mod tests {
         assert_eq!(normal(1, 5, 2).to_bits(), normal(1, 5, 2).to_bits());
         assert_ne!(normal(1, 5, 2), normal(2, 5, 2));
         assert_ne!(normal(1, 5, 2), normal(1, 6, 2));
-        assert_eq!(hold_index(0.3, 0.1), 3);
-        assert_eq!(hold_index(0.29, 0.1), 2);
-        assert_eq!(hold_index(0.0, 0.1), 0);
+        assert_eq!(hold_index(0.3, 0.1), Some(3));
+        assert_eq!(hold_index(0.29, 0.1), Some(2));
+        assert_eq!(hold_index(0.0, 0.1), Some(0));
+        assert_eq!(hold_index(-1e20, 0.1), None);
     }
 }

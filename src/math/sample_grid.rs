@@ -43,29 +43,77 @@ pub fn tolerance(scale: f64, period: f64) -> f64 {
     (REL_TOL * scale.abs().max(period)).min(MAX_FRACTION * period)
 }
 
-/// The grid index k with |x − k T| ≤ `tolerance(scale, T)`, if any.
-pub fn on_grid(x: f64, period: f64, scale: f64) -> Option<i64> {
-    let k = (x / period).round();
-    ((x - k * period).abs() <= tolerance(scale, period)).then_some(k as i64)
+/// Largest sample index |k| a unit counts: 2^53. Every integer up to it is an exact f64, so the index
+/// of a time (t/T rounded) converts to an integer without loss and back (k T) without a second rounding
+/// of k, and every index difference or ±1 stays far inside i64. Beyond it consecutive indices are no
+/// longer distinct doubles and a saturating conversion followed by `k − 1` would wrap (a sample loop
+/// of 2^64 turns): such times are refused. (The grid tolerance of at most 1e-3 T exceeds the spacing
+/// of doubles only below about 2^42 T; between 2^42 and 2^53 periods a master's times may be refused
+/// as off the grid, with a message, but never loop.)
+pub const MAX_INDEX: i64 = 1 << 53;
+
+/// The integer of an already rounded quotient q = x/T, if |q| ≤ [`MAX_INDEX`] (exact conversion).
+pub fn exact_index(q: f64) -> Option<i64> {
+    (q.is_finite() && q.abs() <= MAX_INDEX as f64).then_some(q as i64)
+}
+
+/// Why a time x has no sample index on the grid of period T (for messages naming the bound).
+pub fn beyond(what: &str, x: f64, period: f64) -> String {
+    format!(
+        "{what} {x} s is {:e} sample periods of {period} s from t = 0: at most 2^53 = {:e} periods (|t| <= {:e} s) can be counted exactly",
+        x / period,
+        MAX_INDEX as f64,
+        MAX_INDEX as f64 * period
+    )
+}
+
+/// Checks that a time x lies within [`MAX_INDEX`] periods of 0 (`what` names it in the message).
+pub fn check_time(what: &str, x: f64, period: f64) -> Result<(), String> {
+    match exact_index((x / period).round()) {
+        Some(_) => Ok(()),
+        None => Err(beyond(what, x, period)),
+    }
+}
+
+fn index_of(q: f64, x: f64, period: f64) -> Result<i64, String> {
+    exact_index(q).ok_or_else(|| beyond("time", x, period))
+}
+
+/// The grid index k with |x − k T| ≤ `tolerance(scale, T)`, if any; an error when x/T is beyond
+/// [`MAX_INDEX`].
+pub fn on_grid(x: f64, period: f64, scale: f64) -> Result<Option<i64>, String> {
+    let k = index_of((x / period).round(), x, period)?;
+    Ok(((x - k as f64 * period).abs() <= tolerance(scale, period)).then_some(k))
 }
 
 /// Index k of the interval [k T, (k+1) T) holding t, where a t within the tolerance of a grid instant
 /// counts as on it (so t = 0.3 − 1e-17 or a summed 0.30000000000000004 are both in interval 3 of T = 0.1).
-pub fn index_at(t: f64, period: f64, scale: f64) -> i64 {
-    on_grid(t, period, scale).unwrap_or_else(|| (t / period).floor() as i64)
+pub fn index_at(t: f64, period: f64, scale: f64) -> Result<i64, String> {
+    match on_grid(t, period, scale)? {
+        Some(k) => Ok(k),
+        None => index_of((t / period).floor(), t, period),
+    }
 }
 
 /// Index of the last grid instant strictly before `t_end` (−1 if none), where an instant within the
 /// tolerance of t_end counts as at t_end (not before it): the samples a step ending at t_end takes.
-pub fn last_before(t_end: f64, period: f64, scale: f64) -> i64 {
-    on_grid(t_end, period, scale).unwrap_or_else(|| (t_end / period).ceil() as i64) - 1
+pub fn last_before(t_end: f64, period: f64, scale: f64) -> Result<i64, String> {
+    let k = match on_grid(t_end, period, scale)? {
+        Some(k) => k,
+        None => index_of((t_end / period).ceil(), t_end, period)?,
+    };
+    Ok(k - 1) // |k| <= 2^53: no overflow
 }
 
 /// The number k ≥ 0 of sample times in a communication step h (|h − k T| within the tolerance of a
-/// step ending at magnitude `scale`), or `None` when h is no whole multiple of T. A step within the
-/// tolerance of 0 (a master's last step of rounding size) takes no sample.
+/// step ending at magnitude `scale`), or `None` when h is no whole multiple of T (or more than
+/// [`MAX_INDEX`] periods long). A step within the tolerance of 0 (a master's last step of rounding
+/// size) takes no sample.
 pub fn samples_in(h: f64, period: f64, scale: f64) -> Option<i64> {
-    on_grid(h, period, scale.abs().max(h.abs())).filter(|k| *k >= 0)
+    on_grid(h, period, scale.abs().max(h.abs()))
+        .ok()
+        .flatten()
+        .filter(|k| *k >= 0)
 }
 
 /// A sample counter on the grid start + n T: checks that a master's communication point is the
@@ -88,6 +136,9 @@ impl SampleCounter {
                 tolerance(scale, per)
             ));
         };
+        check_time("communication point", t, per)?;
+        check_time("step end", t + h, per)?;
+        check_time("communication step", h, per)?;
         let due = t0 + n as f64 * per;
         let tol = tolerance(t.abs().max(t0.abs()), per);
         if (t - due).abs() > tol {
@@ -95,7 +146,7 @@ impl SampleCounter {
                 "communication point {t} s is not the next sample instant start + {n} step = {due} s (step = {per} s; a point within {tol:e} s of it is taken as it)"
             ));
         }
-        Ok(k as u64)
+        u64::try_from(k).map_err(|_| format!("communication step {h} s takes a negative number of samples"))
     }
 }
 
@@ -114,17 +165,17 @@ mod tests {
 
     #[test]
     fn grid_instants_and_intervals() {
-        assert_eq!(index_at(0.3, 0.1, 0.3), 3); // 0.3 / 0.1 = 2.9999999999999996
-        assert_eq!(index_at(0.29, 0.1, 0.29), 2);
-        assert_eq!(index_at(0.0, 0.1, 0.0), 0);
-        assert_eq!(index_at(-0.05, 0.1, 0.05), -1);
-        assert_eq!(last_before(0.0, 0.1, 0.0), -1);
-        assert_eq!(last_before(0.3, 0.1, 0.3), 2);
-        assert_eq!(last_before(0.35, 0.1, 0.35), 3);
-        assert_eq!(last_before(0.01, 0.1, 0.01), 0);
+        assert_eq!(index_at(0.3, 0.1, 0.3), Ok(3)); // 0.3 / 0.1 = 2.9999999999999996
+        assert_eq!(index_at(0.29, 0.1, 0.29), Ok(2));
+        assert_eq!(index_at(0.0, 0.1, 0.0), Ok(0));
+        assert_eq!(index_at(-0.05, 0.1, 0.05), Ok(-1));
+        assert_eq!(last_before(0.0, 0.1, 0.0), Ok(-1));
+        assert_eq!(last_before(0.3, 0.1, 0.3), Ok(2));
+        assert_eq!(last_before(0.35, 0.1, 0.35), Ok(3));
+        assert_eq!(last_before(0.01, 0.1, 0.01), Ok(0));
         // the summed clock of 3 steps of 0.1 (0.30000000000000004) is the instant 0.3
-        assert_eq!(index_at(summed(0.1, 3), 0.1, 0.3), 3);
-        assert_eq!(last_before(summed(0.1, 3), 0.1, 0.3), 2);
+        assert_eq!(index_at(summed(0.1, 3), 0.1, 0.3), Ok(3));
+        assert_eq!(last_before(summed(0.1, 3), 0.1, 0.3), Ok(2));
     }
 
     /// Summed clocks over 1e5 steps (the error grows to 1.9e-8 s at 10 000 s) stay on the grid; their
@@ -138,7 +189,11 @@ mod tests {
             for k in 0..n {
                 let exact = k as f64 * h;
                 worst = worst.max((t - exact).abs());
-                assert_eq!(on_grid(t, per, t), Some(k as i64 * ratio), "h = {h}, step {k}, t = {t}");
+                assert_eq!(
+                    on_grid(t, per, t),
+                    Ok(Some(k as i64 * ratio)),
+                    "h = {h}, step {k}, t = {t}"
+                );
                 t += h;
             }
             assert!(
@@ -201,5 +256,35 @@ mod tests {
             period: 0.1,
         };
         assert_eq!(c.step(10, 3.5000000000000004, 0.1, "x"), Ok(1));
+    }
+
+    /// Times beyond 2^53 periods are refused with the bound named; up to it the indices are exact and
+    /// their neighbours (k - 1) do not wrap (before: `(-1e20 / 0.1).ceil() as i64` saturated at
+    /// i64::MIN and `- 1` wrapped to i64::MAX, a sample loop of 2^64 turns).
+    #[test]
+    fn times_beyond_the_exact_index_range_are_refused() {
+        let lim = 9_007_199_254_740_992.0; // 2^53, written out independently of MAX_INDEX
+        assert_eq!(last_before(lim * 0.5, 0.5, lim * 0.5), Ok((1i64 << 53) - 1));
+        assert_eq!(index_at(-lim, 1.0, lim), Ok(-(1i64 << 53)));
+        for t in [-1e20, 1e20, -1e18, 1e18, 1e100, -1e300, 1e300, f64::MAX, -f64::MAX] {
+            for f in [index_at, last_before] {
+                let e = f(t, 0.1, t.abs()).unwrap_err();
+                assert!(e.contains(&format!("{t} s")) && e.contains("2^53"), "{e}");
+            }
+            assert_eq!(on_grid(t, 0.1, t.abs()).map_err(|_| ()), Err(()));
+            assert_eq!(samples_in(t.abs(), 0.1, t.abs()), None);
+        }
+        // f64 infinities and NaN are refused the same way, never cast
+        assert!(index_at(f64::INFINITY, 0.1, 1.0).is_err() && last_before(f64::NAN, 0.1, 1.0).is_err());
+        let c = SampleCounter {
+            start: -1e20,
+            period: 0.1,
+        };
+        let e = c.step(0, -1e20, 0.1, "x").unwrap_err();
+        assert!(
+            e.contains("communication point -100000000000000000000 s") && e.contains("2^53"),
+            "{e}"
+        );
+        assert!(check_time("startTime", 1e14, 0.1).is_ok() && check_time("startTime", 1e14, 0.01).is_err());
     }
 }

@@ -55,6 +55,12 @@ pub fn calendar_year(jd: f64) -> i32 {
 /// Decimal year of a Julian date: the year plus the elapsed fraction of it (the time argument of the
 /// IGRF coefficients).
 pub fn decimal_year(jd: f64) -> f64 {
+    // beyond a million years from J2000 the Julian year is as good, and no integer year is formed
+    // (the year would saturate the i32 cast and y + 1 wrap: −1e18 s gave the year −2147818600)
+    let julian = 2000.0 + (jd - 2_451_545.0) / 365.25;
+    if !(julian.abs() < 1e6) {
+        return julian;
+    }
     let y = calendar_year(jd);
     let start = julian_date(y, 1, 1, 0.0);
     let end = julian_date(y + 1, 1, 1, 0.0);

@@ -82,3 +82,15 @@ fn geodetic_round_trip_and_ned_axes() {
     let m = ecef_to_ned(0.0, 0.0);
     assert!((m - Matrix3::new(0.0, 0.0, 1.0, 0.0, 1.0, 0.0, -1.0, 0.0, 0.0)).norm() < 1e-15);
 }
+
+/// Far from J2000 the decimal year is the Julian year (no saturated integer year that wraps): issue 45.
+#[test]
+fn decimal_year_far_from_j2000_does_not_wrap() {
+    for t in [-1e18, 1e18, -1e20, 1e300, -1e300] {
+        let jd = 2_451_545.0 + t / 86_400.0;
+        let y = decimal_year(jd);
+        let want = 2000.0 + t / 86_400.0 / 365.25;
+        assert!((y - want).abs() <= 1e-9 * want.abs(), "t = {t}: {y}, expected {want}");
+    }
+    assert!((decimal_year(2_451_545.0) - 2000.0).abs() < 0.01);
+}

@@ -57,7 +57,10 @@ impl<M: Model> Fmu<M> {
     pub fn validate(&mut self, exp: &Experiment) -> ModelResult {
         self.v.check_bounds()?;
         self.v.check_finite()?;
+        // every float anywhere (declared or not, evolving or derived): no dormant NaN or infinity
+        leaves::check_all_finite(&self.v, "variable block field ")?;
         if let Some(state) = &mut self.state {
+            leaves::check_all_finite(&*state, "")?;
             let mut v = self.v.clone();
             let fresh = M::initialize(&mut v, exp)?;
             v.check_calculated()?;
@@ -152,6 +155,8 @@ pub trait DynModel: Send {
     /// Checks a restored state and rebuilds its unserialized parts (see [`Fmu::validate`]).
     fn validate(&mut self, exp: &Experiment) -> ModelResult;
     fn is_initialized(&self) -> bool;
+    /// The period of the model's integer time grid for the current parameters ([`Model::time_grid`]).
+    fn time_grid(&self) -> Option<f64>;
     /// Model Exchange (see [`Model::STATES`]); the layer checks lengths and finiteness.
     fn get_states(&self, x: &mut [f64]) -> ModelResult;
     fn set_states(&mut self, x: &[f64]) -> ModelResult;
@@ -166,6 +171,9 @@ pub trait DynModel: Send {
     fn set_state_json(&mut self, state: serde_json::Value) -> ModelResult;
     #[cfg(test)]
     fn evolving(&self) -> &'static [&'static str];
+    /// Test support: (path, byte offset in `to_bytes`) of every f64 of the serialized model.
+    #[cfg(test)]
+    fn float_leaves(&self) -> Vec<(String, usize, u64)>;
 }
 
 impl<M: Model> DynModel for Fmu<M> {
@@ -189,6 +197,9 @@ impl<M: Model> DynModel for Fmu<M> {
     }
     fn do_step(&mut self, t: f64, h: f64) -> ModelResult {
         self.step(t, h)
+    }
+    fn time_grid(&self) -> Option<f64> {
+        M::time_grid(&self.v).filter(|p| p.is_finite() && *p > 0.0)
     }
     fn clone_box(&self) -> Box<dyn DynModel> {
         Box::new(self.clone())
@@ -241,5 +252,17 @@ impl<M: Model> DynModel for Fmu<M> {
     #[cfg(test)]
     fn evolving(&self) -> &'static [&'static str] {
         M::EVOLVING
+    }
+    #[cfg(test)]
+    fn float_leaves(&self) -> Vec<(String, usize, u64)> {
+        let l = leaves::Leaves::of(self).expect("serializable");
+        l.leaves
+            .iter()
+            .zip(&l.offsets)
+            .filter_map(|((p, leaf), o)| match leaf {
+                leaves::Leaf::F64(bits) => Some((l.path(*p).to_string(), *o, *bits)),
+                _ => None,
+            })
+            .collect()
     }
 }

@@ -178,6 +178,13 @@ pub trait Model: Clone + Serialize + DeserializeOwned + Send + 'static {
     fn restored(&mut self) -> ModelResult {
         Ok(())
     }
+    /// The period of the integer time grid the model counts on (sample period, noise hold), if any,
+    /// for the current parameters. The layer refuses a start time, stop time, step end or Model
+    /// Exchange time more than 2^53 periods from 0 (`math::sample_grid::MAX_INDEX`), where a sample
+    /// index is no longer exact; the model's own index arithmetic is checked as well. Default: none.
+    fn time_grid(_v: &Self::Vars) -> Option<f64> {
+        None
+    }
 
     // ----- Model Exchange (optional) ------------------------------------------------------------
 

@@ -62,6 +62,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <signal.h>
+#include <sys/time.h>
+#include <unistd.h>
 
 typedef void *C;
 typedef int St;
@@ -656,14 +659,15 @@ static int me_states(const Fmi *f, int n_fuzz) {
     /* a Model Exchange state is refused by a Co-Simulation instance and the other way round */
     C cs = ready(f, 0);
     void *s_cs = NULL, *s_x = NULL;
-    OKAY(f->deserialize(cs, (const char *)b, n, &s_x));
-    REFUSED(f->set_state(cs, s_x), "fmi2SetFMUstate", "taken from a Model Exchange instance");
+    /* refused already when deserialized (an accepted state can always be set) */
+    REFUSED(f->deserialize(cs, (const char *)b, n, &s_x), "fmi2DeSerializeFMUstate", "taken from a Model Exchange instance");
+    REFUSED(f->set_state(cs, s2), "fmi2SetFMUstate", "taken from a Model Exchange instance");
     OKAY(f->get_state(cs, &s_cs));
     size_t ncs;
     unsigned char *bcs = ser(f, cs, s_cs, &ncs);
     void *s_y = NULL;
-    OKAY(f->deserialize(c, (const char *)bcs, ncs, &s_y));
-    REFUSED(f->set_state(c, s_y), "fmi2SetFMUstate", "taken from a Co-Simulation instance");
+    REFUSED(f->deserialize(c, (const char *)bcs, ncs, &s_y), "fmi2DeSerializeFMUstate", "taken from a Co-Simulation instance");
+    REFUSED(f->set_state(c, s_cs), "fmi2SetFMUstate", "taken from a Co-Simulation instance");
     /* ME calls on the Co-Simulation instance */
     int a, bb;
     EventInfo ei;
@@ -928,11 +932,77 @@ static void cross2(const char *lib2, int n) {
     printf("ok cross %d rounds: %ld calls with the other library's handles refused\n", n, refused);
 }
 
+
+/* ----- epoch: start times far from 0 (issue 45) -----------------------------------------------------
+ * Every call must return within a second (a watchdog timer ends the program naming the call) and either
+ * work or be refused with Error and a message naming the function (and, for the time bound, "2^53"). */
+static const double EPOCHS[] = {1e6, -1e6, 1e10, -1e10, 1e15, -1e15, 1e18, -1e18, 1e20, -1e20,
+                                1e100, -1e100, 1e300, -1e300};
+enum { N_EPOCHS = sizeof EPOCHS / sizeof EPOCHS[0] };
+static const char *volatile watched = "";
+static double watched_t;
+static void watchdog(int sig) {
+    (void)sig;
+    char b[256];
+    int n = snprintf(b, sizeof b, "FAIL %s at startTime %g did not return within 1 s\n", watched, watched_t);
+    if (write(1, b, (size_t)n) < 0) _exit(3);
+    _exit(1);
+}
+static void watch(const char *fn, double t0) {
+    struct itimerval it = {{0, 0}, {1, 0}};
+    watched = fn;
+    watched_t = t0;
+    signal(SIGALRM, watchdog);
+    setitimer(ITIMER_REAL, &it, NULL);
+}
+static void unwatch(void) {
+    struct itimerval it = {{0, 0}, {0, 0}};
+    setitimer(ITIMER_REAL, &it, NULL);
+}
+static int n_epoch_calls, n_epoch_refused, n_epoch_bound;
+/* one timed call: OK, or Error with a message naming fn; returns the status */
+static St epoch_call(St st, const char *fn, double t0) {
+    unwatch();
+    n_epoch_calls++;
+    if (st == OK || st == WARNING) return OK;
+    if (st != ERROR || !strstr(last_msg, fn)) {
+        printf("FAIL %s at startTime %g returned %d with message \"%s\" (expected OK, or Error naming it)\n", fn, t0,
+               st, last_msg);
+        fflush(stdout);
+        exit(1);
+    }
+    n_epoch_refused++;
+    if (strstr(last_msg, "2^53")) n_epoch_bound++;
+    return ERROR;
+}
+#define TIMED(fn, t0, call) (last_msg[0] = 0, watch(fn, t0), epoch_call((call), fn, t0))
+
+static void epoch2(const Fmi *f, double h) {
+    for (int i = 0; i < N_EPOCHS; i++) {
+        double t0 = EPOCHS[i];
+        C c = f->instantiate("epoch", 1, GUID, NULL, &CB, 0, 0);
+        CHECK(c, "instantiate");
+        if (TIMED("fmi2SetupExperiment", t0, f->setup(c, 0, 0.0, t0, 0, 0.0)) == OK &&
+            TIMED("fmi2EnterInitializationMode", t0, f->enter_init(c)) == OK &&
+            TIMED("fmi2ExitInitializationMode", t0, f->exit_init(c)) == OK &&
+            TIMED("fmi2DoStep", t0, f->do_step(c, t0, h, 1)) == OK) {
+            TIMED("fmi2DoStep", t0, f->do_step(c, t0 + h, h, 1));
+        }
+        f->free_instance(c);
+    }
+}
+
 static int main2(int argc, char **argv) {
     if (argc < 4) { fprintf(stderr, "usage: %s LIB GUID MODE ...\n", argv[0]); return 2; }
     LIB = argv[1]; GUID = argv[2];
     const char *mode = argv[3];
-    if (!strcmp(mode, "cycles")) {
+    if (!strcmp(mode, "epoch")) {
+        Fmi f = load();
+        epoch2(&f, argc > 4 ? atof(argv[4]) : 0.1);
+        dlclose(f.lib);
+        printf("ok epoch: %d calls returned within 1 s, %d refused with Error naming the function (%d naming the 2^53 bound)\n",
+               n_epoch_calls, n_epoch_refused, n_epoch_bound);
+    } else if (!strcmp(mode, "cycles")) {
         int n = atoi(argv[4]);
         Fmi f = load();
         double w0 = cycle(&f, 0);
@@ -1252,8 +1322,8 @@ static int main2(int argc, char **argv) {
         REFUSED(f.deserialize(c, (const char *)b, len, &s2), "fmi2DeSerializeFMUstate", "CRC");
         b[len / 2] ^= 1;
         void *s3 = NULL;
-        OKAY(f.deserialize(cs, (const char *)b, len, &s3));
-        REFUSED(f.set_state(cs, s3), "fmi2SetFMUstate", "taken from a Model Exchange instance");
+        REFUSED(f.deserialize(cs, (const char *)b, len, &s3), "fmi2DeSerializeFMUstate", "taken from a Model Exchange instance");
+        REFUSED(f.set_state(cs, s2), "fmi2SetFMUstate", "taken from a Model Exchange instance");
         REFUSED(f.set_time(cs, 0.0), "fmi2SetTime", "instantiated for Co-Simulation");
         REFUSED(f.get_derivatives(cs, NULL, 0), "fmi2GetDerivatives", "instantiated for Co-Simulation");
         free(b);
@@ -1762,9 +1832,36 @@ static void mixed(void) {
         CHECK(get2(a, &out, 1, &w2) == OK && get_f64(c, &out, 1, &w3, 1) == OK, "get both");
         CHECK(memcmp(&w2, &w3, sizeof w2) == 0, "FMI 2.0 and FMI 3.0 instances differ");
     }
+    /* an FMU state belongs to the FMI version of the instance that took it (issue 45) */
+    St (*get_state2)(I, void **) = sym3("fmi2GetFMUstate");
+    St (*set_state2)(I, void *) = sym3("fmi2SetFMUstate");
+    St (*free_state2)(I, void **) = sym3("fmi2FreeFMUstate");
+    void *s2 = NULL, *s3 = NULL;
+    CHECK(get_state2(a, &s2) == OK && get_state(c, &s3) == OK, "get an FMU state through each version");
+    CHECK(set_state2(a, s3) == ERROR, "fmi2SetFMUstate accepted a state taken through FMI 3.0");
+    EXPECT(set_state(c, s2), ERROR, "fmi3SetFMUState");
+    CHECK(strstr(last_msg, "taken by an FMI 2.0 instance"), "fmi3SetFMUState: message does not name the version");
+    CHECK(set_state2(a, s2) == OK && set_state(c, s3) == OK, "a state restored through its own version");
+    CHECK(free_state2(a, &s2) == OK && free_state(c, &s3) == OK, "free states");
     free2(a);
     free_instance(c);
-    printf("ok mixed w_x=%.17g\n", w3);
+    printf("ok mixed w_x=%.17g (FMU states refused across versions)\n", w3);
+}
+
+static void epoch3(double h) {
+    for (int i = 0; i < N_EPOCHS; i++) {
+        double t0 = EPOCHS[i];
+        I c = instantiate("epoch3", GUID, NULL, false, false, false, false, NULL, 0, NULL, log3, NULL);
+        CHECK(c, "fmi3InstantiateCoSimulation");
+        if (TIMED("fmi3EnterInitializationMode", t0, enter_init(c, false, 0.0, t0, false, 0.0)) == OK &&
+            TIMED("fmi3ExitInitializationMode", t0, exit_init(c)) == OK) {
+            bool ev, term, early;
+            double last;
+            if (TIMED("fmi3DoStep", t0, do_step(c, t0, h, false, &ev, &term, &early, &last)) == OK)
+                TIMED("fmi3DoStep", t0, do_step(c, t0 + h, h, false, &ev, &term, &early, &last));
+        }
+        free_instance(c);
+    }
 }
 
 /* reuse mode (FMI 3.0), as reuse_round2: stale instance handles first (b must then run on to the reference),
@@ -1925,6 +2022,10 @@ static int main3(int argc, char **argv) {
             CHECK(memcmp(&w, &ref, sizeof w) == 0, "cycle3 gave different bits");
         }
         printf("ok cycles %d w_x=%.17g\n", n, ref);
+    } else if (!strcmp(mode, "epoch")) {
+        epoch3(argc > 4 ? atof(argv[4]) : 0.1);
+        printf("ok epoch: %d calls returned within 1 s, %d refused with Error naming the function (%d naming the 2^53 bound)\n",
+               n_epoch_calls, n_epoch_refused, n_epoch_bound);
     } else if (!strcmp(mode, "abuse")) {
         abuse();
     } else if (!strcmp(mode, "mixed")) {

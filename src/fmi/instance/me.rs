@@ -55,6 +55,9 @@ impl Instance {
         if !t.is_finite() {
             return Err(Fail::error(format!("time {t} is not finite")));
         }
+        if let Some(period) = self.model.time_grid() {
+            crate::math::sample_grid::check_time("time", t, period).map_err(Fail::error)?;
+        }
         // A solver may evaluate behind an accepted point, but never before the last event (event
         // instants increase, FMI 2.0 section 3.1): checked against the event itself (up to round-off),
         // in event mode too, so that no sequence of small steps back walks past it.

@@ -14,6 +14,7 @@ pub mod me;
 mod values;
 
 use crate::fmi::types::{FsmState, Log3Fn, LoggerFn, Status, LOG_CATEGORIES};
+use crate::math::sample_grid;
 
 /// The master's logger: FMI 2.0 (`fmi2CallbackLogger`) or FMI 3.0 (`fmi3LogMessageCallback`).
 #[derive(Clone, Copy)]
@@ -108,11 +109,16 @@ impl Run {
         if !self.time.is_finite() {
             return Err(format!("time {} is not finite", self.time));
         }
-        if !(self.event_time == f64::NEG_INFINITY
+        // -inf: no event yet, only in the states an instance can be in before it is initialized
+        let uninitialized = matches!(
+            self.fsm,
+            FsmState::Instantiated | FsmState::InitializationMode | FsmState::Terminated | FsmState::Error
+        );
+        if !((self.event_time == f64::NEG_INFINITY && uninitialized)
             || (self.event_time.is_finite() && self.event_time <= self.time + 2e-9 * self.event_time.abs().max(1.0)))
         {
             return Err(format!(
-                "time of the last event {} is not finite or lies after the time {}",
+                "time of the last event (event_time) {} is not finite or lies after the time {}",
                 self.event_time, self.time
             ));
         }
@@ -208,6 +214,7 @@ impl Instance {
                 )));
             }
         }
+        self.check_time_grid(start, stop)?;
         self.run.exp = Experiment {
             start_time: start,
             tolerance,
@@ -229,7 +236,21 @@ impl Instance {
         Ok(())
     }
 
+    /// A start or stop time beyond the exact range of the model's integer time grid (2^53 periods,
+    /// `Model::time_grid` with the current parameters) is refused with the bound named.
+    pub fn check_time_grid(&self, start: f64, stop: Option<f64>) -> CallResult {
+        let Some(period) = self.model.time_grid() else {
+            return Ok(());
+        };
+        sample_grid::check_time("startTime", start, period).map_err(Fail::error)?;
+        if let Some(stop) = stop {
+            sample_grid::check_time("stopTime", stop, period).map_err(Fail::error)?;
+        }
+        Ok(())
+    }
+
     pub fn enter_initialization_mode(&mut self) -> CallResult {
+        self.check_time_grid(self.run.exp.start_time, self.run.exp.stop_time)?;
         self.run.fsm = FsmState::InitializationMode;
         self.run.params_dirty = true;
         self.run.outputs_dirty = true;
@@ -239,6 +260,7 @@ impl Instance {
     /// Applies the parameters. On invalid parameters the instance stays in initialization mode, so
     /// the master may correct them and call again.
     pub fn exit_initialization_mode(&mut self) -> CallResult {
+        self.check_time_grid(self.run.exp.start_time, self.run.exp.stop_time)?;
         self.model.initialize(&self.run.exp).map_err(Fail::error)?;
         self.run.params_dirty = false;
         self.run.outputs_dirty = true;
@@ -278,6 +300,9 @@ impl Instance {
                     t + h
                 )));
             }
+        }
+        if let Some(period) = self.model.time_grid() {
+            sample_grid::check_time("the step's end t + h =", t + h, period).map_err(Fail::error)?;
         }
         if let Err(reason) = self.model.do_step(t, h) {
             self.run.fsm = FsmState::Error;

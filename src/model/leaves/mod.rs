@@ -58,11 +58,15 @@ impl fmt::Display for Leaf {
 }
 
 /// Flattens a serializable value into (path, leaf) pairs, paths as indices into `paths`.
+/// `offsets[i]` is where leaf i starts in the value's postcard encoding (the byte format of FMU
+/// states), so that a test can write into a serialized state at a named field.
 #[derive(Default)]
 pub struct Leaves {
     pub paths: Vec<String>,
     pub leaves: Vec<(u32, Leaf)>,
+    pub offsets: Vec<usize>,
     stack: Vec<u32>,
+    pos: usize,
 }
 
 #[derive(Debug)]
@@ -84,8 +88,8 @@ impl Leaves {
     pub fn of<T: Serialize + ?Sized>(value: &T) -> Result<Leaves, String> {
         let mut l = Leaves {
             paths: vec![String::new()],
-            leaves: Vec::new(),
             stack: vec![0],
+            ..Leaves::default()
         };
         value.serialize(&mut l).map_err(|e| e.0)?;
         Ok(l)
@@ -99,9 +103,12 @@ impl Leaves {
         *self.stack.last().expect("root path")
     }
 
-    fn push(&mut self, leaf: Leaf) {
+    /// A leaf of `size` bytes in the postcard encoding.
+    fn push(&mut self, leaf: Leaf, size: usize) {
         let p = self.cur();
         self.leaves.push((p, leaf));
+        self.offsets.push(self.pos);
+        self.pos += size;
     }
 
     fn enter(&mut self, field: &str) {
@@ -170,6 +177,20 @@ pub fn check_restored<T: Serialize>(restored: &T, fresh: &T, evolving: &[&str]) 
             "restored state: {} is missing (different structure)",
             f.path(*fp)
         ));
+    }
+    Ok(())
+}
+
+/// Every float of a restored value must be finite, evolving or not: a NaN or infinity anywhere in a
+/// state (even in a field nothing reads yet) is refused with the field's path (`what` prefixes it).
+pub fn check_all_finite<T: Serialize + ?Sized>(value: &T, what: &str) -> Result<(), String> {
+    let l = Leaves::of(value)?;
+    for (p, leaf) in &l.leaves {
+        if let Some(x) = leaf.float() {
+            if !x.is_finite() {
+                return Err(format!("restored state: {what}{} = {x} is not finite", l.path(*p)));
+            }
+        }
     }
     Ok(())
 }

@@ -83,6 +83,9 @@ impl BDot {
 
 impl Model for BDot {
     type Vars = BDotVars;
+    fn time_grid(v: &BDotVars) -> Option<f64> {
+        Some(v.sample_period)
+    }
     const EVOLVING: &'static [&'static str] = &["mem"];
     const INFO: ModelInfo = ModelInfo {
         name: "BDot",
@@ -110,14 +113,14 @@ step see the same held input.</p>", crate::sample_grid_note!()),
     fn initialize(v: &mut BDotVars, exp: &Experiment) -> Result<Self, String> {
         v.k = if v.gain_rule == 1 { 2.0 * v.orbit_rate * (1.0 + v.field_inclination.sin()) * v.inertia_min } else { v.gain };
         let alpha = if v.filter_time_constant > 0.0 { (-v.sample_period / v.filter_time_constant).exp() } else { 0.0 };
-        let k0 = sample_index(exp.start_time, v.sample_period);
+        let k0 = sample_index(exp.start_time, v.sample_period)?;
         let d = Derived { period: v.sample_period, k: v.k, alpha, m_max: v.dipole_max, k0 };
         Ok(BDot { d, mem: Memory { next: k0, b_prev: None, rate: [0.0; 3], m: [0.0; 3] } })
     }
 
     fn outputs(&self, v: &mut BDotVars, t: f64) -> ModelResult {
         // a sample due at t and not taken yet is computed from the current input (not latched)
-        let due = sample_index(t, self.d.period) >= self.mem.next;
+        let due = sample_index(t, self.d.period)? >= self.mem.next;
         let mem = if due { self.sample(&self.mem, &v.b_meas)? } else { self.mem.clone() };
         v.m_cmd = Vector3::from(mem.m);
         v.b_dir_rate = Vector3::from(mem.rate);
@@ -125,12 +128,13 @@ step see the same held input.</p>", crate::sample_grid_note!()),
     }
 
     fn step(&mut self, v: &BDotVars, t: f64, h: f64) -> ModelResult {
-        let k_end = last_sample_before(t + h, self.d.period);
-        if k_end - self.mem.next >= MAX_SAMPLES_PER_CALL {
+        let k_end = last_sample_before(t + h, self.d.period)?;
+        let n = k_end.checked_sub(self.mem.next).ok_or("sample count overflows")?;
+        if n >= MAX_SAMPLES_PER_CALL {
             return Err(format!(
                 "a step to t = {} takes {} samples of period {} s (at most {MAX_SAMPLES_PER_CALL} per step)",
                 t + h,
-                k_end - self.mem.next + 1,
+                n + 1,
                 self.d.period
             ));
         }

@@ -5,7 +5,6 @@
 //! tracker's latency (`st_latency`) is compensated by a delayed update (`mekf_delay.rs`).
 
 use std::collections::VecDeque;
-
 use nalgebra::{Matrix3, Quaternion, Rotation3, SMatrix, SVector, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -292,8 +291,9 @@ impl Mekf {
 
     /// Runs the filter through the samples up to k with the inputs v.
     fn propagate(&self, s: &Est, k: i64, v: &MekfVars) -> Result<Est, String> {
-        if k - s.k > MAX_SAMPLES_PER_CALL {
-            return Err(format!("the filter would take {} samples of period {} s in one call (at most {MAX_SAMPLES_PER_CALL})", k - s.k, self.d.period));
+        let n = k.checked_sub(s.k).ok_or("sample count overflows")?;
+        if n > MAX_SAMPLES_PER_CALL {
+            return Err(format!("the filter would take {n} samples of period {} s in one call (at most {MAX_SAMPLES_PER_CALL})", self.d.period));
         }
         let mut s = s.clone();
         for j in s.k + 1..=k {
@@ -305,6 +305,9 @@ impl Mekf {
 
 impl Model for Mekf {
     type Vars = MekfVars;
+    fn time_grid(v: &MekfVars) -> Option<f64> {
+        Some(v.sample_period)
+    }
     const EVOLVING: &'static [&'static str] = &["s"];
     const INFO: ModelInfo = ModelInfo {
         name: "Mekf",
@@ -360,7 +363,7 @@ estimation error squared and the NIS follow chi-square distributions of 6 and ni
         if !(nq > 1e-6 && nq.is_finite()) {
             return Err(format!("parameter q_init has norm {nq}, expected a non-zero quaternion"));
         }
-        let k0 = sample_grid::index_at(exp.start_time, t, exp.start_time);
+        let k0 = sample_grid::index_at(exp.start_time, t, exp.start_time)?;
         let mut p0 = Matrix6::zeros();
         for i in 0..3 {
             p0[(i, i)] = v.sigma_att_init.powi(2);
@@ -403,7 +406,7 @@ estimation error squared and the NIS follow chi-square distributions of 6 and ni
     }
 
     fn outputs(&self, v: &mut MekfVars, t: f64) -> ModelResult {
-        let k = sample_grid::index_at(t, self.d.period, t);
+        let k = sample_grid::index_at(t, self.d.period, t)?;
         let s = if k > self.s.k { self.propagate(&self.s, k, v)? } else { self.s.clone() };
         if s.k < self.d.k0 {
             return Err(format!("the filter has no sample before the start time (t = {t})"));
@@ -420,7 +423,7 @@ estimation error squared and the NIS follow chi-square distributions of 6 and ni
     }
 
     fn step(&mut self, v: &MekfVars, t: f64, h: f64) -> ModelResult {
-        let k_end = sample_grid::last_before(t + h, self.d.period, t + h);
+        let k_end = sample_grid::last_before(t + h, self.d.period, t + h)?;
         if k_end > self.s.k {
             self.s = self.propagate(&self.s, k_end, v)?;
         }

@@ -88,8 +88,9 @@ impl Gyro {
 
     /// Propagates `s` through the samples up to k with the input w.
     fn propagate(&self, s: &Sample, k: i64, w: &Vector3<f64>) -> Result<Sample, String> {
-        if k - s.k > MAX_SAMPLES_PER_CALL {
-            return Err(format!("the gyro would take {} samples of period {} s in one call (at most {MAX_SAMPLES_PER_CALL})", k - s.k, self.d.period));
+        let n = k.checked_sub(s.k).ok_or("sample count overflows")?;
+        if n > MAX_SAMPLES_PER_CALL {
+            return Err(format!("the gyro would take {n} samples of period {} s in one call (at most {MAX_SAMPLES_PER_CALL})", self.d.period));
         }
         let mut s = s.clone();
         for j in s.k + 1..=k {
@@ -101,6 +102,9 @@ impl Gyro {
 
 impl Model for Gyro {
     type Vars = GyroVars;
+    fn time_grid(v: &GyroVars) -> Option<f64> {
+        Some(v.sample_period)
+    }
     const EVOLVING: &'static [&'static str] = &["s"];
     const INFO: ModelInfo = ModelInfo {
         name: "Gyro",
@@ -125,7 +129,7 @@ not depend on the communication step, and an FMU state restores the bias states 
 
     fn initialize(v: &mut GyroVars, exp: &Experiment) -> Result<Self, String> {
         let t = v.sample_period;
-        let k0 = sample_index(exp.start_time, t);
+        let k0 = sample_index(exp.start_time, t)?;
         let phi = (-t / v.bias_corr_time).exp();
         v.gm_std = v.bias_instability * (FLICKER_FLOOR / GM_ADEV_PEAK);
         v.rate_noise_std = v.arw_psd.map(|p| (p / t).sqrt());
@@ -146,7 +150,7 @@ not depend on the communication step, and an FMU state restores the bias states 
     }
 
     fn outputs(&self, v: &mut GyroVars, t: f64) -> ModelResult {
-        let k = sample_index(t, self.d.period);
+        let k = sample_index(t, self.d.period)?;
         let s = if k > self.s.k { self.propagate(&self.s, k, &v.w)? } else { self.s.clone() };
         if s.k < self.d.k0 {
             return Err(format!("the gyro has no sample before the start time (t = {t})"));
@@ -160,7 +164,7 @@ not depend on the communication step, and an FMU state restores the bias states 
     }
 
     fn step(&mut self, v: &GyroVars, t: f64, h: f64) -> ModelResult {
-        let k_end = last_sample_before(t + h, self.d.period);
+        let k_end = last_sample_before(t + h, self.d.period)?;
         if k_end > self.s.k {
             self.s = self.propagate(&self.s, k_end, &v.w)?;
         }

@@ -50,6 +50,9 @@ impl Magnetometer {
 
 impl Model for Magnetometer {
     type Vars = MagnetometerVars;
+    fn time_grid(v: &MagnetometerVars) -> Option<f64> {
+        Some(v.sample_period)
+    }
     const EVOLVING: &'static [&'static str] = &["line"];
     const INFO: ModelInfo = ModelInfo {
         name: "Magnetometer",
@@ -64,7 +67,7 @@ B_R(t)   = (M_E / r^3) [z - 3 (z . r_hat) r_hat],   r_hat(t) = [cos u, sin u cos
     };
 
     fn initialize(v: &mut MagnetometerVars, exp: &Experiment) -> Result<Self, String> {
-        let k0 = sample_index(exp.start_time, v.sample_period);
+        let k0 = sample_index(exp.start_time, v.sample_period)?;
         let d = Derived { period: v.sample_period, k0, seed: v.seed as i64, orbit: v.orbit.orbit(), noise: v.noise, bias: v.bias };
         Ok(Magnetometer { d, line: DelayLine::new([0.0; 3], k0) })
     }
@@ -72,7 +75,7 @@ B_R(t)   = (M_E / r^3) [z - 3 (z . r_hat) r_hat],   r_hat(t) = [cos u, sin u cos
     fn outputs(&self, v: &mut MagnetometerVars, t: f64) -> ModelResult {
         check_unit("q", &v.truth.q)?;
         let q = v.truth.q;
-        let (b, _) = self.line.at(t, self.d.period, 0.0, |k| self.sample(k, &q), |_| true);
+        let (b, _) = self.line.at(t, self.d.period, 0.0, |k| self.sample(k, &q), |_| true)?;
         v.b_meas = Vector3::from(b);
         Ok(())
     }

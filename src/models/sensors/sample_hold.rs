@@ -50,6 +50,9 @@ fn inputs(v: &SampleHoldVars) -> [f64; CHANNELS] {
 
 impl Model for SampleHold {
     type Vars = SampleHoldVars;
+    fn time_grid(v: &SampleHoldVars) -> Option<f64> {
+        Some(v.sample_period)
+    }
     const EVOLVING: &'static [&'static str] = &["line"];
     const INFO: ModelInfo = ModelInfo {
         name: "SampleHold",
@@ -70,13 +73,13 @@ input held at the step's start; with T and d multiples of the communication step
             return Err(format!("parameters delay = {} and sample_period = {}: the delay is more than 1e6 sample periods", v.delay, v.sample_period));
         }
         v.delay_samples = v.delay / v.sample_period;
-        let k0 = sample_index(exp.start_time, v.sample_period);
+        let k0 = sample_index(exp.start_time, v.sample_period)?;
         Ok(SampleHold { period: v.sample_period, delay: v.delay, k0, line: DelayLine::new([v.initial_output; CHANNELS], k0) })
     }
 
     fn outputs(&self, v: &mut SampleHoldVars, t: f64) -> ModelResult {
         let u = inputs(v);
-        let (y, _) = self.line.at(t, self.period, self.delay, |_| u, |_| true);
+        let (y, _) = self.line.at(t, self.period, self.delay, |_| u, |_| true)?;
         [v.y_1, v.y_2, v.y_3, v.y_4, v.y_5, v.y_6, v.y_7, v.y_8] = y;
         Ok(())
     }

@@ -73,6 +73,9 @@ impl StarTracker {
 
 impl Model for StarTracker {
     type Vars = StarTrackerVars;
+    fn time_grid(v: &StarTrackerVars) -> Option<f64> {
+        Some(v.sample_period)
+    }
     const EVOLVING: &'static [&'static str] = &["line"];
     const INFO: ModelInfo = ModelInfo {
         name: "StarTracker",
@@ -97,7 +100,7 @@ attitude held at the step's start.</p>", crate::sample_grid_note!()),
         if v.latency / v.sample_period > 1e6 {
             return Err(format!("parameters latency = {} and sample_period = {}: the latency is more than 1e6 sample periods", v.latency, v.sample_period));
         }
-        let k0 = sample_index(exp.start_time, v.sample_period);
+        let k0 = sample_index(exp.start_time, v.sample_period)?;
         let d = Derived {
             period: v.sample_period,
             latency: v.latency,
@@ -114,7 +117,7 @@ attitude held at the step's start.</p>", crate::sample_grid_note!()),
     fn outputs(&self, v: &mut StarTrackerVars, t: f64) -> ModelResult {
         check_unit("q", &v.truth.q)?;
         let q = v.truth.q;
-        let (s, ok) = self.line.at(t, self.d.period, self.d.latency, |k| self.sample(k, &q), |s| s.valid);
+        let (s, ok) = self.line.at(t, self.d.period, self.d.latency, |k| self.sample(k, &q), |s| s.valid)?;
         v.q_meas = Quaternion::new(s.q[0], s.q[1], s.q[2], s.q[3]);
         v.valid = if ok { 1.0 } else { 0.0 };
         v.st_valid = v.valid;

@@ -72,6 +72,9 @@ impl SunSensor {
 
 impl Model for SunSensor {
     type Vars = SunSensorVars;
+    fn time_grid(v: &SunSensorVars) -> Option<f64> {
+        Some(v.sample_period)
+    }
     const EVOLVING: &'static [&'static str] = &["line"];
     const INFO: ModelInfo = ModelInfo {
         name: "SunSensor",
@@ -92,7 +95,7 @@ is Rayleigh-distributed with mean square 2 sigma^2.</p>", crate::sample_grid_not
     };
 
     fn initialize(v: &mut SunSensorVars, exp: &Experiment) -> Result<Self, String> {
-        let k0 = sample_index(exp.start_time, v.sample_period);
+        let k0 = sample_index(exp.start_time, v.sample_period)?;
         let d = Derived {
             period: v.sample_period,
             k0,
@@ -111,7 +114,7 @@ is Rayleigh-distributed with mean square 2 sigma^2.</p>", crate::sample_grid_not
     fn outputs(&self, v: &mut SunSensorVars, t: f64) -> ModelResult {
         check_unit("q", &v.truth.q)?;
         let q = v.truth.q;
-        let (s, ok) = self.line.at(t, self.d.period, 0.0, |k| self.sample(k, &q), |s| s.valid);
+        let (s, ok) = self.line.at(t, self.d.period, 0.0, |k| self.sample(k, &q), |s| s.valid)?;
         v.sun_meas = Vector3::from(s.s);
         v.valid = if ok { 1.0 } else { 0.0 };
         v.sun_valid = v.valid;

@@ -36,6 +36,9 @@ pub struct FopidController {
 
 impl Model for FopidController {
     type Vars = FopidControllerVars;
+    fn time_grid(v: &FopidControllerVars) -> Option<f64> {
+        Some(v.step)
+    }
     const EVOLVING: &'static [&'static str] = &["law.history"];
     const INFO: ModelInfo = ModelInfo {
         name: "FopidController",

@@ -34,6 +34,9 @@ pub struct PidController {
 
 impl Model for PidController {
     type Vars = PidControllerVars;
+    fn time_grid(v: &PidControllerVars) -> Option<f64> {
+        Some(v.step)
+    }
     const EVOLVING: &'static [&'static str] = &["law.history"];
     const INFO: ModelInfo = ModelInfo {
         name: "PidController",

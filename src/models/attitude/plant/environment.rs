@@ -9,6 +9,7 @@ use super::{AttitudePlant, AttitudePlantVars};
 use crate::math::environment::{gravity_gradient, EARTH_RADIUS};
 use crate::math::surface_forces::{drag, radiation_pressure, solar_pressure, Wrench};
 use crate::math::random::{hold_index, normal};
+use crate::math::sample_grid::{beyond, exact_index, MAX_INDEX};
 
 /// What is constant over one internal step (steps are cut at fault_time and at noise-hold boundaries).
 #[derive(Clone, Copy, Debug)]
@@ -32,14 +33,18 @@ pub fn noise(v: &AttitudePlantVars, k: i64) -> Vector3<f64> {
 }
 
 /// Segment of the instant t (for outputs): fault active from fault_time on, noise interval ⌊t/T_n⌋.
+/// Beyond 2^53 intervals (refused for a noise-on plant by the layer's time bound, `Model::time_grid`)
+/// the last countable interval: a key only, no arithmetic follows.
 pub fn segment_at(v: &AttitudePlantVars, t: f64) -> Segment {
-    Segment { faulted: t >= v.fault_time, noise: noise(v, hold_index(t, v.dist_noise_hold)) }
+    let k = hold_index(t, v.dist_noise_hold).unwrap_or(MAX_INDEX);
+    Segment { faulted: t >= v.fault_time, noise: noise(v, k) }
 }
 
 /// Segment of an event-free piece starting at ts with length len (evaluated at its midpoint).
 pub fn segment_of_piece(v: &AttitudePlantVars, ts: f64, len: f64) -> Segment {
     let mid = ts + 0.5 * len;
-    Segment { faulted: mid >= v.fault_time, noise: noise(v, (mid / v.dist_noise_hold).floor() as i64) }
+    let k = exact_index((mid / v.dist_noise_hold).floor()).unwrap_or(MAX_INDEX);
+    Segment { faulted: mid >= v.fault_time, noise: noise(v, k) }
 }
 
 /// Breakpoints inside (t, t + h): fault onset and the noise-hold boundaries k T_n.
@@ -47,7 +52,8 @@ pub fn breakpoints(v: &AttitudePlantVars, t: f64, h: f64) -> Result<Vec<f64>, St
     let mut b = vec![v.fault_time];
     if noise_on(v) {
         let tn = v.dist_noise_hold;
-        let (k0, k1) = (hold_index(t, tn) + 1, hold_index(t + h, tn));
+        let k0 = hold_index(t, tn).ok_or_else(|| beyond("time", t, tn))? + 1; // |k| <= 2^53: no overflow
+        let k1 = hold_index(t + h, tn).ok_or_else(|| beyond("step end", t + h, tn))?;
         if k1 - k0 > 1_000_000 {
             return Err(format!("dist_noise_hold = {tn} s gives more than 1e6 noise intervals in one step of {h} s"));
         }

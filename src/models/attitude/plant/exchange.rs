@@ -85,7 +85,11 @@ pub const STATES: [StateDecl; super::kinematics::N] = [
 /// The first time event after t: the fault onset or the next noise-hold boundary.
 pub fn next_time_event(v: &AttitudePlantVars, t: f64) -> Option<f64> {
     let fault = Some(v.fault_time).filter(|tf| *tf > t);
-    let noise = noise_on(v).then(|| (hold_index(t, v.dist_noise_hold) + 1) as f64 * v.dist_noise_hold).filter(|tn| *tn > t);
+    let noise = noise_on(v)
+        .then(|| hold_index(t, v.dist_noise_hold))
+        .flatten()
+        .map(|k| (k + 1) as f64 * v.dist_noise_hold) // |k| <= 2^53: no overflow
+        .filter(|tn| *tn > t);
     match (fault, noise) {
         (Some(a), Some(b)) => Some(a.min(b)),
         (a, b) => a.or(b),

@@ -91,6 +91,9 @@ impl AttitudePlant {
 
 impl Model for AttitudePlant {
     type Vars = AttitudePlantVars;
+    fn time_grid(v: &AttitudePlantVars) -> Option<f64> {
+        environment::noise_on(v).then_some(v.dist_noise_hold)
+    }
     const EVOLVING: &'static [&'static str] = &["x", "stepper.h_adapt", "q_dcm"];
     const INFO: ModelInfo = ModelInfo {
         name: "AttitudePlant",

@@ -24,18 +24,18 @@ pub const MAX_SAMPLES_PER_CALL: i64 = 1_000_000;
 
 /// Index of the last sample instant k T strictly before `t_end` (−1 if none; an instant within the grid
 /// tolerance of t_end is at t_end): samples latched by a step that ends at t_end.
-pub fn last_sample_before(t_end: f64, period: f64) -> i64 {
+pub fn last_sample_before(t_end: f64, period: f64) -> Result<i64, String> {
     sample_grid::last_before(t_end, period, t_end)
 }
 
 /// Index k of the sample interval [k T, (k+1) T) holding t (on the grid to its tolerance).
-pub fn sample_index(t: f64, period: f64) -> i64 {
+pub fn sample_index(t: f64, period: f64) -> Result<i64, String> {
     sample_grid::index_at(t, period, t)
 }
 
 /// Index of the sample delivered at t with delay d: the interval of t − d, on the grid to the
 /// tolerance of the times t and d the difference is made of.
-pub fn delivered_index(t: f64, delay: f64, period: f64) -> i64 {
+pub fn delivered_index(t: f64, delay: f64, period: f64) -> Result<i64, String> {
     sample_grid::index_at(t - delay, period, t.abs() + delay.abs())
 }
 
@@ -69,20 +69,20 @@ impl<T: Clone> DelayLine<T> {
         delay: f64,
         fresh: impl FnOnce(i64) -> T,
         usable: impl Fn(&T) -> bool,
-    ) -> (T, bool) {
-        let kd = delivered_index(t, delay, period);
+    ) -> Result<(T, bool), String> {
+        let kd = delivered_index(t, delay, period)?;
         if kd < 0 {
-            return (self.held.clone(), false);
+            return Ok((self.held.clone(), false));
         }
         let s = if kd > self.last {
             Some(fresh(kd))
         } else {
             self.queue.iter().find(|(k, _)| *k == kd).map(|(_, s)| s.clone())
         };
-        match s {
+        Ok(match s {
             Some(s) if usable(&s) => (s, true),
             _ => (self.latest_usable_before(kd, &usable), false),
-        }
+        })
     }
 
     /// The last usable sample delivered before index kd (queue entries below kd, else `held`).
@@ -105,16 +105,21 @@ impl<T: Clone> DelayLine<T> {
         mut sample: impl FnMut(i64) -> T,
         usable: impl Fn(&T) -> bool,
     ) -> ModelResult {
-        let k_end = last_sample_before(t + h, period);
-        let first = self.last + 1;
-        if k_end - first >= MAX_SAMPLES_PER_CALL {
+        let k_end = last_sample_before(t + h, period)?;
+        // checked: a restored `last` is bounded by `check`, but never wrap on the way to the loop
+        let first = self
+            .last
+            .checked_add(1)
+            .ok_or("delay line: last sample index overflows")?;
+        let n = k_end.checked_sub(first).ok_or("delay line: sample count overflows")?;
+        if n >= MAX_SAMPLES_PER_CALL {
             return Err(format!(
                 "a step to t = {} takes {} samples of period {period} s (at most {MAX_SAMPLES_PER_CALL} per step)",
                 t + h,
-                k_end - first + 1
+                n + 1
             ));
         }
-        let kd = delivered_index(t + h, delay, period);
+        let kd = delivered_index(t + h, delay, period)?;
         // drop what is superseded at t + h: entries below kd (the last usable of them becomes `held`),
         // then latch the new samples (those already superseded only update `held`)
         let n_old = self.queue.iter().take_while(|(k, _)| *k < kd).count();
@@ -136,7 +141,7 @@ impl<T: Clone> DelayLine<T> {
 
     /// Invariants of a restored line: ascending indices not above `last`, at most `max_len` entries.
     pub fn check(&self, max_len: usize, first: i64) -> ModelResult {
-        if self.last < first - 1 || self.queue.len() > max_len {
+        if self.last < first - 1 || self.last >= sample_grid::MAX_INDEX || self.queue.len() > max_len {
             return Err(format!(
                 "restored state: delay line with last index {} and {} entries (at most {max_len})",
                 self.last,
@@ -161,10 +166,10 @@ mod tests {
 
     #[test]
     fn sample_instants_before_a_step_end() {
-        assert_eq!(last_sample_before(0.0, 0.1), -1);
-        assert_eq!(last_sample_before(0.3, 0.1), 2); // 0.3 = 3·0.1 is not exact in binary
-        assert_eq!(last_sample_before(0.35, 0.1), 3);
-        assert_eq!(last_sample_before(0.01, 0.1), 0);
+        assert_eq!(last_sample_before(0.0, 0.1), Ok(-1));
+        assert_eq!(last_sample_before(0.3, 0.1), Ok(2)); // 0.3 = 3·0.1 is not exact in binary
+        assert_eq!(last_sample_before(0.35, 0.1), Ok(3));
+        assert_eq!(last_sample_before(0.01, 0.1), Ok(0));
     }
 
     /// Samples of u(t) = t² at k T, delivered at k T + d: the output at t is u(⌊(t − d)/T⌋ T).
@@ -176,7 +181,7 @@ mod tests {
             for n in 0..200 {
                 let t = n as f64 * h;
                 let u = |k: i64| (k as f64 * period).powi(2);
-                let (y, ok) = line.at(t, period, delay, &u, |_| true);
+                let (y, ok) = line.at(t, period, delay, &u, |_| true).unwrap();
                 let kd = ((t - delay) / period + 1e-9).floor() as i64;
                 let want = if kd < 0 { -1.0 } else { u(kd) };
                 assert_eq!(y, want, "delay {delay}, t = {t}");
@@ -205,7 +210,7 @@ mod tests {
                     k as f64 + 10.0
                 }
             };
-            out.push(line.at(t, period, 0.0, &u, |s| *s >= 0.0));
+            out.push(line.at(t, period, 0.0, &u, |s| *s >= 0.0).unwrap());
             line.advance(t, h, period, 0.0, u, |s| *s >= 0.0).unwrap();
         }
         let ys: Vec<f64> = out.iter().map(|(y, _)| *y).collect();
@@ -226,5 +231,21 @@ mod tests {
         let e = line.advance(0.0, 10.0, 1e-6, 0.0, |_| 1.0, |_| true).unwrap_err();
         assert!(e.contains("samples of period"), "{e}");
         assert_eq!(line, DelayLine::new(0.0, 0));
+    }
+
+    /// A start 1e20 s before t = 0 at T = 0.1 s (the case): refused at once, never a loop.
+    #[test]
+    fn a_time_beyond_the_index_range_is_refused_not_looped() {
+        assert!(sample_index(-1e20, 0.1).unwrap_err().contains("2^53"));
+        let mut line = DelayLine::new(0.0, 0);
+        let e = line.advance(-1e20, 0.1, 0.1, 0.0, |_| 1.0, |_| true).unwrap_err();
+        assert!(
+            e.contains("-100000000000000000000 s") || e.contains("-99999999999999990000 s"),
+            "{e}"
+        );
+        // a restored line whose last index is at the end of i64 is refused by `check`
+        line.last = i64::MAX;
+        assert!(line.check(4, 0).is_err());
+        assert!(line.advance(0.0, 0.1, 0.1, 0.0, |_| 1.0, |_| true).is_err());
     }
 }

@@ -73,6 +73,19 @@ struct Stored {
     history: Vec<f64>,
 }
 
+impl Stored {
+    /// Whether a number of the stored law is NaN or infinite. Such a law is decoded as stored and not
+    /// built (no kernels from it): the restored-state check of every model (`leaves::check_all_finite`)
+    /// then refuses it naming the field, which a decoder error could not (postcard drops its text).
+    fn non_finite(&self) -> bool {
+        let p = &self.p;
+        ![p.kp, p.ki, p.kd, p.lambda, p.mu, p.h]
+            .iter()
+            .chain(&self.history)
+            .all(|x| x.is_finite())
+    }
+}
+
 /// Fractional PI^λD^μ law on the GL sums; the error history is the whole state.
 #[derive(Clone)]
 pub struct FopidLaw {
@@ -106,6 +119,19 @@ impl<'de> Deserialize<'de> for FopidLaw {
     /// derived buffers from the history.
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         let s = Stored::deserialize(d)?;
+        if s.non_finite() {
+            let kernel = || GlKernel::new(0.0, 0, s.fast);
+            return Ok(FopidLaw {
+                integral: kernel(),
+                derivative: kernel(),
+                wsum: Vec::new(),
+                scale_i: f64::NAN,
+                scale_d: f64::NAN,
+                p: s.p,
+                fast: s.fast,
+                history: s.history,
+            });
+        }
         FopidLaw::from_history(s.p, s.fast, s.history).map_err(serde::de::Error::custom)
     }
 }
@@ -248,6 +274,13 @@ impl Serialize for PidLaw {
 impl<'de> Deserialize<'de> for PidLaw {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         let s = Stored::deserialize(d)?;
+        if s.non_finite() {
+            return Ok(PidLaw {
+                p: s.p,
+                history: s.history,
+                sum: f64::NAN,
+            });
+        }
         // the PID is the λ = μ = 1 law with the exact running sum: anything else is not its state
         if !s.fast || s.p.lambda != 1.0 || s.p.mu != 1.0 {
             return Err(serde::de::Error::custom(
