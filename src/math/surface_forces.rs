@@ -41,17 +41,28 @@ pub struct Facet {
 impl Facet {
     /// A facet from its declared values: a unit normal from `normal` (refused when zero or not finite
     /// while the area is positive); coefficients checked (C_D ≥ 0; C_s, C_d ≥ 0 with C_s + C_d ≤ 1).
-    pub fn new(name: &str, area: f64, normal: Vector3<f64>, centre: Vector3<f64>, coeffs: [f64; 3]) -> Result<Self, String> {
+    pub fn new(
+        name: &str,
+        area: f64,
+        normal: Vector3<f64>,
+        centre: Vector3<f64>,
+        coeffs: [f64; 3],
+    ) -> Result<Self, String> {
         let [drag_coeff, specular, diffuse] = coeffs;
         if !(area.is_finite() && area >= 0.0) {
             return Err(format!("{name}_area = {area}: a finite area ≥ 0 m² is allowed"));
         }
         let n = normal.norm();
         if area > 0.0 && !(n.is_finite() && n > 0.0) {
-            return Err(format!("{name}_normal = {:?} has no direction: a non-zero finite vector is allowed", normal.as_slice()));
+            return Err(format!(
+                "{name}_normal = {:?} has no direction: a non-zero finite vector is allowed",
+                normal.as_slice()
+            ));
         }
         if !(drag_coeff.is_finite() && drag_coeff >= 0.0) {
-            return Err(format!("{name}_drag_coeff = {drag_coeff}: a finite coefficient ≥ 0 is allowed"));
+            return Err(format!(
+                "{name}_drag_coeff = {drag_coeff}: a finite coefficient ≥ 0 is allowed"
+            ));
         }
         if !(specular >= 0.0 && diffuse >= 0.0 && specular + diffuse <= 1.0) {
             return Err(format!(
@@ -59,7 +70,14 @@ impl Facet {
             ));
         }
         let normal = if area > 0.0 { normal / n } else { Vector3::zeros() };
-        Ok(Facet { area, normal, centre, drag_coeff, specular, diffuse })
+        Ok(Facet {
+            area,
+            normal,
+            centre,
+            drag_coeff,
+            specular,
+            diffuse,
+        })
     }
 }
 
@@ -180,9 +198,13 @@ mod tests {
     #[test]
     fn facets_are_checked() {
         let z = Vector3::zeros();
-        assert!(Facet::new("facet1", 1.0, z, z, [2.2, 0.0, 0.0]).unwrap_err().contains("facet1_normal"));
+        assert!(Facet::new("facet1", 1.0, z, z, [2.2, 0.0, 0.0])
+            .unwrap_err()
+            .contains("facet1_normal"));
         assert!(Facet::new("facet1", 0.0, z, z, [2.2, 0.0, 0.0]).is_ok()); // an unused facet
-        assert!(Facet::new("facet2", 1.0, Vector3::x(), z, [2.2, 0.7, 0.5]).unwrap_err().contains("sum"));
+        assert!(Facet::new("facet2", 1.0, Vector3::x(), z, [2.2, 0.7, 0.5])
+            .unwrap_err()
+            .contains("sum"));
         assert!(Facet::new("facet2", -1.0, Vector3::x(), z, [2.2, 0.0, 0.0]).is_err());
     }
 }

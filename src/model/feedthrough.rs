@@ -107,7 +107,11 @@ const fn count(decls: &[VarDecl], name: &str, causality: Causality) -> usize {
     i = 0;
     while i < decls.len() {
         let d = &decls[i];
-        let meant = if exact { same_str(name, d.name) } else { is_component_of(name, d.name) };
+        let meant = if exact {
+            same_str(name, d.name)
+        } else {
+            is_component_of(name, d.name)
+        };
         if same_causality(d.causality, causality) && meant {
             n += 1;
         }
@@ -285,11 +289,27 @@ mod tests {
         let scalar = scalar_list(&plant).unwrap();
         // the plant's list mixes stems ("torque_applied", "b_eci") and scalar names ("dipole_x", "m_cmd_x")
         assert_eq!(given[0], ("torque_applied", &["torque_cmd", "m_cmd", "b_eci"][..]));
-        let applied = ["torque_cmd_x", "torque_cmd_y", "torque_cmd_z", "m_cmd_x", "m_cmd_y", "m_cmd_z", "b_eci_x", "b_eci_y", "b_eci_z"];
-        for (k, axis) in ["torque_applied_x", "torque_applied_y", "torque_applied_z"].into_iter().enumerate() {
+        let applied = [
+            "torque_cmd_x",
+            "torque_cmd_y",
+            "torque_cmd_z",
+            "m_cmd_x",
+            "m_cmd_y",
+            "m_cmd_z",
+            "b_eci_x",
+            "b_eci_y",
+            "b_eci_z",
+        ];
+        for (k, axis) in ["torque_applied_x", "torque_applied_y", "torque_applied_z"]
+            .into_iter()
+            .enumerate()
+        {
             assert_eq!(scalar[k], (axis, applied.to_vec()));
         }
-        assert_eq!(scalar[3], ("dipole_x", vec!["m_cmd_x", "b_eci_x", "b_eci_y", "b_eci_z"]));
+        assert_eq!(
+            scalar[3],
+            ("dipole_x", vec!["m_cmd_x", "b_eci_x", "b_eci_y", "b_eci_z"])
+        );
         assert_eq!(scalar.len(), 3 + 3 + 3 + 3 * 7);
 
         static INFO: crate::model::ModelInfo = crate::model::ModelInfo {
