@@ -1,10 +1,10 @@
 """The hostile-master checks of `scfmu check` (start_times, stale_handles, state_nan; scfmu.check.hostile) on
 FMUs we ship, FMI 2.0 and 3.0: a continuous controller (PdController) and a sampled sensor law (BDot).
 
-What they report today (issue 45) is asserted with what the fixes of the Rust layer will change: a sampled
-unit hangs on a start time of about -1e18 (its sample index wraps; the fix refuses such a start time at
-initialisation, which also passes), and a freed instance whose address a new instance got steps the new one
-(the fix refuses it, which passes). A NaN written into a serialized state breaks its checksum: refused."""
+Before the fixes of issue 45 a sampled unit hung on a start time of about -1e18 (its sample index wrapped)
+and a freed instance whose address a new instance got stepped the new one; the checks reported both. Now a
+start time beyond the exact sample-index range is refused at initialisation, handles are tokens that are
+never reused, and a NaN written into a serialized state is refused: every row passes."""
 
 from __future__ import annotations
 
@@ -26,19 +26,12 @@ def test_hostile_checks_on_shipped_fmus(fmu):
     rep = check(fmu, quick=True, checks=list(HOSTILE_CHECKS), call_timeout=2)
     for itf in rep.interfaces:
         st = rep.row("start_times", itf)
-        if "BDot" in fmu.name and st["status"] == "fail":  # today: the first DoStep at -1e18 never returns
-            assert st["kind"] == "hang" and st["class"] == "robustness", st
-            call = st["reproducer"][-1]
-            assert call.split("(")[0].endswith("DoStep") and float(call.split(", ")[1]) <= -1e17, call
-        else:
-            assert st["status"] == "pass", st
-            assert st["metrics"]["accepted"] + st["metrics"]["refused"] == 20
+        assert st["status"] == "pass", st
+        assert st["metrics"]["accepted"] + st["metrics"]["refused"] == 20
+        if "BDot" in fmu.name:  # the sampled unit refuses the start times beyond 2^53 sample periods
+            assert st["metrics"]["refused"] >= 10, st["detail"]
         sh = rep.row("stale_handles", itf)
-        if sh["status"] == "fail":  # today: the address is reused and the stale handle steps the new instance
-            assert sh["kind"] == "stale_handle" and sh["rule"].startswith("R5"), sh
-            assert "its address was given to a new instance" in sh["detail"], sh["detail"]
-        else:
-            assert "refused" in sh["detail"], sh
+        assert sh["status"] == "pass" and "freed instance refused" in sh["detail"], sh
         sn = rep.row("state_nan", itf)
         assert sn["status"] == "pass", sn
         m = sn["metrics"]
