@@ -34,6 +34,15 @@ ATTITUDE_FEATURES = [
     {"actuator_mode": 1, "mtq_enable": 1, "gg_enable": 0, "wheel_time_constant": 0.0, **FULL_INERTIA, **MISALIGNED},
     # magnetorquers following the dipole command input m_cmd (B-dot), besides lagging wheels
     {"actuator_mode": 1, "mtq_mode": 1, "gg_enable": 1, "wheel_time_constant": 0.5, **FULL_INERTIA, **MISALIGNED},
+    # the environment inputs: gravity gradient from r, field from b_eci (magnetorquers, residual dipole), drag
+    # and solar pressure on three facets off the centre of mass
+    *({"environment_inputs": 1, "actuator_mode": 1, "mtq_enable": 1, "gg_enable": 1, "wheel_time_constant": lag,
+     "residual_dipole_x": 0.05, "residual_dipole_z": -0.02, **FULL_INERTIA, **MISALIGNED,
+     **{f"facet{k}_{q}": v for k, n, c in ((1, (1.0, 0.3, 0.2), (0.5, 0.1, 0.0)), (2, (-0.2, 1.0, 0.4), (0.0, 0.6, 0.2)),
+                                          (3, (0.3, -0.1, 1.0), (0.1, -0.2, 0.7)))
+        for q, v in (("area", 2.0), ("specular", 0.3), ("diffuse", 0.2),
+                     *((f"normal_{a}", x) for a, x in zip("xyz", n)), *((f"centre_{a}", x) for a, x in zip("xyz", c)))}}
+      for lag in (0.5, 0.0)),  # with lag the field reaches the lag states, without it the wheel momenta
 ]
 CASES = {
     "AttitudePlant": [dict(p, kinematics=k) for k in (0, 1, 2, 3, 4) for p in ATTITUDE_FEATURES],
@@ -55,6 +64,11 @@ SCALE = {"AttitudePlant": 0.01, "RelativeOrbitPlant": 1000.0}
 AT_BOUND = {m: {f"state_ihat_{c}": f"ihat_min_{c}" for c in "xyz"} for m in ("MracController", "AdaptiveFuzzyController")}
 
 
+def _unit(rng):
+    x = rng.standard_normal(3)
+    return x / np.linalg.norm(x)
+
+
 def md_of(model):
     return read_model_description(str(fmu_path(model)))
 
@@ -73,6 +87,9 @@ def probe(model: str, params: dict, seed: int, points: int = 8):
     for name, value in params.items():
         v = by_name[name]
         (fmu.setInteger if v.type == "Integer" else fmu.setReal)([v.valueReference], [value])
+    if params.get("environment_inputs") == 1:  # an orbit, a field and a sun before the first event iteration
+        start = {"r_x": 7.0e6, "v_y": 7.5e3, "b_eci_z": 3e-5, "sun_eci_x": 1.0}
+        fmu.setReal([by_name[k].valueReference for k in start], list(start.values()))
     fmu.exitInitializationMode()
     while fmu.newDiscreteStates()[0]:  # newDiscreteStatesNeeded
         pass
@@ -100,6 +117,12 @@ def probe(model: str, params: dict, seed: int, points: int = 8):
     def draw():
         x = x0 + scale * rng.standard_normal(nx)
         u = scale * rng.standard_normal(len(inputs))
+        if "sun_distance" in names_in:  # the plant's environment: an orbit state, a field, a sun, air
+            env = {"r": _unit(rng) * 7.0e6, "v": _unit(rng) * 7.5e3, "b_eci": _unit(rng) * 3e-5, "sun_eci": _unit(rng)}
+            for stem, vec in env.items():
+                u[[names_in.index(f"{stem}_{c}") for c in "xyz"]] = vec
+            for name, value in (("eclipse", rng.uniform(0.2, 0.8)), ("rho", 1e-9), ("sun_distance", 1.496e11)):
+                u[names_in.index(name)] = value
         for q in ("q", "q_ref"):  # unit quaternion inputs near the identity (controllers check the norm)
             ix = [names_in.index(f"{q}_{c}") for c in "wxyz" if f"{q}_{c}" in names_in]
             if len(ix) == 4:

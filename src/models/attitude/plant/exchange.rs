@@ -44,17 +44,18 @@ const fn s(name: &'static str, unit: &'static str, description: &'static str, on
 // q̇ = ½ q ⊗ ω (entry i not on q_i), Ȧ = −[ω×] A (entry (i, j) on the other two entries of column j
 // and the two rates other than ω_i), the Euler-angle rates on roll, yaw and ω. The wheel momentum and
 // the wheel lag read the command of their axis, their own lag state, and through the magnetorquers
-// (m = k h_w × B / |B|², B = A B_R) every wheel momentum and every attitude entry. The body rates read
+// (m = k h_w × B / |B|², B = A B_R, or B = A b_eci with the environment inputs) every wheel momentum,
+// every attitude entry and the field input. The body rates read
 // everything (full inertia, gyroscopic terms, gravity gradient, actuators): no list.
 const ATT_ALL: [&str; 9] = ["state_att_1", "state_att_2", "state_att_3", "state_att_4", "state_att_5", "state_att_6", "state_att_7", "state_att_8", "state_att_9"];
-const WHEEL_X: [&str; 14] = concat_names(&ATT_ALL, &["state_h_wheel_x", "state_h_wheel_y", "state_h_wheel_z", "state_wheel_torque_x", "torque_cmd_x"]);
-const WHEEL_Y: [&str; 14] = concat_names(&ATT_ALL, &["state_h_wheel_x", "state_h_wheel_y", "state_h_wheel_z", "state_wheel_torque_y", "torque_cmd_y"]);
-const WHEEL_Z: [&str; 14] = concat_names(&ATT_ALL, &["state_h_wheel_x", "state_h_wheel_y", "state_h_wheel_z", "state_wheel_torque_z", "torque_cmd_z"]);
+const WHEEL_X: [&str; 17] = concat_names(&ATT_ALL, &["state_h_wheel_x", "state_h_wheel_y", "state_h_wheel_z", "state_wheel_torque_x", "torque_cmd_x", "b_eci_x", "b_eci_y", "b_eci_z"]);
+const WHEEL_Y: [&str; 17] = concat_names(&ATT_ALL, &["state_h_wheel_x", "state_h_wheel_y", "state_h_wheel_z", "state_wheel_torque_y", "torque_cmd_y", "b_eci_x", "b_eci_y", "b_eci_z"]);
+const WHEEL_Z: [&str; 17] = concat_names(&ATT_ALL, &["state_h_wheel_x", "state_h_wheel_y", "state_h_wheel_z", "state_wheel_torque_z", "torque_cmd_z", "b_eci_x", "b_eci_y", "b_eci_z"]);
 
 // the wheel momenta: ḣ_w = −M τ_rw with M = R(δ) diag(k) (actuator misalignment and scale factor) couples
 // every wheel axis into every body axis
-const H_WHEEL: [&str; 18] = concat_names(&ATT_ALL, &["state_h_wheel_x", "state_h_wheel_y", "state_h_wheel_z", "state_wheel_torque_x",
-    "state_wheel_torque_y", "state_wheel_torque_z", "torque_cmd_x", "torque_cmd_y", "torque_cmd_z"]);
+const H_WHEEL: [&str; 21] = concat_names(&ATT_ALL, &["state_h_wheel_x", "state_h_wheel_y", "state_h_wheel_z", "state_wheel_torque_x",
+    "state_wheel_torque_y", "state_wheel_torque_z", "torque_cmd_x", "torque_cmd_y", "torque_cmd_z", "b_eci_x", "b_eci_y", "b_eci_z"]);
 
 const fn concat_names<const N: usize>(a: &[&'static str], b: &[&'static str]) -> [&'static str; N] {
     crate::model::concat(&[a, b], "")
