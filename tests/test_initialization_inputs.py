@@ -89,16 +89,22 @@ def test_every_unit_reads_its_outputs_with_zero_inputs_in_initialization_mode(pa
         u.freeInstance()
 
 
-def test_a_controller_warns_in_initialization_and_refuses_after_it():
-    messages = []
+def _pd_in_initialization(messages):
+    """A PdController (FMI 2.0 CS) in Initialization Mode with the quaternion input [0, 0, 0, 0]; (unit,
+    value references by name)."""
     md, u = _slave(str(fmu_path("PdController")), messages)
     vr = {v.name: v.valueReference for v in md.modelVariables}
-    q = [vr[k] for k in ("q_w", "q_x", "q_y", "q_z")]
+    u.setupExperiment(startTime=0.0)
+    u.enterInitializationMode()
+    u.setReal([vr[k] for k in ("q_w", "q_x", "q_y", "q_z")], [0.0] * 4)
+    return u, vr
+
+
+def test_a_controller_warns_in_initialization_and_refuses_after_it():
+    messages = []
+    u, vr = _pd_in_initialization(messages)
     torque = [vr[k] for k in ("torque_cmd_x", "torque_cmd_y", "torque_cmd_z")]
     try:
-        u.setupExperiment(startTime=0.0)
-        u.enterInitializationMode()
-        u.setReal(q, [0.0] * 4)
         assert u.getReal(torque) == [0.0, 0.0, 0.0]  # the start values, kept
         assert messages[-1][0] == WARNING and "fmi2GetReal" in messages[-1][2] and "norm 0" in messages[-1][2]
         u.exitInitializationMode()  # still inconsistent: a warning, the instance leaves initialization
@@ -113,12 +119,8 @@ def test_a_controller_warns_in_initialization_and_refuses_after_it():
 def test_consistent_inputs_after_a_warning_compute_the_outputs():
     """After the warning, the inputs the loop then sets are used: the torque equals a PD law's."""
     messages = []
-    md, u = _slave(str(fmu_path("PdController")), messages)
-    vr = {v.name: v.valueReference for v in md.modelVariables}
+    u, vr = _pd_in_initialization(messages)
     try:
-        u.setupExperiment(startTime=0.0)
-        u.enterInitializationMode()
-        u.setReal([vr[k] for k in ("q_w", "q_x", "q_y", "q_z")], [0.0] * 4)
         u.getReal([vr["torque_cmd_x"]])
         c, s = np.cos(0.05), np.sin(0.05)  # 0.1 rad about x
         u.setReal([vr[k] for k in ("q_w", "q_x", "q_y", "q_z")], [c, s, 0.0, 0.0])
