@@ -123,19 +123,27 @@ def c_model_description(variant: str = "ok", guid: str | None = None, fail_time:
     return xml
 
 
+def compile_shared(source: Path, out: Path, defines: list[str], what: str, *, opt: str = "-O2",
+                   libs: tuple[str, ...] = ("-lm",)) -> Path:
+    """gcc `opt` -shared -fPIC (hidden visibility, gnu11, every warning an error, the FMI headers) of one C
+    unit `source` into `out` with the `-D` defines; a failure names `what` with gcc's messages."""
+    cmd = ["gcc", opt, "-shared", "-fPIC", "-fvisibility=hidden", "-std=gnu11", "-Wall", "-Wextra", "-Werror",
+           f"-I{fmi_headers_dir()}", *defines, "-o", str(out), str(source), *libs]
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    if p.returncode != 0:
+        raise RuntimeError(f"gcc failed for {what}:\n{p.stderr}")
+    return out
+
+
 def compile_c_pd(out: Path, variant: str = "ok", guid: str | None = None, fail_time: float = 0.5) -> Path:
     """gcc -O2 -shared -fPIC the C controller into `out` (a .so) with the variant's failure mode."""
     if shutil.which("gcc") is None:
         raise RuntimeError("gcc is needed to build the C foreign unit (scripts/setup.sh installs it)")
     mode = _FAIL_MODE.get(variant, 0)
-    cmd = ["gcc", "-O2", "-shared", "-fPIC", "-fvisibility=hidden", "-std=gnu11", "-Wall", "-Wextra", "-Werror",
-           f"-I{fmi_headers_dir()}", f'-DMODEL_GUID="{guid or c_guid(variant, fail_time)}"',
-           f"-DFAIL_MODE={mode}", f"-DFAIL_TIME={float(fail_time)!r}", f"-DMODEL_EXCHANGE={int(variant == 'me')}",
-           "-o", str(out), str(C_DIR / "c_pd.c"), "-lm"]
-    p = subprocess.run(cmd, capture_output=True, text=True)
-    if p.returncode != 0:
-        raise RuntimeError(f"gcc failed for the C foreign unit ({variant}):\n{p.stderr}")
-    return out
+    return compile_shared(C_DIR / "c_pd.c", out,
+                          [f'-DMODEL_GUID="{guid or c_guid(variant, fail_time)}"', f"-DFAIL_MODE={mode}",
+                           f"-DFAIL_TIME={float(fail_time)!r}", f"-DMODEL_EXCHANGE={int(variant == 'me')}"],
+                          f"the C foreign unit ({variant})")
 
 
 def build_c_pd(dest, variant: str = "ok", *, fail_time: float = 0.5) -> Path:
@@ -262,12 +270,8 @@ def build_c3(dest, model: str) -> Path:
     fmu = dest / f"{model}.fmu"
     with tempfile.TemporaryDirectory(prefix="c3_") as tmp:
         so = Path(tmp) / f"{model}.so"
-        cmd = ["gcc", "-O2", "-shared", "-fPIC", "-fvisibility=hidden", "-std=gnu11", "-Wall", "-Wextra", "-Werror",
-               f"-I{fmi_headers_dir()}", f"-DMODEL={C3_MODELS.index(model) + 1}", f'-DMODEL_TOKEN="{c3_token(model)}"',
-               "-o", str(so), str(C3_DIR / "c3_units.c"), "-lm"]
-        p = subprocess.run(cmd, capture_output=True, text=True)
-        if p.returncode != 0:
-            raise RuntimeError(f"gcc failed for {model}:\n{p.stderr}")
+        compile_shared(C3_DIR / "c3_units.c", so,
+                       [f"-DMODEL={C3_MODELS.index(model) + 1}", f'-DMODEL_TOKEN="{c3_token(model)}"'], model)
         part = fmu.with_suffix(".part")
         with zipfile.ZipFile(part, "w", zipfile.ZIP_DEFLATED) as z:
             z.writestr("modelDescription.xml", c3_model_description(model))

@@ -6,13 +6,12 @@ from __future__ import annotations
 
 import os
 import shutil
-import subprocess
 import tempfile
 import uuid
 import zipfile
 from pathlib import Path
 
-from foreign_units import fmi_headers_dir
+from foreign_units import compile_shared
 
 MIMIC_DIR = Path(__file__).resolve().parent / "foreign" / "mimic"
 # name: (MIMIC number, interfaces, default experiment attributes)
@@ -102,12 +101,8 @@ def build_mimic(dest, name: str) -> Path:
     with tempfile.TemporaryDirectory(prefix="mimic_") as tmp:
         so = Path(tmp) / f"{model}.so"
         if itfs:
-            cmd = ["gcc", "-O1", "-shared", "-fPIC", "-fvisibility=hidden", "-std=gnu11", "-Wall", "-Wextra",
-                   "-Werror", f"-I{fmi_headers_dir()}", f"-DMIMIC={number}", f'-DTOKEN="{token(name)}"',
-                   "-o", str(so), str(MIMIC_DIR / "mimic3.c"), "-lm", "-lpthread"]
-            p = subprocess.run(cmd, capture_output=True, text=True)
-            if p.returncode != 0:
-                raise RuntimeError(f"gcc failed for {model}:\n{p.stderr}")
+            compile_shared(MIMIC_DIR / "mimic3.c", so, [f"-DMIMIC={number}", f'-DTOKEN="{token(name)}"'], model,
+                           opt="-O1", libs=("-lm", "-lpthread"))
         part = fmu.with_suffix(".part")
         with zipfile.ZipFile(part, "w", zipfile.ZIP_DEFLATED) as z:
             z.writestr("modelDescription.xml", model_description(name))
