@@ -134,6 +134,7 @@ impl Model for AttitudePlant {
         let inertia = s * nominal * s;
         // Positive definite iff the Cholesky factorisation exists.
         let chol = nalgebra::Cholesky::new(inertia).ok_or_else(|| format!("inertia matrix {:?} is not positive definite", inertia.as_slice()))?;
+        let facets = v.facets()?;
         let orbit = CircularOrbit { mu: v.mu, radius: v.orbit_radius, inclination: v.orbit_inclination, arg_lat0: v.orbit_arg_lat0, dipole: v.earth_dipole };
         let d = Derived {
             orbit,
@@ -143,8 +144,8 @@ impl Model for AttitudePlant {
             dipole_max: v.mtq_turns * v.mtq_coil_area * v.mtq_max_current,
             actuator_map: nalgebra::Rotation3::new(v.actuator_misalignment).into_inner() * Matrix3::from_diagonal(&v.actuator_scale),
             projection_threshold: exchange::projection_threshold(exp),
-            facets: v.facets()?,
-            has_facets: v.facets()?.iter().any(|f| f.area > 0.0),
+            facets,
+            has_facets: facets.iter().any(|f| f.area > 0.0),
         };
         let angles = (v.init_euler321_roll, v.init_euler321_pitch, v.init_euler321_yaw);
         let mut x = State::zeros();
