@@ -2,9 +2,10 @@
 //! Riccati equation (LQR), pole placement, fuzzy inference, relative orbital motion, predictive-control
 //! gains, counter-based random numbers, the sample grid of the sampled units (a master's rounded
 //! time taken as the grid instant), the orbit environment (the attitude plant's simple one; the true one of
-//! the environment family: time scales and Earth orientation, IGRF-14, the sun and its shadow, atmospheric
-//! density; the drag and solar-pressure forces on a facet model), Grünwald–Letnikov fractional calculus
-//! with the PID / PI^λD^μ laws, and interval type-2 fuzzy inference (Karnik–Mendel type reduction).
+//! the environment family: time scales and Earth orientation, the IAU 1980 nutation and SGP4's TEME frame,
+//! IGRF-14, the sun and its shadow, atmospheric density; the drag and solar-pressure forces on a facet
+//! model), Grünwald–Letnikov fractional calculus with the PID / PI^λD^μ laws, and interval type-2 fuzzy
+//! inference (Karnik–Mendel type reduction).
 //! Each module carries its own unit tests against closed-form results.
 
 pub mod atmosphere;
@@ -17,6 +18,7 @@ pub mod fuzzy;
 pub mod igrf;
 mod igrf14_coefficients;
 pub mod integrate;
+pub mod nutation;
 pub mod orbit;
 pub mod pole_placement;
 pub mod predictive_control;

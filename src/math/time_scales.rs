@@ -92,6 +92,12 @@ pub fn rot3(a: f64) -> Matrix3<f64> {
     Matrix3::new(c, s, 0.0, -s, c, 0.0, 0.0, 0.0, 1.0)
 }
 
+/// Frame rotation about x by `a`.
+pub fn rot1(a: f64) -> Matrix3<f64> {
+    let (s, c) = a.sin_cos();
+    Matrix3::new(1.0, 0.0, 0.0, 0.0, c, s, 0.0, -s, c)
+}
+
 /// Frame rotation about y by `a`.
 pub fn rot2(a: f64) -> Matrix3<f64> {
     let (s, c) = a.sin_cos();

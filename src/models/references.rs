@@ -162,7 +162,8 @@ pub const ALL: &[Reference] = &[
         title: "Astronomical Algorithms",
         venue: "2nd ed., Willmann-Bell, 1998",
         subject: "",
-        used_for: "Julian date of a calendar date and back (Ch. 7)",
+        used_for: "Julian date of a calendar date and back (Ch. 7); a worked example of the IAU 1980 nutation \
+                   (Example 22.a)",
     },
     Reference {
         key: "Hoots-Roehrich-1980",
@@ -180,6 +181,14 @@ pub const ALL: &[Reference] = &[
         subject: "",
         used_for: "the reference SGP4 implementation, its verification element sets (SGP4-VER.TLE) and the TEME \
                    frame of its output",
+    },
+    Reference {
+        key: "Seidelmann-1982",
+        authors: "P. K. Seidelmann",
+        title: "1980 IAU Theory of Nutation: The Final Report of the IAU Working Group on Nutation",
+        venue: "Celestial Mechanics 27, 79-106, 1982",
+        subject: "",
+        used_for: "the IAU 1980 nutation series (106 terms) that turns SGP4's TEME output to J2000 axes",
     },
 ];
 

@@ -10,7 +10,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::declare_variables;
 use crate::math::integrate::{Method, Stepper};
+use crate::math::nutation;
 use crate::math::orbit::{self, Elements, Gravity};
+use crate::math::time_scales::{CENTURY, DAY, JD_J2000, TT_MINUS_UTC};
 use crate::model::{check_derived, check_finite_state, Experiment, Model, ModelInfo, ModelResult, ParamEnum, StateDecl};
 
 pub use tle::{rev_per_day, Tle, WGS72_RADIUS};
@@ -22,6 +24,16 @@ crate::param_enum! {
         Numerical = 0,
         /// 1: SGP4 from the TLE parameters (Co-Simulation only).
         Sgp4 = 1,
+    }
+}
+
+crate::param_enum! {
+    /// `sgp4_frame`: the axes of r and v in the SGP4 mode.
+    pub enum Sgp4Frame {
+        /// 0: SGP4's own TEME (true equator, mean equinox of date), unconverted.
+        Teme = 0,
+        /// 1: the J2000 mean equator and equinox (GCRF to the frame bias), as in the numerical mode.
+        J2000 = 1,
     }
 }
 
@@ -48,7 +60,7 @@ crate::param_enum! {
 declare_variables! {
     pub struct OrbitVars {
         0 => rho: Real = 0.0, Input, "kg/m3", "Atmospheric density at the spacecraft (e.g. the Environment unit's density); 0 = no drag";
-        10 => r: Vec3 = [6_878_137.0, 0.0, 0.0], Output, "m", "Position, ECI (GCRF/J2000 axes; TEME of SGP4 in propagator 1)";
+        10 => r: Vec3 = [6_878_137.0, 0.0, 0.0], Output, "m", "Position, ECI (J2000/GCRF axes; SGP4's TEME in propagator 1 with sgp4_frame 0)";
         13 => v: Vec3 = [0.0, 0.0, 7612.6], Output, "m/s", "Velocity, ECI (same frame as r)";
         16 => t_utc: Real = 0.0, Output, "s", "Elapsed UTC seconds since the epoch epoch_jd_utc (the start time)";
         17 => jd_utc: Real = 2_451_545.0, Output, "d", "UTC Julian date, epoch_jd_utc + t_utc / 86400";
@@ -83,10 +95,11 @@ declare_variables! {
         127 => tle_arg_perigee: Real = 0.0, Parameter, "rad", "TLE argument of perigee (propagator 1)";
         128 => tle_mean_anomaly: Real = 0.0, Parameter, "rad", "TLE mean anomaly (propagator 1)";
         129 => tle_bstar: Real = 0.0, Parameter, "1/m", "TLE drag term B* divided by the WGS-72 earth radius 6378135 m (propagator 1)";
-        140 => propagator: Integer = 0, Parameter, "", "0 = numerical integration (two-body, J2-J4, drag), 1 = SGP4 from the tle_* parameters (output in TEME; Co-Simulation only)", Choice(Propagator::CODES);
+        140 => propagator: Integer = 0, Parameter, "", "0 = numerical integration (two-body, J2-J4, drag), 1 = SGP4 from the tle_* parameters (axes: sgp4_frame; Co-Simulation only)", Choice(Propagator::CODES);
         141 => initial_state: Integer = 0, Parameter, "", "Initial state of propagator 0: 0 = classical elements, 1 = state vector init_r, init_v", Choice(InitialState::CODES);
         142 => zonal_degree: Integer = 2, Parameter, "", "Zonal harmonics of propagator 0: 0 = two-body only, 2 = J2, 3 = J2-J3, 4 = J2-J4", Choice(ZonalDegree::CODES);
         143 => corotating_atmosphere: Boolean = true, Parameter, "", "Drag relative to an atmosphere turning with the Earth (v - omega_E x r); false = still atmosphere";
+        144 => sgp4_frame: Integer = 1, Parameter, "", "Axes of r and v in propagator 1: 1 = J2000 (as propagator 0 and the Environment unit; TEME turned by the IAU 1980 nutation, the 1982 equation of the equinoxes and the IAU 1976 precession), 0 = SGP4's TEME unconverted", Choice(Sgp4Frame::CODES);
     }
 }
 
@@ -128,6 +141,9 @@ pub struct Orbit {
     sgp4: Option<sgp4::Constants>,
     /// Seconds from the TLE epoch to the start time.
     tle_offset: f64,
+    /// Days of UTC from J2000.0 to the start time when the SGP4 state is turned from TEME to J2000 axes
+    /// (`sgp4_frame` 1); None: TEME.
+    j2000_from: Option<f64>,
     /// Master time of the epoch (the start time of the experiment).
     t0: f64,
 }
@@ -135,7 +151,14 @@ pub struct Orbit {
 impl Orbit {
     fn sgp4_state(&self, t: f64) -> Result<State, String> {
         let c = self.sgp4.as_ref().ok_or("SGP4 propagator missing")?;
-        let (r, v) = tle::propagate(c, self.tle_offset + (t - self.t0))?;
+        let (mut r, mut v) = tle::propagate(c, self.tle_offset + (t - self.t0))?;
+        if let Some(d0) = self.j2000_from {
+            // the axes turn at most 1.1e-11 rad/s against each other (math::nutation tests): v is rotated
+            // with r, the transport term (below 1e-4 m/s in low orbit) is left out
+            let t_tt = (d0 + (t - self.t0) / DAY + TT_MINUS_UTC / DAY) / CENTURY;
+            let m = nutation::teme_to_j2000(t_tt);
+            (r, v) = (m * r, m * v);
+        }
         Ok(State::from_column_slice(&[r.x, r.y, r.z, v.x, v.y, v.z]))
     }
 }
@@ -212,7 +235,7 @@ impl Model for Orbit {
         let omega_atm = if v.corotating_atmosphere { v.earth_rate } else { 0.0 };
         let forces = Forces { gravity, ballistic: v.ballistic_coeff, omega_atm };
         let stepper = Stepper::new(Method::DormandPrince, 0.0, v.tolerance);
-        let mut model = Orbit { x: State::zeros(), forces, scale: (1.0, 1.0), stepper, tle: None, sgp4: None, tle_offset: 0.0, t0: exp.start_time };
+        let mut model = Orbit { x: State::zeros(), forces, scale: (1.0, 1.0), stepper, tle: None, sgp4: None, tle_offset: 0.0, j2000_from: None, t0: exp.start_time };
         match propagator {
             Propagator::Numerical => model.x = initial_state(v)?,
             Propagator::Sgp4 => {
@@ -220,6 +243,9 @@ impl Model for Orbit {
                 model.sgp4 = Some(tle::propagator(&t)?);
                 model.tle = Some(t);
                 model.tle_offset = (v.epoch_jd_utc - v.tle_epoch_jd_utc) * 86_400.0;
+                if Sgp4Frame::from_param("sgp4_frame", v.sgp4_frame)? == Sgp4Frame::J2000 {
+                    model.j2000_from = Some(v.epoch_jd_utc - JD_J2000);
+                }
                 model.x = model.sgp4_state(exp.start_time).map_err(|e| format!("at the epoch: {e}"))?;
             }
         }

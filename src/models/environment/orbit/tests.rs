@@ -144,10 +144,12 @@ fn bad_input_is_refused_by_name() {
     assert!(e.contains("decayed"), "{e}");
 }
 
-/// 00005 of the SGP4 verification set (see `tle::tests`), started 360 min after the TLE epoch.
-fn sgp4_orbit() -> Fmu<Orbit> {
+/// 00005 of the SGP4 verification set (see `tle::tests`), started 360 min after the TLE epoch, with its
+/// output in the axes `frame` (`sgp4_frame`).
+fn sgp4_orbit(frame: i32) -> Fmu<Orbit> {
     orbit(|v| {
         v.propagator = 1;
+        v.sgp4_frame = frame;
         v.tle_epoch_jd_utc = 2_451_543.5 + 179.784_950_62;
         v.epoch_jd_utc = v.tle_epoch_jd_utc + 0.25;
         v.tle_mean_motion = rev_per_day(10.824_191_57);
@@ -161,7 +163,7 @@ fn sgp4_orbit() -> Fmu<Orbit> {
 fn sgp4_mode_follows_the_verification_table_and_refuses_model_exchange() {
     // tcppver.out of [Vallado-2006], 00005 at 360 and 720 min (km); the start is 360 min after the
     // TLE epoch, the Julian dates resolve ~40 µs (0.3 m at 7 km/s)
-    let mut p = sgp4_orbit();
+    let mut p = sgp4_orbit(0);
     let mut got = vec![];
     run(&mut p, 21_600.0, 3600.0, |t, v| got.push((t, v.r)));
     let want0 = Vector3::new(-7154.03120202, -3783.17682504, -3536.19412294) * 1e3;
@@ -174,8 +176,30 @@ fn sgp4_mode_follows_the_verification_table_and_refuses_model_exchange() {
 }
 
 #[test]
+fn sgp4_j2000_axes_are_teme_turned_at_each_output_time() {
+    // the same run in both frames: r and v of sgp4_frame 1 are those of 0 turned by the TEME → J2000 matrix
+    // of the output's date (TT = UTC + 69.184 s); mid-2000 the turn is the precession since J2000 (about
+    // 25″) with the nutation (up to 19″) — the independent check against astropy is in test_orbit.py
+    let (mut teme, mut j2k) = (sgp4_orbit(0), sgp4_orbit(1));
+    let (mut a, mut b) = (vec![], vec![]);
+    run(&mut teme, 21_600.0, 3600.0, |_, v| a.push((v.r, v.v)));
+    run(&mut j2k, 21_600.0, 3600.0, |_, v| b.push((v.r, v.v)));
+    let d0 = j2k.v.epoch_jd_utc - crate::math::time_scales::JD_J2000;
+    for (k, ((r0, v0), (r1, v1))) in a.iter().zip(&b).enumerate() {
+        let t_tt = (d0 + (k as f64 * 3600.0 + 69.184) / 86_400.0) / 36_525.0;
+        let m = crate::math::nutation::teme_to_j2000(t_tt);
+        assert!((m * r0 - r1).norm() < 1e-6 && (m * v0 - v1).norm() < 1e-9, "{k}");
+        let angle = r0.angle(r1).to_degrees() * 3600.0;
+        assert!(angle > 1.0 && angle < 60.0, "{angle}″");
+    }
+    let mut p = Fmu::<Orbit>::default();
+    (p.v.propagator, p.v.sgp4_frame) = (1, 2);
+    assert!(p.initialize(&Experiment::default()).unwrap_err().contains("sgp4_frame"));
+}
+
+#[test]
 fn restored_sgp4_state_rebuilds_the_propagator() {
-    let mut p = sgp4_orbit();
+    let mut p = sgp4_orbit(1);
     p.step(0.0, 60.0).unwrap();
     let bytes = postcard::to_allocvec(&p).unwrap();
     let mut q: Fmu<Orbit> = postcard::from_bytes(&bytes).unwrap();
@@ -193,7 +217,7 @@ fn step_cost() {
     for h in [0.1f64, 10.0] {
         for mode in ["numerical J2 + drag", "numerical J4 + drag", "SGP4"] {
             let mut p = match mode {
-                "SGP4" => sgp4_orbit(),
+                "SGP4" => sgp4_orbit(1),
                 "numerical J4 + drag" => orbit(|v| v.zonal_degree = 4),
                 _ => orbit(|_| {}),
             };
