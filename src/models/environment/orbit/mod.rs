@@ -215,7 +215,7 @@ impl Model for Orbit {
     const INFO: ModelInfo = ModelInfo {
         name: "Orbit",
         description: "Earth orbit in an inertial frame: numerical (two-body, J2-J4, drag with a density input) or SGP4 from TLE numbers; position, velocity, time, orbit rate and the LVLH frame",
-        source: "[Vallado-2013] Secs. 2.6, 8.6 (elements, zonal harmonics, drag); [Montenbruck-Gill-2000] Secs. 3.2, 3.5, 4.1; SGP4: [Hoots-Roehrich-1980], [Vallado-2006] via the sgp4 crate",
+        source: "[Vallado-2013] Secs. 2.6, 8.6 (elements, zonal harmonics, drag); [Montenbruck-Gill-2000] Secs. 3.2, 3.5, 4.1; SGP4: [Hoots-Roehrich-1980], [Vallado-2006] via the sgp4 crate; TEME to J2000: [Seidelmann-1982], [Lieske-1977]",
         equations_html: EQUATIONS_HTML,
         default_stop_time: 6000.0,
         default_step: 1.0,
