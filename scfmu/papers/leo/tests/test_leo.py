@@ -90,13 +90,17 @@ def test_nadir_momentum_changes_by_the_integral_of_the_external_torques(nadir):
 def test_nadir_points_at_the_earth_with_the_estimate(nadir):
     q = stack(nadir, "q", "wxyz")
     settled = np.asarray(nadir["time"]) > 600.0
-    assert np.percentile(angle_deg(q, stack(nadir, "q_ref", "wxyz"))[settled], 95) < 0.1
+    # the PD's steady error under the residual-dipole torque (about 1e-6 N·m against k = I ω_n² ≈ 1.2e-3 N·m/rad)
+    # is a few hundredths of a degree; the star tracker (looking at the zenith) is blinded near local noon and the
+    # estimate coasts on the gyro for minutes
+    assert np.percentile(angle_deg(q, stack(nadir, "q_ref", "wxyz"))[settled], 95) < 0.2
     # the reference is the LVLH frame of the logged orbit: body z = -r/|r| in inertial axes
     a_ref = attitude_matrices(stack(nadir, "q_ref", "wxyz"))
     r = stack(nadir, "r")
     nadir_b = np.einsum("nij,nj->ni", a_ref, -r / np.linalg.norm(r, axis=1)[:, None])
     assert np.abs(nadir_b - [0.0, 0.0, 1.0]).max() < 1e-12
-    assert np.percentile(angle_deg(q, stack(nadir, "q_est", "wxyz"))[settled], 95) < 0.05
+    assert np.percentile(angle_deg(q, stack(nadir, "q_est", "wxyz"))[settled], 95) < 0.2
+    assert 0.0 < 1 - np.mean(nadir["st_valid"]) < 0.3
     # the momentum stays inside the wheels' 10 mN·m·s: the magnetorquers dump it
     assert np.abs(stack(nadir, "h_wheel")).max() < 0.5 * 1.5e-5 * 680.0
     # the eclipse against a cylindrical shadow computed here from the logged position and sun: the conical
@@ -121,8 +125,9 @@ def test_sun_pointing_loses_the_sun_sensor_in_eclipse_and_the_estimate_coasts():
     s_b = np.einsum("nij,nj->ni", a, stack(r, "sun_eci"))
     off = np.degrees(np.arccos(np.clip(s_b[:, 0], -1, 1)))
     assert np.percentile(off[lit & late], 95) < 1.0
-    sigma = np.sqrt(np.max(stack(r, "p_att"), axis=1))
-    assert sigma[~lit].max() > 2 * np.median(sigma[lit & late])  # the field alone leaves an axis unobserved
+    # across the sun line (body y, z) the sun sensor bounds the filter's sigma; in the shadow it grows on the gyro
+    sigma = np.sqrt(np.max(stack(r, "p_att", "yz"), axis=1))
+    assert sigma[~lit].max() > 2 * np.median(sigma[lit & late])
 
 
 def test_detumble_on_the_igrf_field():
