@@ -14,7 +14,8 @@ import pytest
 
 from scfmu.report import cli as report_cli
 from scfmu.report import docs, render, rules
-from scfmu.report.types import (BY_CONSTRUCTION, CALIBRATED, CHOSEN, CONFIRMED, DEPENDS, INDEPENDENT, NOT_CHECKABLE,
+from scfmu.report.types import (BY_CONSTRUCTION, BY_CONSTRUCTION_HOLDS, CALIBRATED, CHOSEN, CONFIRMED, DEPENDS,
+                                INDEPENDENT, NOT_CHECKABLE,
                                 NOT_CONFIRMED, NOT_REPRODUCED, REPRODUCED, SAME_ORDERING, Claim, Figure, NumberRow,
                                 PaperSection, Sensitivity, Table, on_bound)
 
@@ -213,6 +214,45 @@ def test_combine_faithful_never_counts_moving_away_as_support():
     assert rules.combine_faithful(False, {"dcm 4": (True, False)})[0] == DEPENDS
     # a reading that breaks the claim only by moving away is no counter-example either
     assert rules.combine_faithful(True, {"x": (False, True)})[0] == CONFIRMED
+
+
+def test_holds_by_construction_is_decided_from_the_agreement_and_counted_apart(tmp_path):
+    """A confirmed claim whose compared quantities agree to rounding level (≤ EPS_MULTIPLE machine epsilons)
+    holds by construction: shown with the reason, never counted as confirmed. A claim that agrees only to
+    1e-9 (two genuinely different computations) stays confirmed; no claim id decides."""
+    import sys
+    eps = sys.float_info.epsilon
+    fixed = Claim("C901-1", "a = b", CONFIRMED, "a and b agree.", agreement=2 * eps)
+    real = Claim("C901-2", "a ≈ b", CONFIRMED, "a and b agree.", agreement=1e-9)
+    assert fixed.verdict == BY_CONSTRUCTION_HOLDS and "could not have failed" in fixed.evidence
+    assert real.verdict == CONFIRMED
+    assert Claim("C901-3", "x", NOT_CONFIRMED, "e", agreement=0.0).verdict == NOT_CONFIRMED   # fails anyway
+    sec = PaperSection("901", "t", "s", [fixed, real])
+    d = render.paper_summary(sec)
+    assert d[CONFIRMED] == 1 and d[BY_CONSTRUCTION_HOLDS] == 1
+    h, m = render.render([sec], tmp_path, {"quick": True})
+    md = m.read_text(encoding="utf-8")
+    assert "| [901](#paper-901) | 0 | 0 | 0 | 0 | 0 | 0 of 0 | 1 | 0 | 0 | 1 |" in md
+    assert "| C901-1 | a = b | ⚙️ holds by construction |" in md
+    got = {r[0]: r[2] for r in parse(h).rows}
+    assert got == {"C901-1": BY_CONSTRUCTION_HOLDS, "C901-2": CONFIRMED}
+
+
+def test_a_claim_supported_only_by_chosen_readings_is_not_confirmed(tmp_path):
+    """Readings chosen after comparing with the paper are never evidence (rules.combine_evidence, the rule of
+    every paper): alone they leave "not confirmed (holds only under a chosen reading: …)"."""
+    assert rules.combine_evidence(False, {"Δ 0.0125": True, "Δ 0.01": False}, ["Δ 0.0125", "Δ 0.01"]) == \
+        (NOT_CONFIRMED, ["Δ 0.0125"])
+    assert rules.combine_evidence(False, {"Δ 0.0125": True, "other": True}, ["Δ 0.0125"]) == (DEPENDS, [])
+    assert rules.combine_evidence(True, {"Δ 0.0125": False}, ["Δ 0.0125"]) == (CONFIRMED, [])
+    assert rules.combine_evidence(False, {"Δ 0.0125": True}) == (DEPENDS, [])          # not chosen: a reading
+    c = Claim("C901-1", "x", NOT_CONFIRMED, "e", chosen_support=["Δ 0.0125"])
+    assert c.verdict_text == "not confirmed (holds only under a chosen reading: Δ 0.0125)"
+    with pytest.raises(ValueError):
+        Claim("C901-1", "x", DEPENDS, "e", chosen_support=["Δ 0.0125"])
+    h, m = render.render([PaperSection("901", "t", "s", [c])], tmp_path, {"quick": True})
+    assert "| C901-1 | x | ❌ not confirmed (holds only under a chosen reading: Δ 0.0125) |" in m.read_text("utf-8")
+    assert parse(h).rows[0][2] == c.verdict_text
 
 
 def test_number_row_validates_and_computes_difference():

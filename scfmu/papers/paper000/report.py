@@ -33,7 +33,7 @@ from .constants import (DCM_READINGS, EFF, EFFORT_RATIO, EI, L_METHODS, L_RUNS, 
 from . import numbers as N
 from ...report import rules
 from .figures import fig_effort, fig_joint, fig_ranking, fig_robust, fig_sweep
-from .report_rules import (RULES, _fmt_cat, _spearman, below, c6_needed_ratio, holds_where, rule_c1,  # noqa: F401
+from .report_rules import (AGREEMENT, RULES, _fmt_cat, _spearman, below, c6_needed_ratio, holds_where, rule_c1,  # noqa: F401
                            rule_c2, rule_c3, rule_c4, rule_c5, rule_c6, rule_c7, verdict)
 
 
@@ -339,7 +339,8 @@ def _claim(c: str, rule, base: dict, per_claim: dict, away_of: dict, needed: lis
                 + (f" It flips only at values that move the paper's own Table 3 numbers further away (listed, "
                    f"not counted): {', '.join(flips_away)}." if flips_away else ""))
     return Claim(c, STATEMENTS[c], v, evidence, figures=[], sensitivity=sens, sensitive_to=flips + [
-        f"{p} (flips it only while moving the paper's numbers away; not counted)" for p in flips_away])
+        f"{p} (flips it only while moving the paper's numbers away; not counted)" for p in flips_away],
+        agreement=AGREEMENT[c](base) if c in AGREEMENT else None)
 
 
 def _setup_and_notes(ctx: Context, base: dict, sws: list) -> tuple[str, str]:
