@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 from scfmu.report import cli as report_cli
-from scfmu.report import docs, render, rules
+from scfmu.report import docs, prose, render, rules, timings
 from scfmu.report.types import (BY_CONSTRUCTION, BY_CONSTRUCTION_HOLDS, CALIBRATED, CHOSEN, CONFIRMED, DEPENDS,
                                 INDEPENDENT, NOT_CHECKABLE,
                                 NOT_CONFIRMED, NOT_REPRODUCED, REPRODUCED, SAME_ORDERING, Claim, Figure, NumberRow,
@@ -24,6 +24,9 @@ ROOT = Path(__file__).resolve().parents[1]
 # The verdicts of the last full build (`scfmu report --workers 2`), claims and reported numbers: the quick
 # build must reach every one of them (it may run fewer points, never another set-up).
 FULL_VERDICTS = ROOT / "tests" / "data" / "report_full_verdicts.json"
+# The numbers the last full build printed (`python -m scfmu.report.prose OUT --values`): what the hand-written
+# prose of the report's pages may cite besides the quick build's numbers.
+FULL_VALUES = ROOT / "tests" / "data" / "report_full_values.json"
 
 # The papers CI builds with --quick: every paper plug-in with a report section.
 CI_PAPERS = report_cli.papers_known()
@@ -417,6 +420,44 @@ def test_report_quick_end_to_end(tmp_path):
         assert render.doc_block(page) == render.docs_table(rows, p), f"docs/paper{p}.md: table is stale"
         assert "claims" in docs.table_blocks(page), f"docs/paper{p}.md has no generated claims table"
         assert docs.stale_blocks(page, p, rows, tables) == [], f"docs/paper{p}.md: stale blocks (scfmu report --docs docs)"
+    # every number written by hand in the report's pages is one the report prints (this build's data, or the last
+    # full build's, recorded), at its written precision; parts recording another command's output say so
+    vals = prose.build_values(out) | set(json.loads(FULL_VALUES.read_text(encoding="utf-8")))
+    for name in prose.PAGES:
+        bad = prose.unmatched((ROOT / name).read_text(encoding="utf-8"), vals)
+        assert bad == [], f"{name}: numbers that are not the report's: {bad}"
+    # the claims the issue names, as classified on the data written
+    assert quick["claims"]["C000-3"] == quick["claims"]["C004-4"] == BY_CONSTRUCTION_HOLDS
+    assert quick["claims"]["C001-2"] == NOT_CONFIRMED
+    assert all(r["obtained"] == CALIBRATED and r["sensitivity"].startswith("over the calibration grid")
+               for k, r in by.items() if k[0] == "004" and ("case 1" in k[1] or "case 2" in k[1]))
+    md = (out / "report.md").read_text(encoding="utf-8")
+    assert "not confirmed (holds only under a chosen reading: sampled, Δ = 0.0125 s)" in md
+
+
+def test_prose_numbers_are_checked_against_the_report_data():
+    """The prose check: numbers outside generated blocks, code, links and identifiers must be in the data, at
+    their written precision; a part recording another command is skipped and named."""
+    page = ("Paper 000 (Table 3, C000-3, 000-9L, issue 46, 2019) gives 156.1; ours 156.4 deg·s and 105.4 at "
+            "s = 5.2. `code 77.7`\n<!-- table:x:begin -->\n| 999 |\n<!-- table:x:end -->\n"
+            "<!-- prose: from scfmu paper 003 tune -->\nJ = 6.00954\n<!-- prose:end -->\n")
+    vals = prose.values("| 156.1 | 156.43 | 5.57 | 89.4 |")
+    assert prose.numbers(page) == ["156.1", "156.4", "105.4", "5.2"]
+    assert prose.unmatched(page, vals) == ["105.4", "5.2"]
+    assert prose.other_parts(page) == ["scfmu paper 003 tune"]
+    assert prose.matches("3.2", {3.24}) and not prose.matches("3.20", {3.24}) and prose.matches("1.5e-4", {1.5004e-4})
+
+
+def test_timings_blocks_are_written_from_the_recorded_builds():
+    """README.md and docs/report.md show the measured times from one source (scfmu/report/timings.json), and the
+    recorded quick build meets its budget on an idle machine."""
+    d = timings.recorded()
+    q = d["quick"]
+    assert q["mode"] == "quick" and q["wall_s"] <= timings.QUICK_BUDGET_S and q["cores"] == 2 and q["workers"] == 2
+    assert "full" in d and d["full"]["mode"] == "full"
+    for name in ("README.md", "docs/report.md"):
+        text = (ROOT / name).read_text(encoding="utf-8")
+        assert timings.TIMINGS_BEGIN in text and not timings.stale(text), f"{name}: timings block is stale"
 
 
 def test_report_missing_paper_is_an_error(tmp_path):

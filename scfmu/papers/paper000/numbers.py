@@ -185,3 +185,31 @@ def metrics_table(base: dict) -> Table:
                  "kg·m²); settling on α with a 2 % band (nan = not settled), overshoot = largest of the three angles",
                  ["run", "controller", "plant kinematics", "command", "EULERINT [deg·s]", "∫Σ|τ| [N·m·s]",
                   "∫‖τ‖² [N²·m²·s]", "settling [s]", "overshoot [%]"], rows)
+
+
+SHARED_READINGS = ("AdaptiveFuzzyController λ-range scale s", "AdaptiveFuzzyController.gamma", "MracController.gamma")
+
+
+def readings_table(sws_full: list, sws_quick: list, all_rows: dict, base: dict) -> Table:
+    """The docs page's table of the adaptive laws' readings (λ-range scale s, γ): EULERINT and effort of the
+    large-command run at each value both builds run (the quick grid is part of the full one), and the largest
+    relative change of EULERINT over every run the sweep replaces (large command, R1, R2 ×1.2 and ×0.8)."""
+    quick = {sw["param"]: set(sw["values"]) for sw in sws_quick}
+    rows = []
+    for sw in sws_full:
+        if sw["param"] not in SHARED_READINGS or sw["param"] not in all_rows:
+            continue
+        rr = all_rows[sw["param"]]
+        main = sw["runs"][0]
+        for i, v in enumerate(sw["values"]):
+            if v not in quick.get(sw["param"], ()):
+                continue
+            ch = [abs(rr[r][i][EI] - base[r][EI]) / abs(base[r][EI]) for r in sw["runs"]
+                  if rr[r][i]["status"] == "ok" and r in base]
+            rows.append([sw["param"], float(v), main, rr[main][i][EI], rr[main][i]["effort_abs"],
+                         100.0 * max(ch) if ch else math.nan])
+    return Table("The adaptive laws' readings at the points both builds run: EULERINT and effort ∫Σ|τ| dt of the "
+                 "large-command run, and the largest change of EULERINT against the defaults over every run the "
+                 "reading replaces (large command, R1, R2 ×1.2 and ×0.8)",
+                 ["reading", "value", "run", "EULERINT (deg·s)", "effort (N·m·s)", "largest EULERINT change (%)"],
+                 rows)

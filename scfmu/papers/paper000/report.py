@@ -350,6 +350,7 @@ def _setup_and_notes(ctx: Context, base: dict, sws: list) -> tuple[str, str]:
              f"{n_sweep} sweep runs on the campaign engine (native), Δ = 0.01 s, t_end = 30 s"
              + (" (quick mode: a few points per sweep)" if ctx.quick else "") + ".")
     notes = (
+        "The fuzzy PD's gain ranges are the paper's, k_p ∈ [0.28, 3] k_r and k_d ∈ [0.08, 0.15] k_r T_r. "
         "Readings: EULERINT in deg·s over [0, 30] s; effort = ∫Σ|τ| dt (the paper's formula is unknown; ∫‖τ‖² dt is "
         "evaluated too). Thresholds: rankings need a 0.5 % margin, 'about the same' ≤ 10 % spread, 'identical' ≤ 1e-6, "
         "'without much more effort' ≤ 1.5 × the quaternion PD's effort. The DCM error law has six readings "
@@ -403,5 +404,7 @@ def build(ctx: Context) -> PaperSection:
     claims[4].tables.append(eff_table)
     calibrations = _calibrations(eff_text)
     mt = N.metrics_table(base)
-    return PaperSection("000", TITLE, setup, claims, figures=figs, tables=[mt], notes=notes, doc_tables={"runs": mt},
+    rt = N.readings_table(sws, sweeps(True), all_rows, base)
+    return PaperSection("000", TITLE, setup, claims, figures=figs, tables=[mt, rt], notes=notes,
+                        doc_tables={"runs": mt, "readings": rt},
                         runtime_s=time.time() - t0, numbers=nums, calibrations=calibrations)

@@ -396,7 +396,7 @@ def number_rows(summary: dict | None = None) -> list:
                                    f"torque: {paper / ours:.4g}× smaller, i.e. a torque scale {scale:.3g}× apart")))
         for unit, f in ISF_UNIT_READINGS.items():
             o = ours * f * f
-            out.append(NumberRow("003", f"{n['label']}, torque read in {unit}", f"{unit}²·s", paper, o,
+            out.append(NumberRow("003", f"{n['label']}, torque read in {unit}", f"({unit})²·s", paper, o,
                                  rules.number_verdict(o, paper, rules.printed_precision(n["value"])), basis=CHOSEN,
                                  paper_text=n["value"],
                                  note=f"reading: the paper's torques in {unit} (ISF × {f * f:g}); no unit is printed, "

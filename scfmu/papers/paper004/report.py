@@ -321,7 +321,8 @@ def _claim4(r3: dict, r3ol: dict) -> Claim:
 
 
 def _setup(S0: float, n0: int, n3: int, n_opt: int) -> str:
-    return (f"FMUs ReferenceCorrector → FeedbackLinearizingController (k_q = 0.5, k_q̇ = 2) → AttitudePlant, "
+    return (f"FMUs ReferenceCorrector → FeedbackLinearizingController (k_q = 0.5, k_q̇ = 2: error poles −1 ± √2/2 = "
+            f"{-1 + math.sqrt(0.5):.3f} and {-1 - math.sqrt(0.5):.3f} 1/s while no torque saturates) → AttitudePlant, "
             f"I = diag(449.5, 264.5, 312.5) kg·m², u_max = 10 N·m per axis, fault (effectiveness 0.1 on every axis) "
             f"from t = 0, start at rest at 321 (yaw, pitch, roll) = ({6 * S0:g}, {-4 * S0:g}, {8 * S0:g}) deg "
             f"(the default direction × {S0:g}, calibrated), RK4 step = communication step = "
