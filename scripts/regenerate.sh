@@ -60,6 +60,7 @@ if [ "$report" = 1 ]; then
     echo "regenerate: report: docs/paperNNN.md blocks and tests/data/report_full_verdicts.json (full build)"
     .venv/bin/scfmu report --docs docs --out out/report
     cp out/report/verdicts.json tests/data/report_full_verdicts.json
+    .venv/bin/python -m scfmu.report.prose out/report --values > tests/data/report_full_values.json
     .venv/bin/python -m scfmu.report.timings --record full out/report/timings.json --write README.md docs/report.md
 fi
 if [ "$figures" = 1 ]; then

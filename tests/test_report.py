@@ -422,10 +422,9 @@ def test_report_quick_end_to_end(tmp_path):
         assert docs.stale_blocks(page, p, rows, tables) == [], f"docs/paper{p}.md: stale blocks (scfmu report --docs docs)"
     # every number written by hand in the report's pages is one the report prints (this build's data, or the last
     # full build's, recorded), at its written precision; parts recording another command's output say so
-    vals = prose.build_values(out) | set(json.loads(FULL_VALUES.read_text(encoding="utf-8")))
-    for name in prose.PAGES:
-        bad = prose.unmatched((ROOT / name).read_text(encoding="utf-8"), vals)
-        assert bad == [], f"{name}: numbers that are not the report's: {bad}"
+    recorded = json.loads(FULL_VALUES.read_text(encoding="utf-8"))
+    bad = prose.check([ROOT / n for n in prose.PAGES], [out], recorded)
+    assert not any(bad.values()), f"numbers of the pages' prose that are not the report's: {bad}"
     # the claims the issue names, as classified on the data written
     assert quick["claims"]["C000-3"] == quick["claims"]["C004-4"] == BY_CONSTRUCTION_HOLDS
     assert quick["claims"]["C001-2"] == NOT_CONFIRMED
@@ -446,6 +445,10 @@ def test_prose_numbers_are_checked_against_the_report_data():
     assert prose.unmatched(page, vals) == ["105.4", "5.2"]
     assert prose.other_parts(page) == ["scfmu paper 003 tune"]
     assert prose.matches("3.2", {3.24}) and not prose.matches("3.20", {3.24}) and prose.matches("1.5e-4", {1.5004e-4})
+    # a paper's page is checked against its own part of the report only
+    assert prose.scope_of("docs/paper000.md") == "000" and prose.scope_of("docs/sensing.md") == "sensing"
+    assert prose.scope_of("docs/report.md") is None
+    assert "\n## Paper 001:" in prose._section("# r\n## Paper 000: a\n1.5\n## Paper 001: b\n2.5\n", "001")
 
 
 def test_timings_blocks_are_written_from_the_recorded_builds():
