@@ -258,6 +258,16 @@ def test_a_claim_supported_only_by_chosen_readings_is_not_confirmed(tmp_path):
     assert parse(h).rows[0][2] == c.verdict_text
 
 
+def test_every_row_states_its_precision_rule():
+    """A row given the printed precision its verdict used states the window beside it (5 % or the precision)."""
+    n = NumberRow("9", "x", "-", 156.1, 156.4, REPRODUCED, precision=0.05)
+    assert n.rule == "reproduced within [148.3, 163.9]: 5 % or the printed precision ± 0.05, whichever is wider"
+    assert render.number_cells(n)[7].endswith(n.rule)
+    assert NumberRow("9", "x", "-", 0.01, 0.012, REPRODUCED, precision=0.005).rule.startswith(
+        "reproduced within [0.005, 0.015]")
+    assert NumberRow("9", "x", "-", 1.0, 1.0, REPRODUCED).rule == ""
+
+
 def test_number_row_validates_and_computes_difference():
     r = NumberRow("9", "x", "s", 100.0, 93.0, NOT_REPRODUCED)
     assert r.rel_diff == pytest.approx(-0.07) and r.independent

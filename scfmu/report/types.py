@@ -163,6 +163,7 @@ class NumberRow:
     basis: str = INDEPENDENT
     bounds: tuple = ()
     sensitivity: str = ""   # a calibrated row: how ours moves across the calibration grid (shown beside it)
+    precision: float | None = None   # the printed-precision half-width the verdict used (the row states its rule)
 
     def __post_init__(self):
         if self.verdict not in NUMBER_VERDICTS:
@@ -188,6 +189,18 @@ class NumberRow:
             return (float(self.ours) - float(self.paper_value)) / abs(float(self.paper_value))
         except (TypeError, ValueError):
             return math.nan
+
+    @property
+    def rule(self) -> str:
+        """The reproduction rule of this row as stated beside it: the window of values that reproduce the
+        paper's, 5 % or the printed precision, whichever is wider ("" when the row gives no precision)."""
+        import math
+        if self.precision is None or self.paper_value is None or not math.isfinite(float(self.paper_value)):
+            return ""
+        p = float(self.paper_value)
+        half = max(float(self.precision), 0.05 * abs(p))
+        return (f"reproduced within [{p - half:.4g}, {p + half:.4g}]: 5 % or the printed precision "
+                f"± {float(self.precision):g}, whichever is wider")
 
     @property
     def independent(self) -> bool:

@@ -75,7 +75,8 @@ def eulerint_rows(m: dict, calibrated: set[str]) -> list[NumberRow]:
         if r["key"] == "fuzzy":
             note += "; T_r calibrated to this number"
         out.append(NumberRow("000", f"Table 3 EULERINT: {r['label']}", rep["eulerint_unit"], paper[i], ours[i], v,
-                             calibration=r["key"] in calibrated, note=note, paper_text=r["eulerint"]))
+                             calibration=r["key"] in calibrated, note=note, paper_text=r["eulerint"],
+                             precision=rules.printed_precision(r["eulerint"])))
     return out
 
 
@@ -116,7 +117,8 @@ def effort_rows(m: dict, ts: dict) -> tuple[list[NumberRow], Table, str]:
                                      rules.same_ordering(i, ours, paper))
             out.append(NumberRow("000", f"Table 4 control effort: {r['label']}", rep["effort_unit"], paper[i], ours[i],
                                  v, note=f"run {r['run']}; definition {d['label']}"
-                                 + ("" if d["fits_abs"] else f" × {d['factor']:.3g}"), paper_text=r["effort"]))
+                                 + ("" if d["fits_abs"] else f" × {d['factor']:.3g}"), paper_text=r["effort"],
+                                 precision=rules.printed_precision(r["effort"])))
         text = f"The definition {fit[name]['label']} fits every row" + ("" if fit[name]["fits_abs"] else
                                                                           " up to a constant factor") + "."
     else:

@@ -165,6 +165,7 @@ def effort_ratio_rows(by_step: dict, reported: dict) -> list:
         else:
             note = f"Ratios: {listing}"
         default = label == DEFAULT_SAMPLE
+        note += f"; rule: reproduced when ours is above {reported['bound']:g}×"
         out.append(NumberRow("001", f"{reported['label']} (T2 = {reported['T2']:g} s)"
                              + ("" if default else f", controller {label}"), reported["unit"], reported["bound"], ours,
                              v, note=("" if default else "reading of the controller's sample step; ") + note,
