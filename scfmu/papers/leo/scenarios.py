@@ -254,7 +254,7 @@ def sun_pointing() -> Scenario:
     sc.unconnected = [*sc.unconnected, "estimator.q_meas_*", "estimator.st_valid", "estimator.b_meas_*"]
     sc.seed_params = [p for p in sc.seed_params if not p.startswith(("star_tracker.", "magnetometer."))]
     sc.log = {k: v for k, v in sc.log.items() if not v.startswith(("star_tracker.", "magnetometer."))}
-    sc.log.update(sun_valid="sun_sensor.valid")
+    sc.log.update(sun_valid="sun_sensor.valid", **log_of("ephemeris", ["sun_ref_x", "sun_ref_y", "sun_ref_z"]))
     return sc
 
 

@@ -108,7 +108,7 @@ def test_nadir_points_at_the_earth_with_the_estimate(nadir):
     ecl = np.asarray(nadir["eclipse"])
     s = stack(nadir, "sun_eci")
     behind = (np.sum(r * s, axis=1) < 0) & (np.linalg.norm(np.cross(r, s), axis=1) < leo.EARTH_RADIUS)
-    assert 0.30 < behind.mean() < 0.40  # a third of the orbit at this β
+    assert 0.30 < behind.mean() < 0.40  # a third of the orbit at this β (the sun 22° from the orbit plane)
     assert abs(np.mean(ecl < 0.5) - behind.mean()) < 0.005
 
 
