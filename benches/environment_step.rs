@@ -201,6 +201,9 @@ struct Case {
     outputs: &'static [&'static str],
 }
 
+/// One cycle of a unit at step index k.
+type Cycle = Box<dyn FnMut(usize)>;
+
 fn vr(model: &str, name: &str) -> u32 {
     registry::find(model)
         .unwrap()
@@ -225,7 +228,7 @@ fn write<M: Model>(m: &mut Fmu<M>, ix: &[usize], u: &[f64]) {
 }
 
 /// A master's cycle directly in Rust: inputs written, `step`, `outputs` at the new time, outputs read.
-fn direct<M: Model + 'static>(case: &Case) -> Box<dyn FnMut(usize)> {
+fn direct<M: Model + 'static>(case: &Case) -> Cycle {
     let mut m = Fmu::<M>::default();
     for (n, v) in case.params.0 {
         if let Some(SlotMut::Real(x)) = m.v.slot(index::<M>(n)) {
@@ -260,7 +263,7 @@ fn direct<M: Model + 'static>(case: &Case) -> Box<dyn FnMut(usize)> {
 }
 
 /// The same cycle through the exported FMI 2.0 functions: `fmi2SetReal`, `fmi2DoStep`, `fmi2GetReal`.
-fn abi(case: &Case) -> Box<dyn FnMut(usize)> {
+fn abi(case: &Case) -> Cycle {
     let entry = registry::find(case.model).unwrap();
     let g = CString::new(guid(entry).as_str()).unwrap();
     let name = CString::new("bench").unwrap();
@@ -352,7 +355,7 @@ fn cases() -> Vec<Case> {
 
 fn main() {
     let cases = cases();
-    let mut loops: Vec<(String, usize, Box<dyn FnMut(usize)>)> = Vec::new();
+    let mut loops: Vec<(String, usize, Cycle)> = Vec::new();
     for c in &cases {
         let d = match c.model {
             "Environment" => direct::<Environment>(c),
