@@ -17,8 +17,8 @@ Where Basilisk 2.12.1 has no module for a piece of the scenario, or needs data f
 - J2: the spherical-harmonics gravity model loaded in memory with the single coefficient C̄20 = −J2/√5
   (EGM-96 J2; the wheel ships no GGM03S file);
 - field: magneticFieldWMM with the WMM2025 coefficient file shipped by the project venv's ``ahrs`` package
-  (--wmm PATH; centered dipole if absent). No SPICE kernels: the Earth's orientation is the identity, so the
-  field does not turn with the Earth under the orbit (cost unchanged, geometry approximate);
+  (--wmm PATH; centered dipole if absent). No SPICE kernels: the Earth turns about the J2000 z axis from GMST
+  at the epoch (planetEphemeris), without precession and nutation;
 - sun: a constant sun message at the epoch's low-precision solar position (the sun moves ~1° in the day);
   eclipse: Basilisk's eclipse module (conical shadow) from that sun and an Earth at the origin;
 - residual dipole: a second MtbEffector with three axis rods holding the constant dipole (Basilisk has no
@@ -48,6 +48,7 @@ DIPOLE_RES = (0.02, -0.01, 0.015)
 RW_JS, RW_UMAX, RW_OMAX = 1.5e-5, 2e-3, 680.0
 MTB_MAX = 0.2  # A·m² per rod (not given by the scenario; a typical 6U torque rod)
 AU = 149_597_870_700.0
+EARTH_RATE = 7.292115e-5  # rad/s
 
 
 def sun_eci(jd: float) -> list[float]:
@@ -58,6 +59,13 @@ def sun_eci(jd: float) -> list[float]:
     eps = math.radians(23.439 - 4e-7 * n)
     r = (1.00014 - 0.01671 * math.cos(g) - 0.00014 * math.cos(2 * g)) * AU
     return [r * math.cos(lam), r * math.cos(eps) * math.sin(lam), r * math.sin(eps) * math.sin(lam)]
+
+
+def gmst(jd: float) -> float:
+    """Greenwich mean sidereal time (IAU 1982, UT1 = UTC), rad."""
+    t = (jd - 2_451_545.0) / 36_525.0
+    sec = 67_310.54841 + (876_600.0 * 3600.0 + 8_640_184.812866) * t + 0.093104 * t * t - 6.2e-6 * t**3
+    return math.radians((sec / 240.0) % 360.0)
 
 
 def facets():
@@ -84,8 +92,8 @@ def run(stop: float, wmm: str | None) -> dict:
                                         rwMotorTorque, tamComm)
     from Basilisk.simulation import (MtbEffector, eclipse, exponentialAtmosphere, facetDragDynamicEffector,
                                      facetSRPDynamicEffector, gravityEffector, magneticFieldCenteredDipole,
-                                     magneticFieldWMM, magnetometer, reactionWheelStateEffector, simpleNav,
-                                     spacecraft, svIntegrators)
+                                     magneticFieldWMM, magnetometer, planetEphemeris, reactionWheelStateEffector,
+                                     simpleNav, spacecraft, svIntegrators)
     from Basilisk.utilities import RigidBodyKinematics as rbk
     from Basilisk.utilities import (SimulationBaseClass, macros, orbitalMotion, simIncludeGravBody, simIncludeRW,
                                     simSetPlanetEnvironment)
@@ -128,10 +136,20 @@ def run(stop: float, wmm: str | None) -> dict:
     sun = messaging.SpicePlanetStateMsgPayload()
     sun.PositionVector, sun.PlanetName = sun_eci(JD_EPOCH), "sun"
     sun_msg = messaging.SpicePlanetStateMsg().write(sun)
-    earth_pl = messaging.SpicePlanetStateMsgPayload()
-    earth_pl.PositionVector, earth_pl.PlanetName = [0.0, 0.0, 0.0], "earth"
-    earth_pl.J20002Pfix = np.eye(3).tolist()
-    earth_msg = messaging.SpicePlanetStateMsg().write(earth_pl)
+    # the Earth turning at its rate from GMST at the epoch (planetEphemeris; its heliocentric orbit shrunk to
+    # a = 1 m so that the Earth stays at the origin of the spacecraft's frame)
+    eph = planetEphemeris.PlanetEphemeris()
+    eph.ModelTag = "earthRotation"
+    eph.setPlanetNames(planetEphemeris.StringVector(["earth"]))
+    eoe = planetEphemeris.ClassicElements()
+    eoe.a, eoe.e, eoe.i, eoe.Omega, eoe.omega, eoe.f = 1.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    eph.planetElements = planetEphemeris.classicElementVector([eoe])
+    eph.rightAscension = planetEphemeris.DoubleVector([0.0])
+    eph.declination = planetEphemeris.DoubleVector([math.pi / 2])
+    eph.lst0 = planetEphemeris.DoubleVector([gmst(JD_EPOCH)])
+    eph.rotRate = planetEphemeris.DoubleVector([EARTH_RATE])
+    add(eph)
+    earth_msg = eph.planetOutMsgs[0]
     ep = messaging.EpochMsgPayload()
     ep.year, ep.month, ep.day, ep.hours, ep.minutes, ep.seconds = EPOCH
     epoch_msg = messaging.EpochMsg().write(ep)
