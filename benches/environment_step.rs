@@ -12,7 +12,12 @@ use std::ffi::{c_int, c_void, CString};
 use std::hint::black_box;
 use std::time::Instant;
 
+use nalgebra::Vector3;
 use spacecraft_fmus::fmi::fmi2::*;
+use spacecraft_fmus::math::atmosphere::exponential_density;
+use spacecraft_fmus::math::igrf;
+use spacecraft_fmus::math::sun::{shadow_factor, sun_position};
+use spacecraft_fmus::math::time_scales::{decimal_year, eci_to_ecef, geodetic, JD_J2000};
 use spacecraft_fmus::model::guid::guid;
 use spacecraft_fmus::model::{Experiment, Fmu, Model, SlotMut, Value, Variables};
 use spacecraft_fmus::models::attitude::AttitudePlant;
@@ -355,6 +360,49 @@ fn cases() -> Vec<Case> {
     ]
 }
 
+/// The pieces of one `Environment` evaluation, directly in Rust (what `Environment::outputs` calls), at the
+/// day and position of cycle k: where its cost goes.
+fn pieces() -> Vec<(String, usize, Cycle)> {
+    let day = |k: usize| 9_575.0 + k as f64 * 0.1 / 86_400.0; // days from J2000.0 (2026-03-20 12:00 UTC on)
+    let pos = |k: usize| Vector3::from(orbit_at(k as f64 * 0.1).0);
+    let coeffs = igrf::coefficients(decimal_year(JD_J2000 + day(0))).unwrap();
+    let piece = |label: &str, f: Cycle| (format!("  piece of Environment: {label} — direct Rust"), 1000, f);
+    vec![
+        piece(
+            "IGRF-14 coefficients at the date (secular variation)",
+            Box::new(move |k| {
+                black_box(igrf::coefficients(decimal_year(JD_J2000 + day(k))).unwrap());
+            }),
+        ),
+        piece(
+            "IGRF-14 field to degree 13 at r_ecef (given coefficients)",
+            Box::new(move |k| {
+                black_box(igrf::field_ecef(&coeffs, &pos(k)));
+            }),
+        ),
+        piece(
+            "ECI to ECEF (precession + GMST) and geodetic coordinates",
+            Box::new(move |k| {
+                let r = eci_to_ecef(day(k)) * pos(k);
+                black_box(geodetic(&r));
+            }),
+        ),
+        piece(
+            "sun position and conical shadow",
+            Box::new(move |k| {
+                let (sun, dist) = sun_position(day(k));
+                black_box(shadow_factor(&pos(k), &(sun * dist)));
+            }),
+        ),
+        piece(
+            "exponential density",
+            Box::new(move |k| {
+                black_box(exponential_density(pos(k).norm() - 6_378_137.0));
+            }),
+        ),
+    ]
+}
+
 fn main() {
     let cases = cases();
     let mut loops: Vec<(String, usize, Cycle)> = Vec::new();
@@ -367,6 +415,8 @@ fn main() {
         loops.push((format!("{} — direct Rust", c.label), c.block, d));
         loops.push((format!("{} — C ABI", c.label), c.block, abi(c)));
     }
+    let n_units = loops.len();
+    loops.extend(pieces());
     println!("one cycle = inputs set, one communication step, outputs read (at a new time and position);");
     println!("{ROUNDS} interleaved rounds; per round the mean over its block of cycles\n");
     let mut idx = vec![0usize; loops.len()];
@@ -402,7 +452,8 @@ fn main() {
         "µs per cycle", "min", "median", "min ÷ plant"
     );
     for (i, (lo, mid)) in stats.iter().enumerate() {
-        let base = stats[plant + i % 2].0;
+        // units: the plant over the same interface; pieces of Environment: the plant in direct Rust
+        let base = stats[plant + if i < n_units { i % 2 } else { 0 }].0;
         println!(
             "{:<96} {:>8.3} {:>10.3} {:>12.2}",
             loops[i].0,
