@@ -39,7 +39,9 @@ DEFAULT_UNCONNECTED = ("torque_dist_*", "dist_*", "h_wheel*", "q_ref_dot*", "q_r
                        # refuses an unwired r, b_eci or sun_eci), and Orbit's density (0 = no drag); r and v by
                        # model, as Environment's r must stay wired
                        "AttitudePlant:r_*", "AttitudePlant:v_*", "b_eci_*", "sun_eci_*", "eclipse", "rho",
-                       "sun_distance")
+                       "sun_distance",
+                       # AttitudeCommand's orbit inputs, read with reference = 1 (nadir) only (which refuses them unwired)
+                       "AttitudeCommand:r_*", "AttitudeCommand:v_*")
 
 
 def matches_input(port: str, patterns, instance: str | None = None, *, stems: bool = False,

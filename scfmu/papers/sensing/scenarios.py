@@ -55,7 +55,7 @@ def build_estimation(name: str, **kw) -> Scenario:
 @functools.cache
 def attitude_scenarios() -> tuple:
     """(name, description) of every registered three-axis attitude loop (an ``AttitudePlant`` with a
-    ``controller``), the variants excluded: the scenarios that take the estimator."""
+    ``controller``) that has no estimator yet, the variants excluded: the scenarios that take the estimator."""
     out = []
     for src in list(REGISTRY.scenario_sources.values()):
         if src.prefix in DERIVED:
@@ -63,7 +63,8 @@ def attitude_scenarios() -> tuple:
         for n, d in src.names():
             sc = get(n)
             names = {c.name for c in sc.components}
-            if {"plant", "controller"} <= names and sc.component("plant").model == "AttitudePlant":
+            if ({"plant", "controller"} <= names and "estimator" not in names
+                    and sc.component("plant").model == "AttitudePlant"):
                 out.append((n, d))
     return tuple(out)
 

@@ -5,7 +5,8 @@ use serde::{Deserialize, Serialize};
 
 use super::shared::{check_unit_quaternions, AttitudeControllerPorts, DcmError, ErrorLaw};
 use crate::declare_variables;
-use crate::model::{check_derived, Experiment, Feedthrough, Model, ModelInfo, ModelResult, ParamEnum};
+use crate::math::attitude::attitude_matrix;
+use crate::model::{check_derived, Experiment, Feedthrough, Model, ModelInfo, ModelResult, ParamEnum, SWITCH};
 
 declare_variables! {
     pub struct PdControllerVars {
@@ -18,6 +19,7 @@ declare_variables! {
         120 => gain_mode: Integer = 0, Parameter, "", "0 = gains from wn, zeta and inertia; 1 = explicit kp_*, kd_*", Choice(&[0, 1]);
         121 => error_law: Integer = 0, Parameter, "", "Error signal: 0 = quaternion, 1 = DCM, 2 = Euler 321 angles", Choice(ErrorLaw::CODES);
         122 => dcm_error: Integer = 0, Parameter, "", "Reading of the DCM error (error_law = 1): 0 = elements of A(q)A(q_ref)^T as printed; 1 = vex of its skew part (= quaternion law); 2 = twice that; 3 = -(transposed elements); 4 = body-to-inertial attitude matrix; 5 = transposed elements of A(q_ref)^T A(q)", Choice(DcmError::CODES);
+        123 => rate_feedforward: Integer = 0, Parameter, "", "0 = rate term on the measured rate w (the paper's law, constant commands); 1 = on the rate error w - A(q) A(q_ref)^T w_ref, for a moving reference (nadir pointing)", Choice(SWITCH);
         200 => k: Vec3 = [0.0; 3], CalculatedParameter, "N.m/rad", "Proportional gain in use";
         203 => k_d: Vec3 = [0.0; 3], CalculatedParameter, "N.m.s/rad", "Rate gain in use (negative)";
     }
@@ -56,7 +58,9 @@ linearisation: e = commanded - actual angle); at large angles they differ by the
 (1 - cos alpha) n n^T of the error matrix, its sign, and (readings 4, 5) the frame in which the error axis is \
 expressed (reference instead of body). [Navabi-2019] does not say which one it used; reading 0 is the default.</p>\n\
 <p>For a constant command and the linear small-angle plant each axis closes to s^2 + 2 zeta wn s + wn^2. \
-w_ref is not used ([Navabi-2019] commands are constant).</p>",
+w_ref is not used unless rate_feedforward = 1 ([Navabi-2019] commands are constant); then the rate term acts on \
+w - A(q) A(q_ref)^T w_ref (w_ref in the commanded body axes, turned into the body axes), which removes the \
+steady lag of -2 zeta w_ref / wn that a reference turning at w_ref leaves with the paper's law.</p>",
         feedthrough: Feedthrough::AllInputs,
         ..ModelInfo::DEFAULT
     };
@@ -78,7 +82,13 @@ w_ref is not used ([Navabi-2019] commands are constant).</p>",
             ErrorLaw::Dcm => self.dcm.error(&v.ports),
             law => law.error(&v.ports),
         };
-        v.ports.torque_cmd = v.k.component_mul(&e) + v.k_d.component_mul(&v.ports.w);
+        let rate = if v.rate_feedforward == 1 {
+            let turn = attitude_matrix(&v.ports.q) * attitude_matrix(&v.ports.q_ref).transpose();
+            v.ports.w - turn * v.ports.w_ref
+        } else {
+            v.ports.w
+        };
+        v.ports.torque_cmd = v.k.component_mul(&e) + v.k_d.component_mul(&rate);
         Ok(())
     }
 

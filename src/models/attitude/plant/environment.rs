@@ -77,6 +77,14 @@ impl Budget {
     }
 }
 
+/// Whether the environment inputs have not been set yet: environment_inputs = 1 with r and b_eci both at
+/// their start value 0. A master that reads the plant's outputs before it first sets its inputs (a
+/// Gauss–Seidel master whose sensors come before the plant) then gets the state outputs and zero for what
+/// depends on the environment; a step refuses the unset inputs (`check_world`).
+pub fn world_unset(v: &AttitudePlantVars) -> bool {
+    v.environment_inputs == 1 && v.r == Vector3::zeros() && v.b_eci == Vector3::zeros()
+}
+
 /// The environment inputs (environment_inputs = 1) checked before they are used: a position outside the
 /// Earth, a unit sun vector when facets feel the sun, an eclipse factor in [0, 1], a density ≥ 0.
 pub fn check_world(v: &AttitudePlantVars, facets: bool) -> Result<(), String> {
@@ -156,6 +164,11 @@ impl AttitudePlant {
 
     /// Disturbance generator + input + the budget: τ_ext.
     pub(super) fn external(&self, v: &AttitudePlantVars, t: f64, a: &Matrix3<f64>, seg: &Segment) -> Vector3<f64> {
+        self.external_with(v, t, a, seg, None)
+    }
+
+    /// [`Self::external`] with the budget already computed (the outputs compute it once for both).
+    pub(super) fn external_with(&self, v: &AttitudePlantVars, t: f64, a: &Matrix3<f64>, seg: &Segment, budget: Option<&Budget>) -> Vector3<f64> {
         let mut tau = v.torque_dist + v.dist_const + seg.noise;
         if v.dist_sin_amp != Vector3::zeros() {
             let wt = v.dist_sin_freq * t;
@@ -165,7 +178,10 @@ impl AttitudePlant {
             // the papers' plant: the same operations as before the budget existed (bit for bit)
             tau += gravity_gradient(self.d.n2, &(a * self.d.orbit.r_hat(t)), &self.inertia);
         } else if self.budget_needs_attitude(v) {
-            tau += self.budget(v, t, a).torque();
+            tau += match budget {
+                Some(b) => b.torque(),
+                None => self.budget(v, t, a).torque(),
+            };
         }
         tau
     }

@@ -22,7 +22,7 @@ use serde::{Deserialize, Serialize};
 pub use kinematics::Kinematics;
 pub use variables::{AttitudePlantVars, FACETS};
 
-use self::environment::{breakpoints, check_world, segment_at, segment_of_piece, Segment};
+use self::environment::{breakpoints, check_world, segment_at, segment_of_piece, world_unset, Budget, Segment};
 use self::kinematics::{attitude_rates, initial_attitude, post_step, v3, State, ATT, HW, TW, W};
 use crate::math::attitude::{euler321_from_dcm, euler321_from_quat, wxyz};
 use crate::math::environment::CircularOrbit;
@@ -163,7 +163,10 @@ impl Model for AttitudePlant {
     }
 
     fn outputs(&self, v: &mut AttitudePlantVars, t: f64) -> ModelResult {
-        check_world(v, self.d.has_facets)?;
+        let unset = world_unset(v);
+        if !unset {
+            check_world(v, self.d.has_facets)?;
+        }
         let x = self.x;
         let q = self.quaternion(&x);
         let a = self.attitude(&x);
@@ -176,8 +179,8 @@ impl Model for AttitudePlant {
         };
         let seg = segment_at(v, t);
         let act = self.actuate(v, t, &x, &a, &seg);
-        let ext = self.external(v, t, &a, &seg);
-        let budget = self.budget(v, t, &a);
+        let budget = if unset { Budget::default() } else { self.budget(v, t, &a) };
+        let ext = self.external_with(v, t, &a, &seg, Some(&budget));
         (v.torque_gg, v.torque_aero, v.torque_srp, v.torque_residual) = (budget.gg, budget.aero.torque, budget.srp.torque, budget.residual);
         (v.force_aero, v.force_srp) = (budget.aero.force, budget.srp.force);
         v.b_body = self.field_body(v, t, &a);

@@ -184,9 +184,15 @@ fn an_unconnected_position_is_refused_with_the_reason() {
     let mut p: P = plant(|v| v.init_w.x = 0.01);
     p.v.environment_inputs = 1;
     p.initialize(&Default::default()).unwrap();
+    // never set (r and b_eci at their start value 0): the state outputs are read, the budget is 0, and a
+    // step refuses the inputs
+    p.outputs(0.0).unwrap();
+    assert_eq!((p.v.w.x, p.v.torque_gg, p.v.b_body), (0.01, Vector3::zeros(), Vector3::zeros()));
+    assert!(p.step(0.0, 0.1).unwrap_err().contains("input r"));
+    // a field without a position is a wiring error, refused at once
+    p.v.b_eci = Vector3::z() * 1e-5;
     let e = p.outputs(0.0).unwrap_err();
     assert!(e.contains("input r") && e.contains("connected"), "{e}");
-    assert!(p.step(0.0, 0.1).unwrap_err().contains("input r"));
 }
 
 #[test]

@@ -1,0 +1,181 @@
+#!/usr/bin/env python3
+"""Figures and tables of docs/leo.md, the 6U CubeSat on its 500 km sun-synchronous orbit, made from the
+packaged FMUs on the compiled engine (``.venv/bin/python scripts/leo_figures.py``):
+
+1. ``leo_detumble.png``: the body rate under B-dot on the IGRF-14 field from a 5 deg/s tip-off;
+2. ``leo_sun_pointing.png``: the eclipse factor, the sun sensor's validity, the pointing error of body +x to
+   the sun and the Mekf's attitude sigma, through two orbits;
+3. ``leo_nadir.png``: one day of nadir pointing: the disturbance torques (gravity gradient, drag, solar
+   pressure, residual dipole), the wheel momentum under magnetorquer dumping and the pointing error.
+
+Each run's logged signals go to ``OUT/leo_<name>.csv`` (SI units in the header), a summary to
+``OUT/leo_summary.csv``. ``--quick``: two orbits of leo/nadir instead of a day (the CI size).
+``--out`` (default docs/); the CSV files go to ``--data`` (default a temporary folder, printed).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import math
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from scfmu.engines import simulate
+from scfmu.papers.leo import scenarios as leo
+
+
+def _plt():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def stack(r, stem: str, comps: str = "xyz") -> np.ndarray:
+    return np.stack([np.asarray(r[f"{stem}_{a}"], dtype=float) for a in comps], axis=1)
+
+
+def attitude_matrices(q: np.ndarray) -> np.ndarray:
+    """A(q) (inertial → body) of scalar-first unit quaternions, n × 3 × 3 (the plant's convention)."""
+    w, x, y, z = (q[:, i] for i in range(4))
+    return np.stack([np.stack([w*w + x*x - y*y - z*z, 2*(x*y + w*z), 2*(x*z - w*y)], axis=1),
+                     np.stack([2*(x*y - w*z), w*w - x*x + y*y - z*z, 2*(y*z + w*x)], axis=1),
+                     np.stack([2*(x*z + w*y), 2*(y*z - w*x), w*w - x*x - y*y + z*z], axis=1)], axis=1)
+
+
+def quat_err_deg(q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
+    d = np.abs(np.sum(q1 * q2, axis=1)) / np.linalg.norm(q1, axis=1) / np.linalg.norm(q2, axis=1)
+    return np.degrees(2 * np.arccos(np.clip(d, -1.0, 1.0)))
+
+
+def write_csv(path: Path, r) -> None:
+    keys = list(r.keys())
+    units = getattr(r, "units", {}) or {}
+    with path.open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow([f"{k} [{units.get(k, '')}]" if units.get(k) else k for k in keys])
+        w.writerows(np.column_stack([np.asarray(r[k], dtype=float) for k in keys]).tolist())
+
+
+def run(name: str, data: Path, stop: float | None = None):
+    sc = leo.build(name)
+    if stop is not None:
+        sc.stop_time = stop
+    t0 = time.perf_counter()
+    r = simulate(sc, engine="auto")
+    wall = time.perf_counter() - t0
+    write_csv(data / f"leo_{name.split('/')[1]}.csv", r)
+    print(f"{name}: {sc.stop_time:.0f} s simulated in {wall:.1f} s", flush=True)
+    return r, wall
+
+
+def detumble(out: Path, data: Path, plt) -> dict:
+    r, wall = run("leo/detumble", data)
+    t = np.asarray(r["time"]) / leo.ORBIT_PERIOD
+    rate = np.degrees(np.linalg.norm(stack(r, "w"), axis=1))
+    fig, ax = plt.subplots(figsize=(8, 4))
+    ax.plot(t, rate)
+    ax.set_yscale("log")
+    ax.set(xlabel="time [orbits]", ylabel="|ω| [deg/s]",
+           title="leo/detumble: B-dot on the IGRF-14 field, 6U, 500 km sun-synchronous orbit")
+    ax.grid(True, which="both", alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(out / "leo_detumble.png", dpi=110)
+    plt.close(fig)
+    return {"scenario": "leo/detumble", "wall_s": wall, "rate_start_deg_s": rate[0], "rate_end_deg_s": rate[-1]}
+
+
+def sun_pointing(out: Path, data: Path, plt) -> dict:
+    r, wall = run("leo/sun-pointing", data)
+    t = np.asarray(r["time"]) / leo.ORBIT_PERIOD
+    a = attitude_matrices(stack(r, "q", "wxyz"))
+    s_b = np.einsum("nij,nj->ni", a, stack(r, "sun_eci"))
+    err = np.degrees(np.arccos(np.clip(s_b[:, 0] / np.linalg.norm(s_b, axis=1), -1, 1)))
+    sigma = np.degrees(np.sqrt(np.max(stack(r, "p_att"), axis=1)))
+    est_err = quat_err_deg(stack(r, "q", "wxyz"), stack(r, "q_est", "wxyz"))
+    fig, axs = plt.subplots(3, 1, figsize=(8, 7), sharex=True)
+    axs[0].plot(t, r["eclipse"], label="eclipse factor (visible fraction of the sun)")
+    axs[0].plot(t, np.asarray(r["sun_valid"]) * 0.9, label="sun sensor valid (× 0.9)")
+    axs[0].set(ylabel="[-]", title="leo/sun-pointing: body +x on the sun through eclipses")
+    axs[0].legend(loc="lower right", fontsize=8)
+    axs[1].plot(t, err)
+    axs[1].set(ylabel="sun off +x [deg]", yscale="log")
+    axs[2].plot(t, est_err, label="Mekf attitude error")
+    axs[2].plot(t, 3 * sigma, label="3σ (largest axis)")
+    axs[2].set(xlabel="time [orbits]", ylabel="[deg]", yscale="log")
+    axs[2].legend(fontsize=8)
+    for ax in axs:
+        ax.grid(True, alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(out / "leo_sun_pointing.png", dpi=110)
+    plt.close(fig)
+    lit = np.asarray(r["eclipse"]) > 0.5
+    late = np.asarray(r["time"]) > 0.25 * leo.ORBIT_PERIOD
+    return {"scenario": "leo/sun-pointing", "wall_s": wall, "eclipse_fraction": 1 - lit.mean(),
+            "pointing_err_lit_p95_deg": float(np.percentile(err[lit & late], 95)),
+            "sigma_lit_median_deg": float(np.median(sigma[lit & late])),
+            "sigma_eclipse_max_deg": float(sigma[~lit].max()) if (~lit).any() else math.nan}
+
+
+def nadir(out: Path, data: Path, plt, stop: float | None) -> dict:
+    r, wall = run("leo/nadir", data, stop)
+    t = np.asarray(r["time"]) / 3600.0
+    err = quat_err_deg(stack(r, "q", "wxyz"), stack(r, "q_ref", "wxyz"))
+    fig, axs = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
+    for stem, label in (("torque_gg", "gravity gradient"), ("torque_aero", "drag"), ("torque_srp", "solar pressure"),
+                        ("torque_residual", "residual dipole")):
+        axs[0].plot(t, np.linalg.norm(stack(r, stem), axis=1), label=label, lw=0.8)
+    axs[0].set(ylabel="|torque| [N·m]", yscale="log", title="leo/nadir: disturbance budget, wheel momentum, pointing")
+    axs[0].legend(fontsize=8, ncol=2)
+    h = stack(r, "h_wheel")
+    for i, a in enumerate("xyz"):
+        axs[1].plot(t, h[:, i] * 1e3, label=f"h_wheel,{a}", lw=0.8)
+    axs[1].axhline(1.5e-5 * 680 * 1e3, color="k", ls=":", lw=0.8, label="wheel capacity")
+    axs[1].axhline(-1.5e-5 * 680 * 1e3, color="k", ls=":", lw=0.8)
+    axs[1].set(ylabel="[mN·m·s]")
+    axs[1].legend(fontsize=8, ncol=4)
+    axs[2].plot(t, err, lw=0.8)
+    axs[2].set(xlabel="time [h]", ylabel="nadir pointing error [deg]", yscale="log")
+    for ax in axs:
+        ax.grid(True, alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(out / "leo_nadir.png", dpi=110)
+    plt.close(fig)
+    settled = np.asarray(r["time"]) > 600.0
+    return {"scenario": "leo/nadir", "wall_s": wall, "simulated_s": float(r["time"][-1]),
+            "pointing_err_p95_deg": float(np.percentile(err[settled], 95)),
+            "h_wheel_max_mNms": float(np.abs(h).max() * 1e3),
+            **{f"{stem}_rms_Nm": float(np.sqrt(np.mean(np.sum(stack(r, stem) ** 2, axis=1))))
+               for stem in ("torque_gg", "torque_aero", "torque_srp", "torque_residual")}}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--out", type=Path, default=Path("docs"))
+    ap.add_argument("--data", type=Path, default=None)
+    ap.add_argument("--quick", action="store_true", help="two orbits of leo/nadir instead of a day")
+    a = ap.parse_args(argv)
+    a.out.mkdir(parents=True, exist_ok=True)
+    data = a.data or Path(tempfile.mkdtemp(prefix="leo_figures_"))
+    data.mkdir(parents=True, exist_ok=True)
+    plt = _plt()
+    rows = [detumble(a.out, data, plt), sun_pointing(a.out, data, plt),
+            nadir(a.out, data, plt, 2 * round(leo.ORBIT_PERIOD) if a.quick else None)]
+    keys = sorted({k for row in rows for k in row} - {"scenario"})
+    with (data / "leo_summary.csv").open("w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=["scenario", *keys])
+        w.writeheader()
+        w.writerows(rows)
+    for row in rows:
+        print(", ".join(f"{k} = {v:.4g}" if isinstance(v, float) else f"{k} = {v}" for k, v in row.items()))
+    print(f"figures in {a.out}/, data in {data}/")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
