@@ -11,7 +11,8 @@ loading, instantiation or set-up). Prints a table of wall and CPU times and the 
 
 Each FMU run happens in a child process of the project venv (one engine, one scenario per process, so a run
 does not inherit the other's loaded libraries or memory); the Basilisk run in a child of .venv-bsk
-(--bsk-python). `--log few` keeps only the attitude, its reference and the wheel momentum of each scenario's log (what the
+(--bsk-python). Wall and CPU time (`time.process_time` of the process that runs the loop) are each the
+minimum over the rounds; on a loaded machine the CPU time is the steadier of the two. `--log few` keeps only the attitude, its reference and the wheel momentum of each scenario's log (what the
 loop costs with little logging); the default logs what the scenario logs (56 signals in leo/nadir-textbook).
 """
 
@@ -96,11 +97,14 @@ def main() -> int:
             loads.append(os.getloadavg()[0])
             print(f"round {i + 1}: {name}: wall {r['wall_s']:.2f} s, cpu {r.get('cpu_s', float('nan')):.2f} s",
                   file=sys.stderr)
-            if name not in best or r["wall_s"] < best[name]["wall_s"]:
+            if name not in best:
                 best[name] = r
+            else:  # the minimum wall and the minimum CPU time, each over the rounds; the rest from the first
+                best[name]["wall_s"] = min(best[name]["wall_s"], r["wall_s"])
+                best[name]["cpu_s"] = min(best[name]["cpu_s"], r["cpu_s"])
     print(f"{start}, load average {min(loads):.1f}–{max(loads):.1f} (1 min, sampled between runs); "
           f"{a.stop:g} s at 0.1 s, min over {a.rounds} interleaved round(s), log: {a.log}")
-    print("| loop | wall [s] | CPU [s] | µs/step (wall) | sanity (final values) |")
+    print("| loop | wall [s] | CPU [s] | µs/step (CPU) | sanity (final values) |")
     print("|---|---:|---:|---:|---|")
     for name, r in best.items():
         steps = r.get("steps") or int(round(a.stop / 0.1))
@@ -111,7 +115,7 @@ def main() -> int:
         else:
             sanity = ", ".join(f"{k} {v:.3g}" for k, v in r["final"].items()) or "—"
         print(f"| {label} | {r['wall_s']:.3f} | {r.get('cpu_s', float('nan')):.3f} | "
-              f"{r['wall_s'] / steps * 1e6:.2f} | {sanity} |")
+              f"{r['cpu_s'] / steps * 1e6:.2f} | {sanity} |")
     nadir, text = best[a.scenarios[0]], best[a.scenarios[1]]
     ratio = nadir["wall_s"] / text["wall_s"]
     print(f"\n{a.scenarios[0]} ÷ {a.scenarios[1]}: {ratio:.2f} wall, {nadir['cpu_s'] / text['cpu_s']:.2f} CPU "
