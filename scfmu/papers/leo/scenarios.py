@@ -119,16 +119,47 @@ def lvlh_start() -> dict:
     h = np.cross(r, v)
     y = -h / np.linalg.norm(h)
     x = np.cross(y, z)
-    a = np.vstack([x, y, z])  # inertial -> body
-    roll, pitch, yaw = math.atan2(a[1, 2], a[2, 2]), -math.asin(a[0, 2]), math.atan2(a[0, 1], a[0, 0])
-    return {"init_euler321_roll": roll, "init_euler321_pitch": pitch, "init_euler321_yaw": yaw,
+    return {**euler321(np.vstack([x, y, z])),  # rows: the body axes in inertial components
             "init_w_x": 0.0, "init_w_y": -np.linalg.norm(h) / np.dot(r, r), "init_w_z": 0.0}
+
+
+def sun_direction(jd: float) -> np.ndarray:
+    """Unit vector to the sun (equator and equinox of date) by the Astronomical Almanac's low-precision formula
+    (about 0.01°); used only for the start of leo/sun-pointing, whose command reads Environment's sun."""
+    n = jd - 2_451_545.0
+    g = math.radians(357.528 + 0.985_600_3 * n)
+    lam = math.radians(280.460 + 0.985_647_4 * n + 1.915 * math.sin(g) + 0.020 * math.sin(2 * g))
+    eps = math.radians(23.439 - 4e-7 * n)
+    return np.array([math.cos(lam), math.cos(eps) * math.sin(lam), math.sin(eps) * math.sin(lam)])
+
+
+SUN_AXIS, SUN_SECONDARY = (1.0, 0.0, 0.0), (0.0, 0.0, 1.0)  # body +x (the sun sensor's boresight) on the sun
+
+
+def sun_start() -> dict:
+    """The plant's initial attitude on the sun-pointing attitude at the epoch (body +x on the sun, body z
+    toward the inertial z axis), within the precession since 2000 (0.36°) of the command's."""
+    s, z = sun_direction(EPOCH_JD), np.array([0.0, 0.0, 1.0])
+    u2 = np.cross(s, z) / np.linalg.norm(np.cross(s, z))
+    a1, b = np.array(SUN_AXIS), np.array(SUN_SECONDARY)
+    a2 = np.cross(a1, b)
+    a = np.column_stack([a1, a2, np.cross(a1, a2)]) @ np.column_stack([s, u2, np.cross(s, u2)]).T
+    return euler321(a)
+
+
+def euler321(a: np.ndarray) -> dict:
+    """The plant's initial 321 angles of an attitude matrix A (inertial → body)."""
+    return {"init_euler321_roll": math.atan2(a[1, 2], a[2, 2]), "init_euler321_pitch": -math.asin(a[0, 2]),
+            "init_euler321_yaw": math.atan2(a[0, 1], a[0, 0])}
 
 
 ENV_SENSOR = {"environment_inputs": 1}
 BUDGET_LOG = [f"{stem}_{a}" for stem in ("torque_gg", "torque_aero", "torque_srp", "torque_residual",
                                          "h_wheel", "dipole") for a in "xyz"]
-ORBIT_LOG = {"altitude": "orbit.altitude", "eclipse": "environment.eclipse", "rho": "environment.rho"}
+ORBIT_LOG = {"altitude": "orbit.altitude", "eclipse": "environment.eclipse", "rho": "environment.rho",
+             **log_of("orbit", ["r_x", "r_y", "r_z"]), **log_of("environment", ["b_eci_x", "b_eci_y", "b_eci_z", "sun_eci_x", "sun_eci_y", "sun_eci_z"])}
+PLANT_LOG = ["q_w", "q_x", "q_y", "q_z", "w_x", "w_y", "w_z", *BUDGET_LOG, "torque_ext_x", "torque_ext_y",
+             "torque_ext_z", "b_body_x", "b_body_y", "b_body_z", "h_total_ref_x", "h_total_ref_y", "h_total_ref_z"]
 PD_GAINS = {"wn": 0.1, "zeta": 0.9, "rate_feedforward": 1}
 UNCONNECTED = [*DEFAULT_UNCONNECTED, "plant.torque_dist_*"]
 
@@ -158,7 +189,7 @@ def detumble() -> Scenario:
 def _pointing(name: str, command: dict, sensors: dict, stop: float, description: str,
               textbook: bool = False) -> Scenario:
     """Orbit, Environment → AttitudeCommand → PD (rate feed-forward) on the Mekf's estimate → plant."""
-    start = lvlh_start() if command.get("reference") == 1 else {}
+    start = {1: lvlh_start, 2: sun_start}.get(command.get("reference"), dict)()
     plant = plant_params(mtq_enable=1, **start)
     if textbook:
         plant.update(environment_inputs=0, gg_enable=1)
@@ -169,7 +200,7 @@ def _pointing(name: str, command: dict, sensors: dict, stop: float, description:
                     Component("controller", "PdController", dict(PD_GAINS), slot=dict(INERTIA)),
                     Component("plant", "AttitudePlant", plant)],
         stop_time=stop, step=0.1,
-        log={**log_of("plant", ["q_w", "q_x", "q_y", "q_z", "w_x", "w_y", "w_z", *BUDGET_LOG]),
+        log={**log_of("plant", PLANT_LOG),
              **log_of("command", ["q_ref_w", "q_ref_x", "q_ref_y", "q_ref_z"]),
              **({} if textbook else ORBIT_LOG)},
         unconnected=list(UNCONNECTED),
@@ -193,9 +224,13 @@ def _pointing(name: str, command: dict, sensors: dict, stop: float, description:
 
 
 def sun_pointing() -> Scenario:
-    sensors = {"mekf": {"use_star_tracker": 0, "init_from_star_tracker": 0}, "star_tracker": {}}
-    sc = _pointing("leo/sun-pointing", {"reference": 2, "sun_axis_x": 1.0, "sun_axis_y": 0.0, "sun_axis_z": 0.0,
-                                       "secondary_axis_x": 0.0, "secondary_axis_z": 1.0},
+    start = sun_start()
+    q0 = quat_from_euler321(start["init_euler321_roll"], start["init_euler321_pitch"], start["init_euler321_yaw"])
+    sensors = {"mekf": {"use_star_tracker": 0, "init_from_star_tracker": 0,
+                        **{f"q_init_{c}": q0[i] for i, c in enumerate("wxyz")}}, "star_tracker": {}}
+    axes = {**{f"sun_axis_{c}": SUN_AXIS[i] for i, c in enumerate("xyz")},
+            **{f"secondary_axis_{c}": SUN_SECONDARY[i] for i, c in enumerate("xyz")}}
+    sc = _pointing("leo/sun-pointing", {"reference": 2, **axes},
                    sensors, float(round(2 * ORBIT_PERIOD)),
                    "6U, 500 km sun-synchronous orbit: body +x on the sun through two orbits and their eclipses, "
                    "Mekf on gyro, sun sensor and magnetometer (no star tracker)")
@@ -203,8 +238,15 @@ def sun_pointing() -> Scenario:
     sc.unconnected = [*sc.unconnected, "estimator.q_meas_*", "estimator.st_valid"]
     sc.seed_params = [p for p in sc.seed_params if not p.startswith("star_tracker.")]
     sc.log = {k: v for k, v in sc.log.items() if not v.startswith("star_tracker.")}
-    sc.log.update(sun_valid="sun_sensor.valid", **log_of("environment", ["sun_eci_x", "sun_eci_y", "sun_eci_z"]))
+    sc.log.update(sun_valid="sun_sensor.valid")
     return sc
+
+
+def quat_from_euler321(roll: float, pitch: float, yaw: float) -> list[float]:
+    """q = q_z(yaw) ⊗ q_y(pitch) ⊗ q_x(roll), scalar first (the plant's 321 convention)."""
+    cr, sr, cp, sp, cy, sy = (f(a / 2) for a in (roll, pitch, yaw) for f in (math.cos, math.sin))
+    return [cy * cp * cr + sy * sp * sr, cy * cp * sr - sy * sp * cr, cy * sp * cr + sy * cp * sr,
+            sy * cp * cr - cy * sp * sr]
 
 
 def nadir(textbook: bool = False) -> Scenario:
