@@ -12,8 +12,8 @@ loading, instantiation or set-up). Prints a table of wall and CPU times and the 
 Each FMU run happens in a child process of the project venv (one engine, one scenario per process, so a run
 does not inherit the other's loaded libraries or memory); the Basilisk run in a child of .venv-bsk
 (--bsk-python). Wall and CPU time (`time.process_time` of the process that runs the loop) are each the
-minimum over the rounds; on a loaded machine the CPU time is the steadier of the two. `--log few` keeps only the attitude, its reference and the wheel momentum of each scenario's log (what the
-loop costs with little logging); the default logs what the scenario logs (56 signals in leo/nadir-textbook).
+minimum over the rounds; on a loaded machine the CPU time is the steadier of the two. `--log few` keeps only the quaternions (q_*: attitude, reference, measurement, estimate) and the wheel
+momentum of each scenario's log (what the loop costs with little logging); the default logs what the scenario logs (56 signals in leo/nadir-textbook).
 """
 
 from __future__ import annotations
