@@ -97,11 +97,13 @@ def plant_params(**extra) -> dict:
 
 
 def orbit_units() -> list[Component]:
-    """``Orbit`` (J2 + drag) and ``Environment`` (IGRF-14, sun, shadow, exponential atmosphere) at the epoch."""
-    return [Component("orbit", "Orbit", {"semi_major_axis": SMA, "eccentricity": 0.0, "inclination": INCLINATION,
+    """``Environment`` (IGRF-14, sun, shadow, exponential atmosphere) and ``Orbit`` (J2 + drag) at the epoch. The
+    Environment comes first in the Gauss–Seidel order: it reads the orbit's position of the communication point
+    and is evaluated once per step, and the orbit's drag reads the density at that position."""
+    return [Component("environment", "Environment", dict(EPOCH_PARAMS)),
+            Component("orbit", "Orbit", {"semi_major_axis": SMA, "eccentricity": 0.0, "inclination": INCLINATION,
                                          "raan": RAAN, "epoch_jd_utc": EPOCH_JD, "ballistic_coeff": BALLISTIC,
-                                         "tolerance": 1e-10}),
-            Component("environment", "Environment", dict(EPOCH_PARAMS))]
+                                         "tolerance": 1e-10})]
 
 
 def initial_state() -> tuple[np.ndarray, np.ndarray]:
@@ -120,7 +122,7 @@ def lvlh_start() -> dict:
     y = -h / np.linalg.norm(h)
     x = np.cross(y, z)
     return {**euler321(np.vstack([x, y, z])),  # rows: the body axes in inertial components
-            "init_w_x": 0.0, "init_w_y": -np.linalg.norm(h) / np.dot(r, r), "init_w_z": 0.0}
+            "init_w_x": 0.0, "init_w_y": float(-np.linalg.norm(h) / np.dot(r, r)), "init_w_z": 0.0}
 
 
 def sun_direction(jd: float) -> np.ndarray:
@@ -287,10 +289,14 @@ BUILDERS = {"leo/detumble": detumble, "leo/sun-pointing": sun_pointing, "leo/nad
 EXPORTED = ("leo/detumble", "leo/sun-pointing", "leo/nadir")
 
 
-def build(name: str, **_kw) -> Scenario:
+def build(name: str, stop_time: float | None = None, **_kw) -> Scenario:
+    """The scenario ``name``; ``stop_time``: a shorter (or longer) run of the same loop."""
     if name not in BUILDERS:
         raise KeyError(f"unknown scenario {name!r}: expected one of {list(BUILDERS)}")
-    return copy.deepcopy(BUILDERS[name]())
+    sc = copy.deepcopy(BUILDERS[name]())
+    if stop_time is not None:
+        sc.stop_time = float(stop_time)
+    return sc
 
 
 def names() -> list[tuple[str, str]]:

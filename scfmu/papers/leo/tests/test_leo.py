@@ -45,7 +45,7 @@ def nadir():
 def test_the_scenarios_are_registered_exported_and_plain_data():
     assert {"leo/detumble", "leo/sun-pointing", "leo/nadir", "leo/nadir-textbook"} <= set(scenarios.names("leo/*"))
     sc = scenarios.get("leo/nadir")
-    assert [c.name for c in sc.components][:3] == ["orbit", "environment", "command"]
+    assert [c.name for c in sc.components][:3] == ["environment", "orbit", "command"]
     assert sc.component("plant").params["environment_inputs"] == 1
     assert sc.stop_time == 86_400.0 and sc.step == 0.1
     # one instant: the Orbit's Julian date is the Environment's calendar epoch
