@@ -8,9 +8,11 @@
 #        are pinned by step 2).
 #   2. tests/test_package_digests.py --write: tests/data/package_digests.json, the one pin: the sha256 of
 #        every file of step 1 (the committed ones and the two members of each FMU, FMI 2.0 and 3.0).
-#   3. with --report: `scfmu report --docs docs` (the full build, about 18 min on 2 cores) rewrites the
+#   3. with --report: `scfmu report --docs docs` (the full build; its measured time is in docs/report.md) rewrites the
 #        generated blocks of docs/paperNNN.md, and its out/report/verdicts.json becomes
-#        tests/data/report_full_verdicts.json (the verdicts every quick build must reach).
+#        tests/data/report_full_verdicts.json (the verdicts every quick build must reach), its printed numbers
+#        tests/data/report_full_values.json, its timings.json the recorded full build (scfmu/report/timings.json)
+#        and the timings blocks of README.md and docs/report.md.
 #   4. with --figures: scripts/adcs_figures.py (docs/adcs_*.png) and scripts/mekf_consistency.py
 #        (docs/mekf_consistency.png, 100 Monte Carlo runs per plant).
 #
@@ -60,6 +62,8 @@ if [ "$report" = 1 ]; then
     echo "regenerate: report: docs/paperNNN.md blocks and tests/data/report_full_verdicts.json (full build)"
     .venv/bin/scfmu report --docs docs --out out/report
     cp out/report/verdicts.json tests/data/report_full_verdicts.json
+    .venv/bin/python -m scfmu.report.prose out/report --values > tests/data/report_full_values.json
+    .venv/bin/python -m scfmu.report.timings --record full out/report/timings.json --write README.md docs/report.md
 fi
 if [ "$figures" = 1 ]; then
     echo "regenerate: figures of docs/adcs.md and docs/estimation.md"

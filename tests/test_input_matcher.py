@@ -71,3 +71,17 @@ def test_model_qualified_patterns_name_the_inputs_of_one_model():
     assert sc._is_unconnected("plant", "r_y") and not sc._is_unconnected("env", "r_y")
     assert not CoSimulation._required(SimpleNamespace(model="AttitudePlant"), "v_z")
     assert CoSimulation._required(SimpleNamespace(model="Environment"), "r_x")
+
+
+def test_the_sensors_environment_inputs_may_stay_open():
+    """Magnetometer's b_eci, SunSensor's sun_eci and eclipse, Ephemeris' r and jd_utc are read with
+    environment_inputs = 1 only: open by default; Environment's r stays required."""
+    sc = Scenario(name="t", components=[Component("mag", "Magnetometer"), Component("sun", "SunSensor"),
+                                        Component("eph", "Ephemeris"), Component("env", "Environment")],
+                  stop_time=1.0, step=0.1)
+    for inst, port in (("mag", "b_eci_x"), ("sun", "sun_eci_z"), ("sun", "eclipse"), ("eph", "r_y"),
+                       ("eph", "jd_utc")):
+        assert sc._is_unconnected(inst, port), (inst, port)
+        assert not CoSimulation._required(SimpleNamespace(model=sc.component(inst).model), port)
+    assert not sc._is_unconnected("env", "r_x")
+    assert CoSimulation._required(SimpleNamespace(model="Environment"), "r_x")

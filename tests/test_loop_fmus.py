@@ -47,7 +47,8 @@ def test_loop_fmu_validates_and_carries_the_scenario(name):
 
 @pytest.mark.parametrize("name,t", [("default", 3.0), ("paper000/000-9L", 2.0), ("paper000/000-11L", 2.0),
                                     ("paper001/c", 0.5), ("wheel_fault", 5.0),
-                                    ("paper003/T2FSMC/N", 2.0), ("paper003/SMC/N", 2.0)])
+                                    ("paper003/T2FSMC/N", 2.0), ("paper003/SMC/N", 2.0),
+                                    ("leo/nadir", 3.0), ("leo/sun-pointing", 3.0), ("leo/detumble", 20.0)])
 def test_loop_fmu_in_simulate_fmu_is_bit_identical_to_reference(name, t):
     """Same fixed step, same Gauss–Seidel order (command, controller, plant, metrics) as the reference
     master, so the expected difference is zero: compared bit for bit at every communication point."""

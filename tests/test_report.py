@@ -13,16 +13,20 @@ from pathlib import Path
 import pytest
 
 from scfmu.report import cli as report_cli
-from scfmu.report import docs, render, rules
-from scfmu.report.types import (BY_CONSTRUCTION, CALIBRATED, CHOSEN, CONFIRMED, DEPENDS, INDEPENDENT, NOT_CHECKABLE,
+from scfmu.report import docs, prose, render, rules, timings
+from scfmu.report.types import (BY_CONSTRUCTION, BY_CONSTRUCTION_HOLDS, CALIBRATED, CHOSEN, CONFIRMED, DEPENDS,
+                                INDEPENDENT, NOT_CHECKABLE,
                                 NOT_CONFIRMED, NOT_REPRODUCED, REPRODUCED, SAME_ORDERING, Claim, Figure, NumberRow,
-                                PaperSection, Sensitivity, Table, on_bound)
+                                PaperSection, Sensitivity, Table, VERDICTS, on_bound)
 
 ROOT = Path(__file__).resolve().parents[1]
 
 # The verdicts of the last full build (`scfmu report --workers 2`), claims and reported numbers: the quick
 # build must reach every one of them (it may run fewer points, never another set-up).
 FULL_VERDICTS = ROOT / "tests" / "data" / "report_full_verdicts.json"
+# The numbers the last full build printed (`python -m scfmu.report.prose OUT --values`): what the hand-written
+# prose of the report's pages may cite besides the quick build's numbers.
+FULL_VALUES = ROOT / "tests" / "data" / "report_full_values.json"
 
 # The papers CI builds with --quick: every paper plug-in with a report section.
 CI_PAPERS = report_cli.papers_known()
@@ -215,6 +219,55 @@ def test_combine_faithful_never_counts_moving_away_as_support():
     assert rules.combine_faithful(True, {"x": (False, True)})[0] == CONFIRMED
 
 
+def test_holds_by_construction_is_decided_from_the_agreement_and_counted_apart(tmp_path):
+    """A confirmed claim whose compared quantities agree to rounding level (≤ EPS_MULTIPLE machine epsilons)
+    holds by construction: shown with the reason, never counted as confirmed. A claim that agrees only to
+    1e-9 (two genuinely different computations) stays confirmed; no claim id decides."""
+    import sys
+    eps = sys.float_info.epsilon
+    fixed = Claim("C901-1", "a = b", CONFIRMED, "a and b agree.", agreement=2 * eps)
+    real = Claim("C901-2", "a ≈ b", CONFIRMED, "a and b agree.", agreement=1e-9)
+    assert fixed.verdict == BY_CONSTRUCTION_HOLDS and "could not have failed" in fixed.evidence
+    assert real.verdict == CONFIRMED
+    assert Claim("C901-3", "x", NOT_CONFIRMED, "e", agreement=0.0).verdict == NOT_CONFIRMED   # fails anyway
+    sec = PaperSection("901", "t", "s", [fixed, real])
+    d = render.paper_summary(sec)
+    assert d[CONFIRMED] == 1 and d[BY_CONSTRUCTION_HOLDS] == 1
+    h, m = render.render([sec], tmp_path, {"quick": True})
+    md = m.read_text(encoding="utf-8")
+    assert "| [901](#paper-901) | 0 | 0 | 0 | 0 | 0 | 0 of 0 | 1 | 0 | 0 | 1 |" in md
+    assert "| C901-1 | a = b | ⚙️ holds by construction |" in md
+    got = {r[0]: r[2] for r in parse(h).rows}
+    assert got == {"C901-1": BY_CONSTRUCTION_HOLDS, "C901-2": CONFIRMED}
+
+
+def test_a_claim_supported_only_by_chosen_readings_is_not_confirmed(tmp_path):
+    """Readings chosen after comparing with the paper are never evidence (rules.combine_evidence, the rule of
+    every paper): alone they leave "not confirmed (holds only under a chosen reading: …)"."""
+    assert rules.combine_evidence(False, {"Δ 0.0125": True, "Δ 0.01": False}, ["Δ 0.0125", "Δ 0.01"]) == \
+        (NOT_CONFIRMED, ["Δ 0.0125"])
+    assert rules.combine_evidence(False, {"Δ 0.0125": True, "other": True}, ["Δ 0.0125"]) == (DEPENDS, [])
+    assert rules.combine_evidence(True, {"Δ 0.0125": False}, ["Δ 0.0125"]) == (CONFIRMED, [])
+    assert rules.combine_evidence(False, {"Δ 0.0125": True}) == (DEPENDS, [])          # not chosen: a reading
+    c = Claim("C901-1", "x", NOT_CONFIRMED, "e", chosen_support=["Δ 0.0125"])
+    assert c.verdict_text == "not confirmed (holds only under a chosen reading: Δ 0.0125)"
+    with pytest.raises(ValueError):
+        Claim("C901-1", "x", DEPENDS, "e", chosen_support=["Δ 0.0125"])
+    h, m = render.render([PaperSection("901", "t", "s", [c])], tmp_path, {"quick": True})
+    assert "| C901-1 | x | ❌ not confirmed (holds only under a chosen reading: Δ 0.0125) |" in m.read_text("utf-8")
+    assert parse(h).rows[0][2] == c.verdict_text
+
+
+def test_every_row_states_its_precision_rule():
+    """A row given the printed precision its verdict used states the window beside it (5 % or the precision)."""
+    n = NumberRow("9", "x", "-", 156.1, 156.4, REPRODUCED, precision=0.05)
+    assert n.rule == "reproduced within [148.3, 163.9]: 5 % or the printed precision ± 0.05, whichever is wider"
+    assert render.number_cells(n)[7].endswith(n.rule)
+    assert NumberRow("9", "x", "-", 0.01, 0.012, REPRODUCED, precision=0.005).rule.startswith(
+        "reproduced within [0.005, 0.015]")
+    assert NumberRow("9", "x", "-", 1.0, 1.0, REPRODUCED).rule == ""
+
+
 def test_number_row_validates_and_computes_difference():
     r = NumberRow("9", "x", "s", 100.0, 93.0, NOT_REPRODUCED)
     assert r.rel_diff == pytest.approx(-0.07) and r.independent
@@ -330,7 +383,7 @@ def test_report_quick_end_to_end(tmp_path):
     got = {row[0]: row[2] for row in page.rows}
     want = [c for p in CI_PAPERS for c in CLAIM_IDS[p]]
     assert list(got) == want
-    assert all(v in (CONFIRMED, NOT_CONFIRMED, DEPENDS) for v in got.values())
+    assert all(v.split(" (holds only")[0] in VERDICTS for v in got.values())
     assert page.imgs and all((out / s).exists() for s in page.imgs)
     md = (out / "report.md").read_text(encoding="utf-8")
     for cid in want:
@@ -377,6 +430,47 @@ def test_report_quick_end_to_end(tmp_path):
         assert render.doc_block(page) == render.docs_table(rows, p), f"docs/paper{p}.md: table is stale"
         assert "claims" in docs.table_blocks(page), f"docs/paper{p}.md has no generated claims table"
         assert docs.stale_blocks(page, p, rows, tables) == [], f"docs/paper{p}.md: stale blocks (scfmu report --docs docs)"
+    # every number written by hand in the report's pages is one the report prints (this build's data, or the last
+    # full build's, recorded), at its written precision; parts recording another command's output say so
+    recorded = json.loads(FULL_VALUES.read_text(encoding="utf-8"))
+    bad = prose.check([ROOT / n for n in prose.PAGES], [out], recorded)
+    assert not any(bad.values()), f"numbers of the pages' prose that are not the report's: {bad}"
+    # the claims the issue names, as classified on the data written
+    assert quick["claims"]["C000-3"] == quick["claims"]["C004-4"] == BY_CONSTRUCTION_HOLDS
+    assert quick["claims"]["C001-2"] == NOT_CONFIRMED
+    assert all(r["obtained"] == CALIBRATED and r["sensitivity"].startswith("over the calibration grid")
+               for k, r in by.items() if k[0] == "004" and ("case 1" in k[1] or "case 2" in k[1]))
+    md = (out / "report.md").read_text(encoding="utf-8")
+    assert "not confirmed (holds only under a chosen reading: sampled, Δ = 0.0125 s)" in md
+
+
+def test_prose_numbers_are_checked_against_the_report_data():
+    """The prose check: numbers outside generated blocks, code, links and identifiers must be in the data, at
+    their written precision; a part recording another command is skipped and named."""
+    page = ("Paper 000 (Table 3, C000-3, 000-9L, issue 46, 2019) gives 156.1; ours 156.4 deg·s and 105.4 at "
+            "s = 5.2. `code 77.7`\n<!-- table:x:begin -->\n| 999 |\n<!-- table:x:end -->\n"
+            "<!-- prose: from scfmu paper 003 tune -->\nJ = 6.00954\n<!-- prose:end -->\n")
+    vals = prose.values("| 156.1 | 156.43 | 5.57 | 89.4 |")
+    assert prose.numbers(page) == ["156.1", "156.4", "105.4", "5.2"]
+    assert prose.unmatched(page, vals) == ["105.4", "5.2"]
+    assert prose.other_parts(page) == ["scfmu paper 003 tune"]
+    assert prose.matches("3.2", {3.24}) and not prose.matches("3.20", {3.24}) and prose.matches("1.5e-4", {1.5004e-4})
+    # a paper's page is checked against its own part of the report only
+    assert prose.scope_of("docs/paper000.md") == "000" and prose.scope_of("docs/sensing.md") == "sensing"
+    assert prose.scope_of("docs/report.md") is None
+    assert "\n## Paper 001:" in prose._section("# r\n## Paper 000: a\n1.5\n## Paper 001: b\n2.5\n", "001")
+
+
+def test_timings_blocks_are_written_from_the_recorded_builds():
+    """README.md and docs/report.md show the measured times from one source (scfmu/report/timings.json), and the
+    recorded quick build meets its budget on an idle machine."""
+    d = timings.recorded()
+    q = d["quick"]
+    assert q["mode"] == "quick" and q["wall_s"] <= timings.QUICK_BUDGET_S and q["cores"] == 2 and q["workers"] == 2
+    assert "full" in d and d["full"]["mode"] == "full"
+    for name in ("README.md", "docs/report.md"):
+        text = (ROOT / name).read_text(encoding="utf-8")
+        assert timings.TIMINGS_BEGIN in text and not timings.stale(text), f"{name}: timings block is stale"
 
 
 def test_report_missing_paper_is_an_error(tmp_path):

@@ -40,7 +40,7 @@ UNITS = {
     "SampleHold": lambda T: {"sample_period": T, "delay": 2 * T},
     "Gyro": lambda T: {"sample_period": T},
     "StarTracker": lambda T: {"sample_period": T, "latency": T},
-    "SunSensor": lambda T: {"sample_period": T, "fov": math.pi, "eclipse": 0},
+    "SunSensor": lambda T: {"sample_period": T, "fov": math.pi, "shadow": 0},
     "Magnetometer": lambda T: {"sample_period": T},
     # the estimation family's sampled units: the Mekf with every update enabled (its inputs change every step,
     # so each of its samples inside a step updates from the step's held measurements once), the B-dot law

@@ -14,6 +14,7 @@ campaigns of a paper are stored under OUT/runs/<name>; running the same command 
 from __future__ import annotations
 
 import argparse
+import json
 import subprocess
 import sys
 import time
@@ -120,6 +121,8 @@ def main(argv=None) -> int:
     from scfmu import campaign
     from scfmu.report import render
 
+    from . import timings
+    start = timings.measure_start()
     t_all = time.time()
     args.out.mkdir(parents=True, exist_ok=True)
     print(f"report: papers {', '.join(papers)}, {'quick' if args.quick else 'full'} mode, {args.workers} Dask "
@@ -161,6 +164,9 @@ def main(argv=None) -> int:
     if args.docs is not None:
         for p in render.update_docs(args.docs, args.out / "numbers.csv", args.out / "doc_tables.json"):
             print(f"updated {p}")
+    rec = timings.build_record(start, args.quick, args.workers, time.time() - t_all,
+                               {s.paper: s.runtime_s for s in sections}, ctx.runs)
+    (args.out / "timings.json").write_text(json.dumps(rec, indent=1) + "\n", encoding="utf-8")
     print("\n" + render.numbers_text(sections))
     print("\n" + render.claims_text(sections))
     print(f"\nreport: {html_path.resolve()}\nmarkdown: {md_path.resolve()}\n"

@@ -15,8 +15,8 @@ import json
 import re
 from pathlib import Path
 
-from .fmt import MD_MARK, _md, fmt_cell
-from .numbers import number_counts, read_numbers_csv, row_independent
+from .fmt import _md, fmt_cell, md_verdict
+from .numbers import number_counts, obtained_text, read_numbers_csv, row_independent
 from .types import INDEPENDENT, NUMBER_VERDICTS, PaperSection, Table
 
 DOC_BEGIN = "<!-- numbers:begin (written by `scfmu report --docs docs`; do not edit by hand) -->"
@@ -44,7 +44,8 @@ def docs_table(rows: list[dict], paper: str) -> str:
         rd = f"{100 * float(rd):+.1f} %" if rd else "–"
         out.append("| " + " | ".join(_md(x) for x in (r["item"], r["unit"], r["paper value"] or "–",
                                                       _g4(r["our value"]) or "–", rd, r["verdict"],
-                                                      r["obtained"])) + " |")
+                                                      obtained_text(r["obtained"], r.get("sensitivity") or "")))
+                   + " |")
     counts = {v: sum(1 for r in n if r["verdict"] == v and r["obtained"] == INDEPENDENT) for v in NUMBER_VERDICTS}
     other = sum(1 for r in n if r["obtained"] != INDEPENDENT)
     out += ["", "Counts of the independent rows: " + ", ".join(f"{v} {k}" for v, k in counts.items())
@@ -70,7 +71,7 @@ def claims_table(sec: PaperSection) -> Table:
     """A paper's claims for its docs page: id, verdict and the claim in our words (what quick and full builds
     share; the readings each verdict names, swept on mode-dependent grids, are in the report)."""
     return Table("claims", ["claim", "verdict", "claim in our words"],
-                 [[c.id, MD_MARK.get(c.verdict, c.verdict), c.statement] for c in sec.claims])
+                 [[c.id, md_verdict(c), c.statement] for c in sec.claims])
 
 
 def section_doc_tables(sec: PaperSection) -> dict[str, str]:

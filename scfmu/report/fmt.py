@@ -5,16 +5,24 @@ from __future__ import annotations
 import html
 import math
 
-from .types import (BASES, BY_CONSTRUCTION, CALIBRATED, CHOSEN, CONFIRMED, DEPENDS, INDEPENDENT, NOT_CHECKABLE,
-                    NOT_CONFIRMED, NOT_REPRODUCED, REPRODUCED, SAME_ORDERING)
+from .types import (BASES, BY_CONSTRUCTION, BY_CONSTRUCTION_HOLDS, CALIBRATED, CHOSEN, CONFIRMED, DEPENDS, INDEPENDENT,
+                    NOT_CHECKABLE, NOT_CONFIRMED, NOT_REPRODUCED, REPRODUCED, SAME_ORDERING)
 
-BADGE = {CONFIRMED: ("#1a7f37", "#ffffff"), NOT_CONFIRMED: ("#cf222e", "#ffffff"), DEPENDS: ("#bf8700", "#ffffff")}
+BADGE = {CONFIRMED: ("#1a7f37", "#ffffff"), NOT_CONFIRMED: ("#cf222e", "#ffffff"), DEPENDS: ("#bf8700", "#ffffff"),
+         BY_CONSTRUCTION_HOLDS: ("#57606a", "#ffffff")}
 BADGE.update({REPRODUCED: ("#1a7f37", "#ffffff"), SAME_ORDERING: ("#bf8700", "#ffffff"),
               NOT_REPRODUCED: ("#cf222e", "#ffffff"), NOT_CHECKABLE: ("#57606a", "#ffffff")})
 BADGE.update({INDEPENDENT: ("#1a7f37", "#ffffff"), CALIBRATED: ("#8250df", "#ffffff"),
               BY_CONSTRUCTION: ("#8250df", "#ffffff"), CHOSEN: ("#8250df", "#ffffff")})
 assert all(b in BADGE for b in BASES)
-MD_MARK = {CONFIRMED: "✅ confirmed", NOT_CONFIRMED: "❌ not confirmed", DEPENDS: "⚠️ depends on a reading"}
+MD_MARK = {CONFIRMED: "✅ confirmed", NOT_CONFIRMED: "❌ not confirmed", DEPENDS: "⚠️ depends on a reading",
+           BY_CONSTRUCTION_HOLDS: "⚙️ holds by construction"}
+
+
+def md_verdict(claim) -> str:
+    """A claim's verdict in Markdown: the mark, and the chosen readings when they are its only support."""
+    mark = MD_MARK.get(claim.verdict, claim.verdict)
+    return mark + claim.verdict_text[len(claim.verdict):]
 
 
 def fmt_cell(v, digits: int = 4) -> str:

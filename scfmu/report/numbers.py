@@ -18,7 +18,7 @@ from .types import INDEPENDENT, NOT_CHECKABLE, NUMBER_VERDICTS, NumberRow, Paper
 
 # numbers.csv: one row per reported number (the same table as the report's "paper vs ours" tables)
 CSV_COLUMNS = ["paper", "item", "unit", "paper value", "our value", "relative difference", "verdict", "obtained",
-               "bounds", "note"]
+               "bounds", "note", "sensitivity", "rule"]
 
 
 def fmt_num(v, digits: int = 4) -> str:
@@ -37,7 +37,14 @@ def fmt_rel(x: float) -> str:
 def number_cells(n: NumberRow) -> list[str]:
     """[item, unit, paper value, our value, relative difference, verdict, obtained, note] as plain text."""
     paper = n.paper_text or fmt_num(n.paper_value)
-    return [n.item, n.unit, paper, fmt_num(n.ours), fmt_rel(n.rel_diff), n.verdict, n.basis, n.note]
+    note = "; ".join(x for x in (n.note, n.rule) if x)
+    return [n.item, n.unit, paper, fmt_num(n.ours), fmt_rel(n.rel_diff), n.verdict, obtained_text(n.basis, n.sensitivity),
+            note]
+
+
+def obtained_text(basis: str, sensitivity: str = "") -> str:
+    """How ours was obtained, with a calibrated row's sensitivity across the calibration grid beside it."""
+    return f"{basis} ({sensitivity})" if sensitivity else basis
 
 
 def number_counts(numbers: list[NumberRow]) -> dict:
@@ -65,7 +72,7 @@ def numbers_csv_rows(sections: list[PaperSection]) -> list[list[str]]:
                         n.paper_text or ("" if n.paper_value is None else f"{float(n.paper_value):.6g}"),
                         "" if n.ours is None else (f"{float(n.ours):.6g}" if _is_num(n.ours) else str(n.ours)),
                         "" if math.isnan(rd) else f"{rd:.6g}", n.verdict, n.basis,
-                        ";".join(f"{b:.6g}" for b in n.bounds), n.note])
+                        ";".join(f"{b:.6g}" for b in n.bounds), n.note, n.sensitivity, n.rule])
     return out
 
 
@@ -101,7 +108,7 @@ def numbers_html(sec: PaperSection) -> str:
         c = number_cells(n)
         rows.append(f"<tr><td>{_e(c[0])}</td><td>{_e(c[1])}</td><td class=\"num\">{_e(c[2])}</td>"
                     f"<td class=\"num\">{_e(c[3])}</td><td class=\"num\">{_e(c[4])}</td><td>{badge(n.verdict)}</td>"
-                    f"<td>{badge(n.basis)}</td><td>{_e(c[7])}</td></tr>")
+                    f"<td>{badge(n.basis)}{_e(' ' + n.sensitivity) if n.sensitivity else ''}</td><td>{_e(c[7])}</td></tr>")
     counts = number_counts(sec.numbers)
     indep = [n for n in sec.numbers if n.independent]
     other = [f"{n.item} ({n.basis})" for n in sec.numbers if n.basis != INDEPENDENT]

@@ -18,10 +18,11 @@ from pathlib import Path
 
 from . import docs as _docs
 from .docs import DOC_BEGIN, DOC_END, doc_block, docs_table, update_docs  # noqa: F401 (the docs blocks)
-from .fmt import BADGE, MD_MARK, _e, _is_num, _md, _paras, badge, fmt_cell  # noqa: F401
+from .fmt import BADGE, MD_MARK, _e, _is_num, _md, _paras, badge, fmt_cell, md_verdict  # noqa: F401
 from .numbers import (CSV_COLUMNS, counts_text, fmt_num, fmt_rel, number_cells, number_counts,  # noqa: F401
                       numbers_csv_rows, numbers_html, numbers_md, numbers_text, read_numbers_csv, write_numbers_csv)
-from .types import (CONFIRMED, DEPENDS, NOT_CONFIRMED, NUMBER_VERDICTS, Claim, PaperSection, Sensitivity, Table)
+from .types import (BY_CONSTRUCTION_HOLDS, CONFIRMED, DEPENDS, NOT_CONFIRMED, NUMBER_VERDICTS, TESTED_VERDICTS, VERDICTS,
+                    Claim, PaperSection, Sensitivity, Table)
 
 CSS = """
 body{font-family:-apple-system,Segoe UI,Helvetica,Arial,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;
@@ -45,6 +46,11 @@ figcaption{color:#57606a;font-size:.9em;margin-top:.3em}
 .sens{background:#f6f8fa;padding:.4em .8em;border-radius:6px;margin:.6em 0}
 pre{white-space:pre-wrap}
 """
+
+
+CLAIM_COUNTS_TEXT = ("Claims: confirmed, depends on a reading and not confirmed count only claims that could have "
+                     "failed; a claim whose outcome the implementation fixes (quantities computed by different routes "
+                     "agree to rounding level) is shown as 'holds by construction' and counted apart.")
 
 
 # ----- HTML pieces ------------------------------------------------------------------------------------
@@ -82,7 +88,7 @@ def sensitivity_html(s: Sensitivity, out_dir: Path) -> str:
 
 
 def claim_html(c: Claim, out_dir: Path) -> str:
-    out = [f'<div class="claim" id="{_e(c.id)}"><h3>{_e(c.id)} {badge(c.verdict)}</h3>',
+    out = [f'<div class="claim" id="{_e(c.id)}"><h3>{_e(c.id)} {verdict_html(c)}</h3>',
            f"<p><i>Claim:</i> {_e(c.statement)}</p>", f"<p><i>Evidence:</i></p>{_paras(c.evidence)}"]
     for t in c.tables:
         out.append(table_html(t))
@@ -104,9 +110,15 @@ def _paper_meta(sec: PaperSection, meta: dict) -> str:
     return ", ".join(bits)
 
 
-def summary_rows(sections: list[PaperSection]) -> list[tuple[str, str, str, str, str]]:
-    """(paper, claim id, statement, verdict, sensitive to) for every claim, in section order."""
-    return [(s.paper, c.id, c.statement, c.verdict, ", ".join(c.sensitive_to) or "–")
+def verdict_html(c: Claim) -> str:
+    """The verdict badge, with the chosen readings when they are the claim's only support."""
+    rest = c.verdict_text[len(c.verdict):]
+    return badge(c.verdict) + (f" <small>{_e(rest.strip())}</small>" if rest else "")
+
+
+def summary_rows(sections: list[PaperSection]) -> list[tuple[str, str, str, str, str, Claim]]:
+    """(paper, claim id, statement, verdict, sensitive to, claim) for every claim, in section order."""
+    return [(s.paper, c.id, c.statement, c.verdict, ", ".join(c.sensitive_to) or "–", c)
             for s in sections for c in s.claims]
 
 
@@ -118,7 +130,7 @@ def paper_summary(sec: PaperSection) -> dict:
     d["independent"] = sum(1 for n in sec.numbers if n.independent)
     d["calibration"] = sum(1 for n in sec.numbers if n.calibration)
     d["other"] = d["not evidence"]
-    for v in (CONFIRMED, DEPENDS, NOT_CONFIRMED):
+    for v in VERDICTS:   # confirmed / depends / not confirmed count only claims that could have failed
         d[v] = sum(1 for c in sec.claims if c.verdict == v)
     return d
 
@@ -135,19 +147,20 @@ def summary_html(sections: list[PaperSection]) -> str:
                     + "".join(f"<td class=\"num\">{d[v]}</td>" for v in NUMBER_VERDICTS)
                     + f"<td class=\"num\">{d['other']}</td>"
                     + f"<td class=\"num\"><a href=\"#numbers{_e(s.paper)}\">{d['independent']} of {d['numbers']}</a></td>"
-                    + "".join(f"<td class=\"num\">{d[v]}</td>" for v in (CONFIRMED, DEPENDS, NOT_CONFIRMED))
-                    + "</tr>")
+                    + "".join(f"<td class=\"num\">{d[v]}</td>" for v in TESTED_VERDICTS)
+                    + f"<td class=\"num\">{d[BY_CONSTRUCTION_HOLDS]}</td></tr>")
     return ("<h2 id=\"at-a-glance\">At a glance</h2><table id=\"glance\"><thead><tr><th>paper</th><th>title</th>"
             + "".join(f"<th>{badge(v)}</th>" for v in NUMBER_VERDICTS)
             + "<th>not evidence</th><th>independent checks</th>"
-            + "".join(f"<th>claims {badge(v)}</th>" for v in (CONFIRMED, DEPENDS, NOT_CONFIRMED))
+            + "".join(f"<th>claims {badge(v)}</th>" for v in TESTED_VERDICTS)
+            + f"<th>not counted: {badge(BY_CONSTRUCTION_HOLDS)}</th>"
             + "</tr></thead><tbody>" + "".join(rows) + "</tbody></table>"
             + "<p class=\"meta\">Reported numbers, counted over the independent rows only: reproduced = within 5 % of the paper's value (or its printed "
               "precision); same ordering only = off, but ranked among the paper's numbers as the paper ranks it; "
               "not checkable = the paper lacks what is needed. Not evidence = a row whose value was calibrated to "
               "the paper's number, is fixed by construction (a search bound or optimiser constraint puts it there) "
               "or was chosen among readings after comparing with the paper: shown, labelled, never counted. The "
-              "full table is <a href=\"numbers.csv\">numbers.csv</a>.</p>")
+              "full table is <a href=\"numbers.csv\">numbers.csv</a>. " + _e(CLAIM_COUNTS_TEXT) + "</p>")
 
 
 def render_html(sections: list[PaperSection], out_dir: Path, meta: dict) -> str:
@@ -162,12 +175,13 @@ def render_html(sections: list[PaperSection], out_dir: Path, meta: dict) -> str:
     head.append(summary_html(sections))
     if meta.get("intro"):
         head.append(_paras(meta["intro"]))
-    counts = {v: sum(1 for r in summary_rows(sections) if r[3] == v) for v in (CONFIRMED, NOT_CONFIRMED, DEPENDS)}
+    counts = {v: sum(1 for r in summary_rows(sections) if r[3] == v)
+              for v in (CONFIRMED, NOT_CONFIRMED, DEPENDS, BY_CONSTRUCTION_HOLDS)}
     head.append("<h2 id=\"summary\">Summary of the claims</h2>")
     head.append("<p>" + " · ".join(f"{badge(v)} {n}" for v, n in counts.items()) + "</p>")
     rows = "".join(
-        f"<tr><td><a href=\"#{_e(cid)}\">{_e(cid)}</a></td><td>{_e(st)}</td><td>{badge(v)}</td><td>{_e(sens)}</td></tr>"
-        for _, cid, st, v, sens in summary_rows(sections))
+        f"<tr><td><a href=\"#{_e(cid)}\">{_e(cid)}</a></td><td>{_e(st)}</td><td>{verdict_html(c)}</td><td>{_e(sens)}</td></tr>"
+        for _, cid, st, v, sens, c in summary_rows(sections))
     head.append("<table id=\"claims\"><thead><tr><th>claim</th><th>statement</th><th>verdict</th>"
                 f"<th>readings examined</th></tr></thead><tbody>{rows}</tbody></table>")
     head.append("<table><caption>Runs and runtime per paper</caption><thead><tr><th>paper</th><th>title</th>"
@@ -219,17 +233,19 @@ def render_md(sections: list[PaperSection], out_dir: Path, meta: dict) -> str:
     out += ["## At a glance", "", "Reported numbers counted over the independent rows only; *not evidence* = "
             "calibrated, fixed by construction or chosen among readings (shown, never counted).", "",
             "| paper | " + " | ".join(NUMBER_VERDICTS) + " | not evidence | independent checks | claims "
-            "confirmed | depends | not confirmed |", "|---|" + "---:|" * (len(NUMBER_VERDICTS) + 5)]
+            "confirmed | depends | not confirmed | not counted: holds by construction |",
+            "|---|" + "---:|" * (len(NUMBER_VERDICTS) + 6)]
     for s in sections:
         d = paper_summary(s)
         out.append(f"| [{s.paper}](#paper-{s.paper}) | " + " | ".join(str(d[v]) for v in NUMBER_VERDICTS)
-                   + f" | {d['other']} | {d['independent']} of {d['numbers']} | {d[CONFIRMED]} | {d[DEPENDS]} | {d[NOT_CONFIRMED]} |")
-    out.append("")
+                   + f" | {d['other']} | {d['independent']} of {d['numbers']} | {d[CONFIRMED]} | {d[DEPENDS]} | "
+                   f"{d[NOT_CONFIRMED]} | {d[BY_CONSTRUCTION_HOLDS]} |")
+    out += ["", CLAIM_COUNTS_TEXT, ""]
     if meta.get("intro"):
         out += [meta["intro"], ""]
     out += ["## Summary of the claims", "", "| claim | statement | verdict | readings examined |", "|---|---|---|---|"]
-    for _, cid, st, v, sens in summary_rows(sections):
-        out.append(f"| {_md(cid)} | {_md(st)} | {_md(MD_MARK.get(v, v))} | {_md(sens)} |")
+    for _, cid, st, v, sens, c in summary_rows(sections):
+        out.append(f"| {_md(cid)} | {_md(st)} | {_md(md_verdict(c))} | {_md(sens)} |")
     out += ["", "| paper | title | simulation runs | runtime (s) |", "|---|---|---:|---:|"]
     for s in sections:
         out.append(f"| {s.paper} | {_md(s.title)} | {fmt_cell((meta.get('runs') or {}).get(s.paper))} | "
@@ -243,7 +259,7 @@ def render_md(sections: list[PaperSection], out_dir: Path, meta: dict) -> str:
                 out += [s.calibrations, ""]
         out += ["### Setup", "", s.setup, ""]
         for c in s.claims:
-            out += [f"### {c.id}: {MD_MARK.get(c.verdict, c.verdict)}", "", f"**Claim:** {c.statement}", "",
+            out += [f"### {c.id}: {md_verdict(c)}", "", f"**Claim:** {c.statement}", "",
                     f"**Evidence:** {c.evidence}", ""]
             for t in c.tables:
                 out += table_md(t)
@@ -274,9 +290,9 @@ def claims_text(sections: list[PaperSection], width: int = 70) -> str:
     """The summary table as plain text for the terminal."""
     rows = summary_rows(sections)
     lines = [f"{'claim':8s} {'verdict':22s} {'statement':{width}s} readings examined"]
-    for _, cid, st, v, sens in rows:
+    for _, cid, st, v, sens, c in rows:
         st1 = st if len(st) <= width else st[: width - 1] + "…"
-        lines.append(f"{cid:8s} {v:22s} {st1:{width}s} {sens}")
+        lines.append(f"{cid:8s} {v:22s} {st1:{width}s} {sens}" + (f" [{c.verdict_text}]" if c.chosen_support else ""))
     return "\n".join(lines)
 
 

@@ -94,6 +94,19 @@ def combine(nominal: bool, readings: dict) -> str:
     return DEPENDS
 
 
+def combine_evidence(nominal: bool, readings: dict, chosen=()) -> tuple[str, list[str]]:
+    """``combine`` over the evidence only: readings named in ``chosen`` (set-ups "chosen among readings" after
+    comparing with the paper, never evidence) are left out of the verdict. Returns (verdict, the chosen
+    readings under which the claim holds while the evidence gives "not confirmed"): a claim whose only
+    support is a chosen reading reads "not confirmed (holds only under a chosen reading: …)"
+    (``Claim.chosen_support``). The same rule for every paper."""
+    chosen = set(chosen)
+    evidence = {k: v for k, v in readings.items() if k not in chosen}
+    v = combine(nominal, evidence)
+    support = [k for k, h in readings.items() if k in chosen and h] if v == NOT_CONFIRMED else []
+    return v, support
+
+
 def holds_where(values: Sequence, holds: Sequence[bool], name: str = "x", unit: str = "") -> str:
     """Plain-words region of ``values`` (in the order given, e.g. ascending) where ``holds`` is true:
     "everywhere tried", "nowhere tried", or contiguous runs such as "0.8 ≤ x ≤ 1.0; x = 1.2"."""
@@ -162,6 +175,18 @@ def printed_precision(text: str) -> float:
         return math.nan
     decimals = len(num.split(".")[1]) if "." in num else 0
     return 0.5 * 10.0 ** (-decimals)
+
+
+def precision_within_requirement(printed: float, paper: float, requirement: float | None, meets: bool) -> float:
+    """The printed-precision half-width of one row, never wider than the paper's own stated requirement: when
+    the paper states that the value meets ``requirement`` (an upper bound, ``meets``), the window may not
+    reach above it; when it states that it fails, not below it. (5 % of the paper's value stays the floor,
+    ``within``.)"""
+    p = printed if finite(printed) else 0.0
+    if requirement is None or not finite(requirement):
+        return p
+    room = (requirement - paper) if meets else (paper - requirement)
+    return max(0.0, min(p, room))
 
 
 def within(ours, paper, rel: float = REL_TOL, precision: float = 0.0) -> bool:

@@ -14,7 +14,16 @@ from pathlib import Path
 CONFIRMED = "confirmed"
 NOT_CONFIRMED = "not confirmed"
 DEPENDS = "depends on a reading"
-VERDICTS = (CONFIRMED, NOT_CONFIRMED, DEPENDS)
+# a claim whose outcome the implementation fixes (quantities computed by different routes agree to rounding
+# level, e.g. equal gains, a plant copy integrated inside the unit): shown as such, never counted as confirmed
+BY_CONSTRUCTION_HOLDS = "holds by construction"
+VERDICTS = (CONFIRMED, NOT_CONFIRMED, DEPENDS, BY_CONSTRUCTION_HOLDS)
+# verdicts of claims that could have failed (what "At a glance" counts as confirmed / not / depends)
+TESTED_VERDICTS = (CONFIRMED, DEPENDS, NOT_CONFIRMED)
+# two quantities the claim says are equal, computed by different routes, that agree to within this many
+# machine epsilons (relative to their magnitude) agree by construction: no independent computation of
+# either lands that close, so the equality is fixed by the implementation and cannot fail
+EPS_MULTIPLE = 100.0
 
 # verdicts of a paper's reported number set beside ours (``NumberRow``)
 REPRODUCED = "reproduced"            # within 5 % of the paper's value, or within its printed precision
@@ -25,13 +34,25 @@ NUMBER_VERDICTS = (REPRODUCED, SAME_ORDERING, NOT_REPRODUCED, NOT_CHECKABLE)
 
 # how a row's "ours" was obtained (``NumberRow.basis``); only an independent row is evidence
 INDEPENDENT = "independent"              # computed under the paper's stated set-up, nothing fitted or chosen
-CALIBRATED = "calibrated"                # a value the paper lacks was fitted to this very number
+CALIBRATED = "calibrated"                # computed from a set-up with a value fitted to a reported number
 BY_CONSTRUCTION = "fixed by construction"  # a constraint or a search bound puts the value where it is
 CHOSEN = "chosen among readings"         # the set-up was picked among several after comparing with the paper
 BASES = (INDEPENDENT, CALIBRATED, BY_CONSTRUCTION, CHOSEN)
 # a value within this relative distance of one of its row's bounds (search bounds, optimiser constraints)
 # sits on that bound
 BOUND_REL = 1e-3
+
+
+def agrees_by_construction(agreement, multiple: float = EPS_MULTIPLE) -> bool:
+    """``agreement`` (the largest relative difference between quantities a claim says are equal, computed by
+    different routes) is at rounding level: at most ``multiple`` machine epsilons (``EPS_MULTIPLE``)."""
+    import math
+    import sys
+    try:
+        a = float(agreement)
+    except (TypeError, ValueError):
+        return False
+    return math.isfinite(a) and abs(a) <= multiple * sys.float_info.epsilon
 
 
 def on_bound(value, bounds, rel: float = BOUND_REL):
@@ -88,10 +109,33 @@ class Claim:
     figures: list[Figure] = field(default_factory=list)
     sensitive_to: list[str] = field(default_factory=list)   # project-choice parameters the verdict depends on
     sensitivity: list[Sensitivity] = field(default_factory=list)
+    # the largest relative difference between the quantities the claim says are equal, computed by different
+    # routes (None: the claim is no equality); at rounding level (``agrees_by_construction``) a "confirmed"
+    # becomes "holds by construction", decided from the numbers, whatever the section said
+    agreement: float | None = None
+    # readings "chosen among readings" (never evidence) under which the claim holds while the evidence does
+    # not confirm it; only with "not confirmed", shown as "not confirmed (holds only under a chosen reading: …)"
+    chosen_support: list[str] = field(default_factory=list)
 
     def __post_init__(self):
         if self.verdict not in VERDICTS:
             raise ValueError(f"{self.id}: verdict {self.verdict!r} is not one of {VERDICTS}")
+        if self.verdict == CONFIRMED and agrees_by_construction(self.agreement):
+            self.verdict = BY_CONSTRUCTION_HOLDS
+            self.evidence += (f" Holds by construction: the quantities compared agree to {float(self.agreement):.2g} "
+                              f"(relative), within {EPS_MULTIPLE:g} machine epsilons, so the implementation fixes the "
+                              f"outcome and the claim could not have failed; not counted as confirmed.")
+        if self.chosen_support and self.verdict != NOT_CONFIRMED:
+            raise ValueError(f"{self.id}: support by chosen readings only goes with {NOT_CONFIRMED!r}, not "
+                             f"{self.verdict!r}")
+
+    @property
+    def verdict_text(self) -> str:
+        """The verdict as printed: "not confirmed (holds only under a chosen reading: …)" when chosen readings
+        are its only support."""
+        if self.chosen_support:
+            return f"{self.verdict} (holds only under a chosen reading: {', '.join(self.chosen_support)})"
+        return self.verdict
 
 
 @dataclass
@@ -105,7 +149,8 @@ class NumberRow:
     older spelling of ``basis=CALIBRATED``; ``bounds`` the search bounds and optimiser constraints that could
     hold ours in place: a row whose value sits on one of them (``on_bound``) is fixed by construction
     whatever basis it was given, so a bound-hitting value is never counted as evidence; ``note`` says what
-    was compared, which reading, or what is missing."""
+    was compared, which reading, the precision rule of the row, or what is missing; ``sensitivity`` (a
+    calibrated row) the range of ours across the calibration grid."""
     paper: str
     item: str
     unit: str
@@ -117,6 +162,8 @@ class NumberRow:
     paper_text: str = ""
     basis: str = INDEPENDENT
     bounds: tuple = ()
+    sensitivity: str = ""   # a calibrated row: how ours moves across the calibration grid (shown beside it)
+    precision: float | None = None   # the printed-precision half-width the verdict used (the row states its rule)
 
     def __post_init__(self):
         if self.verdict not in NUMBER_VERDICTS:
@@ -142,6 +189,18 @@ class NumberRow:
             return (float(self.ours) - float(self.paper_value)) / abs(float(self.paper_value))
         except (TypeError, ValueError):
             return math.nan
+
+    @property
+    def rule(self) -> str:
+        """The reproduction rule of this row as stated beside it: the window of values that reproduce the
+        paper's, 5 % or the printed precision, whichever is wider ("" when the row gives no precision)."""
+        import math
+        if self.precision is None or self.paper_value is None or not math.isfinite(float(self.paper_value)):
+            return ""
+        p = float(self.paper_value)
+        half = max(float(self.precision), 0.05 * abs(p))
+        return (f"reproduced within [{p - half:.4g}, {p + half:.4g}]: 5 % or the printed precision "
+                f"± {float(self.precision):g}, whichever is wider")
 
     @property
     def independent(self) -> bool:

@@ -35,11 +35,12 @@ from pathlib import Path
 
 DEFAULT_UNCONNECTED = ("torque_dist_*", "dist_*", "h_wheel*", "q_ref_dot*", "q_ref_ddot*", "leader_true_anomaly",
                        "m_cmd_*",
-                       # the environment inputs of AttitudePlant, read with environment_inputs = 1 only (which
-                       # refuses an unwired r, b_eci or sun_eci), and Orbit's density (0 = no drag); r and v by
-                       # model, as Environment's r must stay wired
-                       "AttitudePlant:r_*", "AttitudePlant:v_*", "b_eci_*", "sun_eci_*", "eclipse", "rho",
-                       "sun_distance",
+                       # the environment inputs of AttitudePlant, Magnetometer (b_eci), SunSensor (sun_eci,
+                       # eclipse) and Ephemeris (r, jd_utc), read with environment_inputs = 1 only (which refuses an
+                       # unwired r, b_eci, sun_eci or jd_utc), and Orbit's density (0 = no drag); r, v and jd_utc
+                       # by model, as Environment's r must stay wired
+                       "AttitudePlant:r_*", "AttitudePlant:v_*", "Ephemeris:r_*", "Ephemeris:jd_utc", "b_eci_*",
+                       "sun_eci_*", "eclipse", "rho", "sun_distance",
                        # AttitudeCommand's orbit inputs, read with reference = 1 (nadir) only (which refuses them unwired)
                        "AttitudeCommand:r_*", "AttitudeCommand:v_*")
 

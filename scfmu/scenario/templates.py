@@ -118,7 +118,7 @@ def with_sensors(sc: Scenario, name: str | None = None, gyro: dict | None = None
 # flight computer's on-board Ephemeris (sun direction and dipole field in R) feed a Mekf at the gyro's rate,
 # whose estimated attitude and rate replace the raw measurements at the controller's inputs.
 ORBIT_KEYS = ("mu", "orbit_radius", "orbit_inclination", "orbit_arg_lat0", "earth_dipole", "sun_ecliptic_longitude")
-SUN_SENSOR_DEFAULT = {"sample_period": 0.1, "noise": 1.745e-3, "fov": 1.0471975511965976, "eclipse": 1,
+SUN_SENSOR_DEFAULT = {"sample_period": 0.1, "noise": 1.745e-3, "fov": 1.0471975511965976, "shadow": 1,
                       "mount_y": 1.5707963267948966}  # boresight (sensor z) on body +x
 MAGNETOMETER_DEFAULT = {"sample_period": 0.1, "noise_x": 1e-7, "noise_y": 1e-7, "noise_z": 1e-7}
 # the sensors' declared defaults the Mekf's noise model is matched to (tests/test_estimation_loop.py reads

@@ -66,7 +66,7 @@ REF_PARAMS = {
     "AttitudeCommand": {"ref_euler321_roll": 0.3, "ref_euler321_pitch": -0.2, "ref_euler321_yaw": 0.5, "step_time": 1.0},
     "RelativePositionCommand": {"target_pos_x": 10.0, "target_pos_y": -5.0, "target_pos_z": 2.0, "step_time": 10.0},
     "ReferenceCorrector": {"mode": 1, "init_euler321_roll": 0.3, "init_w_x": 0.02, "node_x_1": 0.01, "node_y_2": -0.01, "node_x_4": 0.005},
-    "SunSensor": {"fov": math.pi, "eclipse": 0},
+    "SunSensor": {"fov": math.pi, "shadow": 0},
 }
 # Constant offsets added to the documented input signals where those alone are refused by the unit
 # an input of this name is an atmospheric density (kg/m3): the documented signal keeps it in orbit's range

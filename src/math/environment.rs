@@ -36,9 +36,13 @@ impl CircularOrbit {
 
     /// Dipole field in R: B = (M_E / r³) [ẑ − 3 (ẑ·r̂) r̂] (T); points north at the equator.
     pub fn field_ref(&self, t: f64) -> Vector3<f64> {
-        let r = self.r_hat(t);
-        (Vector3::z() - r * (3.0 * r.z)) * (self.dipole / self.radius.powi(3))
+        dipole_field(&self.r_hat(t), self.radius, self.dipole)
     }
+}
+
+/// Field of a dipole M_E aligned with ẑ (pointing south, as the Earth's) at r r̂: B = (M_E / r³) [ẑ − 3 (ẑ·r̂) r̂] (T).
+pub fn dipole_field(r_hat: &Vector3<f64>, radius: f64, dipole: f64) -> Vector3<f64> {
+    (Vector3::z() - r_hat * (3.0 * r_hat.z)) * (dipole / radius.powi(3))
 }
 
 /// Obliquity of the ecliptic ε (rad), 23.439 281° (J2000).

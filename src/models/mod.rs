@@ -33,7 +33,9 @@
 //! - sensors: truth inputs `q` 0–3 (the plant's attitude), `w` 4–6 (the plant's rate); measured outputs
 //!   from 20 (`w_meas`, `q_meas` + `valid` 24, `sun_meas` + `valid` 23, `b_meas`; `SampleHold` `y_1…8`
 //!   20–27 from `u_1…8` 0–7), diagnostics from 30; `sample_period` 100, `seed` 140, the plant's orbit
-//!   parameters with the plant's references (`mu` 160 … `earth_dipole` 164), `sun_ecliptic_longitude` 165.
+//!   parameters with the plant's references (`mu` 160 … `earth_dipole` 164), `sun_ecliptic_longitude` 165;
+//!   environment inputs (`environment_inputs` 191, as the plant's) `b_eci` 7–9, `sun_eci` 10–12,
+//!   `eclipse` 13, `r` 14–16, `jd_utc` 17; `SunSensor`'s `shadow` 141, `sun_fraction_min` 114.
 //! - environment: epoch `epoch_year` … `epoch_second` 100–105 (`environment::epoch::EpochParams`);
 //!   `Environment`: position `r` 0–2, outputs 20–29, diagnostics 30–39, `hp_exponent` 106, `density_model` 120.
 //! - plants of every family: `integrator` is an Integer with codes 0 RK4, 1 Euler, 2 Dormand–Prince.

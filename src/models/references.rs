@@ -145,7 +145,7 @@ pub const ALL: &[Reference] = &[
         venue: "Section C, low-precision formulas for the Sun (the same in every recent edition)",
         subject: "",
         used_for: "the sun's apparent ecliptic longitude, distance and the obliquity, accurate to 0.01 deg \
-                   from 1950 to 2050",
+                   from 1950 to 2050; the mean longitude of the on-board mean sun of the Ephemeris",
     },
     Reference {
         key: "Lieske-1977",

@@ -10,4 +10,4 @@ from __future__ import annotations
 
 def register(reg) -> None:
     from . import scenarios
-    reg.scenarios("leo", scenarios.build, scenarios.names)
+    reg.scenarios("leo", scenarios.build, scenarios.names, exported=scenarios.EXPORTED)

@@ -75,7 +75,8 @@ def eulerint_rows(m: dict, calibrated: set[str]) -> list[NumberRow]:
         if r["key"] == "fuzzy":
             note += "; T_r calibrated to this number"
         out.append(NumberRow("000", f"Table 3 EULERINT: {r['label']}", rep["eulerint_unit"], paper[i], ours[i], v,
-                             calibration=r["key"] in calibrated, note=note, paper_text=r["eulerint"]))
+                             calibration=r["key"] in calibrated, note=note, paper_text=r["eulerint"],
+                             precision=rules.printed_precision(r["eulerint"])))
     return out
 
 
@@ -116,7 +117,8 @@ def effort_rows(m: dict, ts: dict) -> tuple[list[NumberRow], Table, str]:
                                      rules.same_ordering(i, ours, paper))
             out.append(NumberRow("000", f"Table 4 control effort: {r['label']}", rep["effort_unit"], paper[i], ours[i],
                                  v, note=f"run {r['run']}; definition {d['label']}"
-                                 + ("" if d["fits_abs"] else f" × {d['factor']:.3g}"), paper_text=r["effort"]))
+                                 + ("" if d["fits_abs"] else f" × {d['factor']:.3g}"), paper_text=r["effort"],
+                                 precision=rules.printed_precision(r["effort"])))
         text = f"The definition {fit[name]['label']} fits every row" + ("" if fit[name]["fits_abs"] else
                                                                           " up to a constant factor") + "."
     else:
@@ -185,3 +187,31 @@ def metrics_table(base: dict) -> Table:
                  "kg·m²); settling on α with a 2 % band (nan = not settled), overshoot = largest of the three angles",
                  ["run", "controller", "plant kinematics", "command", "EULERINT [deg·s]", "∫Σ|τ| [N·m·s]",
                   "∫‖τ‖² [N²·m²·s]", "settling [s]", "overshoot [%]"], rows)
+
+
+SHARED_READINGS = ("AdaptiveFuzzyController λ-range scale s", "AdaptiveFuzzyController.gamma", "MracController.gamma")
+
+
+def readings_table(sws_full: list, sws_quick: list, all_rows: dict, base: dict) -> Table:
+    """The docs page's table of the adaptive laws' readings (λ-range scale s, γ): EULERINT and effort of the
+    large-command run at each value both builds run (the quick grid is part of the full one), and the largest
+    relative change of EULERINT over every run the sweep replaces (large command, R1, R2 ×1.2 and ×0.8)."""
+    quick = {sw["param"]: set(sw["values"]) for sw in sws_quick}
+    rows = []
+    for sw in sws_full:
+        if sw["param"] not in SHARED_READINGS or sw["param"] not in all_rows:
+            continue
+        rr = all_rows[sw["param"]]
+        main = sw["runs"][0]
+        for i, v in enumerate(sw["values"]):
+            if v not in quick.get(sw["param"], ()):
+                continue
+            ch = [abs(rr[r][i][EI] - base[r][EI]) / abs(base[r][EI]) for r in sw["runs"]
+                  if rr[r][i]["status"] == "ok" and r in base]
+            rows.append([sw["param"], float(v), main, rr[main][i][EI], rr[main][i]["effort_abs"],
+                         100.0 * max(ch) if ch else math.nan])
+    return Table("The adaptive laws' readings at the points both builds run: EULERINT and effort ∫Σ|τ| dt of the "
+                 "large-command run, and the largest change of EULERINT against the defaults over every run the "
+                 "reading replaces (large command, R1, R2 ×1.2 and ×0.8)",
+                 ["reading", "value", "run", "EULERINT (deg·s)", "effort (N·m·s)", "largest EULERINT change (%)"],
+                 rows)

@@ -33,7 +33,7 @@ from .constants import (DCM_READINGS, EFF, EFFORT_RATIO, EI, L_METHODS, L_RUNS, 
 from . import numbers as N
 from ...report import rules
 from .figures import fig_effort, fig_joint, fig_ranking, fig_robust, fig_sweep
-from .report_rules import (RULES, _fmt_cat, _spearman, below, c6_needed_ratio, holds_where, rule_c1,  # noqa: F401
+from .report_rules import (AGREEMENT, RULES, _fmt_cat, _spearman, below, c6_needed_ratio, holds_where, rule_c1,  # noqa: F401
                            rule_c2, rule_c3, rule_c4, rule_c5, rule_c6, rule_c7, verdict)
 
 
@@ -339,7 +339,8 @@ def _claim(c: str, rule, base: dict, per_claim: dict, away_of: dict, needed: lis
                 + (f" It flips only at values that move the paper's own Table 3 numbers further away (listed, "
                    f"not counted): {', '.join(flips_away)}." if flips_away else ""))
     return Claim(c, STATEMENTS[c], v, evidence, figures=[], sensitivity=sens, sensitive_to=flips + [
-        f"{p} (flips it only while moving the paper's numbers away; not counted)" for p in flips_away])
+        f"{p} (flips it only while moving the paper's numbers away; not counted)" for p in flips_away],
+        agreement=AGREEMENT[c](base) if c in AGREEMENT else None)
 
 
 def _setup_and_notes(ctx: Context, base: dict, sws: list) -> tuple[str, str]:
@@ -349,6 +350,7 @@ def _setup_and_notes(ctx: Context, base: dict, sws: list) -> tuple[str, str]:
              f"{n_sweep} sweep runs on the campaign engine (native), Δ = 0.01 s, t_end = 30 s"
              + (" (quick mode: a few points per sweep)" if ctx.quick else "") + ".")
     notes = (
+        "The fuzzy PD's gain ranges are the paper's, k_p ∈ [0.28, 3] k_r and k_d ∈ [0.08, 0.15] k_r T_r. "
         "Readings: EULERINT in deg·s over [0, 30] s; effort = ∫Σ|τ| dt (the paper's formula is unknown; ∫‖τ‖² dt is "
         "evaluated too). Thresholds: rankings need a 0.5 % margin, 'about the same' ≤ 10 % spread, 'identical' ≤ 1e-6, "
         "'without much more effort' ≤ 1.5 × the quaternion PD's effort. The DCM error law has six readings "
@@ -402,5 +404,7 @@ def build(ctx: Context) -> PaperSection:
     claims[4].tables.append(eff_table)
     calibrations = _calibrations(eff_text)
     mt = N.metrics_table(base)
-    return PaperSection("000", TITLE, setup, claims, figures=figs, tables=[mt], notes=notes, doc_tables={"runs": mt},
+    rt = N.readings_table(sws, sweeps(True), all_rows, base)
+    return PaperSection("000", TITLE, setup, claims, figures=figs, tables=[mt, rt], notes=notes,
+                        doc_tables={"runs": mt, "readings": rt},
                         runtime_s=time.time() - t0, numbers=nums, calibrations=calibrations)

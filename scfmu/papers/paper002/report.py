@@ -70,7 +70,7 @@ def gain_rows(gains: dict, reported: dict) -> list:
                              + ("; " if len(cands) > 1 else "") + "ours: PSO on our plant (paper002/data/gains.json)",
                              paper_text=" / ".join(g["candidates"]) if len(cands) <= 4 else
                              f"{g['candidates'][0]} … {g['candidates'][-1]} ({len(cands)} readings)",
-                             bounds=p2.BOUNDS[g["gain"]]))
+                             bounds=p2.BOUNDS[g["gain"]], precision=rules.printed_precision(text)))
     return out
 
 

@@ -393,12 +393,13 @@ def number_rows(summary: dict | None = None) -> list:
         v = rules.number_verdict(ours, paper, rules.printed_precision(n["value"]))
         out.append(NumberRow("003", n["label"], "N²·m²·s", paper, ours, v, paper_text=f"{n['value']} (no unit)",
                              note=(f"{n['text']}; ours over our horizon and command, ISF = ∫‖τ‖² dt of the applied "
-                                   f"torque: {paper / ours:.4g}× smaller, i.e. a torque scale {scale:.3g}× apart")))
+                                   f"torque: {paper / ours:.4g}× smaller, i.e. a torque scale {scale:.3g}× apart"),
+                                 precision=rules.printed_precision(n["value"])))
         for unit, f in ISF_UNIT_READINGS.items():
             o = ours * f * f
-            out.append(NumberRow("003", f"{n['label']}, torque read in {unit}", f"{unit}²·s", paper, o,
+            out.append(NumberRow("003", f"{n['label']}, torque read in {unit}", f"({unit})²·s", paper, o,
                                  rules.number_verdict(o, paper, rules.printed_precision(n["value"])), basis=CHOSEN,
-                                 paper_text=n["value"],
+                                 paper_text=n["value"], precision=rules.printed_precision(n["value"]),
                                  note=f"reading: the paper's torques in {unit} (ISF × {f * f:g}); no unit is printed, "
                                       f"so this is a reading picked by comparing, not evidence"))
     if not out:

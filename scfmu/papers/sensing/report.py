@@ -67,9 +67,9 @@ def build(ctx) -> PaperSection:
         rows=[[r["group"], r["controller"], f"{r['truth']:.4g}", _cell(r, "sensed"), _cell(r, "est"),
                f"{r['rank_truth']} / {r['rank_sensed']} / {r['rank_est']}"] for r in rows])
     setup = (f"Paper 000's large slew (one scenario per controller) and paper 003's cases N, C, S, W (GA-SMC, "
-             f"T2F-SMC), each run once with the plant's truth and {seeds} times (seeds 1…{seeds}) with sensors and "
+             f"T2F-SMC; the paper's 150 s{', quick mode: 30 s' if ctx.quick else ''}), each run once with the plant's truth and {seeds} times (seeds 1…{seeds}) with sensors and "
              f"with the estimator in the loop; {n_runs} runs on the native engine.")
-    notes = ("Sensor suite (project choice): gyro 100 Hz, ARW 0.15 deg/sqrt(h), bias instability 1 deg/h; star "
+    notes = ("Sensor suite (project choice): gyro 100 Hz, ARW 0.15 deg/sqrt(h), bias instability 1 deg/h (Gauss–Markov, τ_c 300 s); star "
              "tracker 5 Hz, 5/41 arcsec, 0.1 s latency; sun sensor 10 Hz, 0.1 deg, 60 deg field of view, none in "
              "eclipse; magnetometer 10 Hz, 100 nT; Mekf at 100 Hz with the sensors' own noise; flight computer "
              "10 Hz with a 0.05 s delay. docs/sensing.md discusses the results.")

@@ -15,7 +15,7 @@ from ...scenario.model import Scenario
 from ...scenario.templates import with_estimation, with_sensors
 
 PAPER000_LARGE = {"default": "PD (quaternion)", "paper000/000-7L": "LQR", "paper000/000-8L": "pole placement",
-                  "paper000/000-9L": "MRAC (quaternion)", "paper000/000-10L": "fuzzy PD",
+                  "paper000/000-9L": "MRAC (linear coordinates)", "paper000/000-10L": "fuzzy PD",
                   "paper000/000-11L": "adaptive fuzzy"}
 PAPER003 = {f"paper003/{c}/{k}": f"paper 003 case 003-{k}, {c}" for c in ("SMC", "T2FSMC") for k in "NCSWU"}
 EXPORTED = ("sensing/default", "sensing/paper003/T2FSMC/N")

@@ -1,25 +1,28 @@
-//! `Magnetometer`: the dipole field of the plant's orbit in body axes with bias and noise, sampled at
-//! its own rate, seeded.
+//! `Magnetometer`: the geomagnetic field in body axes with bias and noise, sampled at its own rate,
+//! seeded: the dipole field of the plant's circular orbit, or (environment_inputs = 1) the true field
+//! `b_eci` from `Environment`.
 
 use nalgebra::{Quaternion, Vector3};
 use serde::{Deserialize, Serialize};
 
-use super::shared::{sample_index, check_unit, max_queue, DelayLine, OrbitParams, TrueAttitude};
+use super::shared::{check_unit, field_input, max_queue, sample_index, DelayLine, FieldInput, OrbitParams, TrueAttitude};
 use crate::declare_variables;
 use crate::math::attitude::attitude_matrix;
 use crate::math::environment::CircularOrbit;
 use crate::math::random::normal;
-use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult};
+use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult, SWITCH};
 
 declare_variables! {
     pub struct MagnetometerVars {
         truth: TrueAttitude;
         orbit: OrbitParams;
+        world: FieldInput;
         20 => b_meas: Vec3 = [0.0; 3], Output, "T", "Measured geomagnetic field, body axes, held between samples";
         100 => sample_period: Real = 0.1, Parameter, "s", "Sample period T", Range(1e-6, 1e4);
         103 => noise: Vec3 = [1e-7; 3], Parameter, "T", "1-sigma white noise per axis (default 100 nT)", NonNegative;
         110 => bias: Vec3 = [0.0; 3], Parameter, "T", "Constant bias per axis";
         140 => seed: Integer = 1, Parameter, "", "Seed of the counter-based noise generator";
+        191 => environment_inputs: Integer = 0, Parameter, "", "0 = the dipole field of the circular orbit (parameters 160-164); 1 = the input b_eci (Environment's true field; the attitude q is then relative to the inertial axes, as the plant's with its environment_inputs = 1)", Choice(SWITCH);
     }
 }
 
@@ -31,6 +34,8 @@ struct Derived {
     orbit: CircularOrbit,
     noise: Vector3<f64>,
     bias: Vector3<f64>,
+    /// environment_inputs = 1: the field is the input b_eci.
+    world: bool,
 }
 
 #[derive(Clone, Serialize, Deserialize)]
@@ -40,11 +45,24 @@ pub struct Magnetometer {
 }
 
 impl Magnetometer {
-    fn sample(&self, k: i64, q: &Quaternion<f64>) -> [f64; 3] {
+    /// Sample k from the inputs held at t_k: the field in R is `b_eci` (environment_inputs = 1) or the
+    /// circular orbit's dipole at t_k.
+    fn sample(&self, k: i64, q: &Quaternion<f64>, b_eci: Option<&Vector3<f64>>) -> [f64; 3] {
         let d = &self.d;
-        let b = attitude_matrix(q) * d.orbit.field_ref(k as f64 * d.period) + d.bias
+        let field = match b_eci {
+            Some(b) => *b,
+            None => d.orbit.field_ref(k as f64 * d.period),
+        };
+        let b = attitude_matrix(q) * field + d.bias
             + Vector3::from_fn(|i, _| d.noise[i] * normal(d.seed, k, i as u64));
         [b.x, b.y, b.z]
+    }
+
+    /// The inputs a sample reads, checked: q, and b_eci with the environment inputs.
+    fn inputs(&self, v: &MagnetometerVars) -> Result<(Quaternion<f64>, Option<Vector3<f64>>), String> {
+        check_unit("q", &v.truth.q)?;
+        let b = if self.d.world { Some(field_input(&v.world.b_eci)?) } else { None };
+        Ok((v.truth.q, b))
     }
 }
 
@@ -56,35 +74,46 @@ impl Model for Magnetometer {
     const EVOLVING: &'static [&'static str] = &["line"];
     const INFO: ModelInfo = ModelInfo {
         name: "Magnetometer",
-        description: "Three-axis magnetometer: the plant's dipole field in body axes with bias and white noise, sampled at its own rate, seeded",
-        source: "magnetometer model of [Markley-Crassidis-2014] Sec. 4.5 (field + bias + white noise); the non-tilted dipole of the plant's orbit environment ([T2FSMC-LEO] set-up, project choice)",
+        description: "Three-axis magnetometer: the plant's dipole field, or the true field of Environment, in body axes with bias and white noise, sampled at its own rate, seeded",
+        source: "magnetometer model of [Markley-Crassidis-2014] Sec. 4.5 (field + bias + white noise); the non-tilted dipole of the plant's orbit environment ([T2FSMC-LEO] set-up, project choice) or the IGRF-14 field of Environment",
         equations_html: concat!("<pre>samples at t_k = k T, held until the next sample:\n\
 b_meas,k = A(q(t_k)) B_R(t_k) + b + sigma (.) n_k,   n_k,i = N(seed, k, i) of math::random\n\
+environment_inputs = 0:\n\
 B_R(t)   = (M_E / r^3) [z - 3 (z . r_hat) r_hat],   r_hat(t) = [cos u, sin u cos i, sin u sin i],  u = u_0 + n t\n\
-(the plant's field: same orbit parameters and value references 160-164)</pre>", crate::sample_grid_note!()),
+           (the plant's field: same orbit parameters and value references 160-164)\n\
+environment_inputs = 1:\n\
+B_R(t_k) = b_eci(t_k), the input held at t_k (Environment's IGRF-14 field, J2000 axes; q relative to them)</pre>\n\
+<p>With environment_inputs = 1, wire b_eci from an <code>Environment</code> unit (the names match); an unwired \
+(zero) or non-finite b_eci is refused with an error naming it. With 0 (the default) the input is not read.</p>", crate::sample_grid_note!()),
         feedthrough: Feedthrough::AllInputs,
         ..ModelInfo::DEFAULT
     };
 
     fn initialize(v: &mut MagnetometerVars, exp: &Experiment) -> Result<Self, String> {
         let k0 = sample_index(exp.start_time, v.sample_period)?;
-        let d = Derived { period: v.sample_period, k0, seed: v.seed as i64, orbit: v.orbit.orbit(), noise: v.noise, bias: v.bias };
+        let d = Derived {
+            period: v.sample_period,
+            k0,
+            seed: v.seed as i64,
+            orbit: v.orbit.orbit(),
+            noise: v.noise,
+            bias: v.bias,
+            world: v.environment_inputs == 1,
+        };
         Ok(Magnetometer { d, line: DelayLine::new([0.0; 3], k0) })
     }
 
     fn outputs(&self, v: &mut MagnetometerVars, t: f64) -> ModelResult {
-        check_unit("q", &v.truth.q)?;
-        let q = v.truth.q;
-        let (b, _) = self.line.at(t, self.d.period, 0.0, |k| self.sample(k, &q), |_| true)?;
+        let (q, b_eci) = self.inputs(v)?;
+        let (b, _) = self.line.at(t, self.d.period, 0.0, |k| self.sample(k, &q, b_eci.as_ref()), |_| true)?;
         v.b_meas = Vector3::from(b);
         Ok(())
     }
 
     fn step(&mut self, v: &MagnetometerVars, t: f64, h: f64) -> ModelResult {
-        check_unit("q", &v.truth.q)?;
-        let q = v.truth.q;
+        let (q, b_eci) = self.inputs(v)?;
         let mut line = self.line.clone();
-        line.advance(t, h, self.d.period, 0.0, |k| self.sample(k, &q), |_| true)?;
+        line.advance(t, h, self.d.period, 0.0, |k| self.sample(k, &q, b_eci.as_ref()), |_| true)?;
         self.line = line;
         Ok(())
     }
@@ -128,5 +157,35 @@ mod tests {
             let sd = (e.iter().map(|v| v[i] * v[i]).sum::<f64>() / n as f64).sqrt();
             assert!((sd / m.v.noise[i] - 1.0).abs() < 4.0 / (2.0 * n as f64).sqrt(), "axis {i}: {sd}");
         }
+    }
+
+    #[test]
+    fn field_from_the_environment_input() {
+        // noise-free, environment_inputs = 1: b_meas = A(q) b_eci + bias, A(q) = R1(roll) R2(pitch) R3(yaw) by hand
+        let mut m = Fmu::<Magnetometer>::default();
+        (m.v.noise, m.v.environment_inputs) = (Vector3::zeros(), 1);
+        m.v.bias = Vector3::new(1e-8, 0.0, -2e-8);
+        m.initialize(&Experiment::default()).unwrap();
+        m.v.truth.q = quat_from_euler321(-0.4, 0.7, 2.1);
+        m.v.world.b_eci = Vector3::new(1.2e-5, -3.4e-5, 2.2e-5);
+        m.outputs(0.0).unwrap();
+        let r1 = |a: f64| nalgebra::Matrix3::new(1.0, 0.0, 0.0, 0.0, a.cos(), a.sin(), 0.0, -a.sin(), a.cos());
+        let r2 = |a: f64| nalgebra::Matrix3::new(a.cos(), 0.0, -a.sin(), 0.0, 1.0, 0.0, a.sin(), 0.0, a.cos());
+        let r3 = |a: f64| nalgebra::Matrix3::new(a.cos(), a.sin(), 0.0, -a.sin(), a.cos(), 0.0, 0.0, 0.0, 1.0);
+        let want = r1(-0.4) * r2(0.7) * r3(2.1) * m.v.world.b_eci + m.v.bias;
+        assert!((m.v.b_meas - want).norm() < 1e-12 * want.norm(), "{} vs {want}", m.v.b_meas);
+        // the sample holds the input of its instant: a new field read at the next sample only
+        m.step(0.0, 0.05).unwrap();
+        m.v.world.b_eci *= 2.0;
+        m.outputs(0.05).unwrap();
+        assert!((m.v.b_meas - want).norm() < 1e-12 * want.norm());
+        m.step(0.05, 0.05).unwrap();
+        m.outputs(0.1).unwrap();
+        let want2 = r1(-0.4) * r2(0.7) * r3(2.1) * m.v.world.b_eci + m.v.bias;
+        assert!((m.v.b_meas - want2).norm() < 1e-12 * want2.norm(), "{} vs {want2}", m.v.b_meas);
+        // unwired (zero) field: refused by name
+        m.v.world.b_eci = Vector3::zeros();
+        assert!(m.outputs(0.1).unwrap_err().contains("input b_eci"));
+        assert!(m.step(0.1, 0.1).unwrap_err().contains("input b_eci"));
     }
 }

@@ -9,7 +9,7 @@ import pytest
 
 from scfmu.fmu import fmu_path
 from scfmu.papers.paper000 import report as p
-from scfmu.report.types import CONFIRMED, DEPENDS, NOT_CONFIRMED, Context, PaperSection
+from scfmu.report.types import BY_CONSTRUCTION_HOLDS, CONFIRMED, DEPENDS, NOT_CONFIRMED, Context, PaperSection
 
 
 def row(ei, eff=100.0, sq=1000.0, ts=5.0, os_=0.0):
@@ -55,6 +55,29 @@ def test_c2_spread_threshold():
     assert p.rule_c2(m)[0]
     m["000-1"] = row(16.5 * 0.90)  # 11.1 %
     assert not p.rule_c2(m)[0]
+
+
+def _claim_c3(m: dict):
+    """C000-3's claim from a table, as build() decides it (no sweeps)."""
+    empty = {c: [] for c in p.RULES}
+    return p._claim("C000-3", p.RULES["C000-3"], m, empty, {c: [] for c in p.RULES}, [])
+
+
+def test_c3_holds_by_construction_is_detected_from_the_numbers():
+    """Equal gains make LQR, pole placement and PD agree to rounding level: the claim holds by construction,
+    never "confirmed". Broken on purpose (LQR's EULERINT off by 1e-9 relative, as a genuinely different
+    computation would be), the same rule passes (≤ 1e-6) and the claim is an ordinary "confirmed": what
+    decides is the measured agreement, not the claim's id."""
+    m = paper_like()
+    eps = 2.220446049250313e-16
+    m["000-7L"] = row(156 * (1 + 2 * eps))         # a rounding-level difference, as our runs show (2e-16)
+    c = _claim_c3(m)
+    assert c.verdict == BY_CONSTRUCTION_HOLDS and c.agreement <= 100 * eps and "Holds by construction" in c.evidence
+    m["000-7L"] = row(156 * (1 + 1e-9))
+    c = _claim_c3(m)
+    assert c.verdict == CONFIRMED and c.agreement > 1e-10
+    m["000-7L"] = row(156 * 1.01)                    # and a real difference fails the rule
+    assert _claim_c3(m).verdict == NOT_CONFIRMED
 
 
 def test_c3_identical_tolerance():
@@ -167,8 +190,8 @@ def test_quick_build(tmp_path):
     assert isinstance(sec, PaperSection)
     assert [c.id for c in sec.claims] == [f"C000-{i}" for i in range(1, 8)]
     by = {c.id: c for c in sec.claims}
-    # identical PD/LQR/pole placement; small-command agreement except with the doubled-gain DCM reading 2
-    assert by["C000-3"].verdict == CONFIRMED
+    # identical PD/LQR/pole placement, to rounding level: the gains are equal by construction
+    assert by["C000-3"].verdict == BY_CONSTRUCTION_HOLDS and "Holds by construction" in by["C000-3"].evidence
     s2 = [x for x in by["C000-2"].sensitivity if x.parameter == "PdController.dcm_error"][0]
     # reading 2 (doubled gain) breaks C000-2 but also moves the large-command DCM EULERINT away from the paper's
     # 161.5 deg·s: such a reading is left out of the verdict

@@ -41,3 +41,30 @@ impl OrbitParams {
         }
     }
 }
+
+// The environment inputs (issue 43), read with `environment_inputs = 1` only: named as the outputs of
+// `Environment` (`b_eci`, `sun_eci`, `eclipse`) and `Orbit` (`r`, `jd_utc`), so they connect by name, with
+// one value reference each across the family.
+
+declare_variables! {
+    /// The true geomagnetic field, from `Environment.b_eci_*`.
+    pub struct FieldInput {
+        7 => b_eci: Vec3 = [0.0; 3], Input, "T", "Geomagnetic field at the spacecraft, inertial (ECI, J2000) axes, from Environment (environment_inputs = 1; the start value 0 is refused)";
+    }
+}
+
+declare_variables! {
+    /// The true sun and shadow, from `Environment.sun_eci_*` and `Environment.eclipse`.
+    pub struct SunInputs {
+        10 => sun_eci: Vec3 = [0.0; 3], Input, "", "Direction Earth to sun, inertial (ECI, J2000) axes, from Environment; normalised here (environment_inputs = 1; the start value 0 is refused)";
+        13 => eclipse: Real = 1.0, Input, "", "Visible fraction of the solar disk, 0 (umbra) to 1 (full sun), from Environment (environment_inputs = 1; unwired: always full sun)";
+    }
+}
+
+declare_variables! {
+    /// The position and date the flight computer knows, from `Orbit.r_*` and `Orbit.jd_utc`.
+    pub struct PositionInputs {
+        14 => r: Vec3 = [0.0; 3], Input, "m", "Spacecraft position, inertial (ECI, J2000) axes, e.g. from GPS = Orbit's r (environment_inputs = 1; the start value 0 is refused)";
+        17 => jd_utc: Real = 0.0, Input, "d", "UTC Julian date, from Orbit (environment_inputs = 1; the start value 0 is refused)";
+    }
+}
