@@ -115,9 +115,13 @@ mod tests {
     fn environment_inputs_refused_by_name() {
         let z = Vector3::zeros();
         assert!(field_input(&z).unwrap_err().contains("input b_eci"));
-        assert!(field_input(&Vector3::new(f64::NAN, 0.0, 1e-5)).unwrap_err().contains("input b_eci"));
+        assert!(field_input(&Vector3::new(f64::NAN, 0.0, 1e-5))
+            .unwrap_err()
+            .contains("input b_eci"));
         assert!(sun_input(&z).unwrap_err().contains("input sun_eci"));
-        assert!(sun_input(&Vector3::new(f64::INFINITY, 0.0, 0.0)).unwrap_err().contains("input sun_eci"));
+        assert!(sun_input(&Vector3::new(f64::INFINITY, 0.0, 0.0))
+            .unwrap_err()
+            .contains("input sun_eci"));
         assert!((sun_input(&Vector3::new(3.0, 0.0, 4.0)).unwrap() - Vector3::new(0.6, 0.0, 0.8)).norm() < 1e-16);
         assert!(eclipse_input(1.5).unwrap_err().contains("input eclipse"));
         assert!(eclipse_input(f64::NAN).unwrap_err().contains("input eclipse"));
