@@ -143,7 +143,8 @@ def check(scenario: Scenario, instantiate: bool = True) -> Report:
         for k, val in c.params.items():
             v = vars_of[c.name].get(k)
             if v is None or v.causality != "parameter":
-                rep.errors.append(f"{c.name} ({c.model}): no parameter {k!r}{did_you_mean(k, params)}")
+                rep.errors.append(f"{c.name} ({c.model}): no parameter {k!r}"
+                                  + (f" ({k!r} is its {v.causality})" if v is not None else did_you_mean(k, params)))
                 continue
             problem = value_problem(f"{c.name}.{k}", v, val)
             if problem:
