@@ -8,7 +8,7 @@
 //!
 //! Run: `cargo bench --bench environment_step` (release profile). Results go to docs/benchmarks.md by hand.
 
-use std::ffi::{c_int, c_void, CString};
+use std::ffi::c_int;
 use std::hint::black_box;
 use std::time::Instant;
 
@@ -18,7 +18,6 @@ use spacecraft_fmus::math::atmosphere::exponential_density;
 use spacecraft_fmus::math::igrf;
 use spacecraft_fmus::math::sun::{shadow_factor, sun_position};
 use spacecraft_fmus::math::time_scales::{decimal_year, eci_to_ecef, geodetic, JD_J2000};
-use spacecraft_fmus::model::guid::guid;
 use spacecraft_fmus::model::{Experiment, Fmu, Model, SlotMut, Value, Variables};
 use spacecraft_fmus::models::attitude::AttitudePlant;
 use spacecraft_fmus::models::environment::{Environment, Orbit};
@@ -73,27 +72,9 @@ const SGP4_REALS: &[(&str, f64)] = &[
 ];
 const ORBIT_OUT: &[&str] = &["r_x", "r_y", "r_z", "v_x", "v_y", "v_z"];
 
-/// Paper 003 configuration of plant_step.rs: wheels with lag, magnetorquers, gravity gradient, disturbances.
-const P003_REALS: &[(&str, f64)] = &[
-    ("inertia_xx", 4.0),
-    ("inertia_yy", 5.0),
-    ("inertia_zz", 3.5),
-    ("inertia_xy", 0.05),
-    ("inertia_xz", -0.03),
-    ("inertia_yz", 0.02),
-    ("init_w_x", 0.01),
-    ("init_w_y", -0.005),
-    ("wheel_time_constant", 0.1),
-    ("dist_const_x", 5e-4),
-    ("dist_sin_amp_x", 5e-4),
-    ("dist_sin_amp_y", 5e-4),
-    ("dist_sin_amp_z", 5e-4),
-    ("dist_sin_freq", 0.1),
-    ("dist_noise_std_x", 5e-4),
-    ("dist_noise_std_y", 5e-4),
-    ("dist_noise_std_z", 5e-4),
-];
-const P003_INTS: &[(&str, i32)] = &[("actuator_mode", 1), ("mtq_enable", 1), ("gg_enable", 1)];
+/// Paper 003 configuration of plant_step.rs (one module for both benches).
+mod shared;
+use shared::{INTS as P003_INTS, REALS as P003_REALS};
 
 /// The 6U of `leo/nadir` in its environment: six box facets about a centre of mass offset by
 /// (0.005, 0.010, 0.020) m, residual dipole, wheels, magnetorquers, gravity gradient from r; one RK4 step per
@@ -271,21 +252,7 @@ fn direct<M: Model + 'static>(case: &Case) -> Cycle {
 
 /// The same cycle through the exported FMI 2.0 functions: `fmi2SetReal`, `fmi2DoStep`, `fmi2GetReal`.
 fn abi(case: &Case) -> Cycle {
-    let entry = registry::find(case.model).unwrap();
-    let g = CString::new(guid(entry).as_str()).unwrap();
-    let name = CString::new("bench").unwrap();
-    // The logger is never called on the success path; NULL avoids a C-variadic function.
-    let cb = Box::leak(Box::new(CallbackFunctions {
-        logger: None,
-        allocate_memory: None,
-        free_memory: None,
-        step_finished: None,
-        component_environment: std::ptr::null_mut(),
-    }));
-    let c: *mut c_void = fmi2Instantiate(registry::ALL, name.as_ptr(), 1, g.as_ptr(), std::ptr::null(), cb, 0, 0);
-    assert!(!c.is_null());
-    assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), 0);
-    assert_eq!(fmi2EnterInitializationMode(c), 0);
+    let c = shared::instantiate(case.model);
     let (rv, rx): (Vec<u32>, Vec<f64>) = case.params.0.iter().map(|(n, v)| (vr(case.model, n), *v)).unzip();
     assert_eq!(fmi2SetReal(c, rv.as_ptr(), rv.len(), rx.as_ptr()), 0);
     for (n, v) in case.params.1 {

@@ -5,12 +5,11 @@
 //!
 //! Run: `cargo bench --bench plant_step` (release profile). Results go to docs/benchmarks.md by hand.
 
-use std::ffi::{c_int, CString};
+use std::ffi::c_int;
 use std::hint::black_box;
 use std::time::Instant;
 
 use spacecraft_fmus::fmi::fmi2::*;
-use spacecraft_fmus::model::guid::guid;
 use spacecraft_fmus::model::{Experiment, Fmu, SlotMut, Variables};
 use spacecraft_fmus::models::attitude::plant::AttitudePlantVars;
 use spacecraft_fmus::models::attitude::AttitudePlant;
@@ -18,28 +17,8 @@ use spacecraft_fmus::registry;
 
 const DT: f64 = 0.1;
 
-/// Paper 003 configuration: full inertia, wheels with lag, magnetorquers, gravity gradient,
-/// constant + sinusoidal + white-noise disturbance torques.
-const REALS: &[(&str, f64)] = &[
-    ("inertia_xx", 4.0),
-    ("inertia_yy", 5.0),
-    ("inertia_zz", 3.5),
-    ("inertia_xy", 0.05),
-    ("inertia_xz", -0.03),
-    ("inertia_yz", 0.02),
-    ("init_w_x", 0.01),
-    ("init_w_y", -0.005),
-    ("wheel_time_constant", 0.1),
-    ("dist_const_x", 5e-4),
-    ("dist_sin_amp_x", 5e-4),
-    ("dist_sin_amp_y", 5e-4),
-    ("dist_sin_amp_z", 5e-4),
-    ("dist_sin_freq", 0.1),
-    ("dist_noise_std_x", 5e-4),
-    ("dist_noise_std_y", 5e-4),
-    ("dist_noise_std_z", 5e-4),
-];
-const INTS: &[(&str, i32)] = &[("actuator_mode", 1), ("mtq_enable", 1), ("gg_enable", 1)];
+mod shared;
+use shared::{INTS, REALS};
 
 fn vr(name: &str) -> u32 {
     registry::find("AttitudePlant")
@@ -92,31 +71,7 @@ fn direct_model() -> Fmu<AttitudePlant> {
 }
 
 fn abi_instance() -> *mut std::ffi::c_void {
-    let entry = registry::find("AttitudePlant").unwrap();
-    let g = CString::new(guid(entry).as_str()).unwrap();
-    let name = CString::new("bench").unwrap();
-    // The logger is never called on the success path; NULL avoids defining a C-variadic function,
-    // which stable Rust cannot do.
-    let cb = Box::leak(Box::new(CallbackFunctions {
-        logger: None,
-        allocate_memory: None,
-        free_memory: None,
-        step_finished: None,
-        component_environment: std::ptr::null_mut(),
-    }));
-    let c = fmi2Instantiate(
-        spacecraft_fmus::registry::ALL,
-        name.as_ptr(),
-        1,
-        g.as_ptr(),
-        std::ptr::null(),
-        cb,
-        0,
-        0,
-    );
-    assert!(!c.is_null());
-    assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), 0);
-    assert_eq!(fmi2EnterInitializationMode(c), 0);
+    let c = shared::instantiate("AttitudePlant");
     let (rv, rx): (Vec<u32>, Vec<f64>) = REALS.iter().map(|(n, v)| (vr(n), *v)).unzip();
     assert_eq!(fmi2SetReal(c, rv.as_ptr(), rv.len(), rx.as_ptr()), 0);
     let (iv, ix): (Vec<u32>, Vec<c_int>) = INTS.iter().map(|(n, v)| (vr(n), *v)).unzip();
