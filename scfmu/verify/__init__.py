@@ -60,6 +60,7 @@ LS_NS = "http://fmi-standard.org/fmi-ls-manifest"
 LS_VERSION = "1.0.0-alpha.1"
 LS_DESCRIPTION = "Layered Standard providing information on related files included in an FMU."
 MAX_ROWS = 1000
+LONG_RUN_STEPS = 500_000  # a loop FMU's scenario longer than this: the reference experiment is its first MAX_ROWS steps
 # Parameter values of the reference experiment where the defaults leave every output constant (a command
 # with a zero step, a sun sensor whose sun is outside its field of view): written as <Model>_ref.ssv
 REF_PARAMS = {
@@ -126,8 +127,16 @@ def reference_experiment(md, inputs: bool = True) -> Experiment:
     start = float(de.startTime or 0.0) if de else 0.0
     stop = float(de.stopTime) if de and de.stopTime is not None else 1.0
     base = float(de.stepSize) if de and de.stepSize else (stop - start) / 100
-    m = max(1, math.ceil(round((stop - start) / base) / MAX_ROWS))
-    return Experiment(start, stop, base * m, params=dict(REF_PARAMS.get(md.coSimulation.modelIdentifier, {})), inputs=inputs)
+    n = round((stop - start) / base)
+    if not inputs and n > LONG_RUN_STEPS:
+        # a loop FMU of a long scenario (a day of leo/nadir): its first MAX_ROWS communication steps
+        return Experiment(start, start + round(base * MAX_ROWS, 12), base, params=dict(REF_PARAMS.get(
+            md.coSimulation.modelIdentifier, {})), inputs=inputs)
+    # the output interval: m steps, m the smallest divisor of n giving at most MAX_ROWS rows, so that it divides
+    # the duration (importers such as fmi-rs refuse an interval that does not)
+    m = next(k for k in range(max(1, math.ceil(n / MAX_ROWS)), n + 1) if n % k == 0)
+    step = base * m if m == max(1, math.ceil(n / MAX_ROWS)) else round(base * m, 12)
+    return Experiment(start, stop, step, params=dict(REF_PARAMS.get(md.coSimulation.modelIdentifier, {})), inputs=inputs)
 
 
 def _real_type(md) -> str:
