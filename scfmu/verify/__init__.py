@@ -59,8 +59,8 @@ MANIFEST = f"{REF_DIR}/fmi-ls-manifest.xml"
 LS_NS = "http://fmi-standard.org/fmi-ls-manifest"
 LS_VERSION = "1.0.0-alpha.1"
 LS_DESCRIPTION = "Layered Standard providing information on related files included in an FMU."
-MAX_ROWS = 1000
-LONG_RUN_STEPS = 500_000  # a loop FMU's scenario longer than this: the reference experiment is its first MAX_ROWS steps
+# at most MAX_ROWS rows; a loop FMU's scenario of more than LONG_RUN_STEPS steps: its first MAX_ROWS steps
+MAX_ROWS, LONG_RUN_STEPS = 1000, 500_000
 # Parameter values of the reference experiment where the defaults leave every output constant (a command
 # with a zero step, a sun sensor whose sun is outside its field of view): written as <Model>_ref.ssv
 REF_PARAMS = {
@@ -72,11 +72,8 @@ REF_PARAMS = {
 # Constant offsets added to the documented input signals where those alone are refused by the unit
 # an input of this name is an atmospheric density (kg/m3): the documented signal keeps it in orbit's range
 DENSITY_INPUT = "rho"
-REF_INPUT_OFFSETS = {
-    "Environment": {"r_x": 6_878_137.0},  # 500 km above the equator (|r| below the Earth's radius is refused)
-}
-REL_TOL = 1e-6
-ABS_TOL = 1e-12
+REF_INPUT_OFFSETS = {"Environment": {"r_x": 6_878_137.0}}  # 500 km above the equator (|r| < Earth's radius refused)
+REL_TOL, ABS_TOL = 1e-6, 1e-12
 IMPORTERS = ("fmpy", "fmusim")
 # fixed entry metadata: the injected files are byte-identical from build to build
 _DATE = (1980, 1, 1, 0, 0, 0)
@@ -106,11 +103,7 @@ class Experiment:
 
     @classmethod
     def parse(cls, text: str) -> "Experiment":
-        kv = {}
-        for line in text.splitlines():
-            if "," in line:
-                k, v = line.split(",", 1)
-                kv[k.strip()] = float(v)
+        kv = {k.strip(): float(v) for k, v in (line.split(",", 1) for line in text.splitlines() if "," in line)}
         try:
             return cls(kv["StartTime"], kv["StopTime"], kv["StepSize"], kv.get("RelTol", REL_TOL), kv.get("AbsTol", ABS_TOL))
         except KeyError as e:
@@ -127,16 +120,12 @@ def reference_experiment(md, inputs: bool = True) -> Experiment:
     start = float(de.startTime or 0.0) if de else 0.0
     stop = float(de.stopTime) if de and de.stopTime is not None else 1.0
     base = float(de.stepSize) if de and de.stepSize else (stop - start) / 100
-    n = round((stop - start) / base)
-    if not inputs and n > LONG_RUN_STEPS:
-        # a loop FMU of a long scenario (a day of leo/nadir): its first MAX_ROWS communication steps
-        return Experiment(start, start + round(base * MAX_ROWS, 12), base, params=dict(REF_PARAMS.get(
-            md.coSimulation.modelIdentifier, {})), inputs=inputs)
-    # the output interval: m steps, m the smallest divisor of n giving at most MAX_ROWS rows, so that it divides
-    # the duration (importers such as fmi-rs refuse an interval that does not)
-    m = next(k for k in range(max(1, math.ceil(n / MAX_ROWS)), n + 1) if n % k == 0)
-    step = base * m if m == max(1, math.ceil(n / MAX_ROWS)) else round(base * m, 12)
-    return Experiment(start, stop, step, params=dict(REF_PARAMS.get(md.coSimulation.modelIdentifier, {})), inputs=inputs)
+    n, params = round((stop - start) / base), dict(REF_PARAMS.get(md.coSimulation.modelIdentifier, {}))
+    if not inputs and n > LONG_RUN_STEPS:  # a loop FMU of a long scenario (a day of leo/nadir): its first steps
+        return Experiment(start, start + round(base * MAX_ROWS, 12), base, params=params, inputs=inputs)
+    m0 = max(1, math.ceil(n / MAX_ROWS))  # m steps per row, m dividing n: fmi-rs refuses an interval that does not
+    m = next(k for k in range(m0, n + 1) if n % k == 0)
+    return Experiment(start, stop, base * m if m == m0 else round(base * m, 12), params=params, inputs=inputs)
 
 
 def _real_type(md) -> str:
