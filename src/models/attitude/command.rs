@@ -6,7 +6,9 @@ use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
 use crate::declare_variables;
-use crate::math::attitude::{euler321_from_quat, quat_from_dcm, quat_from_euler321};
+use crate::math::attitude::{euler321_from_quat, quat_from_euler321};
+use crate::math::orbit;
+use crate::math::wahba::{self, quat_nonneg, triad};
 use crate::model::{check_derived, Experiment, Feedthrough, Model, ModelInfo, ModelResult, ParamEnum};
 use crate::param_enum;
 
@@ -41,33 +43,18 @@ pub struct AttitudeCommand {
     reference: Reference,
 }
 
-/// The attitude matrix (rows: the commanded body axes in the reference frame) whose body axis `a` lies
-/// along `u` and whose body axis `b` lies in the plane of `u` and `w` (toward `w`): the TRIAD construction.
-fn two_axis(a: &Vector3<f64>, b: &Vector3<f64>, u: &Vector3<f64>, w: &Vector3<f64>) -> Matrix3<f64> {
-    let (a1, u1) = (a.normalize(), u.normalize());
-    let (a2, u2) = (a1.cross(b).normalize(), u1.cross(w).normalize());
-    let (a3, u3) = (a1.cross(&a2), u1.cross(&u2));
-    // A maps reference components to body components: A u_k = a_k
-    Matrix3::from_columns(&[a1, a2, a3]) * Matrix3::from_columns(&[u1, u2, u3]).transpose()
-}
-
+/// The unit vector of an input; the message names it and asks whether it is wired.
 fn unit(name: &str, x: &Vector3<f64>) -> Result<Vector3<f64>, String> {
-    let n = x.norm();
-    if !(n > 0.0 && n.is_finite()) {
-        return Err(format!("input {name} = ({}, {}, {}) is not a direction (is it connected?)", x.x, x.y, x.z));
-    }
-    Ok(x / n)
+    wahba::unit(&format!("input {name}"), x).map_err(|e| format!("{e} (is it connected?)"))
 }
 
 impl AttitudeCommand {
     /// Nadir: rows of A = the LVLH axes in inertial components; the frame turns at (r x v)/|r|^2 about the
     /// orbit normal, i.e. at -|r x v|/|r|^2 about its own y axis.
     fn nadir(v: &AttitudeCommandVars) -> Result<(Matrix3<f64>, Vector3<f64>), String> {
-        let z = -unit("r", &v.r)?;
-        let h = v.r.cross(&v.v);
-        let y = -unit("r x v (velocity v along r or unwired)", &h)?;
-        let x = y.cross(&z);
-        let rate = h.norm() / v.r.norm_squared();
+        unit("r", &v.r)?;
+        let [x, y, z] = orbit::lvlh_axes(&v.r, &v.v).map_err(|e| format!("inputs r, v: {e}"))?;
+        let rate = v.r.cross(&v.v).norm() / v.r.norm_squared();
         Ok((Matrix3::from_rows(&[x.transpose(), y.transpose(), z.transpose()]), Vector3::new(0.0, -rate, 0.0)))
     }
 }
@@ -118,7 +105,7 @@ q_ref from A by Shepperd's method, sign with q_w &gt;= 0; roll/pitch/yaw_ref = e
             }
             Reference::Nadir => {
                 let (a, w) = Self::nadir(v)?;
-                (quat_from_dcm(&a), w)
+                (quat_nonneg(&a), w)
             }
             Reference::Sun => {
                 let s = unit("sun_eci", &v.sun_eci)?;
@@ -126,10 +113,12 @@ q_ref from A by Shepperd's method, sign with q_w &gt;= 0; roll/pitch/yaw_ref = e
                 if s.cross(&z).norm() < 1e-6 {
                     return Err("sun_eci is along the inertial z axis: the sun-pointing attitude about it is undefined".into());
                 }
-                (quat_from_dcm(&two_axis(&v.sun_axis, &v.secondary_axis, &s, &z)), Vector3::zeros())
+                // TRIAD: sun_axis matched to the sun exactly, secondary_axis turned toward z (both pairs are checked
+                // apart already: at initialisation and just above)
+                (quat_nonneg(&triad(&v.sun_axis, &v.secondary_axis, &s, &z, 0.0)?), Vector3::zeros())
             }
         };
-        v.q_ref = if q.w < 0.0 { -q } else { q };
+        v.q_ref = q;
         [v.roll_ref, v.pitch_ref, v.yaw_ref] = euler321_from_quat(&v.q_ref);
         v.w_ref = w;
         Ok(())
