@@ -112,6 +112,7 @@ class Registry:
         self.papers: dict[str, Paper] = {}
         self.benchmark_cases: list[BenchmarkCase] = []
         self.controllers: list[BuiltinController] = []
+        self.dispersion_sets: dict[str, dict] = {}
         self._loaded = False
         self._current = ""
 
@@ -123,6 +124,18 @@ class Registry:
             raise ValueError(f"scenario prefix {prefix!r} registered twice "
                              f"({self.scenario_sources[prefix].plugin} and {self._current})")
         self.scenario_sources[prefix] = ScenarioSource(prefix, build, names, tuple(exported), self._current)
+
+    def dispersions(self, scenario: str, space: dict) -> None:
+        """The default dispersions of ``scenario``'s Monte Carlo campaign (``scfmu campaign NAME --runs N``):
+        ``{"instance.parameter": "DIST:A:B"}`` in the syntax of ``scfmu campaign --random``."""
+        if scenario in self.dispersion_sets:
+            raise ValueError(f"dispersions of {scenario!r} registered twice")
+        self.dispersion_sets[scenario] = dict(space)
+
+    def dispersions_of(self, scenario: str) -> dict:
+        """The registered dispersions of ``scenario`` ({} when it has none)."""
+        self.load()
+        return dict(self.dispersion_sets.get(scenario, {}))
 
     def metrics(self, name: str, compute: Callable, columns, logs=None) -> None:
         if name in self.metric_sets and self.metric_sets[name].compute is not compute:

@@ -27,6 +27,8 @@ from pathlib import Path
 
 
 from .. import campaign
+from .. import metrics as run_metrics
+from ..registry import REGISTRY
 from ..scenario import options
 from ..scenario.check import IncompatibleUnit, override_problems, require
 from ..scenario.options import value
@@ -101,6 +103,21 @@ def parse_random(items: list[str]) -> dict:
     return space
 
 
+def runs_space(sc, args) -> list[str]:
+    """``--runs N``: the scenario's registered dispersions, each run's own draw of every seed parameter
+    (recorded in its row), then the user's ``--random`` axes (which replace a dispersion of the same name)."""
+    bounded_int("--runs", args.runs, 1, MAX_RUNS)
+    disp = REGISTRY.dispersions_of(sc.name)
+    if not disp:
+        raise UsageError(f"--runs: scenario {sc.name!r} declares no dispersions (scenarios with them: "
+                         f"{', '.join(sorted(REGISTRY.dispersion_sets)) or 'none'}); use --random ... --samples N")
+    if args.seeds:
+        raise UsageError(f"--seeds {args.seeds!r}: not with --runs, which draws each run's seeds "
+                         f"({', '.join(sc.seed_params)})")
+    seeds = {p: f"int:{SEED_RANGE[0] + 1}:{SEED_RANGE[1]}" for p in sc.seed_params}
+    return [f"{k}={v}" for k, v in {**disp, **seeds}.items()] + list(args.random)
+
+
 def build(args) -> campaign.Campaign:
     sc = options.build(args, notice=lambda t: print(t, file=sys.stderr))
     bounded_int("--samples", args.samples, 1, MAX_RUNS)
@@ -138,6 +155,8 @@ def build(args) -> campaign.Campaign:
         g = campaign.grid(axes)
         sets = [dict(a, **b) for a in sets for b in g]
     seeds = parse_seeds(args.seeds)
+    if args.runs is not None:
+        args.random, args.samples = runs_space(sc, args), args.runs
     if args.random:
         bounded_int("the number of runs", len(sets) * args.samples * len(seeds), 1, MAX_RUNS)
         r = campaign.random_sample(parse_random(args.random), args.samples, args.sample_seed)
@@ -159,6 +178,9 @@ def _parser() -> argparse.ArgumentParser:
     ap.add_argument("--grid", action="append", default=[], metavar="INST.VAR=V1,V2,...", help="grid axis (repeatable)")
     ap.add_argument("--random", action="append", default=[], metavar="INST.VAR=DIST:A:B", help="random axis (repeatable)")
     ap.add_argument("--samples", type=int, default=100, help="number of random samples (with --random)")
+    ap.add_argument("--runs", type=int, default=None, metavar="N",
+                    help="a Monte Carlo of N runs over the scenario's own dispersions (e.g. mission/tipoff), each "
+                         "run with its own seeds (drawn with --sample-seed)")
     ap.add_argument("--sample-seed", type=int, default=0, help="seed of the random sampler")
     ap.add_argument("--list", help="JSON file: list of override dicts")
     ap.add_argument("--seeds", default="", help="run seeds given to the scenario's seed parameters: 0,1,2 or 0:10")
@@ -179,7 +201,8 @@ def _parser() -> argparse.ArgumentParser:
     ap.add_argument("--out", default=None, help="output folder (default out/campaign/<scenario>)")
     ap.add_argument("--overwrite", action="store_true", help="replace a different campaign found in --out")
     ap.add_argument("--no-progress", action="store_true")
-    ap.add_argument("--metric", default="eulerint_deg_s", help="metric of the figures")
+    ap.add_argument("--metric", default=None, help="metric of the summary and the figures (default: the scenario's "
+                    "metric set's first column, e.g. eulerint_deg_s or t_fine_pointing_s)")
     ap.add_argument("--plot-vs", action="append", default=[], metavar="INST.VAR", help="metric-vs-parameter figure")
     ap.add_argument("--no-plots", action="store_true")
     ap.add_argument("--check", action="store_true", help="first run `scfmu check --quick` on every unit given as "
@@ -187,8 +210,9 @@ def _parser() -> argparse.ArgumentParser:
     return ap
 
 
-def _summary(table, out: Path) -> tuple[list, list]:
-    """Prints the status counts, the failed runs and the main metrics' ranges; returns (rows, ok rows)."""
+def _summary(table, out: Path, metric: str) -> tuple[list, list]:
+    """Prints the status counts, the failed runs and the main metrics' spread (min, median, p95, p99, max over the
+    ok runs, and how many ok runs have no value: e.g. never reached fine pointing); returns (rows, ok rows)."""
     rows = table.to_pylist()
     ok = [r for r in rows if r["status"] == "ok"]
     counts: dict[str, int] = {}
@@ -200,11 +224,14 @@ def _summary(table, out: Path) -> tuple[list, list]:
         if r["status"] != "ok":
             print(f"  run {r['run']}: {r['status']}: {r['message'][:160]}")
     import numpy as np
-    for m in ("eulerint_deg_s", "ise", "settling_s", "effort_abs", "final_error"):
+    names = dict.fromkeys([metric, "eulerint_deg_s", "ise", "settling_s", "effort_abs", "final_error"])
+    for m in (m for m in names if ok and m in ok[0]):
         v = np.array([r[m] for r in ok], dtype=float)
-        v = v[np.isfinite(v)]
-        if v.size:
-            print(f"  {m:16s} min {v.min():12.6g}  median {np.median(v):12.6g}  max {v.max():12.6g}  ({v.size} runs)")
+        fin = v[np.isfinite(v)]
+        if fin.size:
+            p50, p95, p99 = np.percentile(fin, [50, 95, 99])
+            print(f"  {m:16s} min {fin.min():11.6g}  median {p50:11.6g}  p95 {p95:11.6g}  p99 {p99:11.6g}  "
+                  f"max {fin.max():11.6g}  ({fin.size} runs{f', {v.size - fin.size} without a value' if fin.size < v.size else ''})")
     return rows, ok
 
 
@@ -243,6 +270,9 @@ def main(argv=None) -> int:
     args = _parser().parse_args(argv)
 
     c = build(args)
+    if args.metric is None:
+        cols = run_metrics.columns(c.scenario.metrics)
+        args.metric = cols[0] if cols else "eulerint_deg_s"
     try:
         require(c.scenario, warn=lambda t: print(f"warning: {t}", file=sys.stderr))
     except IncompatibleUnit as e:
@@ -272,7 +302,7 @@ def main(argv=None) -> int:
         if "holds another campaign" in str(e) or "other FMU builds" in str(e):
             raise UsageError(f"{e} (--overwrite replaces it)") from None
         raise
-    rows, ok = _summary(table, out)
+    rows, ok = _summary(table, out, args.metric)
     if not args.no_plots and ok:
         _figures(c, table, out, args)
     if len(ok) < len(rows):
