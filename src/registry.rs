@@ -5,7 +5,7 @@
 use crate::export::Extras;
 pub use crate::export::Family;
 use crate::model::{concat, total_len, ModelEntry};
-use crate::models::{attitude, environment, estimation, formation, sensors, single_axis};
+use crate::models::{adcs, attitude, environment, estimation, formation, sensors, single_axis};
 
 /// The families, each a folder under `src/models/` and a page `docs/models/<slug>.md` (title and overview
 /// go into the catalogue the library exports).
@@ -52,9 +52,15 @@ pub const FAMILIES: &[Family] = &[
         overview: include_str!("models/environment/README.md"),
         fmus: environment::FMUS,
     },
+    Family {
+        slug: "adcs",
+        title: "ADCS modes: mode manager, estimate gate and command switch",
+        overview: include_str!("models/adcs/README.md"),
+        fmus: adcs::FMUS,
+    },
 ];
 
-const LISTS: [&[ModelEntry]; 7] = [
+const LISTS: [&[ModelEntry]; 8] = [
     FAMILIES[0].fmus,
     FAMILIES[1].fmus,
     FAMILIES[2].fmus,
@@ -62,6 +68,7 @@ const LISTS: [&[ModelEntry]; 7] = [
     FAMILIES[4].fmus,
     FAMILIES[5].fmus,
     FAMILIES[6].fmus,
+    FAMILIES[7].fmus,
 ];
 const _: () = assert!(FAMILIES.len() == LISTS.len(), "every family goes into the registry");
 

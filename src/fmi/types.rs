@@ -37,6 +37,10 @@ pub const LOG_CATEGORIES: &[(&str, &str)] = &[
     ("logStatusError", "Errors (always forwarded to the logger)"),
     ("logStatusFatal", "Fatal errors (always forwarded to the logger)"),
     ("logCalls", "Every FMI function call with its arguments (debug logging)"),
+    (
+        "logEvents",
+        "Events of a model's law, e.g. a mode change, one line each (debug logging)",
+    ),
     ("logAll", "All of the above"),
 ];
 

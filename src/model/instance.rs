@@ -121,6 +121,11 @@ impl<M: Model> Fmu<M> {
         self.state.as_mut().is_some_and(|s| s.completed_integrator_step(v, t))
     }
 
+    /// The event lines the last step produced ([`Model::take_log`]), emptied.
+    pub fn take_log(&mut self) -> Vec<String> {
+        self.state.as_mut().map(|s| s.take_log()).unwrap_or_default()
+    }
+
     /// Whether the parameters have been applied (there is an internal state).
     pub fn is_initialized(&self) -> bool {
         self.state.is_some()
@@ -148,6 +153,8 @@ pub trait DynModel: Send {
     fn initialize(&mut self, exp: &Experiment) -> ModelResult;
     fn update_outputs(&mut self, t: f64) -> ModelResult;
     fn do_step(&mut self, t: f64, h: f64) -> ModelResult;
+    /// The event lines of the last step, emptied ([`Model::take_log`]).
+    fn take_log(&mut self) -> Vec<String>;
     fn clone_box(&self) -> Box<dyn DynModel>;
     fn to_bytes(&self) -> Result<Vec<u8>, String>;
     /// Replaces `self` by the decoded state; `self` is unchanged on error.
@@ -197,6 +204,9 @@ impl<M: Model> DynModel for Fmu<M> {
     }
     fn do_step(&mut self, t: f64, h: f64) -> ModelResult {
         self.step(t, h)
+    }
+    fn take_log(&mut self) -> Vec<String> {
+        Fmu::take_log(self)
     }
     fn time_grid(&self) -> Option<f64> {
         M::time_grid(&self.v).filter(|p| p.is_finite() && *p > 0.0)

@@ -185,6 +185,14 @@ pub trait Model: Clone + Serialize + DeserializeOwned + Send + 'static {
     fn time_grid(_v: &Self::Vars) -> Option<f64> {
         None
     }
+    /// Event lines for the master's log (a mode change, a discrete event of the law) that the last `step`
+    /// produced: the layer takes them after every successful `fmi2DoStep`/`fmi3DoStep` and sends each to
+    /// the logger with status OK under the category `logEvents` (shown with debug logging on). Keep the
+    /// buffer out of the serialized state (`#[serde(skip)]`) and fill it only when the step succeeds.
+    /// Default: none.
+    fn take_log(&mut self) -> Vec<String> {
+        Vec::new()
+    }
 
     // ----- Model Exchange (optional) ------------------------------------------------------------
 

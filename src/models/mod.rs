@@ -38,8 +38,21 @@
 //!   `eclipse` 13, `r` 14–16, `jd_utc` 17; `SunSensor`'s `shadow` 141, `sun_fraction_min` 114.
 //! - environment: epoch `epoch_year` … `epoch_second` 100–105 (`environment::epoch::EpochParams`);
 //!   `Environment`: position `r` 0–2, outputs 20–29, diagnostics 30–39, `hp_exponent` 106, `density_model` 120.
+//! - adcs (`adcs/mod.rs`): `ModeManager` inputs `w_meas` 0–2, `sun_valid` 3, `sun_meas` 4–6, `p_att` 7–9,
+//!   `nis` 10, `nis_dim` 11, `actuator_fault` 12, `recover` 13, `safe_request` 14; outputs `mode` 20,
+//!   `time_in_mode` 21, `mode_changes` 22, `torque_select` 23, `dipole_select` 24, `estimator_init` 25,
+//!   `controller_enable` 26; diagnostics `rate` 30, `sigma_att` 31, `nis_avg` 32, `sun_angle` 33,
+//!   `last_reason` 34; `sample_period` 100, `rate_detumbled` 101, `rate_tumbling` 102, `rate_safe` 103,
+//!   `sun_angle_acquired` 104, `sun_angle_lost` 105, `sun_axis` 106–108, `sigma_converged` 109,
+//!   `sigma_diverged` 110, `nis_max` 111, `nis_diverged` 112, `nis_time_constant` 113, `min_dwell` 114,
+//!   `fault_confirm_time` 115, `recover_time` 116, `init_duration` 117, `initial_mode` 120,
+//!   `safe_on_divergence` 121. `EstimateGate`: `q_est` 0–3, `w_est` 4–6, `q_ref` 7–10, `w_ref` 11–13
+//!   (the controllers' references), `enable` 14 in; `q` 20–23, `w` 24–26 out. `CommandSwitch`:
+//!   `torque_safe` 0–2, `torque_fine` 3–5, `m_bdot` 6–8, `torque_select` 9, `dipole_select` 10 in;
+//!   `torque_cmd` 20–22, `m_cmd` 23–25 out (the plant's input names).
 //! - plants of every family: `integrator` is an Integer with codes 0 RK4, 1 Euler, 2 Dormand–Prince.
 
+pub mod adcs;
 pub mod attitude;
 pub mod environment;
 pub mod estimation;

@@ -190,6 +190,23 @@ pub const ALL: &[Reference] = &[
         subject: "",
         used_for: "the IAU 1980 nutation series (106 terms) that turns SGP4's TEME output to J2000 axes",
     },
+    Reference {
+        key: "ECSS-E-ST-60-30C",
+        authors: "European Cooperation for Space Standardization",
+        title: "Space engineering: Satellite attitude and orbit control system (AOCS) requirements",
+        venue: "ECSS-E-ST-60-30C, ESA Requirements and Standards Division, 2013",
+        subject: "",
+        used_for: "AOCS modes (safe mode, acquisition, nominal pointing), mode transitions and the selection of \
+                   the control laws by mode",
+    },
+    Reference {
+        key: "Bar-Shalom-2001",
+        authors: "Y. Bar-Shalom, X. R. Li, T. Kirubarajan",
+        title: "Estimation with Applications to Tracking and Navigation",
+        venue: "Wiley, 2001",
+        subject: "",
+        used_for: "filter consistency by the normalized innovation squared (NIS) and its average over time",
+    },
 ];
 
 #[cfg(test)]

@@ -308,6 +308,9 @@ impl Instance {
             self.run.fsm = FsmState::Error;
             return Err(Fail::error(format!("step from t = {t} failed: {reason}")));
         }
+        for line in self.model.take_log() {
+            self.log(Status::Ok, "logEvents", &line);
+        }
         // Continue on the master's grid: no accumulation of round-off in the FMU time.
         self.run.time = t + h;
         self.run.outputs_dirty = true; // computed when read
