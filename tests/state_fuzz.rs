@@ -80,12 +80,16 @@ fn run_and_serialize(model: &'static str) -> (TestFmu, Vec<u8>) {
         for (i, n) in inputs.iter().enumerate() {
             let x = ((k + 3 * i) as f64 * 0.05).sin();
             // an atmospheric density (Orbit's rho) is non-negative and thin in orbit: 0.01 kg/m3 would
-            // bring the orbit down within seconds
-            let density = registry::find(model)
-                .unwrap()
-                .decl(n)
-                .is_some_and(|d| d.unit == "kg/m3");
-            p.set(n, if density { 1e-12 * (1.0 + x) } else { 0.01 * x });
+            // bring the orbit down within seconds; a variance (ModeManager's p_att) is non-negative
+            let unit = registry::find(model).unwrap().decl(n).map_or("", |d| d.unit);
+            p.set(
+                n,
+                match unit {
+                    "kg/m3" => 1e-12 * (1.0 + x),
+                    "rad2" => 1e-4 * (1.0 + x),
+                    _ => 0.01 * x,
+                },
+            );
         }
         assert_eq!(p.step(k as f64 * h, h), OK, "{model} step {k}: {:?}", p.messages());
     }
