@@ -37,7 +37,8 @@ PLANTS = {"AttitudePlant": 18, "SingleAxisPlant": 3, "RelativeOrbitPlant": 7}
 STATEFUL = {"MracController": 9, "AdaptiveFuzzyController": 9, "ReferenceCorrector": 13, "AttitudeMetrics": 4,
             "PredictivePidController": 6}
 STATIC_LAWS = {"PdController", "LqrController", "PolePlacementController", "FuzzyPdController", "SlidingModeController",
-               "Type2FuzzySmcController", "FeedbackLinearizingController", "AttitudeCommand", "RelativePositionCommand"}
+               "Type2FuzzySmcController", "FeedbackLinearizingController", "SunSafeController", "AttitudeCommand",
+               "RelativePositionCommand"}
 # sampled laws (a sample time) and the sensors (sampled noise): Co-Simulation only
 CS_ONLY = {"PidController", "FopidController", "Gyro", "StarTracker", "SunSensor", "Magnetometer", "SampleHold", "Mekf"}
 N_STATES = {**PLANTS, **STATEFUL}

@@ -35,6 +35,8 @@ from pathlib import Path
 
 DEFAULT_UNCONNECTED = ("torque_dist_*", "dist_*", "h_wheel*", "q_ref_dot*", "q_ref_ddot*", "leader_true_anomaly",
                        "m_cmd_*",
+                       # PdController's reference acceleration, read with rate_feedforward = 2 only
+                       "w_ref_dot_*",
                        # the environment inputs of AttitudePlant, Magnetometer (b_eci), SunSensor (sun_eci,
                        # eclipse) and Ephemeris (r, jd_utc), read with environment_inputs = 1 only (which refuses an
                        # unwired r, b_eci, sun_eci or jd_utc), and Orbit's density (0 = no drag); r, v and jd_utc

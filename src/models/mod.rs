@@ -15,11 +15,19 @@
 //!
 //! Family-wide assignments:
 //! - attitude controllers: ports 0–13 in (`q` 0–3, `w` 4–6, `q_ref` 7–10, `w_ref` 11–13), 20–22 out
-//!   (`torque_cmd`); reserved 14–19 for further common inputs (e.g. wheel momentum); nominal inertia
+//!   (`torque_cmd`); reserved 14–19 for further common inputs: `h_wheel` 14–16 (sliding-mode controllers),
+//!   `w_ref_dot` 17–19 (`PdController`, `AttitudeCommand`'s output of that name); inputs of the controllers
+//!   fed by sensors instead of an estimate and a command (`SunSafeController`, extension: 60–69): `w_meas`
+//!   60–62 (the Gyro's output), `sun_meas` 63–65, `sun_valid` 66 (the SunSensor's outputs); nominal inertia
 //!   `inertia_xx/yy/zz` 100–102; `wn` 103, `zeta` 104; `error_law` 121, `defuzz` 122; fuzzy output set values
 //!   `c_small` 215, `c_big` 216 (calculated); fuzzy input
 //!   scales `e_scale` 115, `edot_scale` 116, `sigma` 117, `mf_half_width` 118; MRAC block
-//!   (`shared::mrac::MracVariables`) outputs 30–44, parameters 100–110 and 120, calculated 200–205.
+//!   (`shared::mrac::MracVariables`) outputs 30–44, parameters 100–110 and 120, calculated 200–205;
+//!   `SunSafeController`: `sun_axis` 105–107, `spin_rate` 108, `torque_max` 109, diagnostics `sun_angle` 30,
+//!   `sun_seen` 31, calculated `k_p` 200–202, `k_d` 203–205 (as `PdController`'s `k_d`).
+//! - attitude command (`AttitudeCommand`): inputs `r` 0–2, `v` 3–5, `sun_eci` 6–8; outputs `q_ref` 10–13,
+//!   `w_ref` 14–16, `roll/pitch/yaw_ref` 17–19, `w_ref_dot` 20–22; `sun_axis` 105–107, `secondary_axis`
+//!   108–110, `target_eci` 111–113.
 //! - attitude plant: `inertia_xx/yy/zz` 100–102 as in the controllers; `integrator` 140,
 //!   `max_internal_step` 130.
 //! - paper 004 (`FeedbackLinearizingController`, `ReferenceCorrector`): `q_ref_dot` 50–52 and

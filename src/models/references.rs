@@ -66,6 +66,15 @@ pub const ALL: &[Reference] = &[
                    and magnetometer measurements",
     },
     Reference {
+        key: "Wie-Weiss-Arapostathis-1989",
+        authors: "B. Wie, H. Weiss, A. Arapostathis",
+        title: "Quaternion feedback regulator for spacecraft eigenaxis rotations",
+        venue: "Journal of Guidance, Control, and Dynamics 12(3), 375-380, 1989",
+        subject: "",
+        used_for: "quaternion feedback u = -K q_e - C w: the sun-acquisition (safe-mode) law on the shortest \
+                   rotation to the sun",
+    },
+    Reference {
         key: "Avanzini-Giulietti-2012",
         authors: "G. Avanzini, F. Giulietti",
         title: "Magnetic Detumbling of a Rigid Spacecraft",

@@ -1,6 +1,7 @@
 //! Three-axis attitude controllers. Every controller embeds the common port block
 //! (`crate::models::ports::AttitudeControllerPorts`: `q_*`, `w_*`, `q_ref_*`, `w_ref_*` → `torque_cmd_*`), so they
-//! swap as black boxes; what several controllers share lives in `shared/` (not FMUs).
+//! swap as black boxes; what several controllers share lives in `shared/` (not FMUs). The safe-mode
+//! `SunSafeController` reads the gyro and the sun sensor instead (its own ports, by the sensors' names).
 //!
 //! A new controller: one file here, and one line in the list below.
 
@@ -16,4 +17,5 @@ crate::fmus! {
     feedback_linearizing_controller::FeedbackLinearizingController,
     sliding_mode_controller::SlidingModeController,
     type2_fuzzy_smc_controller::Type2FuzzySmcController,
+    sun_safe_controller::SunSafeController,
 }
