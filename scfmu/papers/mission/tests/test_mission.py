@@ -16,6 +16,7 @@ from scfmu.engines import simulate
 from scfmu.papers.mission import metrics, scenarios as mission
 from scfmu.registry import REGISTRY
 
+FINE_REQUIREMENT_DEG = 0.2  # the mission's fine-pointing requirement (p95 after the slew), a project choice
 SUN_ACQ, DET, FINE, SAFE, DETUMBLE = (mission.SUN_ACQUISITION, mission.DETERMINATION, mission.FINE_POINTING,
                                       mission.SAFE, mission.DETUMBLE)
 
@@ -88,7 +89,7 @@ def test_tipoff_thresholds_hold_on_the_truth(tipoff):
 def test_tipoff_ends_on_nadir(tipoff):
     row = metrics.compute(tipoff)
     assert row["reached_fine"] == 1
-    assert row["fine_error_p95_deg"] < 0.1
+    assert row["fine_error_p95_deg"] < FINE_REQUIREMENT_DEG
 
 
 def test_wheel_fault_enters_safe_within_the_detection_time_and_recovers_on_command(fault):
@@ -121,3 +122,22 @@ def test_the_engines_agree_bit_for_bit_on_the_first_minute():
         r = simulate(sc, engine=engine)
         for k in ("mode", "w_x", "q_w", "torque_applied_y", "dipole_z"):
             np.testing.assert_array_equal(np.asarray(r[k]), np.asarray(ref[k]), err_msg=f"{engine}: {k}")
+
+
+def test_the_mission_campaign_ci_sized(tmp_path, capsys):
+    """`scfmu campaign mission/tipoff --runs 4` on Dask: each run its own dispersions and seeds (recorded in its
+    row), every run to fine pointing without chatter, and the summary's percentiles those of the rows."""
+    from scfmu.campaign import read_results
+    from scfmu.campaign.cli import main
+    assert main(["mission/tipoff", "--runs", "4", "--workers", "2", "--out", str(tmp_path), "--no-progress",
+                 "--no-plots"]) == 0
+    rows = read_results(tmp_path).to_pylist()
+    assert len(rows) == 4 and all(r["status"] == "ok" for r in rows)
+    for p in ("p:gyro.seed", "p:star_tracker.seed", "p:plant.init_w_x", "p:plant.inertia_scale_y"):
+        assert len({r[p] for r in rows}) == 4, p
+    assert all(abs(r["p:plant.init_w_y"]) <= math.radians(5) for r in rows)
+    assert all(r["reached_fine"] == 1 and r["mode_chatter"] == 0 for r in rows)
+    t = np.array([r["t_fine_pointing_s"] for r in rows])
+    out = capsys.readouterr().out
+    line = next(x for x in out.splitlines() if x.strip().startswith("t_fine_pointing_s"))
+    assert f"p95 {np.percentile(t, 95):11.6g}" in line and f"median {np.median(t):11.6g}" in line
