@@ -34,6 +34,11 @@ ATTITUDE_FEATURES = [
     {"actuator_mode": 1, "mtq_enable": 1, "gg_enable": 0, "wheel_time_constant": 0.0, **FULL_INERTIA, **MISALIGNED},
     # magnetorquers following the dipole command input m_cmd (B-dot), besides lagging wheels
     {"actuator_mode": 1, "mtq_mode": 1, "gg_enable": 1, "wheel_time_constant": 0.5, **FULL_INERTIA, **MISALIGNED},
+    # the command and the dumping law sharing the coils (mtq_mode 2): the dumping share fed forward to the
+    # wheels, (m - clamp(m_cmd)) x B, reads m_cmd where the sum is clamped (with lag: the lag states; without:
+    # the wheel momenta); a gain that clamps every axis at some points (B is near the body z axis here)
+    *({"actuator_mode": 1, "mtq_enable": 1, "mtq_mode": 2, "mtq_k_dump": 0.5, "gg_enable": 1, "wheel_time_constant": lag,
+       **FULL_INERTIA, **MISALIGNED} for lag in (0.5, 0.0)),
     # the environment inputs: gravity gradient from r, field from b_eci (magnetorquers, residual dipole), drag
     # and solar pressure on three facets off the centre of mass
     *({"environment_inputs": 1, "actuator_mode": 1, "mtq_enable": 1, "gg_enable": 1, "wheel_time_constant": lag,

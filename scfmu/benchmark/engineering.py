@@ -62,7 +62,7 @@ def limits(sc, t: np.ndarray) -> tuple[np.ndarray, float]:
     """(torque limit per sample and axis (n, 3) [N·m], wheel momentum limit [N·m·s] or inf)."""
     p = robustness.plant_values(sc, PLANT)
     eff = np.array([p.get(f"effectiveness_{a}", 1.0) for a in "xyz"])
-    faulted = (t >= p.get("fault_time", 0.0))[:, None]
+    faulted = ((t >= p.get("fault_time", 0.0)) & (t < p.get("fault_clear_time", 1e30)))[:, None]
     if int(p.get("actuator_mode", 0)) == 1:
         base = np.full(3, p["wheel_torque_coeff"] * p["wheel_max_current"])
         hmax = p["wheel_inertia"] * p["wheel_max_speed"]

@@ -15,7 +15,7 @@ name of exactly one *other* instance. Exceptions are explicit:
   (``"plant.torque_dist_*"``), left at their start value (or at the value given in ``inputs``).
   ``DEFAULT_UNCONNECTED`` lists the optional inputs of the current FMUs (disturbance inputs, wheel
   momentum, reference-rate feed-forward, leader anomaly, the plant's magnetorquer command, used only with
-  mtq_mode = 1) that the historical master left open.
+  mtq_mode = 1 or 2, the Mekf's coarse re-initialisation) that the historical master left open.
 
 An input that has no source and matches no ``unconnected`` pattern is an error.
 
@@ -44,7 +44,9 @@ DEFAULT_UNCONNECTED = ("torque_dist_*", "dist_*", "h_wheel*", "q_ref_dot*", "q_r
                        "AttitudePlant:r_*", "AttitudePlant:v_*", "Ephemeris:r_*", "Ephemeris:jd_utc", "b_eci_*",
                        "sun_eci_*", "eclipse", "rho", "sun_distance",
                        # AttitudeCommand's orbit inputs, read with reference = 1 (nadir) only (which refuses them unwired)
-                       "AttitudeCommand:r_*", "AttitudeCommand:v_*")
+                       "AttitudeCommand:r_*", "AttitudeCommand:v_*",
+                       # the Mekf's coarse re-initialisation, read only while init_request >= 0.5 (start 0)
+                       "Mekf:q_coarse_*", "Mekf:init_request")
 
 
 def matches_input(port: str, patterns, instance: str | None = None, *, stems: bool = False,

@@ -29,7 +29,10 @@
 //!   `w_ref` 14–16, `roll/pitch/yaw_ref` 17–19, `w_ref_dot` 20–22; `sun_axis` 105–107, `secondary_axis`
 //!   108–110, `target_eci` 111–113.
 //! - attitude plant: `inertia_xx/yy/zz` 100–102 as in the controllers; `integrator` 140,
-//!   `max_internal_step` 130.
+//!   `max_internal_step` 130; ports 0–80 (`actuator_fault` 80, the health flag), parameters 100–198
+//!   (`fault_clear_time` 198), facets 210–269.
+//! - estimation: `Mekf` inputs 0–25 (`q_coarse` 21–24, `init_request` 25), outputs from 40, parameters
+//!   100–128 (`sigma_att_coarse` 128).
 //! - paper 004 (`FeedbackLinearizingController`, `ReferenceCorrector`): `q_ref_dot` 50–52 and
 //!   `q_ref_ddot` 53–55 (controller inputs = corrector outputs), `u_ol` 56–58; gains `k_q` 160–162,
 //!   `k_qdot` 163–165; the corrector's plant-copy parameters keep the plant's references

@@ -2,7 +2,9 @@
 //! small-angle attitude errors and three gyro biases, a unit reference quaternion kept unit by the
 //! multiplicative reset, propagation with the gyro, Joseph-form updates from star-tracker quaternions
 //! and from body-frame unit vectors (sun sensor, magnetometer) with their reference directions; a star
-//! tracker's latency (`st_latency`) is compensated by a delayed update (`mekf_delay.rs`).
+//! tracker's latency (`st_latency`) is compensated by a delayed update (`mekf_delay.rs`); a coarse attitude
+//! re-initialises the filter on request (`init_request`, `mekf_coarse.rs`). The equations of the FMU's
+//! documentation are in `mekf_equations.html`.
 
 use std::collections::VecDeque;
 use nalgebra::{Matrix3, Quaternion, Rotation3, SMatrix, SVector, Vector3};
@@ -16,6 +18,8 @@ use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult};
 
 #[path = "mekf_delay.rs"]
 mod delay;
+#[path = "mekf_coarse.rs"]
+mod coarse;
 
 /// At most this many filter samples per doStep (bounded work: a longer step is refused before any work).
 pub const MAX_SAMPLES_PER_CALL: i64 = 1_000_000;
@@ -32,6 +36,8 @@ declare_variables! {
         14 => sun_valid: Real = 1.0, Input, "", "Sun-sensor validity (the SunSensor's sun_valid, equal to its valid): >= 0.5 = sun_meas usable";
         15 => b_meas: Vec3 = [0.0, 0.0, 1.0], Input, "T", "Measured geomagnetic field, body axes (the Magnetometer's b_meas; only its direction is used)";
         18 => b_ref: Vec3 = [1.0, 0.0, 0.0], Input, "T", "Geomagnetic field in R (the Ephemeris' b_ref or another field model; only its direction is used)";
+        21 => q_coarse: Quat = [1.0, 0.0, 0.0, 0.0], Input, "", "Coarse attitude quaternion of B relative to R (e.g. the Triad's or Quest's q_est; normalised by the filter), read only when init_request >= 0.5";
+        25 => init_request: Real = 0.0, Input, "", "Re-initialisation request: >= 0.5 at a filter sample = the attitude estimate becomes q_coarse with covariance sigma_att_coarse^2 I, uncorrelated with the bias (bias estimate and covariance kept), before that sample's updates";
         40 => q_est: Quat = [1.0, 0.0, 0.0, 0.0], Output, "", "Estimated attitude quaternion of B relative to R (the plant's q convention), held between samples";
         44 => w_est: Vec3 = [0.0; 3], Output, "rad/s", "Estimated body rate: gyro rate minus estimated bias";
         47 => bias_est: Vec3 = [0.0; 3], Output, "rad/s", "Estimated gyro bias";
@@ -57,6 +63,7 @@ declare_variables! {
         125 => use_sun: Integer = 0, Parameter, "", "1 = update with sun_meas when sun_valid >= 0.5 and sun_meas is new", Choice(SWITCH);
         126 => use_mag: Integer = 0, Parameter, "", "1 = update with b_meas whenever it is new", Choice(SWITCH);
         127 => st_latency: Real = 0.0, Parameter, "s", "Star-tracker latency compensated by the filter (as the StarTracker's latency): a quaternion arriving at sample k was measured at sample k - st_latency/sample_period (a whole number, at most 1000)", Range(0.0, 10.0);
+        128 => sigma_att_coarse: Real = 0.05, Parameter, "rad", "1-sigma attitude error per axis of q_coarse, the covariance of a re-initialisation (init_request >= 0.5)", Range(1e-12, 3.2);
     }
 }
 
@@ -81,6 +88,8 @@ struct Derived {
     use_mag: bool,
     /// Star-tracker latency in samples (0: no compensation, the history stays empty).
     delay: usize,
+    /// Attitude variance of a coarse re-initialisation, sigma_att_coarse².
+    coarse_var: f64,
 }
 
 /// The filter after sample k: estimate, covariance, the gyro rate to propagate with, the last used
@@ -239,6 +248,7 @@ impl Mekf {
             let p = t * s.p * t.transpose() + d.q_proc;
             s.p = (p + p.transpose()) * 0.5;
         }
+        coarse::reinitialize(&mut s, v, d.coarse_var)?;
         (s.innovation, s.nis, s.nis_dim) = (Vector3::zeros(), 0.0, 0);
         let qm = [v.q_meas.w, v.q_meas.i, v.q_meas.j, v.q_meas.k];
         if !v.st_valid.is_finite() || !v.sun_valid.is_finite() {
@@ -313,46 +323,7 @@ impl Model for Mekf {
         name: "Mekf",
         description: "Multiplicative extended Kalman filter of attitude and gyro bias: gyro propagation, star-tracker (with latency compensation) and sun/magnetometer vector updates (Joseph form), covariance, innovation and NIS outputs",
         source: "multiplicative EKF of [Lefferts-Markley-Shuster-1982] in the discrete form of [Markley-Crassidis-2014] Ch. 6 (state transition and process noise of a gyro with angle and rate random walk); vector measurement on the tangent plane of the predicted direction and measurement-once rule: project choice",
-        equations_html: concat!("<pre>state: q_hat (unit), b_hat; error state x = (dtheta, db), q = q_hat (x) exp(dtheta/2), covariance P (6x6)\n\
-samples at t_k = k T; at the first sample k0: q_hat = q_init, b_hat = bias_init, P = diag(sigma_att_init^2 I, sigma_bias_init^2 I)\n\
-propagation k-1 -> k with the mean gyro rate of samples k-1 and k (trapezoidal rule):\n\
-  w_hat = (w_meas,k-1 + w_meas,k)/2 - b_hat,   q_hat <- q_hat (x) exp(w_hat T / 2)\n\
-  P <- Phi P Phi^T + Q,   Phi = [[Phi11, Phi12], [0, I]]\n\
-  Phi11 = I - [w_hat x] sin(wT)/w + [w_hat x]^2 (1 - cos wT)/w^2\n\
-  Phi12 = [w_hat x] (1 - cos wT)/w^2 - I T - [w_hat x]^2 (wT - sin wT)/w^3\n\
-  Q = [[(N^2 T + K^2 T^3/3) I, -K^2 T^2/2 I], [-K^2 T^2/2 I, K^2 T I]]   (N^2 = arw_psd, K^2 = rrw_psd, per axis)\n\
-star-tracker update (use_star_tracker = 1, st_valid >= 0.5, q_meas new):\n\
-  nu = log(q_hat* (x) q_meas)  (rotation vector),  H = [I 0],  R = M diag(sc^2, sc^2, sa^2) M^T,  M = R(st_mount)\n\
-vector update (sun: use_sun = 1, sun_valid >= 0.5; magnetometer: use_mag = 1; measurement new):\n\
-  b_hat = A(q_hat) r/|r|,  E = [e1 e2] unit vectors perpendicular to b_hat\n\
-  nu = E^T b_meas/|b_meas|,  H = [E^T [b_hat x], 0],  R = sigma^2 I_2\n\
-each update (sequential: star tracker, sun, magnetometer), Joseph form:\n\
-  S = H P H^T + R,  K = P H^T S^-1,  dx = K nu,  P <- (I - K H) P (I - K H)^T + K R K^T  (symmetrised)\n\
-  reset: q_hat <- q_hat (x) exp(dtheta/2) (normalised),  b_hat <- b_hat + db\n\
-  nis += nu^T S^-1 nu,  nis_dim += dim(nu)\n\
-star-tracker latency (st_latency = d T > 0): q_meas arriving at sample k was measured at sample s = k - d;\n\
-  kept: q_hat_j, b_hat_j, P_j and T_j = (I - K H of sample j's vector updates) Phi_j for j = s..k\n\
-  update of sample s (after the vector updates of sample k): nu = log(q_hat_s* (x) q_meas), S = P_s,att + R,\n\
-    K = P_s H^T S^-1, dx_s = K nu, P_s+ (Joseph);  nis += nu^T S^-1 nu, nis_dim += 3\n\
-  carried over the delay (Larsen): M_j = T_j ... T_s+1, for j = s+1..k:\n\
-    dx_j = M_j dx_s (reset of q_hat_j, b_hat_j),  P_j <- P_j - M_j (P_s - P_s+) M_j^T\n\
-  first measurement (init_from_star_tracker = 1): q_hat_j <- q_meas (x) q_hat_s* (x) q_hat_j, P_s,att = R\n\
-outputs (held until the next sample): q_est = q_hat, w_est = w_meas,k - b_hat, bias_est = b_hat,\n\
-  p_att, p_bias = diag(P), innovation = star-tracker nu used at sample k, nis, nis_dim of sample k</pre>\n\
-<p>A measurement is used once: an update happens only when the measurement differs from the last one used \
-(sensors hold their output between their samples, so a held sample is not used again). With \
-init_from_star_tracker = 1 the first usable star-tracker measurement sets the attitude estimate and its \
-covariance (the star tracker's noise) instead of updating it. With st_latency = 0 a quaternion is taken \
-as measured at its arrival; st_latency (a whole number d of sample periods, at most 1000, else refused at \
-initialization) compensates a star tracker's latency: the innovation is formed against the estimate of the \
-measurement's sample and the correction is carried to the current sample through the stored transitions \
-(Larsen's method over the whole kept history, so that the next delayed measurement sees the earlier ones; \
-exact for a linear system when the star tracker is the only measurement, the vector updates inside the \
-delay use gains without the delayed information; a measurement taken before the first sample is not used). \
-Sun and magnetometer directions are taken as measured at their arrival. The discrete ARW model \
-assumes one gyro sample per filter sample (filter period = gyro period). A sample strictly inside a \
-communication step sees the inputs held at the step's start. With the true noise densities the normalized \
-estimation error squared and the NIS follow chi-square distributions of 6 and nis_dim degrees of freedom.</p>", crate::sample_grid_note!()),
+        equations_html: concat!(include_str!("mekf_equations.html"), crate::sample_grid_note!()),
         feedthrough: Feedthrough::AllInputs,
         ..ModelInfo::DEFAULT
     };
@@ -386,6 +357,7 @@ estimation error squared and the NIS follow chi-square distributions of 6 and ni
             use_sun: v.use_sun == 1,
             use_mag: v.use_mag == 1,
             delay: delay::delay_samples(v.st_latency, t)?,
+            coarse_var: v.sigma_att_coarse * v.sigma_att_coarse,
         };
         let s = Est {
             k: k0 - 1,

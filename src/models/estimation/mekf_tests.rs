@@ -23,6 +23,12 @@ type Sample = (Vector3<f64>, Vector3<f64>, Vector3<f64>, f64, i32);
 
 /// Runs the filter with a communication step h = T; returns one [`Sample`] per sample.
 fn run(f: &mut Fmu<Mekf>, n: usize, seed: i64, arw: f64, sc: f64, b: Vector3<f64>) -> Vec<Sample> {
+    run_with(f, n, seed, arw, sc, b, |_, _, _| {})
+}
+
+/// [`run`] with `hook(sample, filter, true attitude)` called before each sample's outputs (after the
+/// sensors' inputs are set): a test changes further inputs there.
+fn run_with(f: &mut Fmu<Mekf>, n: usize, seed: i64, arw: f64, sc: f64, b: Vector3<f64>, mut hook: impl FnMut(usize, &mut Fmu<Mekf>, &Quaternion<f64>)) -> Vec<Sample> {
     f.initialize(&Experiment::default()).unwrap();
     let tp = f.v.sample_period;
     let mut tr = Truth { q: quat_from_euler321(0.3, -0.2, 1.0), b };
@@ -36,6 +42,7 @@ fn run(f: &mut Fmu<Mekf>, n: usize, seed: i64, arw: f64, sc: f64, b: Vector3<f64
             qm = tr.q * quat_exp(&nse);
         }
         f.v.q_meas = qm;
+        hook(i, f, &tr.q);
         f.outputs(t).unwrap();
         let e = quat_log(&(f.v.q_est.conjugate() * tr.q));
         out.push((e, f.v.p_att, f.v.bias_est - tr.b, f.v.nis, f.v.nis_dim));
@@ -289,3 +296,6 @@ fn a_latency_off_the_sample_grid_or_too_long_is_refused() {
     (f.v.st_latency, f.v.sample_period) = (0.3, 0.1); // summed decimals: 0.3 / 0.1 = 2.9999999999999996
     f.initialize(&Experiment::default()).unwrap();
 }
+
+#[path = "mekf_coarse_tests.rs"]
+mod coarse;

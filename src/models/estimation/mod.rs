@@ -2,8 +2,9 @@
 //! turn measurements into an attitude estimate, and the B-dot detumbling law on the magnetometer.
 //! `Mekf` reads the gyro's `w_meas`, the star tracker's `q_meas`/`valid` and optionally body directions with
 //! their reference directions, and gives `q_est`, `w_est` (to the controllers' `q_*`, `w_*` inputs by
-//! explicit connections); value references: inputs 0–20, outputs from 40, diagnostics (covariance,
-//! innovation, NIS) from 50; `sample_period` 100.
+//! explicit connections); value references: inputs 0–20, the coarse re-initialisation `q_coarse` 21–24
+//! and `init_request` 25, outputs from 40, diagnostics (covariance, innovation, NIS) from 50;
+//! `sample_period` 100, `sigma_att_coarse` 128.
 //! `Triad` and `Quest` are static laws (Model Exchange as well as Co-Simulation) solving Wahba's problem
 //! from the sun sensor's and the magnetometer's body-frame directions and their reference-frame
 //! directions (`crate::math::wahba`); `BDot` is sampled at its own rate with the sensors' integer sample

@@ -1,5 +1,6 @@
 //! Actuators: ideal torque with saturation and faults (mode 0), or three reaction wheels with lag,
-//! torque and momentum limits plus magnetorquer momentum dumping (mode 1).
+//! torque and momentum limits plus magnetorquer momentum dumping (mode 1); the magnetorquers' dipole from
+//! the dumping law, the command m_cmd, or both (mtq_mode 0, 1, 2).
 
 use nalgebra::{Matrix3, Vector3};
 
@@ -44,9 +45,28 @@ impl AttitudePlant {
         v.mtq_mode == 0 && Self::wheels(v) && v.mtq_enable == 1
     }
 
-    /// The magnetorquers follow the dipole command input m_cmd (mtq_mode 1).
+    /// The magnetorquers follow the dipole command input m_cmd (mtq_mode 1, or 2 when the dumping law
+    /// does not run: no wheels or mtq_enable 0).
     pub(super) fn mtq_external(v: &AttitudePlantVars) -> bool {
-        v.mtq_mode == 1
+        v.mtq_mode == 1 || (v.mtq_mode == 2 && !Self::mtq_shared(v))
+    }
+
+    /// The magnetorquers follow m_cmd plus the dumping law's dipole (mtq_mode 2, wheels, mtq_enable).
+    pub(super) fn mtq_shared(v: &AttitudePlantVars) -> bool {
+        v.mtq_mode == 2 && Self::wheels(v) && v.mtq_enable == 1
+    }
+
+    /// mtq_mode 2 with the dumping law: m = clamp(m_cmd + k_dump (h_w × B)/|B|²) per axis (the dumping
+    /// term 0 when |B| < 1e-12 T); returns (m, the torque fed forward to the wheels, m × B). The wheels get
+    /// the torque of the dumping share m − clamp(m_cmd) (as in mtq_mode 0); the commanded share acts on
+    /// the body besides them (as in mtq_mode 1). With m_cmd = 0 and an unsaturated sum this is mtq_mode 0.
+    fn shared_dipole(&self, v: &AttitudePlantVars, t: f64, a: &Matrix3<f64>, hw: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
+        let lim = Vector3::repeat(self.d.dipole_max);
+        let b = self.field_body(v, t, a);
+        let b2 = b.norm_squared();
+        let raw = if b2.sqrt() >= 1e-12 { hw.cross(&b) * (v.mtq_k_dump / b2) } else { Vector3::zeros() };
+        let m = clamp3(v.m_cmd + raw, lim);
+        (m, (m - clamp3(v.m_cmd, lim)).cross(&b), m.cross(&b))
     }
 
     /// Commanded dipole (each axis clamped at the dipole limit) and its torque m × B (mtq_mode 1).
@@ -81,8 +101,13 @@ impl AttitudePlant {
                 tau_mtq = dipole.cross(&b);
             }
         }
+        // the command and the dumping law share the coils (mtq_mode 2): only the dumping share is fed forward
+        let mut tau_ff = tau_mtq;
+        if Self::mtq_shared(v) {
+            (dipole, tau_ff, tau_mtq) = self.shared_dipole(v, t, a, &hw);
+        }
         // wheel torque command with the known magnetic torque of the dumping law fed forward, first-order lag
-        let rw_cmd = (u - tau_mtq) * v.wheel_gain;
+        let rw_cmd = (u - tau_ff) * v.wheel_gain;
         // an external dipole command (mtq_mode 1) acts besides the wheels, without feed-forward
         if Self::mtq_external(v) {
             (dipole, tau_mtq) = self.external_dipole(v, t, a);

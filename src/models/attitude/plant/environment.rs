@@ -1,7 +1,7 @@
 //! The plant's environment: disturbance generator (constant, sinusoid, seeded zero-order-held white
 //! noise), gravity gradient and the geomagnetic field on a circular orbit or from the environment inputs,
 //! drag and solar pressure on the facets, the residual dipole's torque, and the events (fault
-//! onset, noise-hold boundaries) at which a communication step is cut.
+//! onset and end, noise-hold boundaries) at which a communication step is cut.
 
 use nalgebra::{Matrix3, Vector3};
 
@@ -11,7 +11,8 @@ use crate::math::surface_forces::{drag, radiation_pressure, solar_pressure, Wren
 use crate::math::random::{hold_index, normal};
 use crate::math::sample_grid::{beyond, exact_index, MAX_INDEX};
 
-/// What is constant over one internal step (steps are cut at fault_time and at noise-hold boundaries).
+/// What is constant over one internal step (steps are cut at fault_time, fault_clear_time and at noise-hold
+/// boundaries).
 #[derive(Clone, Copy, Debug)]
 pub struct Segment {
     pub faulted: bool,
@@ -32,24 +33,32 @@ pub fn noise(v: &AttitudePlantVars, k: i64) -> Vector3<f64> {
     Vector3::from_fn(|i, _| v.dist_noise_std[i] * normal(s, k, i as u64))
 }
 
-/// Segment of the instant t (for outputs): fault active from fault_time on, noise interval ⌊t/T_n⌋.
+/// A fault_clear_time at or beyond this is "never": the faults are permanent (no time event).
+pub const PERMANENT: f64 = 1e30;
+
+/// Whether t lies in the fault window [fault_time, fault_clear_time) (the configured faults act).
+pub fn fault_window(v: &AttitudePlantVars, t: f64) -> bool {
+    t >= v.fault_time && t < v.fault_clear_time
+}
+
+/// Segment of the instant t (for outputs): fault active in [fault_time, fault_clear_time), noise interval ⌊t/T_n⌋.
 /// Beyond 2^53 intervals (refused for a noise-on plant by the layer's time bound, `Model::time_grid`)
 /// the last countable interval: a key only, no arithmetic follows.
 pub fn segment_at(v: &AttitudePlantVars, t: f64) -> Segment {
     let k = hold_index(t, v.dist_noise_hold).unwrap_or(MAX_INDEX);
-    Segment { faulted: t >= v.fault_time, noise: noise(v, k) }
+    Segment { faulted: fault_window(v, t), noise: noise(v, k) }
 }
 
 /// Segment of an event-free piece starting at ts with length len (evaluated at its midpoint).
 pub fn segment_of_piece(v: &AttitudePlantVars, ts: f64, len: f64) -> Segment {
     let mid = ts + 0.5 * len;
     let k = exact_index((mid / v.dist_noise_hold).floor()).unwrap_or(MAX_INDEX);
-    Segment { faulted: mid >= v.fault_time, noise: noise(v, k) }
+    Segment { faulted: fault_window(v, mid), noise: noise(v, k) }
 }
 
-/// Breakpoints inside (t, t + h): fault onset and the noise-hold boundaries k T_n.
+/// Breakpoints inside (t, t + h): fault onset and end, and the noise-hold boundaries k T_n.
 pub fn breakpoints(v: &AttitudePlantVars, t: f64, h: f64) -> Result<Vec<f64>, String> {
-    let mut b = vec![v.fault_time];
+    let mut b = vec![v.fault_time, v.fault_clear_time];
     if noise_on(v) {
         let tn = v.dist_noise_hold;
         let k0 = hold_index(t, tn).ok_or_else(|| beyond("time", t, tn))? + 1; // |k| <= 2^53: no overflow

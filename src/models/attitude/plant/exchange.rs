@@ -17,7 +17,7 @@
 
 use nalgebra::Matrix3;
 
-use super::environment::noise_on;
+use super::environment::{noise_on, PERMANENT};
 use super::kinematics::{post_step, Kinematics, ATT};
 use super::{AttitudePlant, AttitudePlantVars};
 use crate::math::attitude::orthonormalize;
@@ -45,17 +45,20 @@ const fn s(name: &'static str, unit: &'static str, description: &'static str, on
 // and the two rates other than ω_i), the Euler-angle rates on roll, yaw and ω. The wheel momentum and
 // the wheel lag read the command of their axis, their own lag state, and through the magnetorquers
 // (m = k h_w × B / |B|², B = A B_R, or B = A b_eci with the environment inputs) every wheel momentum,
-// every attitude entry and the field input. The body rates read
+// every attitude entry and the field input; with mtq_mode 2 the dumping share of the summed dipole fed
+// forward to the wheels, (m − clamp(m_cmd)) × B, reads the dipole commands (axis i the other two; every
+// one through the misaligned wheels' momenta). The body rates read
 // everything (full inertia, gyroscopic terms, gravity gradient, actuators): no list.
 const ATT_ALL: [&str; 9] = ["state_att_1", "state_att_2", "state_att_3", "state_att_4", "state_att_5", "state_att_6", "state_att_7", "state_att_8", "state_att_9"];
-const WHEEL_X: [&str; 17] = concat_names(&ATT_ALL, &["state_h_wheel_x", "state_h_wheel_y", "state_h_wheel_z", "state_wheel_torque_x", "torque_cmd_x", "b_eci_x", "b_eci_y", "b_eci_z"]);
-const WHEEL_Y: [&str; 17] = concat_names(&ATT_ALL, &["state_h_wheel_x", "state_h_wheel_y", "state_h_wheel_z", "state_wheel_torque_y", "torque_cmd_y", "b_eci_x", "b_eci_y", "b_eci_z"]);
-const WHEEL_Z: [&str; 17] = concat_names(&ATT_ALL, &["state_h_wheel_x", "state_h_wheel_y", "state_h_wheel_z", "state_wheel_torque_z", "torque_cmd_z", "b_eci_x", "b_eci_y", "b_eci_z"]);
+const WHEEL_X: [&str; 19] = concat_names(&ATT_ALL, &["state_h_wheel_x", "state_h_wheel_y", "state_h_wheel_z", "state_wheel_torque_x", "torque_cmd_x", "b_eci_x", "b_eci_y", "b_eci_z", "m_cmd_y", "m_cmd_z"]);
+const WHEEL_Y: [&str; 19] = concat_names(&ATT_ALL, &["state_h_wheel_x", "state_h_wheel_y", "state_h_wheel_z", "state_wheel_torque_y", "torque_cmd_y", "b_eci_x", "b_eci_y", "b_eci_z", "m_cmd_x", "m_cmd_z"]);
+const WHEEL_Z: [&str; 19] = concat_names(&ATT_ALL, &["state_h_wheel_x", "state_h_wheel_y", "state_h_wheel_z", "state_wheel_torque_z", "torque_cmd_z", "b_eci_x", "b_eci_y", "b_eci_z", "m_cmd_x", "m_cmd_y"]);
 
 // the wheel momenta: ḣ_w = −M τ_rw with M = R(δ) diag(k) (actuator misalignment and scale factor) couples
 // every wheel axis into every body axis
-const H_WHEEL: [&str; 21] = concat_names(&ATT_ALL, &["state_h_wheel_x", "state_h_wheel_y", "state_h_wheel_z", "state_wheel_torque_x",
-    "state_wheel_torque_y", "state_wheel_torque_z", "torque_cmd_x", "torque_cmd_y", "torque_cmd_z", "b_eci_x", "b_eci_y", "b_eci_z"]);
+const H_WHEEL: [&str; 24] = concat_names(&ATT_ALL, &["state_h_wheel_x", "state_h_wheel_y", "state_h_wheel_z", "state_wheel_torque_x",
+    "state_wheel_torque_y", "state_wheel_torque_z", "torque_cmd_x", "torque_cmd_y", "torque_cmd_z", "b_eci_x", "b_eci_y", "b_eci_z",
+    "m_cmd_x", "m_cmd_y", "m_cmd_z"]);
 
 const fn concat_names<const N: usize>(a: &[&'static str], b: &[&'static str]) -> [&'static str; N] {
     crate::model::concat(&[a, b], "")
@@ -83,18 +86,17 @@ pub const STATES: [StateDecl; super::kinematics::N] = [
     s("state_wheel_torque_z", "N.m", "Continuous state: lagged wheel torque z (actuator mode 1, wheel lag > 0)", &WHEEL_Z),
 ];
 
-/// The first time event after t: the fault onset or the next noise-hold boundary.
+/// The first time event after t: the fault onset, the fault end (unless permanent) or the next
+/// noise-hold boundary.
 pub fn next_time_event(v: &AttitudePlantVars, t: f64) -> Option<f64> {
     let fault = Some(v.fault_time).filter(|tf| *tf > t);
+    let clear = Some(v.fault_clear_time).filter(|tc| *tc > t && *tc < PERMANENT);
     let noise = noise_on(v)
         .then(|| hold_index(t, v.dist_noise_hold))
         .flatten()
         .map(|k| (k + 1) as f64 * v.dist_noise_hold) // |k| <= 2^53: no overflow
         .filter(|tn| *tn > t);
-    match (fault, noise) {
-        (Some(a), Some(b)) => Some(a.min(b)),
-        (a, b) => a.or(b),
-    }
+    [fault, clear, noise].into_iter().flatten().reduce(f64::min)
 }
 
 impl AttitudePlant {

@@ -66,7 +66,7 @@ impl AttitudePlant {
     /// ẋ with the inputs held.
     fn derivative(&self, v: &AttitudePlantVars, t: f64, x: &State, seg: &Segment) -> State {
         let w = v3(x, W);
-        let needs_a = self.budget_needs_attitude(v) || Self::mtq(v) || Self::mtq_external(v);
+        let needs_a = self.budget_needs_attitude(v) || Self::mtq(v) || Self::mtq_external(v) || Self::mtq_shared(v);
         let a = if needs_a { self.attitude(x) } else { Matrix3::identity() };
         let act = self.actuate(v, t, x, &a, seg);
         let tau = act.torque + self.external(v, t, &a, seg);
@@ -135,6 +135,12 @@ impl Model for AttitudePlant {
         // Positive definite iff the Cholesky factorisation exists.
         let chol = nalgebra::Cholesky::new(inertia).ok_or_else(|| format!("inertia matrix {:?} is not positive definite", inertia.as_slice()))?;
         let facets = v.facets()?;
+        if v.fault_configured() && v.fault_clear_time <= v.fault_time {
+            return Err(format!(
+                "parameter fault_clear_time = {} s is not after fault_time = {} s while a fault is configured (effectiveness < 1, stuck or bias): the fault would never act",
+                v.fault_clear_time, v.fault_time
+            ));
+        }
         let orbit = CircularOrbit { mu: v.mu, radius: v.orbit_radius, inclination: v.orbit_inclination, arg_lat0: v.orbit_arg_lat0, dipole: v.earth_dipole };
         let d = Derived {
             orbit,
@@ -194,6 +200,7 @@ impl Model for AttitudePlant {
         v.torque_ext = ext;
         v.h_wheel = hw;
         v.dipole = act.dipole;
+        v.actuator_fault = if seg.faulted && v.fault_configured() { 1.0 } else { 0.0 };
         Ok(())
     }
 
@@ -232,7 +239,7 @@ impl Model for AttitudePlant {
 
     // Model Exchange: the 18-entry state vector as it is (`kinematics::N`; unused entries stay 0 and
     // have derivative 0), the right-hand side of the internal integrator, time events at the fault
-    // onset and the noise-hold boundaries, and the invariant kept by projection at events (exchange.rs).
+    // onset and end and the noise-hold boundaries, and the invariant kept by projection at events (exchange.rs).
     const STATES: Option<&'static [StateDecl]> = Some(&exchange::STATES);
     fn get_states(&self, _v: &Self::Vars, x: &mut [f64]) {
         x.copy_from_slice(self.x.as_slice());

@@ -1,4 +1,4 @@
-//! The declared variables of `AttitudePlant` (ports 0–79, parameters 100–197, calculated 200–203, facets
+//! The declared variables of `AttitudePlant` (ports 0–80, parameters 100–198, calculated 200–203, facets
 //! 210–269).
 
 use super::kinematics::Kinematics;
@@ -29,7 +29,7 @@ declare_variables! {
         38 => dipole: Vec3 = [0.0; 3], Output, "A.m2", "Magnetorquer dipole m, body axes";
         41 => b_body: Vec3 = [0.0; 3], Output, "T", "Geomagnetic field in body axes";
         // appended (issue 37): external magnetorquer command
-        44 => m_cmd: Vec3 = [0.0; 3], Input, "A.m2", "Magnetorquer dipole command, body axes (mtq_mode = 1; e.g. from BDot)";
+        44 => m_cmd: Vec3 = [0.0; 3], Input, "A.m2", "Magnetorquer dipole command, body axes (mtq_mode = 1, or 2 added to the dumping dipole; e.g. from BDot)";
         // appended (issue 43): the environment as inputs (environment_inputs = 1), by the Environment/Orbit port names
         47 => r: Vec3 = [0.0; 3], Input, "m", "Spacecraft position, Earth-centred inertial axes (environment_inputs = 1; R is then that frame)";
         50 => v: Vec3 = [0.0; 3], Input, "m/s", "Spacecraft velocity, inertial axes (environment_inputs = 1)";
@@ -45,6 +45,8 @@ declare_variables! {
         71 => torque_residual: Vec3 = [0.0; 3], Output, "N.m", "Torque of the residual magnetic dipole m_res x B, body axes";
         74 => force_aero: Vec3 = [0.0; 3], Output, "N", "Aerodynamic force on the facets, body axes";
         77 => force_srp: Vec3 = [0.0; 3], Output, "N", "Solar-radiation-pressure force on the facets, body axes";
+        // appended (issue 44): actuator health telemetry
+        80 => actuator_fault: Real = 0.0, Output, "", "Actuator health flag: 1 while an actuator fault is active (fault_time <= t < fault_clear_time with effectiveness_* < 1, fault_stuck_* = 1 or fault_bias_* != 0), 0 otherwise";
         // parameters: body
         100 => inertia: Diag3 = [1000.0, 500.0, 700.0], Parameter, "kg.m2", "Inertia matrix diagonal entry ([Navabi-2019] default)", Positive;
         103 => inertia_xy: Real = 0.0, Parameter, "kg.m2", "Inertia matrix entry xy (matrix entry, not product of inertia)";
@@ -103,13 +105,15 @@ declare_variables! {
         184 => actuator_scale: Vec3 = [1.0; 3], Parameter, "", "Actuator scale factor k: actuator i delivers k_i times its limited torque (tau_body = R(delta) diag(k) tau_actuators)", Positive;
         187 => actuator_misalignment: Vec3 = [0.0; 3], Parameter, "rad", "Actuator-triad misalignment: rotation vector delta of the actuator axes relative to the body axes (R(delta) = exp([delta x]))";
         // appended (issue 37): source of the magnetorquer dipole
-        190 => mtq_mode: Integer = 0, Parameter, "", "Magnetorquer dipole: 0 = internal momentum dumping (actuator_mode 1 with mtq_enable 1; otherwise none); 1 = the input m_cmd, each axis clamped at mtq_dipole_max, in either actuator mode (the internal dumping law is off)", Choice(SWITCH);
+        190 => mtq_mode: Integer = 0, Parameter, "", "Magnetorquer dipole: 0 = internal momentum dumping (actuator_mode 1 with mtq_enable 1; otherwise none); 1 = the input m_cmd, each axis clamped at mtq_dipole_max, in either actuator mode (the internal dumping law is off); 2 = m_cmd plus the unscaled internal dumping dipole k_dump (h_w x B)/|B|^2 (actuator_mode 1 with mtq_enable 1), the sum clamped per axis as in 1", Choice(MTQ_MODES);
         // appended (issue 43): the environment's source and the disturbance model's constants (project choices)
         191 => environment_inputs: Integer = 0, Parameter, "", "0 = the circular orbit and dipole field above (the papers' plant); 1 = position, velocity, field, sun, eclipse and density from the inputs (gravity gradient from r; drag, solar pressure and residual dipole)", Choice(SWITCH);
         192 => residual_dipole: Vec3 = [0.0; 3], Parameter, "A.m2", "Residual magnetic dipole m_res of the spacecraft, body axes (both sources of the field)";
         195 => earth_rotation_rate: Real = 7.292115e-5, Parameter, "rad/s", "Earth rotation rate: the air co-rotates, v_rel = v - w_E z x r";
         196 => solar_flux: Real = 1361.0, Parameter, "W/m2", "Solar flux at one astronomical unit (pressure = flux / c, scaled with (1 au / d)^2)", NonNegative;
         197 => eclipse_shadows_srp: Integer = 1, Parameter, "", "1 = the solar pressure is multiplied by the input eclipse (visible fraction), 0 = ignore it", Choice(SWITCH);
+        // appended (issue 44): transient faults
+        198 => fault_clear_time: Real = 1e30, Parameter, "s", "End of all actuator faults (effectiveness, bias, stuck): from this time on the actuators are healthy again (the ground reset the unit); 1e30 = permanent faults";
         // appended (issue 43): up to six flat facets (a box, or a box and panels) for drag and solar pressure
         210 => facet1_area: Real = 0.0, Parameter, "m2", "Facet 1: area (0 = no facet)", NonNegative;
         211 => facet1_normal: Vec3 = [0.0; 3], Parameter, "", "Facet 1: outward normal, body axes (normalised)";
@@ -155,6 +159,9 @@ declare_variables! {
     }
 }
 
+/// Codes of `mtq_mode`: 0 internal dumping, 1 the command m_cmd, 2 the command plus the dumping.
+pub const MTQ_MODES: &[i32] = &[0, 1, 2];
+
 /// Facets of the facet model.
 pub const FACETS: usize = 6;
 
@@ -175,5 +182,10 @@ impl AttitudePlantVars {
     /// The stuck flags as booleans.
     pub fn stuck(&self) -> [bool; 3] {
         [self.fault_stuck_x == 1, self.fault_stuck_y == 1, self.fault_stuck_z == 1]
+    }
+
+    /// Whether any actuator fault is configured: an effectiveness below 1, a stuck actuator or a bias.
+    pub fn fault_configured(&self) -> bool {
+        self.effectiveness.iter().any(|a| *a < 1.0) || self.stuck().iter().any(|s| *s) || self.fault_bias != nalgebra::Vector3::zeros()
     }
 }

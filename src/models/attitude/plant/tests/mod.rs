@@ -12,6 +12,7 @@ use crate::model::Fmu;
 type P = Fmu<AttitudePlant>;
 
 mod actuators;
+mod health;
 mod robustness;
 mod world;
 
