@@ -172,6 +172,8 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="6 runs per controller, one orbit each")
     ap.add_argument("--runs", type=int, default=200, help="campaign runs per controller (default 200)")
     ap.add_argument("--user", default=None, help="a user's attitude controller FMU for the FINE_POINTING place")
+    ap.add_argument("--user-param", action="append", default=[], metavar="NAME=VALUE",
+                    help="a parameter of the user's unit (repeatable), e.g. wn=0.1")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--out", default="docs")
     ap.add_argument("--data", default=None)
@@ -191,7 +193,8 @@ def main(argv=None) -> int:
     stop = mission.leo.ORBIT_PERIOD if args.quick else None
     controllers = dict(CONTROLLERS)
     if args.user:
-        controllers["user"] = (str(Path(args.user).resolve()), {})
+        params = {k: float(v) for k, _, v in (p.partition("=") for p in args.user_param)}
+        controllers["user"] = (str(Path(args.user).resolve()), params)
     results = {}
     for label, (model, params) in controllers.items():
         rows = campaign_rows(label, model, params, runs, stop, data, args.workers)
