@@ -72,7 +72,9 @@ REF_PARAMS = {
 # Constant offsets added to the documented input signals where those alone are refused by the unit
 # an input of this name is an atmospheric density (kg/m3): the documented signal keeps it in orbit's range
 DENSITY_INPUT = "rho"
-REF_INPUT_OFFSETS = {"Environment": {"r_x": 6_878_137.0}}  # 500 km above the equator (|r| < Earth's radius refused)
+REF_INPUT_OFFSETS = {"Environment": {"r_x": 6_878_137.0},  # 500 km above the equator (|r| < Earth's radius refused)
+                     # ModeManager refuses a negative variance: the covariance inputs around 0.2 rad²
+                     "ModeManager": {"p_att_x": 0.2, "p_att_y": 0.2, "p_att_z": 0.2}}
 REL_TOL, ABS_TOL = 1e-6, 1e-12
 IMPORTERS = ("fmpy", "fmusim")
 # fixed entry metadata: the injected files are byte-identical from build to build

@@ -158,3 +158,16 @@ def test_a_users_controller_takes_the_fine_pointing_place(tmp_path):
     row = metrics.compute(r)
     assert row["fine_error_p95_deg"] == pytest.approx(lag, rel=0.1)
     assert math.isnan(row["t_on_target_s"])  # its lag exceeds the 0.2° requirement: never on target
+
+
+@pytest.mark.parametrize("argv,needle", [
+    (["default", "--runs", "3"], "--runs: scenario 'default' declares no dispersions"),
+    (["mission/tipoff", "--runs", "0"], "--runs 0: allowed: a whole number in [1, 10000000]"),
+    (["mission/tipoff", "--runs", "2", "--seeds", "0:2"], "not with --runs, which draws each run's seeds")])
+def test_runs_refusals_are_one_line_with_exit_2(argv, needle, tmp_path):
+    import subprocess
+    import sys
+    p = subprocess.run([sys.executable, "-m", "scfmu", "campaign", *argv, "--out", str(tmp_path)],
+                       capture_output=True, text=True, timeout=120)
+    assert p.returncode == 2 and needle in p.stderr and "Traceback" not in p.stderr
+    assert len(p.stderr.strip().splitlines()) == 1
