@@ -324,9 +324,10 @@ fn closed_loop_in_a_fmi_rs_master_equals_the_loop_fmu() {
             }
         }
     }
-    // into the controller: q, w (plant), q_ref, w_ref (command); into the plant: torque_cmd; into metrics the rest
+    // into the controller: q, w (plant), q_ref, w_ref, w_ref_dot (command); into the plant: torque_cmd; into
+    // metrics the rest
     let per_dst: Vec<usize> = (0..4).map(|d| links.iter().filter(|l| l.0 == d).count()).collect();
-    assert_eq!(per_dst, [0, 14, 3, 11], "links: {links:?}");
+    assert_eq!(per_dst, [0, 17, 3, 11], "links: {links:?}");
     let vr_of = |i: usize, name: &str| {
         fmus[i]
             .1
