@@ -74,7 +74,9 @@ REF_PARAMS = {
 DENSITY_INPUT = "rho"
 REF_INPUT_OFFSETS = {"Environment": {"r_x": 6_878_137.0},  # 500 km above the equator (|r| < Earth's radius refused)
                      # ModeManager refuses a negative variance: the covariance inputs around 0.2 rad²
-                     "ModeManager": {"p_att_x": 0.2, "p_att_y": 0.2, "p_att_z": 0.2}}
+                     "ModeManager": {"p_att_x": 0.2, "p_att_y": 0.2, "p_att_z": 0.2},
+                     # CommandSwitch: select the safe torque and the B-dot dipole (codes 1), not zero outputs
+                     "CommandSwitch": {"torque_select": 1.0, "dipole_select": 1.0}}
 REL_TOL, ABS_TOL = 1e-6, 1e-12
 IMPORTERS = ("fmpy", "fmusim")
 # fixed entry metadata: the injected files are byte-identical from build to build
