@@ -291,9 +291,15 @@ EXPORTED = ("leo/detumble", "leo/sun-pointing", "leo/nadir")
 
 def build(name: str, stop_time: float | None = None, **_kw) -> Scenario:
     """The scenario ``name``; ``stop_time``: a shorter (or longer) run of the same loop."""
-    if name not in BUILDERS:
-        raise KeyError(f"unknown scenario {name!r}: expected one of {list(BUILDERS)}")
-    sc = copy.deepcopy(BUILDERS[name]())
+    return built(BUILDERS, name, stop_time)
+
+
+def built(builders: dict, name: str, stop_time: float | None = None) -> Scenario:
+    """The scenario ``name`` of a plug-in's ``builders`` (name → function), with ``stop_time`` when given (the
+    ``build`` of the plug-ins that build on this spacecraft: leo, mission)."""
+    if name not in builders:
+        raise KeyError(f"unknown scenario {name!r}: expected one of {list(builders)}")
+    sc = copy.deepcopy(builders[name]())
     if stop_time is not None:
         sc.stop_time = float(stop_time)
     return sc

@@ -25,6 +25,7 @@ import math
 
 import numpy as np
 
+from ...metrics import error_rotation_deg
 from .scenarios import ARRAY_POWER, MODES, SAFE_LOAD
 
 FINE_SETTLE = 600.0
@@ -52,7 +53,8 @@ def attitude_matrices(q: np.ndarray) -> np.ndarray:
 
 
 def error_angle_deg(q: np.ndarray, q_ref: np.ndarray) -> np.ndarray:
-    return np.degrees(2 * np.arccos(np.clip(np.abs(np.sum(q * q_ref, axis=1)), 0.0, 1.0)))
+    """The angle [deg] of the rotation from the attitude to the reference, per sample."""
+    return np.linalg.norm(error_rotation_deg(q, q_ref), axis=1)
 
 
 def transitions(t: np.ndarray, mode: np.ndarray) -> list[tuple[float, int, int]]:

@@ -36,7 +36,6 @@ The loop, in Gauss–Seidel order:
 
 from __future__ import annotations
 
-import copy
 import math
 
 from ...scenario.model import Component, Scenario, log_of
@@ -170,12 +169,7 @@ EXPORTED = ("mission/tipoff", "mission/wheel-fault")
 
 def build(name: str, stop_time: float | None = None, **_kw) -> Scenario:
     """The scenario ``name``; ``stop_time``: a shorter (or longer) run of the same loop."""
-    if name not in BUILDERS:
-        raise KeyError(f"unknown scenario {name!r}: expected one of {list(BUILDERS)}")
-    sc = copy.deepcopy(BUILDERS[name]())
-    if stop_time is not None:
-        sc.stop_time = float(stop_time)
-    return sc
+    return leo.built(BUILDERS, name, stop_time)
 
 
 def names() -> list[tuple[str, str]]:
