@@ -69,13 +69,11 @@ REF_PARAMS = {
     "ReferenceCorrector": {"mode": 1, "init_euler321_roll": 0.3, "init_w_x": 0.02, "node_x_1": 0.01, "node_y_2": -0.01, "node_x_4": 0.005},
     "SunSensor": {"fov": math.pi, "shadow": 0},
 }
-# Constant offsets added to the documented input signals where those alone are refused by the unit
 # an input of this name is an atmospheric density (kg/m3): the documented signal keeps it in orbit's range
 DENSITY_INPUT = "rho"
-REF_INPUT_OFFSETS = {"Environment": {"r_x": 6_878_137.0},  # 500 km above the equator (|r| < Earth's radius refused)
-                     # ModeManager refuses a negative variance: the covariance inputs around 0.2 rad²
-                     "ModeManager": {"p_att_x": 0.2, "p_att_y": 0.2, "p_att_z": 0.2},
-                     # CommandSwitch: select the safe torque and the B-dot dipole (codes 1), not zero outputs
+# Offsets to input signals a unit would refuse. Environment: 500 km above the equator (|r| < Earth's radius
+# refused); ModeManager: variances around 0.2 rad²; CommandSwitch: safe torque and B-dot dipole (codes 1)
+REF_INPUT_OFFSETS = {"Environment": {"r_x": 6_878_137.0}, "ModeManager": {f"p_att_{a}": 0.2 for a in "xyz"},
                      "CommandSwitch": {"torque_select": 1.0, "dipole_select": 1.0}}
 REL_TOL, ABS_TOL = 1e-6, 1e-12
 IMPORTERS = ("fmpy", "fmusim")
