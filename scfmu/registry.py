@@ -80,6 +80,23 @@ class BenchmarkCase:
 
 
 @dataclass
+class MissionCase:
+    """A mission scenario of a family's benchmark (``scfmu benchmark --mission``): each controller takes the
+    place ``slot`` (the FINE_POINTING law) in ``runs`` dispersed runs of ``scenario`` (its registered
+    dispersions, the same draws for every controller); ``metric`` (seconds, lower is better; never reached:
+    not finite) ranks them by its p95, ``handover`` is reported beside it."""
+    family: str
+    scenario: str
+    label: str
+    slot: str = "controller"
+    runs: int = 20
+    quick_runs: int = 4
+    metric: str = "t_on_target_s"
+    handover: str = "t_fine_pointing_s"
+    plugin: str = ""
+
+
+@dataclass
 class BuiltinController:
     """A controller of the family that the benchmark runs beside the user's: a model, its parameters (its
     paper's tuning) and its design envelope, i.e. how it is configured on each benchmark scenario:
@@ -112,6 +129,7 @@ class Registry:
         self.papers: dict[str, Paper] = {}
         self.benchmark_cases: list[BenchmarkCase] = []
         self.controllers: list[BuiltinController] = []
+        self.mission_cases: list[MissionCase] = []
         self.dispersion_sets: dict[str, dict] = {}
         self._loaded = False
         self._current = ""
@@ -155,6 +173,10 @@ class Registry:
         """A scenario of ``family``'s controller benchmark (``scfmu benchmark --family``)."""
         self.benchmark_cases.append(BenchmarkCase(family, scenario, label, slot, seeds, primary, signal,
                                                   dict(overrides or {}), monte_carlo, self._current))
+
+    def mission(self, family: str, scenario: str, label: str, **kw) -> None:
+        """A mission scenario of ``family``'s benchmark (``scfmu benchmark --mission``; :class:`MissionCase`)."""
+        self.mission_cases.append(MissionCase(family, scenario, label, **kw, plugin=self._current))
 
     def controller(self, family: str, model: str, label: str, params: dict | None = None, home=(), retune=None,
                    outside: str = "", unused=()) -> None:

@@ -43,6 +43,7 @@ from ..scenario.plan import PlanError, build_plan
 from ..scenario.resolve import unbound_slots
 from . import engineering, engineering_page
 from . import estimator as estimator_runs
+from . import mission as mission_runs
 from .common import (COLUMNS, METRIC_UNITS, RESOLUTION, RESPONSE_RESOLUTION, SECTIONS, TITLES, UNIT,  # noqa: F401
                      WARNINGS, Entry, _check_error_growth, _slug, add_column, add_section, add_warning, equal,
                      error_series, identical_groups, metric_title, ranks, resolution)
@@ -105,13 +106,15 @@ def unit_scenario(base, case, unit: str, unit_params: dict | None = None, port_m
 def run(unit: str | None, family: str, out: str | Path, label: str | None = None, unit_params: dict | None = None,
         port_map: dict | None = None, quick: bool = False, workers: int = 2, controllers: list[str] | None = None,
         cases: list[str] | None = None, client=None, log=print, profile=None, strict: bool = False,
-        estimator: bool = False) -> list[Entry]:
+        estimator: bool = False, mission: bool = False, mission_runs_n: int | None = None) -> list[Entry]:
     """Runs the benchmark and writes ``index.html``, ``benchmark.md``, ``results.csv`` and ``figures/``
     into ``out``; returns the entries. ``unit``: a path to an FMU or a model name (None: built-ins only);
     ``profile``: a :class:`scfmu.scenario.profile.Profile` (or a path to one) for the unit; ``strict``: raise
     :class:`StrictRefusal` before any run when a slot value would not reach the unit; ``estimator``: also run
     every pair on its scenario's ``sensing+estimation/`` variant (:mod:`.estimator`) and show the primary
-    metric with the estimator in the loop in a column (about twice the runs)."""
+    metric with the estimator in the loop in a column (about twice the runs); ``mission``: also run every
+    controller in the family's mission scenario (:mod:`.mission`; ``mission_runs_n`` runs, default the case's
+    number, its quick number with ``quick``) and add the mission section with its p95 times."""
     cases, ctrls, profile, unit_label = _select(unit, family, label, controllers, cases, profile)
     if family == "attitude":  # its stability margins need python-control (the campaigns extra): say so first
         engineering.require_margins()
@@ -128,6 +131,10 @@ def run(unit: str | None, family: str, out: str | Path, label: str | None = None
     pairs: dict = {}  # (case, controller) -> scenario, for the Monte Carlo and the margins
     t0 = time.time()
     studies = None
+    mcase = mission_runs.case_of(family) if mission else None
+    if mission and mcase is None:
+        raise KeyError(f"family {family!r} has no mission scenario")
+    missions: tuple = ()
     try:
         for case in cases:
             sets, seeds = _case_overrides(case, quick)
@@ -152,6 +159,13 @@ def run(unit: str | None, family: str, out: str | Path, label: str | None = None
                                                                         j[3], out)] if x is not None]
                 for job in [pool.submit(estimator_runs.run_pair, client, log, *j) for j in est_jobs]:
                     job.result()
+            if mcase is not None:
+                n = mission_runs_n or (mcase.quick_runs if quick else mcase.runs)
+                ms, mjobs = mission_runs.prepare(mcase, ctrls, (unit_params, port_map, profile), configured, out, n, log)
+                for job in [pool.submit(mission_runs.run_pair, client, log, mcase, *j) for j in mjobs]:
+                    job.result()
+                mission_runs.write_csv(out, mcase, ms)
+                missions = (mcase, ms)
         if family == "attitude":  # robustness Monte Carlo and stability margins (scfmu.benchmark.engineering)
             studies = engineering.studies(cases, pairs, entries, out, client, quick, log)
     finally:
@@ -159,7 +173,8 @@ def run(unit: str | None, family: str, out: str | Path, label: str | None = None
             client.close()
             if cluster is not None:
                 cluster.close()
-    write_page(out, family, cases, entries, unit_label=unit_label, quick=quick, seconds=time.time() - t0)
+    write_page(out, family, cases, entries, unit_label=unit_label, quick=quick, seconds=time.time() - t0,
+               mission=missions)
     if family == "attitude":
         engineering_page.append_to_page(out, cases, entries, ranks(cases, entries), unit_label, studies)
     return entries
@@ -294,4 +309,5 @@ def _run_pair(client, log, e: Entry, case, sc, c, folder: Path) -> None:
         + (f"; {e.config}" if e.envelope == "retuned" else ""))
 
 
-add_warning(engineering.saturation_warnings)  # time in actuator saturation (scfmu.benchmark.engineering)
+add_warning(engineering.saturation_warnings)
+add_section(mission_runs.section)  # scfmu benchmark --mission  # time in actuator saturation (scfmu.benchmark.engineering)

@@ -4,7 +4,8 @@ controllers; one HTML + Markdown page (``out/benchmark/<family>/``) with the war
 that reached no parameter of the unit, built-ins re-tuned for or not designed for a plant, runs whose error
 grew, ties), the metrics with their units, pass/fail, the unit's rank per scenario and overlaid responses.
 ``--profile FILE`` binds the unit's parameters to each scenario's slot values (e.g. ``J1 = "inertia_xx"``);
-``--strict`` refuses to run when one would not reach the unit."""
+``--strict`` refuses to run when one would not reach the unit; ``--mission`` adds the p95 time to fine pointing of
+every controller as the fine-pointing law of the family's mission scenario (:mod:`scfmu.benchmark.mission`)."""
 
 from __future__ import annotations
 
@@ -18,6 +19,7 @@ from ..scenario import profile as profiles
 from ..scenario.options import fmu_file, pairs, value
 from ..scenario.values import UsageError, did_you_mean
 from . import StrictRefusal, run, selected_cases
+from .mission import case_of as mission_case
 from .options import unit_options
 
 
@@ -45,6 +47,12 @@ def _parser() -> argparse.ArgumentParser:
     ap.add_argument("--estimator", action="store_true",
                     help="also run every pair with the estimator in the loop (sensing+estimation/<scenario>: sensors, "
                          "ephemeris, Mekf, 10 Hz flight computer) and show its primary metric in a column (twice the runs)")
+    ap.add_argument("--mission", action="store_true",
+                    help="also run every controller as the fine-pointing law of the family's mission scenario "
+                         "(attitude: mission/tipoff, tip-off to fine pointing) over dispersed runs, and give the p95 "
+                         "time to on target per controller (20 runs, 4 with --quick)")
+    ap.add_argument("--mission-runs", type=int, default=None, metavar="N",
+                    help="the number of dispersed mission runs per controller (with --mission)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--out", default=None, help="output folder (default out/benchmark/<family>)")
     ap.add_argument("--check", action="store_true", help="first run `scfmu check --quick` on the unit (an .fmu); "
@@ -96,6 +104,14 @@ def main(argv=None) -> int:
                              f"{did_you_mean(c, names)}; allowed: {', '.join(names)}")
     if a.workers < 1 or a.workers > 1024:
         raise UsageError(f"--workers {a.workers}: allowed: a whole number in [1, 1024]")
+    if a.mission_runs is not None and not a.mission:
+        raise UsageError(f"--mission-runs {a.mission_runs}: only with --mission")
+    if a.mission_runs is not None and not 1 <= a.mission_runs <= 100_000:
+        raise UsageError(f"--mission-runs {a.mission_runs}: allowed: a whole number in [1, 100000]")
+    if a.mission and mission_case(a.family) is None:
+        have = sorted({c.family for c in REGISTRY.mission_cases})
+        raise UsageError(f"--mission: family {a.family!r} has no mission scenario; allowed with --family "
+                         f"{' or '.join(have) or '(none registered)'}")
     unit = _unit(a)
     if unit and a.check:
         from ..check import check_quick
@@ -122,11 +138,12 @@ def main(argv=None) -> int:
     try:
         entries = run(unit, a.family, out, label=label, unit_params=params, port_map=port_map, quick=a.quick, workers=a.workers,
                       controllers=controllers, cases=only, profile=prof, strict=a.strict,
-                      estimator=a.estimator)
+                      estimator=a.estimator, mission=a.mission, mission_runs_n=a.mission_runs)
     except StrictRefusal as e:
         print(f"scfmu benchmark: {e}", file=sys.stderr)
         return 2
-    print(f"wrote {out / 'index.html'}, {out / 'benchmark.md'} and {out / 'results.csv'}")
+    print(f"wrote {out / 'index.html'}, {out / 'benchmark.md'} and {out / 'results.csv'}"
+          + (f" (mission: {out / 'mission.csv'})" if a.mission else ""))
     mine = [e for e in entries if e.controller == label] if label else []
     unbound = sorted({u for e in mine for u in e.unbound})
     for u in unbound:

@@ -105,11 +105,12 @@ def warnings(cases, entries: list[Entry], unit_label, ctx: dict) -> list[str]:
     return out
 
 
-def write_page(out: Path, family: str, cases, entries: list[Entry], unit_label, quick: bool, seconds: float) -> None:
+def write_page(out: Path, family: str, cases, entries: list[Entry], unit_label, quick: bool, seconds: float,
+               mission: tuple = ()) -> None:
     """Writes ``results.csv``, ``benchmark.md`` and ``index.html`` (the sections registered by
-    :func:`add_section` included)."""
+    :func:`add_section` included; ``mission``: (mission case, its entries) of ``--mission``)."""
     rk = ranks(cases, entries)
-    ctx = {"family": family, "unit_label": unit_label, "quick": quick, "ranks": rk}
+    ctx = {"family": family, "unit_label": unit_label, "quick": quick, "ranks": rk, "mission": mission}
     _write_csv(out, family, cases, entries, rk)
     who = f"{unit_label} beside the built-in controllers" if unit_label else "the built-in controllers"
     title = f"Controller benchmark ({family}): {who}"

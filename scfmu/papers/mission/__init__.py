@@ -14,3 +14,6 @@ def register(reg) -> None:
     reg.scenarios("mission", scenarios.build, scenarios.names, exported=scenarios.EXPORTED)
     reg.metrics("mission", metrics.compute, metrics.COLUMNS, metrics.LOGS)
     reg.dispersions("mission/tipoff", scenarios.DISPERSIONS)
+    reg.mission("attitude", "mission/tipoff", "tip-off to fine pointing (mission/tipoff: detumble, sun acquisition, "
+                "determination, then the controller under test points nadir on the Mekf's estimate)",
+                runs=20, quick_runs=4, metric="t_on_target_s", handover="t_fine_pointing_s")
