@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import time
 
+import numpy as np
+
 from ..scenario.model import Scenario
 from .instances import as_plan
 
@@ -96,13 +98,16 @@ def run_libcosim(scenario: Scenario) -> dict:
     return out
 
 
-def run_libcosim_ssp(ssp_path, stop_time: float | None = None) -> dict:
+def run_libcosim_ssp(ssp_path, stop_time: float | None = None, series=()) -> dict:
     """Runs an ``.ssp`` written by ``scfmu.ssp`` on libcosim's own SSP loader (components, parameter
     bindings and connections all come from the archive; the fixed step from the scfmu annotation).
-    Returns the final value of every logged key of the scenario, like :func:`run_libcosim`."""
+    Returns the final value of every logged key of the scenario, like :func:`run_libcosim` (Integer outputs
+    read as integers); ``series``: logged keys also recorded at every step by libcosim's time-series observer,
+    returned as ``out["series"][key] = (times [s], values)`` (the values after each step, step 1 on)."""
     import shutil
 
     from fmpy import read_model_description
+    from libcosimpy.CosimEnums import CosimVariableType
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
     from libcosimpy.CosimObserver import CosimObserver
@@ -118,15 +123,38 @@ def run_libcosim_ssp(ssp_path, stop_time: float | None = None) -> dict:
         ex = CosimExecution.from_ssp_file(str(ssp_path), step_size=int(round(sc.step * NS)))
         obs = CosimObserver.create_last_value()
         ex.add_observer(obs)
+        model = {c.name: c.model for c in sc.components}
+        mvs = {m: {v.name: v for v in read_model_description(str(p)).modelVariables} for m, p in files.items()}
+        items = {key: (ex.slave_index_from_instance_name(inst), mvs[model[inst]][var])
+                 for key, inst, var in sc.log_items()}
+        n = int(round(t_end / sc.step))
+        ts = CosimObserver.create_time_series(buffer_size=n + 2) if series else None
+        if ts is not None:
+            ex.add_observer(ts)
+            for key in series:
+                i, v = items[key]
+                kind = CosimVariableType.INTEGER if v.type == "Integer" else CosimVariableType.REAL
+                if not ts.start_time_series(i, v.valueReference, kind):
+                    raise RuntimeError(f"libcosim: cannot observe {key}")
         if not ex.simulate_until(target_time=int(round(t_end * NS))):
             raise RuntimeError("libcosim: simulate_until failed")
-        model = {c.name: c.model for c in sc.components}
-        vrs = {m: {v.name: v.valueReference for v in read_model_description(str(p)).modelVariables}
-               for m, p in files.items()}
         out = {}
-        for key, inst, var in sc.log_items():
-            i = ex.slave_index_from_instance_name(inst)
-            out[key] = obs.last_real_values(i, [vrs[model[inst]][var]])[0]
+        for key, (i, v) in items.items():
+            read = obs.last_integer_values if v.type == "Integer" else obs.last_real_values
+            out[key] = read(i, [v.valueReference])[0]
+        if ts is not None:
+            out["series"] = {key: _samples(ts, *items[key], n) for key in series}
         return out
     finally:
         shutil.rmtree(work, ignore_errors=True)
+
+
+def _samples(ts, i: int, v, n: int, chunk: int = 50_000):
+    """(times [s], values) of steps 1 … n of a time-series observer."""
+    read = ts.time_series_integer_samples if v.type == "Integer" else ts.time_series_real_samples
+    t, y = [], []
+    for first in range(1, n + 1, chunk):
+        tt, _, yy = read(i, v.valueReference, from_step=first, sample_count=min(chunk, n + 1 - first))
+        t += tt
+        y += yy
+    return np.asarray(t, dtype=float) / NS, np.asarray(y, dtype=float)

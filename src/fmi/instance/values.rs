@@ -192,7 +192,7 @@ impl Instance {
     /// outputs that inconsistent inputs do not yet allow are read as kept, with a warning
     /// ([`Self::ensure_outputs_or_keep`]).
     pub fn get_values(&mut self, kind: VarKind, vrs: &[u32], mut write: impl FnMut(usize, Value)) -> CallResult {
-        let warning = match self.ensure_outputs_or_keep() {
+        let mut warning = match self.ensure_outputs_or_keep() {
             Err(f) if f.status == Status::Warning => Some(f),
             other => {
                 other?;
@@ -202,7 +202,24 @@ impl Instance {
         for (i, vr) in vrs.iter().enumerate() {
             if kind == VarKind::Real && *vr >= RESERVED_VR_START {
                 if let Some(var) = self.layer_var(*vr) {
-                    write(i, Value::Real(self.layer_value(var)?));
+                    let x = match self.layer_value(var) {
+                        Ok(x) => x,
+                        // a master that reads every variable before it has set the inputs (libcosim's
+                        // initialization reads, then transfers, then reads again): the same tolerance as
+                        // for the outputs, a derivative the inputs do not yet allow reads as 0
+                        Err(f) if self.run.fsm == FsmState::InitializationMode => {
+                            warning.get_or_insert(Fail {
+                                status: Status::Warning,
+                                reason: format!(
+                                    "{}; read as 0 until the inputs are consistent in Initialization Mode",
+                                    f.reason
+                                ),
+                            });
+                            0.0
+                        }
+                        Err(f) => return Err(f),
+                    };
+                    write(i, Value::Real(x));
                     continue;
                 }
             }
