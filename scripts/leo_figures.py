@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from scfmu.engines import simulate
+from scfmu.metrics import to_body
 from scfmu.papers.leo import scenarios as leo
 
 
@@ -38,14 +39,6 @@ def _plt():
 
 def stack(r, stem: str, comps: str = "xyz") -> np.ndarray:
     return np.stack([np.asarray(r[f"{stem}_{a}"], dtype=float) for a in comps], axis=1)
-
-
-def attitude_matrices(q: np.ndarray) -> np.ndarray:
-    """A(q) (inertial → body) of scalar-first unit quaternions, n × 3 × 3 (the plant's convention)."""
-    w, x, y, z = (q[:, i] for i in range(4))
-    return np.stack([np.stack([w*w + x*x - y*y - z*z, 2*(x*y + w*z), 2*(x*z - w*y)], axis=1),
-                     np.stack([2*(x*y - w*z), w*w - x*x + y*y - z*z, 2*(y*z + w*x)], axis=1),
-                     np.stack([2*(x*z + w*y), 2*(y*z - w*x), w*w - x*x - y*y + z*z], axis=1)], axis=1)
 
 
 def quat_err_deg(q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
@@ -96,13 +89,11 @@ def detumble(out: Path, data: Path, plt) -> dict:
 def sun_pointing(out: Path, data: Path, plt) -> dict:
     r, wall = run("leo/sun-pointing", data)
     t = np.asarray(r["time"]) / leo.ORBIT_PERIOD
-    a = attitude_matrices(stack(r, "q", "wxyz"))
-    s_b = np.einsum("nij,nj->ni", a, stack(r, "sun_eci"))
+    s_b = to_body(stack(r, "q", "wxyz"), stack(r, "sun_eci"))
     err = np.degrees(np.arccos(np.clip(s_b[:, 0] / np.linalg.norm(s_b, axis=1), -1, 1)))
     # across the sun line (body y, z: what the sun sensor observes); about it the attitude is not observed
     sigma = np.degrees(np.sqrt(np.max(stack(r, "p_att", "yz"), axis=1)))
-    a_est = attitude_matrices(stack(r, "q_est", "wxyz"))
-    s_est = np.einsum("nij,nj->ni", a_est, stack(r, "sun_ref"))  # the on-board sun, which the filter uses
+    s_est = to_body(stack(r, "q_est", "wxyz"), stack(r, "sun_ref"))  # the on-board sun, which the filter uses
     # the estimate's error across the sun line: the on-board sun seen through the estimate against the true sun in
     # body axes
     est_err = np.degrees(np.arccos(np.clip(np.sum(s_b * s_est, axis=1), -1, 1)))

@@ -31,6 +31,7 @@ import numpy as np
 from scfmu import campaign
 from scfmu.campaign.cli import parse_random
 from scfmu.engines import simulate
+from scfmu.metrics import to_body
 from scfmu.papers.mission import metrics, scenarios as mission
 from scfmu.registry import REGISTRY
 
@@ -105,7 +106,7 @@ def fault_figure(r, out: Path, plt) -> dict:
     ax[1].plot(t, stack(r, "wheel_speed"), label=["x", "y", "z"])
     ax[1].set_ylabel("wheel speed [rad/s]")
     ax[1].legend(fontsize=8)
-    s_b = np.einsum("nij,nj->ni", metrics.attitude_matrices(stack(r, "q", "wxyz")), stack(r, "sun_eci"))
+    s_b = to_body(stack(r, "q", "wxyz"), stack(r, "sun_eci"))
     ax[2].plot(t, np.degrees(np.arccos(np.clip(s_b[:, 0] / np.linalg.norm(s_b, axis=1), -1, 1))))
     ax[2].set_ylabel("+x to sun [deg]")
     ax[3].plot(t, metrics.array_power(r), label="array (+x, cosine × visible fraction)")

@@ -28,17 +28,11 @@ from ahrs.filters import QUEST, TRIAD, Davenport
 from fmpy.fmi1 import FMICallException
 
 from scfmu.fmu import Fmu, fmu_path
+from scfmu.metrics import attitude_matrix  # A(q), v_B = A v_R (numpy, tested against SciPy)
 
 TOL = 1e-9
 N_CASES = 40
 AX = "xyz"
-
-
-def attitude_matrix(q):
-    """A(q), v_B = A v_R, scalar-first q (the project's convention, written here independently)."""
-    w, v = q[0], np.asarray(q[1:])
-    vx = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
-    return (w * w - v @ v) * np.eye(3) + 2 * np.outer(v, v) - 2 * w * vx
 
 
 def random_quaternion(rng):
