@@ -28,6 +28,7 @@ import numpy as np
 from scfmu.engines import simulate
 from scfmu.metrics import to_body
 from scfmu.papers.leo import scenarios as leo
+from scfmu.results import write_parquet
 
 
 def _plt():
@@ -44,15 +45,6 @@ def stack(r, stem: str, comps: str = "xyz") -> np.ndarray:
 def quat_err_deg(q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
     d = np.abs(np.sum(q1 * q2, axis=1)) / np.linalg.norm(q1, axis=1) / np.linalg.norm(q2, axis=1)
     return np.degrees(2 * np.arccos(np.clip(d, -1.0, 1.0)))
-
-
-def write_parquet(path: Path, r) -> None:
-    """The logged signals as a Parquet table, each column's SI unit in its field metadata."""
-    import pyarrow as pa
-    import pyarrow.parquet as pq
-    units = getattr(r, "units", {}) or {}
-    fields = [pa.field(k, pa.float64(), metadata={"unit": units.get(k, "")}) for k in r.keys()]
-    pq.write_table(pa.table([np.asarray(r[k], dtype=float) for k in r.keys()], schema=pa.schema(fields)), path)
 
 
 def run(name: str, data: Path, stop: float | None = None, log_every: int = 1, overrides: dict | None = None,

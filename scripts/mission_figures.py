@@ -34,6 +34,7 @@ from scfmu.engines import simulate
 from scfmu.metrics import to_body
 from scfmu.papers.mission import metrics, scenarios as mission
 from scfmu.registry import REGISTRY
+from scfmu.results import write_parquet
 
 CONTROLLERS = {"PD": ("PdController", {}), "LQR": ("LqrController", {})}
 
@@ -43,14 +44,6 @@ def _plt():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     return plt
-
-
-def write_parquet(path: Path, r) -> None:
-    import pyarrow as pa
-    import pyarrow.parquet as pq
-    units = getattr(r, "units", {}) or {}
-    fields = [pa.field(k, pa.float64(), metadata={"unit": units.get(k, "")}) for k in r.keys()]
-    pq.write_table(pa.table([np.asarray(r[k], dtype=float) for k in r.keys()], schema=pa.schema(fields)), path)
 
 
 def run(name: str, data: Path):
