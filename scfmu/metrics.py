@@ -211,6 +211,34 @@ def logs_needed(name: str) -> tuple | None:
     return REGISTRY.metric_set(name).logs
 
 
+# ----- attitude matrix -------------------------------------------------------------------------------------
+# The project's convention (README "Conventions", src/math/attitude.rs): scalar-first Hamilton quaternions
+# q = [w, x, y, z] of the body frame B relative to the reference (inertial) frame R.
+
+
+def attitude_matrix(q) -> np.ndarray:
+    """A(q), the attitude matrix (direction cosine matrix) of scalar-first unit quaternions q = [w, x, y, z]:
+    v_B = A(q) v_R maps a vector's reference-frame (inertial) components into body components, the *passive*
+    reading, A(q) = (w² − |q_v|²) I + 2 q_v q_vᵀ − 2 w [q_v×] (the plant's ``attitude_matrix`` in
+    src/math/attitude.rs); A(p ⊗ q) = A(q) A(p). It is the transpose of the *active* rotation matrix of the same
+    quaternion: scipy's ``Rotation.from_quat([x, y, z, w]).as_matrix().T`` (scipy is scalar-last).
+    ``q``: shape (..., 4), one quaternion or many (not normalised here); returns shape (..., 3, 3)."""
+    q = np.asarray(q, dtype=float)
+    one = q.ndim == 1  # one quaternion: Python floats (the same numbers, a tenth of the time in an ODE's rhs)
+    w, x, y, z = q.tolist() if one else np.moveaxis(q, -1, 0)
+    a = [w*w + x*x - y*y - z*z, 2*(x*y + w*z), 2*(x*z - w*y),
+         2*(x*y - w*z), w*w - x*x + y*y - z*z, 2*(y*z + w*x),
+         2*(x*z + w*y), 2*(y*z - w*x), w*w - x*x - y*y + z*z]
+    return (np.array(a) if one else np.stack(a, axis=-1)).reshape(q.shape[:-1] + (3, 3))
+
+
+def to_body(q, v) -> np.ndarray:
+    """A(q) v: the body components of vectors given in the reference frame (see :func:`attitude_matrix`), sample
+    by sample. ``q``: shape (..., 4), ``v``: shape (..., 3) (broadcast); returns shape (..., 3). scipy:
+    ``Rotation.from_quat([x, y, z, w]).apply(v, inverse=True)``."""
+    return np.einsum("...ij,...j->...i", attitude_matrix(q), np.asarray(v, dtype=float))
+
+
 # ----- pointing errors (in the spirit of the ECSS pointing error engineering handbook) ----------------------
 # The error signal e(t) is a vector (here the small-rotation vector of the body relative to the reference,
 # in degrees) or a scalar, sampled at times t. The *evaluation period* is [t_start, t_end] (the pointing

@@ -1,4 +1,4 @@
-"""Writing logged signals (the dict returned by CoSimulation.run) to CSV, and the units of signals and
+"""Writing logged signals (the dict returned by CoSimulation.run) to CSV or Parquet, and the units of signals and
 metrics (as the units declare them; a metric's unit follows from the signal it is read from or from its
 name's suffix)."""
 
@@ -26,6 +26,17 @@ def write_csv(path: Path, signals: dict, keys: list[str] | None = None, every: i
             w.writerows(table.tolist())
         else:
             w.writerows([[format(x, fmt) for x in row] for row in table])
+
+
+def write_parquet(path: Path, signals) -> None:
+    """The logged signals as a Parquet table, one float64 column per signal, each column's SI unit in its field
+    metadata (``unit``; from ``signals.units`` when the result has them, else "")."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+    units = getattr(signals, "units", {}) or {}
+    fields = [pa.field(k, pa.float64(), metadata={"unit": units.get(k, "")}) for k in signals.keys()]
+    columns = [np.asarray(signals[k], dtype=float) for k in signals.keys()]
+    pq.write_table(pa.table(columns, schema=pa.schema(fields)), path)
 
 
 def declared_unit(v) -> str:

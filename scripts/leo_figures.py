@@ -26,7 +26,9 @@ from pathlib import Path
 import numpy as np
 
 from scfmu.engines import simulate
+from scfmu.metrics import to_body
 from scfmu.papers.leo import scenarios as leo
+from scfmu.results import write_parquet
 
 
 def _plt():
@@ -40,26 +42,9 @@ def stack(r, stem: str, comps: str = "xyz") -> np.ndarray:
     return np.stack([np.asarray(r[f"{stem}_{a}"], dtype=float) for a in comps], axis=1)
 
 
-def attitude_matrices(q: np.ndarray) -> np.ndarray:
-    """A(q) (inertial → body) of scalar-first unit quaternions, n × 3 × 3 (the plant's convention)."""
-    w, x, y, z = (q[:, i] for i in range(4))
-    return np.stack([np.stack([w*w + x*x - y*y - z*z, 2*(x*y + w*z), 2*(x*z - w*y)], axis=1),
-                     np.stack([2*(x*y - w*z), w*w - x*x + y*y - z*z, 2*(y*z + w*x)], axis=1),
-                     np.stack([2*(x*z + w*y), 2*(y*z - w*x), w*w - x*x - y*y + z*z], axis=1)], axis=1)
-
-
 def quat_err_deg(q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
     d = np.abs(np.sum(q1 * q2, axis=1)) / np.linalg.norm(q1, axis=1) / np.linalg.norm(q2, axis=1)
     return np.degrees(2 * np.arccos(np.clip(d, -1.0, 1.0)))
-
-
-def write_parquet(path: Path, r) -> None:
-    """The logged signals as a Parquet table, each column's SI unit in its field metadata."""
-    import pyarrow as pa
-    import pyarrow.parquet as pq
-    units = getattr(r, "units", {}) or {}
-    fields = [pa.field(k, pa.float64(), metadata={"unit": units.get(k, "")}) for k in r.keys()]
-    pq.write_table(pa.table([np.asarray(r[k], dtype=float) for k in r.keys()], schema=pa.schema(fields)), path)
 
 
 def run(name: str, data: Path, stop: float | None = None, log_every: int = 1, overrides: dict | None = None,
@@ -96,13 +81,11 @@ def detumble(out: Path, data: Path, plt) -> dict:
 def sun_pointing(out: Path, data: Path, plt) -> dict:
     r, wall = run("leo/sun-pointing", data)
     t = np.asarray(r["time"]) / leo.ORBIT_PERIOD
-    a = attitude_matrices(stack(r, "q", "wxyz"))
-    s_b = np.einsum("nij,nj->ni", a, stack(r, "sun_eci"))
+    s_b = to_body(stack(r, "q", "wxyz"), stack(r, "sun_eci"))
     err = np.degrees(np.arccos(np.clip(s_b[:, 0] / np.linalg.norm(s_b, axis=1), -1, 1)))
     # across the sun line (body y, z: what the sun sensor observes); about it the attitude is not observed
     sigma = np.degrees(np.sqrt(np.max(stack(r, "p_att", "yz"), axis=1)))
-    a_est = attitude_matrices(stack(r, "q_est", "wxyz"))
-    s_est = np.einsum("nij,nj->ni", a_est, stack(r, "sun_ref"))  # the on-board sun, which the filter uses
+    s_est = to_body(stack(r, "q_est", "wxyz"), stack(r, "sun_ref"))  # the on-board sun, which the filter uses
     # the estimate's error across the sun line: the on-board sun seen through the estimate against the true sun in
     # body axes
     est_err = np.degrees(np.arccos(np.clip(np.sum(s_b * s_est, axis=1), -1, 1)))

@@ -31,8 +31,10 @@ import numpy as np
 from scfmu import campaign
 from scfmu.campaign.cli import parse_random
 from scfmu.engines import simulate
+from scfmu.metrics import to_body
 from scfmu.papers.mission import metrics, scenarios as mission
 from scfmu.registry import REGISTRY
+from scfmu.results import write_parquet
 
 CONTROLLERS = {"PD": ("PdController", {}), "LQR": ("LqrController", {})}
 
@@ -42,14 +44,6 @@ def _plt():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     return plt
-
-
-def write_parquet(path: Path, r) -> None:
-    import pyarrow as pa
-    import pyarrow.parquet as pq
-    units = getattr(r, "units", {}) or {}
-    fields = [pa.field(k, pa.float64(), metadata={"unit": units.get(k, "")}) for k in r.keys()]
-    pq.write_table(pa.table([np.asarray(r[k], dtype=float) for k in r.keys()], schema=pa.schema(fields)), path)
 
 
 def run(name: str, data: Path):
@@ -105,7 +99,7 @@ def fault_figure(r, out: Path, plt) -> dict:
     ax[1].plot(t, stack(r, "wheel_speed"), label=["x", "y", "z"])
     ax[1].set_ylabel("wheel speed [rad/s]")
     ax[1].legend(fontsize=8)
-    s_b = np.einsum("nij,nj->ni", metrics.attitude_matrices(stack(r, "q", "wxyz")), stack(r, "sun_eci"))
+    s_b = to_body(stack(r, "q", "wxyz"), stack(r, "sun_eci"))
     ax[2].plot(t, np.degrees(np.arccos(np.clip(s_b[:, 0] / np.linalg.norm(s_b, axis=1), -1, 1))))
     ax[2].set_ylabel("+x to sun [deg]")
     ax[3].plot(t, metrics.array_power(r), label="array (+x, cosine × visible fraction)")

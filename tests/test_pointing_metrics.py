@@ -1,5 +1,6 @@
 """Pointing metrics (scfmu.metrics.pointing_errors, error_rotation_deg, saturation_fraction) against answers
-known in closed form on synthetic signals (constant bias, ramp, sinusoid) and against SciPy's rotations."""
+known in closed form on synthetic signals (constant bias, ramp, sinusoid) and against SciPy's rotations; the
+attitude matrix A(q) and A(q) v (scfmu.metrics.attitude_matrix, to_body) against SciPy and a closed form."""
 
 import math
 
@@ -7,7 +8,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from scfmu.metrics import error_rotation_deg, pointing_errors, saturation_fraction
+from quat_oracle import qmul
+from scfmu.metrics import attitude_matrix, error_rotation_deg, pointing_errors, saturation_fraction, to_body
 
 
 def test_constant_bias():
@@ -67,6 +69,36 @@ def test_error_rotation_against_scipy():
     np.testing.assert_allclose(e, np.degrees(small.as_rotvec()), atol=1e-9)
     # the sign of a quaternion does not matter
     np.testing.assert_allclose(error_rotation_deg(-wxyz(q), wxyz(q_ref)), expect, atol=1e-9)
+
+
+def test_attitude_matrix_against_scipy():
+    # A(q) is passive (reference -> body components): the transpose of SciPy's active matrix of the same
+    # rotation; SciPy's quaternions are scalar-last, ours scalar-first
+    rot = Rotation.random(40, random_state=np.random.default_rng(7))
+    xyzw = rot.as_quat()
+    q = np.column_stack([xyzw[:, 3], xyzw[:, :3]])
+    a = attitude_matrix(q)
+    assert a.shape == (40, 3, 3)
+    np.testing.assert_allclose(a, np.transpose(rot.as_matrix(), (0, 2, 1)), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(attitude_matrix(-q), a, rtol=0, atol=1e-15)  # q and -q: one attitude
+    assert attitude_matrix(q[3]).shape == (3, 3)
+    np.testing.assert_array_equal(attitude_matrix(q[3]), a[3])  # one quaternion = the same numbers as a row
+    v = np.random.default_rng(8).normal(size=(40, 3))
+    np.testing.assert_allclose(to_body(q, v), rot.apply(v, inverse=True), rtol=0, atol=1e-14)
+    np.testing.assert_allclose(to_body(q[5], v[5]), rot[5].apply(v[5], inverse=True), rtol=0, atol=1e-14)
+    np.testing.assert_allclose(to_body(q, v[0]), rot.apply(v[0], inverse=True), rtol=0, atol=1e-14)  # broadcast
+    # composition of Hamilton products: A(p ⊗ q) = A(q) A(p)
+    pq = np.stack([qmul(p, qq) for p, qq in zip(q[:20], q[20:])])
+    np.testing.assert_allclose(attitude_matrix(pq), attitude_matrix(q[20:]) @ attitude_matrix(q[:20]), atol=1e-15)
+
+
+def test_attitude_matrix_closed_form():
+    # the body turned +90 deg about z from the reference: the reference x axis is body -y, reference y is body +x
+    s = math.sqrt(0.5)
+    q = [s, 0.0, 0.0, s]
+    np.testing.assert_allclose(to_body(q, [1.0, 0.0, 0.0]), [0.0, -1.0, 0.0], atol=1e-15)
+    np.testing.assert_allclose(to_body(q, [0.0, 1.0, 0.0]), [1.0, 0.0, 0.0], atol=1e-15)
+    np.testing.assert_allclose(attitude_matrix([1.0, 0.0, 0.0, 0.0]), np.eye(3), rtol=0, atol=0)
 
 
 def test_saturation_fraction():

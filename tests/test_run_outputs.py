@@ -81,3 +81,22 @@ def test_result_units_and_pandas():
     df = res.to_pandas()
     assert df.shape == (101, len(res) - 1) and df.index.name == "time"
     assert np.array_equal(df["w_y"].to_numpy(), res["w_y"])
+
+
+def test_write_parquet_keeps_every_signal_and_its_unit(tmp_path):
+    import pyarrow.parquet as pq
+
+    from scfmu.results import write_parquet
+
+    class Logged(dict):
+        units = {"time": "s", "w_x": "rad/s"}
+
+    r = Logged(time=[0.0, 0.5, 1.0], w_x=np.array([1.0, -2.0, 3.5]), mode=[0, 1, 1])
+    write_parquet(tmp_path / "r.parquet", r)
+    t = pq.read_table(tmp_path / "r.parquet")
+    assert t.column_names == ["time", "w_x", "mode"]
+    assert [t.schema.field(k).metadata[b"unit"] for k in t.column_names] == [b"s", b"rad/s", b""]
+    assert all(str(t.schema.field(k).type) == "double" for k in t.column_names)
+    assert t.column("w_x").to_pylist() == [1.0, -2.0, 3.5] and t.column("mode").to_pylist() == [0.0, 1.0, 1.0]
+    write_parquet(tmp_path / "plain.parquet", {"a": [1.0]})  # a plain dict: no units, empty metadata
+    assert pq.read_table(tmp_path / "plain.parquet").schema.field("a").metadata[b"unit"] == b""

@@ -25,7 +25,7 @@ import math
 
 import numpy as np
 
-from ...metrics import error_rotation_deg
+from ...metrics import error_rotation_deg, to_body
 from .scenarios import ARRAY_POWER, MODES, SAFE_LOAD
 
 FINE_SETTLE = 600.0
@@ -42,14 +42,6 @@ LOGS = ("mode", "mode_changes", "eclipse", *_V, *[f"q_{c}" for c in "wxyz"], *[f
 
 def _stack(r, stem, comps="xyz"):
     return np.stack([np.asarray(r[f"{stem}_{c}"], dtype=float) for c in comps], axis=1)
-
-
-def attitude_matrices(q: np.ndarray) -> np.ndarray:
-    """A(q) (inertial → body) of scalar-first unit quaternions, shape (n, 3, 3)."""
-    w, x, y, z = q.T
-    return np.stack([np.stack([w*w + x*x - y*y - z*z, 2*(x*y + w*z), 2*(x*z - w*y)], axis=1),
-                     np.stack([2*(x*y - w*z), w*w - x*x + y*y - z*z, 2*(y*z + w*x)], axis=1),
-                     np.stack([2*(x*z + w*y), 2*(y*z - w*x), w*w - x*x - y*y + z*z], axis=1)], axis=1)
 
 
 def error_angle_deg(q: np.ndarray, q_ref: np.ndarray) -> np.ndarray:
@@ -70,7 +62,7 @@ def chatter(changes: list[tuple[float, int, int]], window: float = CHATTER_WINDO
 
 def array_power(r: dict) -> np.ndarray:
     """The +x array's power [W] per sample: ARRAY_POWER · max(0, x_b · s_b) · visible fraction."""
-    s_b = np.einsum("nij,nj->ni", attitude_matrices(_stack(r, "q", "wxyz")), _stack(r, "sun_eci"))
+    s_b = to_body(_stack(r, "q", "wxyz"), _stack(r, "sun_eci"))
     return ARRAY_POWER * np.clip(s_b[:, 0], 0.0, None) * np.asarray(r["eclipse"], dtype=float)
 
 

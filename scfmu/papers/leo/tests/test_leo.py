@@ -14,6 +14,7 @@ import pytest
 
 from scfmu import scenario as scenarios
 from scfmu.engines import simulate
+from scfmu.metrics import attitude_matrix, to_body  # numpy, tested against SciPy: independent of the plant
 from scfmu.papers.leo import scenarios as leo
 
 ORBIT = leo.ORBIT_PERIOD
@@ -21,14 +22,6 @@ ORBIT = leo.ORBIT_PERIOD
 
 def stack(r, stem, comps="xyz"):
     return np.stack([np.asarray(r[f"{stem}_{a}"], dtype=float) for a in comps], axis=1)
-
-
-def attitude_matrices(q):
-    """A(q), inertial → body, scalar-first unit quaternions (written out here, independent of the plant)."""
-    w, x, y, z = q.T
-    return np.stack([np.stack([w*w + x*x - y*y - z*z, 2*(x*y + w*z), 2*(x*z - w*y)], axis=1),
-                     np.stack([2*(x*y - w*z), w*w - x*x + y*y - z*z, 2*(y*z + w*x)], axis=1),
-                     np.stack([2*(x*z + w*y), 2*(y*z - w*x), w*w - x*x - y*y + z*z], axis=1)], axis=1)
 
 
 def angle_deg(q1, q2):
@@ -58,15 +51,15 @@ def test_the_scenarios_are_registered_exported_and_plain_data():
 
 def test_nadir_gravity_gradient_and_residual_dipole_are_the_closed_forms(nadir):
     r_i = stack(nadir, "r")
-    a = attitude_matrices(stack(nadir, "q", "wxyz"))
+    q = stack(nadir, "q", "wxyz")
     inertia = np.diag([leo.INERTIA[f"inertia_{c}{c}"] for c in "xyz"])
     rn = np.linalg.norm(r_i, axis=1)
-    rb = np.einsum("nij,nj->ni", a, r_i / rn[:, None])
+    rb = to_body(q, r_i / rn[:, None])
     gg = 3 * leo.MU / rn[:, None] ** 3 * np.cross(rb, rb @ inertia)
     got = stack(nadir, "torque_gg")
     assert np.abs(gg).max() > 1e-9  # a real torque (about 3e-9 N·m for this box near nadir)
     assert np.abs(got - gg).max() <= 1e-9 * np.abs(gg).max() + 1e-22
-    b_b = np.einsum("nij,nj->ni", a, stack(nadir, "b_eci"))
+    b_b = to_body(q, stack(nadir, "b_eci"))
     res = np.cross(np.array(leo.RESIDUAL_DIPOLE), b_b)
     assert np.abs(stack(nadir, "torque_residual") - res).max() <= 1e-9 * np.abs(res).max()
     # the IGRF field at 500 km: 18–50 µT over an orbit
@@ -76,7 +69,7 @@ def test_nadir_gravity_gradient_and_residual_dipole_are_the_closed_forms(nadir):
 
 def test_nadir_momentum_changes_by_the_integral_of_the_external_torques(nadir):
     """d/dt (A^T (I w + h_w)) = A^T (τ_ext + m × B): the wheels exchange momentum with the body only."""
-    a = attitude_matrices(stack(nadir, "q", "wxyz"))
+    a = attitude_matrix(stack(nadir, "q", "wxyz"))
     tau_b = stack(nadir, "torque_ext") + np.cross(stack(nadir, "dipole"), stack(nadir, "b_body"))
     tau_i = np.einsum("nji,nj->ni", a, tau_b)
     t = np.asarray(nadir["time"])
@@ -95,9 +88,8 @@ def test_nadir_points_at_the_earth_with_the_estimate(nadir):
     # estimate coasts on the gyro for minutes
     assert np.percentile(angle_deg(q, stack(nadir, "q_ref", "wxyz"))[settled], 95) < 0.2
     # the reference is the LVLH frame of the logged orbit: body z = -r/|r| in inertial axes
-    a_ref = attitude_matrices(stack(nadir, "q_ref", "wxyz"))
     r = stack(nadir, "r")
-    nadir_b = np.einsum("nij,nj->ni", a_ref, -r / np.linalg.norm(r, axis=1)[:, None])
+    nadir_b = to_body(stack(nadir, "q_ref", "wxyz"), -r / np.linalg.norm(r, axis=1)[:, None])
     assert np.abs(nadir_b - [0.0, 0.0, 1.0]).max() < 1e-12
     assert np.percentile(angle_deg(q, stack(nadir, "q_est", "wxyz"))[settled], 95) < 0.2
     assert 0.0 < 1 - np.mean(nadir["st_valid"]) < 0.3
@@ -121,8 +113,7 @@ def test_sun_pointing_loses_the_sun_sensor_in_eclipse_and_the_estimate_coasts():
     lit = ecl == 1.0
     late = np.asarray(r["time"]) > 0.25 * ORBIT
     assert valid[lit & late].mean() > 0.95  # the +x boresight holds the sun when lit
-    a = attitude_matrices(stack(r, "q", "wxyz"))
-    s_b = np.einsum("nij,nj->ni", a, stack(r, "sun_eci"))
+    s_b = to_body(stack(r, "q", "wxyz"), stack(r, "sun_eci"))
     off = np.degrees(np.arccos(np.clip(s_b[:, 0], -1, 1)))
     assert np.percentile(off[lit & late], 95) < 1.0
     # across the sun line (body y, z) the sun sensor bounds the filter's sigma; in the shadow it grows on the gyro

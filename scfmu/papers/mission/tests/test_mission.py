@@ -13,6 +13,7 @@ import pytest
 
 from scfmu import scenario as scenarios
 from scfmu.engines import simulate
+from scfmu.metrics import to_body
 from scfmu.papers.mission import metrics, scenarios as mission
 from scfmu.registry import REGISTRY
 
@@ -36,7 +37,7 @@ def sequence(r):
 
 def sun_angle_deg(r):
     """The angle between body +x and the true sun, from the plant's attitude and the Environment's sun."""
-    s_b = np.einsum("nij,nj->ni", metrics.attitude_matrices(stack(r, "q", "wxyz")), stack(r, "sun_eci"))
+    s_b = to_body(stack(r, "q", "wxyz"), stack(r, "sun_eci"))
     return np.degrees(np.arccos(np.clip(s_b[:, 0] / np.linalg.norm(s_b, axis=1), -1.0, 1.0)))
 
 

@@ -25,7 +25,8 @@ import re
 import numpy as np
 import pytest
 
-from scfmu.fmu import Fmu, fmu_path
+from fmu_drive import drive, fmu_file, restored_runs
+from scfmu.fmu import Fmu
 
 AX = "xyz"
 QN = "wxyz"
@@ -33,11 +34,6 @@ H = 0.25
 T_END = 150.0
 PARAMS = {"fault_confirm_time": 2.0}
 SAFE, DETUMBLE, SUN_ACQ, DETERMINATION, FINE = range(5)
-
-
-def fmu_file(model: str, fmi: int):
-    p = fmu_path(model)
-    return p if fmi == 2 else p.parent / "fmi3" / p.name
 
 
 def script(t: float) -> dict:
@@ -71,12 +67,7 @@ OUTS = ["time_in_mode", "torque_select", "dipole_select", "estimator_init", "con
 def mission(f: Fmu, k0: int, k1: int, loop: tuple | None = None) -> list[tuple]:
     """Communication points k0..k1-1: set the script's inputs, read the outputs (mode first), step. With
     `loop` = (switch, gate) the manager's selections go to a CommandSwitch and an EstimateGate."""
-    rows = []
-    for k in range(k0, k1):
-        t = k * H
-        u = script(t)
-        f.set_reals(list(u), list(u.values()))
-        f.set("nis_dim", 3)
+    def read(f: Fmu, t: float) -> tuple:
         row = (t, f.get("mode"), f.get("mode_changes"), f.get("last_reason"), *f.get_reals(OUTS))
         if loop:
             sw, gate = loop
@@ -86,9 +77,9 @@ def mission(f: Fmu, k0: int, k1: int, loop: tuple | None = None) -> list[tuple]:
                     *gate.get_reals([f"q_{c}" for c in QN]))
             sw.do_step(t, H)
             gate.do_step(t, H)
-        rows.append(row)
-        f.do_step(t, H)
-    return rows
+        return row
+
+    return drive(f, k0, k1, H, lambda k: script(k * H) | {"nis_dim": 3}, read, read_before_step=True)
 
 
 def transitions(rows) -> list[tuple]:
@@ -151,21 +142,7 @@ def test_fmu_state_restores_mid_mission_bit_for_bit(fmi):
     f = Fmu("ModeManager", PARAMS, path=fmu_file("ModeManager", fmi))
     try:
         mission(f, 0, 400)  # t = 100 s, in DETERMINATION with a NIS average running
-        s = f.slave
-        get, put, ser, des, free = ((s.getFMUstate, s.setFMUstate, s.serializeFMUstate, s.deSerializeFMUstate,
-                                     s.freeFMUstate) if fmi == 2 else
-                                    (s.getFMUState, s.setFMUState, s.serializeFMUState, s.deserializeFMUState,
-                                     s.freeFMUState))
-        state = get()
-        blob = ser(state)
-        a = mission(f, 400, 600)
-        put(state)
-        b = mission(f, 400, 600)
-        restored = des(blob)
-        put(restored)
-        c = mission(f, 400, 600)
-        free(state)
-        free(restored)
+        a, b, c, _ = restored_runs(f, mission, 400, 600)
     finally:
         f.close()
     assert a == b == c and transitions([(0, DETERMINATION)] + a) == [(107.0, 3, 4), (133.0, 4, 0)]

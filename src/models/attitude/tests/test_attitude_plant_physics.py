@@ -15,6 +15,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from scfmu.fmu import Fmu
+from scfmu.metrics import attitude_matrix  # README: A(q) = (qw² − |qv|²) I + 2 qv qvᵀ − 2 qw [qv×]
 
 SUMMARY: list[str] = []
 
@@ -44,13 +45,6 @@ def inertia_matrix(p: dict) -> np.ndarray:
     return np.array([[p["inertia_xx"], p["inertia_xy"], p["inertia_xz"]],
                      [p["inertia_xy"], p["inertia_yy"], p["inertia_yz"]],
                      [p["inertia_xz"], p["inertia_yz"], p["inertia_zz"]]])
-
-
-def A_of_q(q) -> np.ndarray:
-    """README: A(q) = (qw² − |qv|²) I + 2 qv qvᵀ − 2 qw [qv×]."""
-    w, v = q[0], np.asarray(q[1:4])
-    sk = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
-    return (w * w - v @ v) * np.eye(3) + 2 * np.outer(v, v) - 2 * w * sk
 
 
 VEC = lambda f, name: np.array(f.get_reals([f"{name}_x", f"{name}_y", f"{name}_z"]))  # noqa: E731
@@ -350,7 +344,7 @@ def ref_model(p):
 
     def rhs(t, x, u, noise, eff):
         q, w, hw, tw = x[0:4], x[4:7], x[7:10], x[10:13]
-        A = A_of_q(q)
+        A = attitude_matrix(q)
         uu = p.get("orbit_arg_lat0", 0.0) + n * t
         r = np.array([math.cos(uu), math.sin(uu) * math.cos(inc), math.sin(uu) * math.sin(inc)])
         BR = M_E / R_ORB**3 * (np.array([0, 0, 1.0]) - 3 * r[2] * r)

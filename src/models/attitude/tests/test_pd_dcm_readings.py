@@ -10,15 +10,9 @@ import pytest
 
 from quat_oracle import qconj, qmul
 from scfmu.fmu import Fmu
+from scfmu.metrics import attitude_matrix  # A(q), v_B = A v_R (numpy, tested against SciPy)
 
 K = np.array([1000.0, 500.0, 700.0])  # wn = 1: k = I
-
-
-def attitude_matrix(q):
-    """Inertial → body attitude matrix of a scalar-first unit quaternion (Shuster/Markley form)."""
-    w, v = q[0], np.asarray(q[1:])
-    vx = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
-    return (w * w - v @ v) * np.eye(3) + 2 * np.outer(v, v) - 2 * w * vx
 
 
 def oracle(reading: int, q, qr):

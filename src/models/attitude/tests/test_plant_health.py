@@ -17,7 +17,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from scfmu.fmu import Fmu, fmu_path
+from fmu_drive import fmu_file
+from scfmu.fmu import Fmu
 
 AX = "xyz"
 VEC = lambda f, n: np.array(f.get_reals([f"{n}_{a}" for a in AX]))  # noqa: E731
@@ -31,8 +32,7 @@ TRANSIENT = {**{f"inertia_{a}{a}": J for a in AX}, **{f"u_max_{a}": 10.0 for a i
 
 
 def plant(params: dict, fmi: int = 2, interface: str = "cs") -> Fmu:
-    path = fmu_path("AttitudePlant") if fmi == 2 else fmu_path("AttitudePlant").parent / "fmi3" / "AttitudePlant.fmu"
-    return Fmu("AttitudePlant", params, path=path, interface=interface, me_method="RK4", me_max_step=0.01)
+    return Fmu("AttitudePlant", params, path=fmu_file("AttitudePlant", fmi), interface=interface, me_method="RK4", me_max_step=0.01)
 
 
 @pytest.mark.parametrize("fmi,interface", [(2, "cs"), (3, "cs"), (2, "me"), (3, "me")])

@@ -13,19 +13,13 @@ import numpy as np
 import pytest
 
 from scfmu.fmu import Fmu
+from scfmu.metrics import attitude_matrix  # A(q), v_B = A v_R (numpy, tested against SciPy)
 
 J = np.array([1000.0, 500.0, 700.0])  # the plant's and the controller's default inertia
 WN, ZETA = 0.1, 0.9  # the controller's defaults
 K, C = 2 * WN ** 2 * J, 2 * ZETA * WN * J
 INPUTS = ["w_meas_x", "w_meas_y", "w_meas_z", "sun_meas_x", "sun_meas_y", "sun_meas_z", "sun_valid"]
 TORQUE = ["torque_cmd_x", "torque_cmd_y", "torque_cmd_z"]
-
-
-def attitude_matrix(q):
-    """Inertial → body attitude matrix of a scalar-first unit quaternion."""
-    w, v = q[0], np.asarray(q[1:])
-    vx = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
-    return (w * w - v @ v) * np.eye(3) + 2 * np.outer(v, v) - 2 * w * vx
 
 
 def closed_form(a, s, w, valid, spin=0.0):

@@ -19,19 +19,13 @@ from scipy.integrate import solve_ivp
 
 from quat_oracle import qconj, qmul
 from scfmu.fmu import Fmu
+from scfmu.metrics import attitude_matrix  # A(q), v_B = A v_R (numpy, tested against SciPy)
 
 MU = 3.986004418e14
 A_SMA, ECC = 8.0e6, 0.1  # perigee 7200 km
 INC, RAAN, ARGP = math.radians(51.6), math.radians(30.0), math.radians(40.0)
 N_MEAN = math.sqrt(MU / A_SMA ** 3)
 J = np.array([1000.0, 500.0, 700.0])
-
-
-def attitude_matrix(q):
-    """Inertial → body attitude matrix of a scalar-first unit quaternion."""
-    w, v = q[0], np.asarray(q[1:])
-    vx = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
-    return (w * w - v @ v) * np.eye(3) + 2 * np.outer(v, v) - 2 * w * vx
 
 
 def rot3(a):

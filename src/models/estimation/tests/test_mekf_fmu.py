@@ -14,6 +14,7 @@ import zipfile
 import numpy as np
 import pytest
 
+from fmu_drive import drive as drive_unit, fmu_file, restored_runs
 from scfmu.fmu import Fmu, fmu_path
 
 QN = ("w", "x", "y", "z")
@@ -44,15 +45,14 @@ def inputs(k: int, rng_seed: int = 1):
     return w_meas, q_st
 
 
+IN = [f"w_meas_{a}" for a in AX] + [f"q_meas_{a}" for a in QN]
+OUT = [*(f"q_est_{a}" for a in QN), *(f"p_att_{a}" for a in AX), *(f"bias_est_{a}" for a in AX), "nis"]
+
+
 def drive(f: Fmu, k0: int, k1: int) -> np.ndarray:
-    out = []
-    names = [*(f"q_est_{a}" for a in QN), *(f"p_att_{a}" for a in AX), *(f"bias_est_{a}" for a in AX), "nis"]
-    for k in range(k0, k1):
-        w, q = inputs(k)
-        f.set_reals([f"w_meas_{a}" for a in AX] + [f"q_meas_{a}" for a in QN], [*w, *q])
-        f.do_step(k * T, T)
-        out.append(f.get_reals(names))
-    return np.array(out)
+    """Samples k0..k1-1 of the independent truth: the outputs after each step, one row per sample."""
+    return np.array(drive_unit(f, k0, k1, T, lambda k: dict(zip(IN, np.concatenate(inputs(k)))),
+                               lambda f, t: f.get_reals(OUT)))
 
 
 @pytest.mark.parametrize("st_latency", [0.0, 0.1])
@@ -60,25 +60,10 @@ def drive(f: Fmu, k0: int, k1: int) -> np.ndarray:
 def test_fmu_state_restore_mid_run_is_bit_identical(fmi, st_latency):
     """With st_latency = 0.1 s the state carries the delay history of 11 samples (estimates, covariances,
     transitions): restored, the delayed updates continue bit for bit."""
-    path = fmu_path("Mekf") if fmi == 2 else fmu_path("Mekf").parent / "fmi3" / "Mekf.fmu"
-    f = Fmu("Mekf", {"sigma_bias_init": 1e-4, "st_latency": st_latency}, path=path)
+    f = Fmu("Mekf", {"sigma_bias_init": 1e-4, "st_latency": st_latency}, path=fmu_file("Mekf", fmi))
     try:
         drive(f, 0, 300)
-        s = f.slave
-        get, put, ser, des, free = ((s.getFMUstate, s.setFMUstate, s.serializeFMUstate, s.deSerializeFMUstate,
-                                     s.freeFMUstate) if fmi == 2 else
-                                    (s.getFMUState, s.setFMUState, s.serializeFMUState, s.deserializeFMUState,
-                                     s.freeFMUState))
-        state = get()
-        blob = ser(state)
-        a = drive(f, 300, 500)
-        put(state)
-        b = drive(f, 300, 500)
-        restored = des(blob)
-        put(restored)
-        c = drive(f, 300, 500)
-        free(state)
-        free(restored)
+        a, b, c, blob = restored_runs(f, drive, 300, 500)
     finally:
         f.close()
     assert np.array_equal(a, b) and np.array_equal(a, c)

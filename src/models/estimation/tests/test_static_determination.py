@@ -27,18 +27,13 @@ import pytest
 from ahrs.filters import QUEST, TRIAD, Davenport
 from fmpy.fmi1 import FMICallException
 
-from scfmu.fmu import Fmu, fmu_path
+from fmu_drive import fmu_file
+from scfmu.fmu import Fmu
+from scfmu.metrics import attitude_matrix  # A(q), v_B = A v_R (numpy, tested against SciPy)
 
 TOL = 1e-9
 N_CASES = 40
 AX = "xyz"
-
-
-def attitude_matrix(q):
-    """A(q), v_B = A v_R, scalar-first q (the project's convention, written here independently)."""
-    w, v = q[0], np.asarray(q[1:])
-    vx = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
-    return (w * w - v @ v) * np.eye(3) + 2 * np.outer(v, v) - 2 * w * vx
 
 
 def random_quaternion(rng):
@@ -54,11 +49,6 @@ def qdist(q, p):
 
 def conj(q):
     return np.array([q[0], -q[1], -q[2], -q[3]])
-
-
-def fmu_file(model: str, fmi: int):
-    p = fmu_path(model)
-    return p if fmi == 2 else p.parent / "fmi3" / p.name
 
 
 class Unit:
