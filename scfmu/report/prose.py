@@ -39,7 +39,7 @@ DATA_FILES = ("report.md", "numbers.csv", "doc_tables.json")
 
 _BLOCK = re.compile(r"<!-- (numbers|table:[A-Za-z0-9_.-]+|timings):begin.*?<!-- \1:end -->", re.S)
 _OTHER = re.compile(r"<!-- prose: from (.*?) -->.*?<!-- prose:end -->", re.S)
-_CHECKED = re.compile(r"<!-- prose: checked against (.*?) -->(.*?)<!-- prose:end -->", re.S)
+_CHECKED = re.compile(r"(?<!`)<!-- prose: checked against ([^`\n>]*?) -->(.*?)<!-- prose:end -->", re.S)
 _PAIR = re.compile(r"(?<![\w.])(\d+(?:\.\d+)?)(?:[^\d;:|()\n]{0,24}?\s)?(?:at|for) "
                    r"([A-Za-zΔθλμκσΦτ][\w]{0,8}) = -?(\d+(?:\.\d+)?)(?![\w]|\.\d)")
 _RUNS = re.compile(r"(?<![\w.])(\d+(?:\.\d+)?)(?:[^\d;:|()\n]{0,24}?\s)?(?:for|over|in) (\d+) (runs|samples|points)\b")
