@@ -13,8 +13,10 @@ A part of a page that documents the models or a paper's settings says where its 
 ``<!-- prose: checked against PATH[, PATH …] -->`` … ``<!-- prose:end -->``: its numbers must be the report's or
 numbers of those files of the repository (``modelDescription/<Model>.xml``: every variable's start, min, max
 and value reference, i.e. the FMUs' declarations; ``.py``: the numeric literals of the module; ``.json``,
-``.csv``: every number of the data). A part fenced with ``<!-- prose: from <command> -->`` … ``<!-- prose:end
--->`` records another command's output and is not checked; the test lists those parts.
+``.csv``: every number of the data; the value of a variable declared in rad also in degrees). In such a part
+a parameter table's row ``| `kp`, `ki`, `kd` | 2, 0.1, 8 |`` is checked name by name: each default must be
+that variable's declared start. A part fenced with ``<!-- prose: from <command> -->`` … ``<!-- prose:end -->``
+records another command's output and is not checked; no page has one now, and a test keeps it so.
 
 Pairs. A number written with the setting it holds at (``105.4 at s = 2.62``, ``0.0125 for c = 25``) must
 have both numbers in one row of the data (a line of the report, a ``numbers.csv`` row, a line of a
@@ -38,7 +40,7 @@ PAGES = ("docs/paper000.md", "docs/paper001.md", "docs/paper002.md", "docs/paper
 DATA_FILES = ("report.md", "numbers.csv", "doc_tables.json")
 
 _BLOCK = re.compile(r"<!-- (numbers|table:[A-Za-z0-9_.-]+|timings):begin.*?<!-- \1:end -->", re.S)
-_OTHER = re.compile(r"<!-- prose: from (.*?) -->.*?<!-- prose:end -->", re.S)
+_OTHER = re.compile(r"(?<!`)<!-- prose: from (.*?) -->.*?<!-- prose:end -->", re.S)
 _CHECKED = re.compile(r"(?<!`)<!-- prose: checked against ([^`\n>]*?) -->(.*?)<!-- prose:end -->", re.S)
 _PAIR = re.compile(r"(?<![\w.])(\d+(?:\.\d+)?)(?:[^\d;:|()\n]{0,24}?\s)?(?:at|for) "
                    r"([A-Za-zΔθλμκσΦτ][\w]{0,8}) = -?(\d+(?:\.\d+)?)(?![\w]|\.\d)")
@@ -151,8 +153,7 @@ def file_rows(root: Path, name: str) -> list[set[float]]:
         raise FileNotFoundError(f"prose: checked against {name}: no such file under {root}")
     text = path.read_text(encoding="utf-8")
     if path.suffix == ".xml":
-        attrs = re.compile(r'\b(?:start|min|max|nominal|valueReference)="([^"]*)"')
-        return [values(" ".join(attrs.findall(v))) for v in re.split(r"<(?:ScalarVariable|Float64|Int32|Boolean)\b", text)]
+        return [_variable_values(v) for v in re.split(r"<(?:ScalarVariable|Float64|Int32|Boolean)\b", text)]
     if path.suffix == ".py":
         import ast
         lines: dict[int, set[float]] = {}
@@ -161,6 +162,15 @@ def file_rows(root: Path, name: str) -> list[set[float]]:
                 lines.setdefault(node.lineno, set()).add(abs(float(node.value)))
         return list(lines.values())
     return [values(line) for line in text.splitlines()]
+
+
+def _variable_values(xml: str) -> set[float]:
+    """A declared variable's start, min, max, nominal and value reference; in degrees too when its unit is rad."""
+    import math
+    v = values(" ".join(re.findall(r'\b(?:start|min|max|nominal)="([^"]*)"', xml)))
+    if re.search(r'\bunit="rad(?:/s)?"', xml):
+        v |= {math.degrees(x) for x in v}
+    return v | values(" ".join(re.findall(r'\bvalueReference="([^"]*)"', xml)))
 
 
 def scoped_values(dirs: list[Path]) -> dict:
@@ -203,6 +213,46 @@ def unpaired(text: str, rows: list[set[float]]) -> list[str]:
             if not any(matches(x, r) and matches(y, r) for r in rows)]
 
 
+def declared_starts(root: Path, files: list[str]) -> dict[str, set[float]]:
+    """{variable name: its declared start (and in degrees when the unit is rad)} of the modelDescription files."""
+    out: dict[str, set[float]] = {}
+    for f in files:
+        if f.endswith(".xml"):
+            for v in re.split(r"<(?:ScalarVariable|Float64|Int32|Boolean)\b", (Path(root) / f).read_text(encoding="utf-8")):
+                m = re.search(r'\bname="([^"]+)"', v)
+                if m and 'start="' in v:
+                    out.setdefault(m.group(1), set()).update(_variable_values(re.sub(r'\b(?:min|max|nominal|valueReference)="[^"]*"', "", v)))
+    return out
+
+
+def _names(cell: str) -> list[str]:
+    """The parameter names a table cell gives in code marks; ``inertia_xx/yy/zz`` is three names."""
+    out = []
+    for n in re.findall(r"`([A-Za-z_][\w/]*)`", cell):
+        head, *tails = n.split("/")
+        stem = head.rsplit("_", 1)[0] + "_" if tails and "_" in head else ""
+        out += [head] + [stem + t for t in tails]
+    return out
+
+
+def wrong_defaults(body: str, starts: dict[str, set[float]]) -> list[str]:
+    """Rows ``| `name`, … | default, … |`` of a parameter table whose defaults are not the declared starts, name by
+    name (a row whose names are not all declared variables is not a parameter row)."""
+    bad = []
+    for line in body.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) < 2 or not line.lstrip().startswith("|"):
+            continue
+        names = _names(cells[0])
+        nums = _NUM.findall(cells[1].replace("−", "-"))
+        if not names or not all(n in starts for n in names) or len(nums) not in (1, len(names)):
+            continue
+        for n, t in zip(names, nums * len(names) if len(nums) == 1 else nums):
+            if not matches(t, starts[n]):
+                bad.append(f"{n} = {t}")
+    return bad
+
+
 def check_text(text: str, vals: set[float], rows: list[set[float]], root: Path) -> list[str]:
     """The numbers of a page that are not in the data, and its pairs that share no row; the parts checked against
     files also against those files."""
@@ -212,6 +262,7 @@ def check_text(text: str, vals: set[float], rows: list[set[float]], root: Path) 
         v2 = vals.union(*frows)
         bad += [t for t in _NUM.findall(prose(body).replace("−", "-")) if not matches(t, v2)]
         bad += unpaired(body, rows + frows)
+        bad += wrong_defaults(body, declared_starts(root, files))
     return bad
 
 
