@@ -75,8 +75,8 @@ def test_a_number_not_in_the_named_files_fails():
     bad = _check("docs/sensing.md", _broken("docs/sensing.md", "τ_c = 300 s", "τ_c = 350 s"))
     assert bad == ["350"]
     with pytest.raises(FileNotFoundError):
-        _check("docs/paper004.md", _broken("docs/paper004.md", "checked against scfmu/papers/paper004/tests/test_paper004.py",
-                                           "checked against scfmu/papers/paper004/tests/no_such_file.py"))
+        _check("docs/paper004.md", _broken("docs/paper004.md", "paper004/tests/test_paper004.py -->",
+                                           "paper004/tests/no_such_file.py -->"))
 
 
 def test_the_tuning_block_is_the_committed_tuning():

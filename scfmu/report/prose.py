@@ -216,12 +216,13 @@ def unpaired(text: str, rows: list[set[float]]) -> list[str]:
 def declared_starts(root: Path, files: list[str]) -> dict[str, set[float]]:
     """{variable name: its declared start (and in degrees when the unit is rad)} of the modelDescription files."""
     out: dict[str, set[float]] = {}
-    for f in files:
-        if f.endswith(".xml"):
-            for v in re.split(r"<(?:ScalarVariable|Float64|Int32|Boolean)\b", (Path(root) / f).read_text(encoding="utf-8")):
-                m = re.search(r'\bname="([^"]+)"', v)
-                if m and 'start="' in v:
-                    out.setdefault(m.group(1), set()).update(_variable_values(re.sub(r'\b(?:min|max|nominal|valueReference)="[^"]*"', "", v)))
+    for f in (f for f in files if f.endswith(".xml")):
+        text = (Path(root) / f).read_text(encoding="utf-8")
+        for v in re.split(r"<(?:ScalarVariable|Float64|Int32|Boolean)\b", text):
+            m = re.search(r'\bname="([^"]+)"', v)
+            if m and 'start="' in v:
+                start = re.sub(r'\b(?:min|max|nominal|valueReference)="[^"]*"', "", v)
+                out.setdefault(m.group(1), set()).update(_variable_values(start))
     return out
 
 

@@ -122,8 +122,9 @@ def tuning_table(path=None) -> Table:
     rows = []
     for c in NAMES:
         r, g = ctl[c], ctl[c]["gains"]
+        per_run = r["run_seconds"] / r["evaluations"]
         rows.append([c, *(f"{g[k]:.6g}" if k in g else "–" for k in ("kp", "ki", "kd", "lambda", "mu")),
-                     f"{r['cost']:.8g}", r["iterations"], r["evaluations"], f"{r['run_seconds'] / r['evaluations']:.2f}",
+                     f"{r['cost']:.8g}", r["iterations"], r["evaluations"], f"{per_run:.2f}",
                      "stall" if r["stall_rule_fired"] else r["stop"]])
     runs = sum(r["evaluations"] for r in ctl.values())
     run_s = sum(r["run_seconds"] for r in ctl.values())
@@ -132,7 +133,7 @@ def tuning_table(path=None) -> Table:
                  f"{d['total_seconds']:.0f} s wall, {run_s:.0f} s of runs"])
     return Table(f"The committed PSO tuning (finished {d['finished_utc'][:10]}): {s['particles']} particles, at most "
                  f"{s['max_iterations']} iterations, stall rule {s['stall']}, one Dask LocalCluster ({d['machine']}); "
-                 f"cost = MAE (deg) on the nominal {s['theta_ref_deg']:g}° step, {s['t_end_s']:g} s, h = {s['step_s']:g} s, "
-                 f"equal to the direct two-FMU loop's to {gap:.1e}",
+                 f"cost = MAE (deg) on the nominal {s['theta_ref_deg']:g}° step, {s['t_end_s']:g} s, "
+                 f"h = {s['step_s']:g} s, equal to the direct two-FMU loop's to {gap:.1e}",
                  ["controller", "K_P", "K_I", "K_D", "λ", "μ", "cost = MAE (deg)", "iterations", "runs",
                   "s per run", "stop"], rows)
