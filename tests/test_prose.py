@@ -58,11 +58,19 @@ def test_a_right_number_at_a_wrong_setting_fails():
     assert prose.unpaired(page, [{105.4, 2.62}, {9.1, 20.0}]) == ["105.4 at s = 5.2"]
 
 
+def test_a_table_row_with_a_wrong_setting_fails():
+    """A hand-written table row pairs its numbers: the MAE of the wheel time constant 0.4 s written on the 0.3 s row
+    fails, although every number of it is one the report prints."""
+    row = "| 002-4 | wheel_time_constant_s | 0.4 | 3.4796 | 3.4795 | 3.5073 | 3.5062 | PID |"
+    bad = _check("docs/paper002.md", _broken("docs/paper002.md", row, row.replace("| 0.4 |", "| 0.3 |")))
+    assert bad == ["row 0.3 3.4796 3.4795 3.5073 3.5062"]
+
+
 def test_a_wrong_parameter_default_fails():
     """A default in a checked parameter table is the declared start of that variable, name by name: K_D's 9 and the
     swapped inertia defaults fail although 9, 3.5 and 5.0 are numbers of the declarations."""
     bad = _check("docs/paper002.md", _broken("docs/paper002.md", "| 2, 0.1, 8 |", "| 2, 0.1, 9 |"))
-    assert bad == ["kd = 9"]
+    assert bad == ["row 2 0.1 9", "kd = 9"]
     bad = _check("docs/paper003.md", _broken("docs/paper003.md", "| 4.0, 5.0, 3.5 |", "| 4.0, 3.5, 5.0 |"))
     assert bad == ["inertia_yy = 3.5", "inertia_zz = 5.0"]
 

@@ -21,7 +21,8 @@ records another command's output and is not checked; no page has one now, and a 
 Pairs. A number written with the setting it holds at (``105.4 at s = 2.62``, ``0.0125 for c = 25``) must
 have both numbers in one row of the data (a line of the report, a ``numbers.csv`` row, a line of a
 generated table, a line or a declared variable of a named file, or a row of the recorded full build), so a
-right number with a wrong setting fails although each number alone is one the report prints.
+right number with a wrong setting fails although each number alone is one the report prints. A row of a
+hand-written table pairs its numbers the same way: they must share one row of the data.
 
   python -m scfmu.report.prose OUT [OUT2 …] --pages docs/paper000.md …   # the unmatched numbers per page
   python -m scfmu.report.prose OUT --values > tests/data/report_full_values.json   # record a full build
@@ -213,6 +214,17 @@ def unpaired(text: str, rows: list[set[float]]) -> list[str]:
             if not any(matches(x, r) and matches(y, r) for r in rows)]
 
 
+def unrowed(text: str, rows: list[set[float]]) -> list[str]:
+    """The rows of a hand-written table (two numbers or more) whose numbers share no row of the data: a table row
+    pairs its numbers as "X at s = Y" does."""
+    bad = []
+    for line in prose(text).replace("−", "-").splitlines():
+        toks = _NUM.findall(line) if line.lstrip().startswith("|") else []
+        if len(toks) > 1 and not any(all(matches(t, r) for t in toks) for r in rows):
+            bad.append("row " + " ".join(toks))
+    return bad
+
+
 def declared_starts(root: Path, files: list[str]) -> dict[str, set[float]]:
     """{variable name: its declared start (and in degrees when the unit is rad)} of the modelDescription files."""
     out: dict[str, set[float]] = {}
@@ -257,12 +269,12 @@ def wrong_defaults(body: str, starts: dict[str, set[float]]) -> list[str]:
 def check_text(text: str, vals: set[float], rows: list[set[float]], root: Path) -> list[str]:
     """The numbers of a page that are not in the data, and its pairs that share no row; the parts checked against
     files also against those files."""
-    bad = unmatched(text, vals) + unpaired(text, rows)
+    bad = unmatched(text, vals) + unpaired(text, rows) + unrowed(text, rows)
     for files, body in checked_parts(text):
         frows = [r for f in files for r in file_rows(root, f)]
         v2 = vals.union(*frows)
         bad += [t for t in _NUM.findall(prose(body).replace("−", "-")) if not matches(t, v2)]
-        bad += unpaired(body, rows + frows)
+        bad += unpaired(body, rows + frows) + unrowed(body, rows + frows)
         bad += wrong_defaults(body, declared_starts(root, files))
     return bad
 
