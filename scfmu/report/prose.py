@@ -279,9 +279,10 @@ def check_text(text: str, vals: set[float], rows: list[set[float]], root: Path) 
     return bad
 
 
-def check(pages, dirs: list[Path], recorded: dict | None = None, root: Path | None = None) -> dict[str, list[str]]:
+def check(pages, dirs: list[Path], recorded: dict | None = None, root: Path = Path(".")) -> dict[str, list[str]]:
     """{page: numbers of its prose that are not in its part of the builds' data (or of the recorded data, or of
-    the files a part names), and pairs that share no row}."""
+    the files a part names, relative to the repository's folder ``root``), and pairs and table rows that share no
+    row}."""
     out = {}
     for p in pages:
         sc = scope_of(str(p))
@@ -292,8 +293,7 @@ def check(pages, dirs: list[Path], recorded: dict | None = None, root: Path | No
             rows += build_rows(d, sc)
         vals |= set((recorded or {}).get(sc or "all", []))
         rows += [set(r) for r in (recorded or {}).get("rows", {}).get(sc or "all", [])]
-        r = Path(root) if root else Path(p).resolve().parents[1]
-        out[str(p)] = check_text(Path(p).read_text(encoding="utf-8"), vals, rows, r)
+        out[str(p)] = check_text(Path(p).read_text(encoding="utf-8"), vals, rows, Path(root))
     return out
 
 
