@@ -433,7 +433,7 @@ def test_report_quick_end_to_end(tmp_path):
     # every number written by hand in the report's pages is one the report prints (this build's data, or the last
     # full build's, recorded), at its written precision; parts recording another command's output say so
     recorded = json.loads(FULL_VALUES.read_text(encoding="utf-8"))
-    bad = prose.check([ROOT / n for n in prose.PAGES], [out], recorded)
+    bad = prose.check([ROOT / n for n in prose.PAGES], [out], recorded, ROOT)
     assert not any(bad.values()), f"numbers of the pages' prose that are not the report's: {bad}"
     # the claims the issue names, as classified on the data written
     assert quick["claims"]["C000-3"] == quick["claims"]["C004-4"] == BY_CONSTRUCTION_HOLDS

@@ -443,6 +443,6 @@ def build(ctx) -> PaperSection:
         setup=_setup(t_end, gtxt, len(R.sets)),
         claims=[c1, c2, _claim3(R, dg, dv, fig_sweeps), _claim4(R, dg, dv, fig_sweeps), _claim5(R, dg, dv, fig_sweeps)],
         notes=_notes(ctx.quick),
-        runtime_s=time.time() - t0, doc_tables={"printed": tab_pg},
+        runtime_s=time.time() - t0, doc_tables={"printed": tab_pg, "tuning": report_tables.tuning_table()},
         numbers=gain_rows(gains, common.reported("scfmu.papers.paper002")),
         calibrations=CALIBRATIONS)

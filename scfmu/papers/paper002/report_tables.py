@@ -110,3 +110,30 @@ def sweep_table(pl: dict, m: dict, kind: str, label: str) -> Table:
     """MAE of the four controllers (``m``: {controller: MAE per point}) along one sweep."""
     return Table(f"MAE (deg) against {label}", [label, *NAMES],
                  [[x, *(m[c][j] for c in NAMES)] for j, x in enumerate(pl[kind])], digits=5)
+
+
+def tuning_table(path=None) -> Table:
+    """The committed PSO tuning (paper002/data/gains.json, written by ``scfmu paper 002 tune``): the gains, cost,
+    iterations and runs of each swarm and the totals; the same in quick and full builds (it runs nothing)."""
+    import json
+    from .model import GAINS_FILE
+    d = json.loads((path or GAINS_FILE).read_text(encoding="utf-8"))
+    ctl, s = d["controllers"], d["setup"]
+    rows = []
+    for c in NAMES:
+        r, g = ctl[c], ctl[c]["gains"]
+        per_run = r["run_seconds"] / r["evaluations"]
+        rows.append([c, *(f"{g[k]:.6g}" if k in g else "–" for k in ("kp", "ki", "kd", "lambda", "mu")),
+                     f"{r['cost']:.8g}", r["iterations"], r["evaluations"], f"{per_run:.2f}",
+                     "stall" if r["stall_rule_fired"] else r["stop"]])
+    runs = sum(r["evaluations"] for r in ctl.values())
+    run_s = sum(r["run_seconds"] for r in ctl.values())
+    gap = max(abs(r["cost"] - r["cost_direct_loop"]) for r in ctl.values())
+    rows.append(["all four", "", "", "", "", "", "", "", runs, f"{run_s / runs:.2f}",
+                 f"{d['total_seconds']:.0f} s wall, {run_s:.0f} s of runs"])
+    return Table(f"The committed PSO tuning (finished {d['finished_utc'][:10]}): {s['particles']} particles, at most "
+                 f"{s['max_iterations']} iterations, stall rule {s['stall']}, one Dask LocalCluster ({d['machine']}); "
+                 f"cost = MAE (deg) on the nominal {s['theta_ref_deg']:g}° step, {s['t_end_s']:g} s, "
+                 f"h = {s['step_s']:g} s, equal to the direct two-FMU loop's to {gap:.1e}",
+                 ["controller", "K_P", "K_I", "K_D", "λ", "μ", "cost = MAE (deg)", "iterations", "runs",
+                  "s per run", "stop"], rows)
