@@ -51,7 +51,7 @@ TIPOFF_ATTITUDE = (0.7, -0.4, 2.1)  # 321 angles at separation [rad]
 # (wn sin(θ/2) / ζ ≤ 0.033 rad/s = 1.9 deg/s, the balance of its two terms), so that acquiring the sun from behind
 # does not read as tumbling; a fault flag held 2 s before it counts
 MANAGER = {"sample_period": 1.0, "sun_axis_x": 1.0, "sun_axis_y": 0.0, "sun_axis_z": 0.0,
-           "rate_tumbling": math.radians(3.0), "fault_confirm_time": 2.0}
+           "rate_tumbling": math.radians(3.0), "fault_confirm_time": 2.0, "nis_source": 1}
 SAFE_LAW = {"wn": 0.03, "zeta": 0.9, "sun_axis_x": 1.0, "sun_axis_y": 0.0, "sun_axis_z": 0.0}
 GYRO = {**GYRO_DEFAULT, "sample_period": STEP}
 SUN_SENSOR = {"sample_period": STEP, "noise": 1.745e-3, "fov": math.pi, "shadow": 1, "mount_y": math.pi / 2,

@@ -19,6 +19,8 @@ declare_variables! {
         12 => actuator_fault: Real = 0.0, Input, "", "Actuator health flag (>= 0.5: fault; from the plant or a fault detector)";
         13 => recover: Real = 0.0, Input, "", "Ground command: leave SAFE (>= 0.5)";
         14 => safe_request: Real = 0.0, Input, "", "Ground command: enter SAFE (>= 0.5)";
+        15 => nis_sum: Real = 0.0, Input, "", "Running sum of the estimator's NIS since its start (the Mekf's nis_sum; read when nis_source = 1)";
+        16 => nis_dim_sum: Real = 0.0, Input, "", "Running sum of the innovation dimensions (the Mekf's nis_dim_sum; read when nis_source = 1)";
         20 => mode: Integer = 1, Output, "", "Mode: 0 SAFE, 1 DETUMBLE, 2 SUN_ACQUISITION, 3 DETERMINATION, 4 FINE_POINTING (held between samples)";
         21 => time_in_mode: Real = 0.0, Output, "s", "Time in the mode at the last sample";
         22 => mode_changes: Integer = 0, Output, "", "Number of mode changes since the start";
@@ -49,6 +51,7 @@ declare_variables! {
         117 => init_duration: Real = 1.0, Parameter, "s", "Duration of estimator_init = 1 after the entry into DETERMINATION", NonNegative;
         120 => initial_mode: Integer = 1, Parameter, "", "Mode at the start: 0 SAFE, 1 DETUMBLE, 2 SUN_ACQUISITION, 3 DETERMINATION, 4 FINE_POINTING", Choice(super::modes::Mode::CODES);
         121 => safe_on_divergence: Integer = 1, Parameter, "", "1 = FINE_POINTING goes to SAFE when sigma_att > sigma_diverged or nis_avg > nis_diverged; 0 = not", Choice(SWITCH);
+        122 => nis_source: Integer = 0, Parameter, "", "0 = nis and nis_dim of the estimator's current sample; 1 = the increments of nis_sum and nis_dim_sum since the last sample (no update is missed whatever the master's order or coupling delay)", Choice(SWITCH);
     }
 }
 
@@ -59,19 +62,24 @@ pub struct ModeManager {
     k0: i64,
     /// Index of the next sample to take.
     next: i64,
+    /// (nis_sum, nis_dim_sum) at the last sample taken (nis_source = 1).
+    seen: (f64, f64),
     /// Mode changes of the last step, for the log.
     #[serde(skip)]
     log: Vec<String>,
 }
 
-fn inputs(v: &ModeManagerVars) -> Result<Inputs, String> {
+/// The law's inputs; with nis_source = 1, the NIS and dimension are the running sums' increments since
+/// `seen` (the sums at the last sample taken).
+fn inputs(v: &ModeManagerVars, seen: (f64, f64)) -> Result<Inputs, String> {
+    let (nis, nis_dim) = if v.nis_source == 1 { increments(v, seen)? } else { (v.nis, v.nis_dim) };
     let u = Inputs {
         w_meas: v.w_meas,
         sun_valid: v.sun_valid,
         sun_meas: v.sun_meas,
         p_att: v.p_att,
-        nis: v.nis,
-        nis_dim: v.nis_dim,
+        nis,
+        nis_dim,
         actuator_fault: v.actuator_fault,
         recover: v.recover,
         safe_request: v.safe_request,
@@ -80,12 +88,23 @@ fn inputs(v: &ModeManagerVars) -> Result<Inputs, String> {
     Ok(u)
 }
 
+fn increments(v: &ModeManagerVars, seen: (f64, f64)) -> Result<(f64, i32), String> {
+    let (dn, dd) = (v.nis_sum - seen.0, v.nis_dim_sum - seen.1);
+    if !(dn.is_finite() && dd.is_finite()) || dd < 0.0 || dd != dd.round() || dd > f64::from(i32::MAX) || (dd > 0.0 && dn < -1e-9 * v.nis_sum.abs().max(1.0)) {
+        return Err(format!(
+            "inputs nis_sum = {}, nis_dim_sum = {} after {} and {} at the last sample: running sums that do not decrease (whole dimensions) are expected (are they connected to the Mekf's nis_sum and nis_dim_sum?)",
+            v.nis_sum, v.nis_dim_sum, seen.0, seen.1
+        ));
+    }
+    Ok((dn.max(0.0), dd as i32))
+}
+
 impl Model for ModeManager {
     type Vars = ModeManagerVars;
     fn time_grid(v: &ModeManagerVars) -> Option<f64> {
         Some(v.sample_period)
     }
-    const EVOLVING: &'static [&'static str] = &["law.s", "next"];
+    const EVOLVING: &'static [&'static str] = &["law.s", "next", "seen"];
     const INFO: ModelInfo = ModelInfo {
         name: "ModeManager",
         description: "ADCS mode manager: SAFE, DETUMBLE, SUN_ACQUISITION, DETERMINATION and FINE_POINTING with prioritised transitions, hysteresis bands, a dwell time and fault confirmation; selects the torque and dipole laws, enables the pointing controller and re-initialises the estimator; sampled at its own rate, each mode change logged",
@@ -119,14 +138,14 @@ impl Model for ModeManager {
         };
         let k0 = sample_index(exp.start_time, v.sample_period)?;
         let law = ModeLogic::new(p, v.initial_mode, k0 as f64 * v.sample_period)?;
-        Ok(ModeManager { law, k0, next: k0, log: Vec::new() })
+        Ok(ModeManager { law, k0, next: k0, seen: (v.nis_sum, v.nis_dim_sum), log: Vec::new() })
     }
 
     fn outputs(&self, v: &mut ModeManagerVars, t: f64) -> ModelResult {
         // a sample due at t and not taken yet is computed from the current input (not latched)
         let mut law = self.law.clone();
         if sample_index(t, self.law.p.period)? >= self.next {
-            law.sample(self.next as f64 * self.law.p.period, &inputs(v)?);
+            law.sample(self.next as f64 * self.law.p.period, &inputs(v, self.seen)?);
         }
         let (s, sel) = (&law.s, law.selection());
         v.mode = s.mode.code();
@@ -156,14 +175,20 @@ impl Model for ModeManager {
         if n < 0 {
             return Ok(());
         }
-        let u = inputs(v)?;
+        let mut u = inputs(v, self.seen)?;
         let mut law = self.law.clone();
         let mut lines = vec![];
         for k in self.next..=k_end {
             let o = law.sample(k as f64 * period, &u);
             lines.extend(law.describe(&o));
+            if v.nis_source == 1 {
+                (u.nis, u.nis_dim) = (0.0, 0); // the increments count once, at the step's first sample
+            }
         }
         (self.law, self.next) = (law, k_end + 1);
+        if v.nis_source == 1 {
+            self.seen = (v.nis_sum, v.nis_dim_sum);
+        }
         self.log.extend(lines);
         Ok(())
     }

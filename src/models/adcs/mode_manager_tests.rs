@@ -71,3 +71,42 @@ fn bad_inputs_and_parameters_are_refused_by_name() {
     let e = f.initialize(&Experiment::default()).unwrap_err();
     assert!(e.contains("sun_angle_acquired") && e.contains("sun_angle_lost"), "{e}");
 }
+
+/// DETERMINATION with a converged covariance and the sun on its axis; the estimator updates at t = k + 0.5
+/// only (between the manager's samples, as a star tracker seen behind a coupling delay): the per-sample
+/// inputs nis/nis_dim are 0 at every sample, the running sums grow by 3 (dimension) and 3.0 (NIS) per update.
+fn determination_with_updates_between_samples(nis_source: i32) -> (i32, i32) {
+    let mut f = unit(|v| {
+        v.initial_mode = 3;
+        v.nis_source = nis_source;
+        v.p_att = Vector3::new(1e-8, 1e-8, 1e-8);
+        (v.sun_valid, v.sun_meas) = (1.0, Vector3::new(1.0, 0.0, 0.0));
+    });
+    let h = 0.5;
+    for n in 0..60 {
+        let t = n as f64 * h;
+        f.outputs(t).unwrap();
+        f.step(t, h).unwrap();
+        if n % 2 == 0 {
+            (f.v.nis_sum, f.v.nis_dim_sum) = (f.v.nis_sum + 3.0, f.v.nis_dim_sum + 3.0); // the update at t + 0.5
+        }
+    }
+    f.outputs(30.0).unwrap();
+    (f.v.mode, f.v.last_reason)
+}
+
+#[test]
+fn running_sums_see_every_update_the_per_sample_inputs_miss() {
+    assert_eq!(determination_with_updates_between_samples(0), (3, 0), "no update at any sample: no NIS, no hand-over");
+    assert_eq!(determination_with_updates_between_samples(1), (4, 11), "NIS/dim = 1 < nis_max: CONVERGED");
+}
+
+#[test]
+fn a_running_sum_that_decreases_is_refused() {
+    let mut f = unit(|v| v.nis_source = 1);
+    f.v.nis_dim_sum = 6.0;
+    f.step(0.0, 1.0).unwrap();
+    f.v.nis_dim_sum = 3.0;
+    let e = f.step(1.0, 1.0).unwrap_err();
+    assert!(e.contains("running sums that do not decrease") && e.contains("nis_dim_sum = 3"), "{e}");
+}

@@ -46,6 +46,8 @@ declare_variables! {
         56 => innovation: Vec3 = [0.0; 3], Output, "rad", "Star-tracker innovation of the current sample: rotation vector from the predicted attitude (with st_latency > 0: the estimate of the measurement's sample) to the measured one (0 without a star-tracker update)";
         59 => nis: Real = 0.0, Output, "", "Normalized innovation squared of the current sample's updates, summed over them (0 without updates)";
         60 => nis_dim: Integer = 0, Output, "", "Innovation dimension of the current sample: 3 per star-tracker update + 2 per vector update (0 = no update)";
+        61 => nis_sum: Real = 0.0, Output, "", "Running sum of nis over every sample since the start (a consumer sampled at its own times, or behind a coupling delay, takes the increments and misses no update)";
+        62 => nis_dim_sum: Real = 0.0, Output, "", "Running sum of nis_dim over every sample since the start (a whole number)";
         100 => sample_period: Real = 0.01, Parameter, "s", "Sample period T of the filter (equal to the gyro's, so that each gyro sample is used once)", Range(1e-6, 1e4);
         101 => q_init: Quat = [1.0, 0.0, 0.0, 0.0], Parameter, "", "Initial attitude estimate (normalised; replaced by the first star-tracker measurement if init_from_star_tracker = 1)";
         105 => bias_init: Vec3 = [0.0; 3], Parameter, "rad/s", "Initial bias estimate", Range(-1.0, 1.0);
@@ -108,6 +110,9 @@ struct Est {
     innovation: Vector3<f64>,
     nis: f64,
     nis_dim: i32,
+    /// Running sums of nis and nis_dim over the samples since the start.
+    nis_sum: f64,
+    nis_dim_sum: f64,
     /// With a star-tracker latency: the filter after each of the last `delay` + 1 samples (the newest is
     /// this one), for the delayed update (`mekf_delay`).
     hist: VecDeque<delay::Entry>,
@@ -293,6 +298,7 @@ impl Mekf {
             self.delayed_star_update(&mut s, t, q_new)?;
         }
         s.w = v.w_meas;
+        (s.nis_sum, s.nis_dim_sum) = (s.nis_sum + s.nis, s.nis_dim_sum + f64::from(s.nis_dim));
         if !(s.q.coords.iter().all(|x| x.is_finite()) && s.p.iter().all(|x| x.is_finite())) {
             return Err(format!("the estimate became non-finite at sample {k}"));
         }
@@ -372,6 +378,8 @@ impl Model for Mekf {
             innovation: Vector3::zeros(),
             nis: 0.0,
             nis_dim: 0,
+            nis_sum: 0.0,
+            nis_dim_sum: 0.0,
             hist: VecDeque::new(),
         };
         Ok(Mekf { d, s })
@@ -391,6 +399,7 @@ impl Model for Mekf {
         v.innovation = s.innovation;
         v.nis = s.nis;
         v.nis_dim = s.nis_dim;
+        (v.nis_sum, v.nis_dim_sum) = (s.nis_sum, s.nis_dim_sum);
         Ok(())
     }
 
