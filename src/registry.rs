@@ -2,9 +2,8 @@
 //! this list concatenates the families. The C ABI's model lookup and the tests iterate over [`ALL`];
 //! `src/cdylib` exports it with [`EXTRAS`], and the packaging tool sees it only through that catalogue.
 
-use crate::export::Extras;
-pub use crate::export::Family;
-use crate::model::{concat, total_len, ModelEntry};
+pub use crate::model::Family;
+use crate::model::{concat, total_len, Extras, ModelEntry};
 use crate::models::{adcs, attitude, environment, estimation, formation, sensors, single_axis};
 
 /// The families, each a folder under `src/models/` and a page `docs/models/<slug>.md` (title and overview
