@@ -25,6 +25,7 @@ import re
 import numpy as np
 import pytest
 
+from fmu_state_replay import replay_three_ways
 from scfmu.fmu import Fmu, fmu_path
 
 AX = "xyz"
@@ -151,21 +152,7 @@ def test_fmu_state_restores_mid_mission_bit_for_bit(fmi):
     f = Fmu("ModeManager", PARAMS, path=fmu_file("ModeManager", fmi))
     try:
         mission(f, 0, 400)  # t = 100 s, in DETERMINATION with a NIS average running
-        s = f.slave
-        get, put, ser, des, free = ((s.getFMUstate, s.setFMUstate, s.serializeFMUstate, s.deSerializeFMUstate,
-                                     s.freeFMUstate) if fmi == 2 else
-                                    (s.getFMUState, s.setFMUState, s.serializeFMUState, s.deserializeFMUState,
-                                     s.freeFMUState))
-        state = get()
-        blob = ser(state)
-        a = mission(f, 400, 600)
-        put(state)
-        b = mission(f, 400, 600)
-        restored = des(blob)
-        put(restored)
-        c = mission(f, 400, 600)
-        free(state)
-        free(restored)
+        a, b, c, _ = replay_three_ways(f, fmi, lambda: mission(f, 400, 600))
     finally:
         f.close()
     assert a == b == c and transitions([(0, DETERMINATION)] + a) == [(107.0, 3, 4), (133.0, 4, 0)]

@@ -14,6 +14,7 @@ import zipfile
 import numpy as np
 import pytest
 
+from fmu_state_replay import replay_three_ways
 from scfmu.fmu import Fmu, fmu_path
 
 QN = ("w", "x", "y", "z")
@@ -64,21 +65,7 @@ def test_fmu_state_restore_mid_run_is_bit_identical(fmi, st_latency):
     f = Fmu("Mekf", {"sigma_bias_init": 1e-4, "st_latency": st_latency}, path=path)
     try:
         drive(f, 0, 300)
-        s = f.slave
-        get, put, ser, des, free = ((s.getFMUstate, s.setFMUstate, s.serializeFMUstate, s.deSerializeFMUstate,
-                                     s.freeFMUstate) if fmi == 2 else
-                                    (s.getFMUState, s.setFMUState, s.serializeFMUState, s.deserializeFMUState,
-                                     s.freeFMUState))
-        state = get()
-        blob = ser(state)
-        a = drive(f, 300, 500)
-        put(state)
-        b = drive(f, 300, 500)
-        restored = des(blob)
-        put(restored)
-        c = drive(f, 300, 500)
-        free(state)
-        free(restored)
+        a, b, c, blob = replay_three_ways(f, fmi, lambda: drive(f, 300, 500))
     finally:
         f.close()
     assert np.array_equal(a, b) and np.array_equal(a, c)
