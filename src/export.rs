@@ -74,39 +74,14 @@ pub use crate::catalogue::{
 };
 pub use crate::math;
 pub use crate::model::{
-    check, check_derived, check_finite_state, Bound, Causality, Experiment, Feedthrough, Fmu, Model, ModelEntry,
-    ModelInfo, ModelResult, ParamEnum, Start, StateDecl, VarDecl, VarKind, Variability, Variables, DERIVATIVE_VR_BASE,
-    RESERVED_VR_START, STATE_VR_BASE, SWITCH,
+    check, check_derived, check_finite_state, Bound, Causality, Experiment, Extras, Family, Feedthrough, Fmu, Model,
+    ModelEntry, ModelInfo, ModelResult, ParamEnum, Start, StateDecl, VarDecl, VarKind, Variability, Variables,
+    DERIVATIVE_VR_BASE, RESERVED_VR_START, STATE_VR_BASE, SWITCH,
 };
 pub use crate::models::ports::{check_unit_quaternions, AttitudeControllerPorts};
 pub use crate::{declare_variables, export_fmus, param_enum};
 pub use nalgebra::{Quaternion, Vector3};
 pub use serde::{Deserialize, Serialize};
-
-/// A family of models: a page `docs/models/<slug>.md` with a title, a Markdown overview and the
-/// models in page order (the project's families are `crate::registry::FAMILIES`; a model crate may
-/// declare its own and pass them to `export_fmus!`).
-pub struct Family {
-    pub slug: &'static str,
-    pub title: &'static str,
-    /// Markdown overview (the project's: the family folder's README.md).
-    pub overview: &'static str,
-    pub fmus: &'static [ModelEntry],
-}
-
-/// What a library exports besides its models: its families and its bibliography (both may be empty).
-#[derive(Clone, Copy)]
-pub struct Extras {
-    pub families: &'static [Family],
-    pub references: &'static [Reference],
-}
-
-impl Extras {
-    pub const NONE: Extras = Extras {
-        families: &[],
-        references: &[],
-    };
-}
 
 /// The description of a model entry, as the library exports it.
 pub fn describe(e: &ModelEntry) -> ModelDescription {
@@ -121,7 +96,7 @@ pub fn describe(e: &ModelEntry) -> ModelDescription {
             Feedthrough::AllInputs => FeedthroughDescription::AllInputs,
             // FMI scalar names (a vector stem expanded)
             Feedthrough::Some(_) => FeedthroughDescription::Some(
-                crate::model::feedthrough::scalar_list(e)
+                crate::model::scalar_list(e)
                     .unwrap_or_default()
                     .into_iter()
                     .map(|(o, ins)| (o.to_string(), ins.iter().map(|s| s.to_string()).collect()))

@@ -11,7 +11,7 @@
 //! - `model`: what a model is (declared variables + init/outputs/step), the declaration macro, GUIDs.
 //! - `models`: the project's FMUs, one folder per family; `registry` lists them.
 //! - `math`: shared math (attitude conventions, integrators, ...), unit-tested on its own.
-//! - `units`: the unit table every declared unit must come from.
+//! - `units`: the unit table every declared unit must come from; `text`: const string helpers.
 //!
 //! Workspace members next to this crate: `src/cdylib` (the shared library of the project's FMUs: one
 //! `export_fmus!` line over the registry, like a user's crate) and `src/package` (the packaging tool
@@ -25,6 +25,7 @@ pub mod math;
 pub mod model;
 pub mod models;
 pub mod registry;
+pub mod text;
 pub mod units;
 
 /// The linear-algebra crate of the declarations (`Vec3`, `Diag3`, `Quat` fields), re-exported so that

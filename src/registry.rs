@@ -2,63 +2,29 @@
 //! this list concatenates the families. The C ABI's model lookup and the tests iterate over [`ALL`];
 //! `src/cdylib` exports it with [`EXTRAS`], and the packaging tool sees it only through that catalogue.
 
-use crate::export::Extras;
-pub use crate::export::Family;
-use crate::model::{concat, total_len, ModelEntry};
+pub use crate::model::Family;
+use crate::model::{concat, total_len, Extras, ModelEntry};
 use crate::models::{adcs, attitude, environment, estimation, formation, sensors, single_axis};
+
+/// One [`Family`] a row: slug, FMU list, folder under `src/models/` (its README.md is the overview), title.
+macro_rules! families {
+    ($( $slug:literal, $fmus:expr, $dir:literal, $title:literal; )*) => {
+        &[$( Family { slug: $slug, title: $title, overview: include_str!(concat!("models/", $dir, "/README.md")), fmus: $fmus } ),*]
+    };
+}
 
 /// The families, each a folder under `src/models/` and a page `docs/models/<slug>.md` (title and overview
 /// go into the catalogue the library exports).
-pub const FAMILIES: &[Family] = &[
-    Family {
-        slug: "attitude",
-        title: "Three-axis attitude: plant, command, metrics and reference corrector",
-        overview: include_str!("models/attitude/README.md"),
-        fmus: attitude::FMUS,
-    },
-    Family {
-        slug: "attitude-control",
-        title: "Three-axis attitude controllers",
-        overview: include_str!("models/attitude/control/README.md"),
-        fmus: attitude::control::FMUS,
-    },
-    Family {
-        slug: "single-axis",
-        title: "Single axis with reaction-wheel lag: plant, PID and fractional-order PID",
-        overview: include_str!("models/single_axis/README.md"),
-        fmus: single_axis::FMUS,
-    },
-    Family {
-        slug: "formation",
-        title: "Formation flying: relative orbit, command and predictive PID",
-        overview: include_str!("models/formation/README.md"),
-        fmus: formation::FMUS,
-    },
-    Family {
-        slug: "sensors",
-        title: "Sensors and timing: gyro, star tracker, sun sensor, magnetometer, sample-and-hold",
-        overview: include_str!("models/sensors/README.md"),
-        fmus: sensors::FMUS,
-    },
-    Family {
-        slug: "estimation",
-        title: "Attitude estimation, determination and detumbling: MEKF, TRIAD, QUEST, B-dot",
-        overview: include_str!("models/estimation/README.md"),
-        fmus: estimation::FMUS,
-    },
-    Family {
-        slug: "environment",
-        title: "Orbital environment: orbit, geomagnetic field, sun, eclipse and atmosphere",
-        overview: include_str!("models/environment/README.md"),
-        fmus: environment::FMUS,
-    },
-    Family {
-        slug: "adcs",
-        title: "ADCS modes: mode manager, estimate gate and command switch",
-        overview: include_str!("models/adcs/README.md"),
-        fmus: adcs::FMUS,
-    },
-];
+pub const FAMILIES: &[Family] = families! {
+    "attitude", attitude::FMUS, "attitude", "Three-axis attitude: plant, command, metrics and reference corrector";
+    "attitude-control", attitude::control::FMUS, "attitude/control", "Three-axis attitude controllers";
+    "single-axis", single_axis::FMUS, "single_axis", "Single axis with reaction-wheel lag: plant, PID and fractional-order PID";
+    "formation", formation::FMUS, "formation", "Formation flying: relative orbit, command and predictive PID";
+    "sensors", sensors::FMUS, "sensors", "Sensors and timing: gyro, star tracker, sun sensor, magnetometer, sample-and-hold";
+    "estimation", estimation::FMUS, "estimation", "Attitude estimation, determination and detumbling: MEKF, TRIAD, QUEST, B-dot";
+    "environment", environment::FMUS, "environment", "Orbital environment: orbit, geomagnetic field, sun, eclipse and atmosphere";
+    "adcs", adcs::FMUS, "adcs", "ADCS modes: mode manager, estimate gate and command switch";
+};
 
 const LISTS: [&[ModelEntry]; 8] = [
     FAMILIES[0].fmus,

@@ -111,7 +111,7 @@ pub const fn is_defined(name: &str) -> bool {
     }
     let mut i = 0;
     while i < UNITS.len() {
-        if crate::model::same_str(UNITS[i].0, name) {
+        if crate::text::same_str(UNITS[i].0, name) {
             return true;
         }
         i += 1;

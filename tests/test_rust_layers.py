@@ -1,8 +1,13 @@
-"""The FMI layer's import rules (src/fmi/), read from the code's own paths: every `use` and every
-`crate::fmi::…` / `super::…` path names a module file; the graph of those references has no circle,
-FMI 3.0 files never reference FMI 2.0 files (nor the other way round). Brace imports (`use super::{a, b}`)
-are expanded first. A child module may use its parent's items (`instance/me.rs` adds methods to the
-`Instance` of `instance/mod.rs`) as long as no circle results; `mod.rs` may re-export its children."""
+"""The Rust import rules, read from the code's own paths: in every crate under src/ (the runtime crate
+`src/` with the models, `src/cdylib`, `src/package/src`) every `crate::…`, `super::…` and `self::…` path
+and every path through a child module (`declare::concat` in `model/mod.rs`) names a module file; the graph
+of those references between files has no circle anywhere (no file circle), and in the FMI layer
+(src/fmi/) FMI 3.0 files never reference FMI 2.0 files (nor the other way round). Brace imports
+(`use super::{a, b}`) are expanded first. A child module may use its parent's items as long as no circle
+results, so a `mod.rs` that re-exports its children keeps what the children need in a leaf of their own
+(`model/contract.rs`, `model/entry.rs`). Not counted: comments, `$crate::…` paths of macro bodies (they
+resolve where the macro is expanded), and test-only code (`tests.rs`, files under a `tests/` folder, a
+file's own `#[cfg(test)] mod tests { … }`), which may reach anywhere."""
 
 from __future__ import annotations
 
@@ -10,19 +15,29 @@ import re
 from pathlib import Path
 
 
-ROOT = Path(__file__).resolve().parents[1] / "src" / "fmi"
-BRACES = re.compile(r"\b((?:crate::fmi|super|self)(?:::\w+)*)::\{([^{}]*)\}")  # `use super::{a, b::c}`
-PATH = re.compile(r"\b(crate::fmi(?:::\w+)*|super(?:::\w+)+|self::\{[^}]*\}|self(?:::\w+)+)")
+SRC = Path(__file__).resolve().parents[1] / "src"
+# (crate root, folders below it that are other crates)
+CRATES = [(SRC, ("cdylib", "package")), (SRC / "cdylib", ()), (SRC / "package" / "src", ())]
+BRACES = re.compile(r"(?<!\$)\b((?:crate|super|self)(?:::\w+)*)::\{([^{}]*)\}")  # `use super::{a, b::c}`
+PATH = re.compile(r"(?<!\$)\b(crate(?:::\w+)+|super(?:::\w+)+|self::\{[^}]*\}|self(?:::\w+)+)")
+CHILD = re.compile(r"(?<![\w:$])(\w+)::")  # `declare::concat`: a path through a child module
 
 
 def module_of(path: Path, root: Path) -> tuple[str, ...]:
-    rel = path.relative_to(root).with_suffix("")
-    parts = rel.parts
+    parts = path.relative_to(root).with_suffix("").parts
+    if parts in (("lib",), ("main",)):
+        return ()
     return parts[:-1] if parts[-1] == "mod" else parts
 
 
-def modules(root: Path) -> dict[tuple[str, ...], Path]:
-    return {module_of(p, root): p for p in root.rglob("*.rs")}
+def modules(root: Path, other_crates=()) -> dict[tuple[str, ...], Path]:
+    out = {}
+    for p in sorted(root.rglob("*.rs")):
+        rel = p.relative_to(root).parts
+        if rel[0] in other_crates or rel == ("main.rs",):  # a binary's main.rs is a crate of its own
+            continue
+        out[module_of(p, root)] = p
+    return out
 
 
 def resolve(segments: list[str], mods: dict) -> tuple[str, ...] | None:
@@ -33,27 +48,34 @@ def resolve(segments: list[str], mods: dict) -> tuple[str, ...] | None:
     return None
 
 
-def edges(root: Path) -> dict[tuple[str, ...], set[tuple[str, ...]]]:
-    mods = modules(root)
+def code_of(path: Path) -> str | None:
+    """The non-test code of a file without comments; None for a test-only file."""
+    if path.name == "tests.rs" or "tests" in path.parent.parts[-1:]:
+        return None
+    text = re.sub(r"//[^\n]*", "", path.read_text())
+    text = text.split("#[cfg(test)]\nmod tests {")[0]
+    return BRACES.sub(lambda m: " ".join(f"{m.group(1)}::{item.strip()}" for item in m.group(2).split(",")
+                                         if item.strip() and not item.strip().startswith("*")), text)
+
+
+def edges(root: Path, other_crates=()) -> dict[tuple[str, ...], set[tuple[str, ...]]]:
+    mods = modules(root, other_crates)
     graph: dict[tuple[str, ...], set[tuple[str, ...]]] = {m: set() for m in mods}
     for mod, path in mods.items():
-        if path.name == "tests.rs":
-            continue  # a test-only module may reach anywhere
-        text = re.sub(r"//[^\n]*", "", path.read_text())
-        text = text.split("#[cfg(test)]\nmod tests {")[0]  # a file's own unit tests may reach anywhere
-        text = BRACES.sub(lambda m: " ".join(f"{m.group(1)}::{item.strip()}" for item in m.group(2).split(",")
-                                             if item.strip() and not item.strip().startswith("*")), text)
+        text = code_of(path)
+        if text is None:
+            continue
         for m in PATH.finditer(text):
             p = m.group(1)
-            if p.startswith("crate::fmi"):
-                segs = p.split("::")[2:]
+            if p.startswith("crate"):
+                segs = p.split("::")[1:]
             elif p.startswith("self"):
-                base = list(mod)
                 inner = p[len("self::"):].strip("{}")
+                segs = None
                 for part in inner.split(","):
                     name = part.strip().split("::")[0]
                     if name and name != "*":
-                        target = resolve(base + [name], mods)
+                        target = resolve(list(mod) + [name], mods)
                         if target and target != mod:
                             graph[mod].add(target)
                 continue
@@ -65,6 +87,9 @@ def edges(root: Path) -> dict[tuple[str, ...], set[tuple[str, ...]]]:
             target = resolve(segs, mods)
             if target is not None and target != mod:
                 graph[mod].add(target)
+        for m in CHILD.finditer(text):
+            if mod + (m.group(1),) in mods:
+                graph[mod].add(mod + (m.group(1),))
     return graph
 
 
@@ -74,7 +99,7 @@ def cycles(graph) -> list[list]:
     def visit(n):
         state[n] = 1
         stack.append(n)
-        for m in graph[n]:
+        for m in sorted(graph[n]):
             if state.get(m) == 1:
                 out.append(stack[stack.index(m):] + [m])
             elif m not in state:
@@ -82,42 +107,74 @@ def cycles(graph) -> list[list]:
         stack.pop()
         state[n] = 2
 
-    for n in graph:
+    for n in sorted(graph):
         if n not in state:
             visit(n)
     return out
 
 
-def violations(root: Path) -> list[str]:
-    graph = edges(root)
-    bad = [" -> ".join("::".join(x) or "fmi" for x in c) for c in cycles(graph)]
+def name(m: tuple[str, ...]) -> str:
+    return "::".join(m) or "crate"
+
+
+def violations(root: Path, other_crates=()) -> list[str]:
+    graph = edges(root, other_crates)
+    bad = [" -> ".join(name(x) for x in c) for c in cycles(graph)]
+    versions = {("fmi", "fmi2"), ("fmi", "fmi3")}
     for a, targets in graph.items():
         for b in targets:
-            if a[:1] in {("fmi3",), ("fmi2",)} and b[:1] in {("fmi3",), ("fmi2",)} and a[:1] != b[:1]:
-                bad.append(f"{'::'.join(a)} references {'::'.join(b)} (one FMI version imports the other)")
+            if a[:2] in versions and b[:2] in versions and a[:2] != b[:2]:
+                bad.append(f"{name(a)} references {name(b)} (one FMI version imports the other)")
     return sorted(set(bad))
 
 
-def test_the_fmi_layer_has_no_circle_and_no_import_across_versions():
-    assert violations(ROOT) == []
+def test_no_file_circle_in_any_crate_and_no_import_across_fmi_versions():
+    found = {str(root.relative_to(SRC.parent)): violations(root, other) for root, other in CRATES}
+    assert all(v == [] for v in found.values()), found
+
+
+def test_the_whole_crate_is_read():
+    """Every file under src/ belongs to one crate's graph, models and the FMI layer included."""
+    read = set()
+    for root, other in CRATES:
+        read |= set(modules(root, other).values())
+    # not read: the packager's main.rs and its integration tests (each a crate of its own, test-only)
+    every = {p for p in SRC.rglob("*.rs") if p.parent != SRC / "package" / "tests"} - {SRC / "package" / "src" / "main.rs"}
+    assert every == read
+    graph = edges(SRC, ("cdylib", "package"))
+    assert ("models", "attitude", "plant", "environment") in graph[("models", "attitude", "plant")]
+    assert ("fmi", "boundary") in graph[("fmi", "fmi3", "common")]
 
 
 def test_the_rule_catches_a_circle_and_a_cross_version_import(tmp_path):
-    """The check can fail: a tree with abi.rs <-> abi_me.rs (the old layout) and an FMI 3.0 file using FMI 2.0."""
-    (tmp_path / "fmi2").mkdir()
-    (tmp_path / "fmi3").mkdir()
-    (tmp_path / "mod.rs").write_text("pub mod abi;\nmod abi_me;\npub mod fmi2;\npub mod fmi3;\n")
-    (tmp_path / "abi.rs").write_text("pub use super::abi_me::*;\npub fn call() {}\n")
-    (tmp_path / "abi_me.rs").write_text("use super::abi::call;\n")
-    (tmp_path / "fmi2" / "mod.rs").write_text("pub mod common;\n")
-    (tmp_path / "fmi2" / "common.rs").write_text("pub fn call() {}\n")
-    (tmp_path / "fmi3" / "mod.rs").write_text("pub mod common;\n")
-    (tmp_path / "fmi3" / "common.rs").write_text("use crate::fmi::fmi2::common::call;\nuse super::mask;\n")
+    """The check can fail: a tree with abi.rs <-> abi_me.rs (the old layout), an FMI 3.0 file using FMI 2.0,
+    a circle through a brace import and one through a parent that re-exports its child."""
+    fmi = tmp_path / "fmi"
+    (fmi / "fmi2").mkdir(parents=True)
+    (fmi / "fmi3").mkdir()
+    (tmp_path / "lib.rs").write_text("pub mod fmi;\npub mod model;\n")
+    (fmi / "mod.rs").write_text("pub mod abi;\nmod abi_me;\npub mod fmi2;\npub mod fmi3;\n")
+    (fmi / "abi.rs").write_text("pub use super::abi_me::*;\npub fn call() {}\n")
+    (fmi / "abi_me.rs").write_text("use super::abi::call;\n")
+    (fmi / "fmi2" / "mod.rs").write_text("pub mod common;\n")
+    (fmi / "fmi2" / "common.rs").write_text("pub fn call() {}\n")
+    (fmi / "fmi3" / "mod.rs").write_text("pub mod common;\n")
+    (fmi / "fmi3" / "common.rs").write_text("use crate::fmi::fmi2::common::call;\nuse super::mask;\n")
     found = violations(tmp_path)
-    assert any("abi -> abi_me -> abi" in v or "abi_me -> abi -> abi_me" in v for v in found), found
-    assert any("fmi3::common references fmi2::common" in v for v in found), found
+    assert any("fmi::abi -> fmi::abi_me -> fmi::abi" in v or "fmi::abi_me -> fmi::abi -> fmi::abi_me" in v
+               for v in found), found
+    assert any("fmi::fmi3::common references fmi::fmi2::common" in v for v in found), found
     # a circle through a brace import is found too
-    (tmp_path / "x.rs").write_text("use super::{y::f, abi};\n")
-    (tmp_path / "y.rs").write_text("use super::x::g;\n")
-    (tmp_path / "mod.rs").write_text("pub mod abi;\nmod abi_me;\npub mod fmi2;\npub mod fmi3;\nmod x;\nmod y;\n")
-    assert any(v in ("x -> y -> x", "y -> x -> y") for v in violations(tmp_path)), violations(tmp_path)
+    (fmi / "x.rs").write_text("use super::{y::f, abi};\n")
+    (fmi / "y.rs").write_text("use super::x::g;\n")
+    assert any(v in ("fmi::x -> fmi::y -> fmi::x", "fmi::y -> fmi::x -> fmi::y") for v in violations(tmp_path))
+    # and one between a mod.rs that uses its child by a bare path and the child that uses the parent
+    (tmp_path / "model").mkdir()
+    (tmp_path / "model" / "mod.rs").write_text("mod declare;\npub use declare::same_str;\npub trait Model {}\n")
+    (tmp_path / "model" / "declare.rs").write_text("use super::Model;\npub fn same_str() {}\n")
+    assert "model -> model::declare -> model" in violations(tmp_path), violations(tmp_path)
+    # while `$crate::` paths of a macro body, comments and a file's own unit tests do not count
+    (tmp_path / "model" / "declare.rs").write_text(
+        "// super::Model\nmacro_rules! m { () => { $crate::model::Model } }\n"
+        "#[cfg(test)]\nmod tests {\n    use super::super::Model;\n}\n")
+    assert "model -> model::declare -> model" not in violations(tmp_path), violations(tmp_path)

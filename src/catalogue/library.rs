@@ -6,7 +6,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::decl::{initial_of, Causality, Initial, Reference, Start, VarKind, Variability};
+use super::decl::{initial_of, Bound, Causality, Initial, Reference, Start, VarKind, Variability};
 
 /// Version of the catalogue's byte layout; the packaging tool refuses any other.
 pub const CATALOGUE_FORMAT: u32 = 4;
@@ -194,8 +194,7 @@ pub enum BoundDescription {
 
 impl BoundDescription {
     /// The static bound with the same checks; a choice list is checked here, not by `Bound`.
-    fn simple(&self) -> Option<super::Bound> {
-        use super::Bound;
+    fn simple(&self) -> Option<Bound> {
         Some(match *self {
             BoundDescription::Any => Bound::Any,
             BoundDescription::Positive => Bound::Positive,
@@ -208,7 +207,7 @@ impl BoundDescription {
 
     /// As `Bound::check_real`.
     pub fn check_real(&self, name: &str, v: f64) -> Result<(), String> {
-        self.simple().unwrap_or(super::Bound::Any).check_real(name, v)
+        self.simple().unwrap_or(Bound::Any).check_real(name, v)
     }
 
     /// As `Bound::check_integer`.

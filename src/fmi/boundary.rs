@@ -293,3 +293,21 @@ pub fn log_without_instance(logger: Logger, env: *mut c_void, instance_name: *co
         }
     }
 }
+
+/// The `#[no_mangle] extern "C"` wrappers of [`export_fmus!`](crate::export_fmus), one table line per C
+/// function (`c2::fmi2GetReal(c: Component, vr: *const u32, n: usize, v: *mut f64) -> c_int;`): each
+/// wrapper has the standard name and signature and only forwards its arguments to the function of the
+/// same name in the module given, where the code is. Shared by `__export_fmi2!`, `__export_fmi3!` and
+/// `__export_fmi3_values!`, expanded in the crate that links the library. Not meant to be used on its own.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __fmi_forward {
+    ($( $module:ident :: $name:ident ( $( $arg:ident : $ty:ty ),* $(,)? ) $( -> $ret:ty )? ; )*) => {
+        $(
+            #[no_mangle]
+            pub extern "C" fn $name( $( $arg: $ty ),* ) $( -> $ret )? {
+                $module::$name( $( $arg ),* )
+            }
+        )*
+    };
+}

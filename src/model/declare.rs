@@ -29,7 +29,8 @@
 //! A duplicated value reference or name anywhere in the block (embedded blocks included) is a compile
 //! error.
 
-use super::VarDecl;
+use crate::catalogue::decl::{Bound, Causality, Start, VarDecl, VarKind};
+use crate::text::same_str;
 
 /// Sum of the lengths of slices (array length of their concatenation).
 pub const fn total_len<T>(parts: &[&[T]]) -> usize {
@@ -75,21 +76,6 @@ pub const fn no_duplicate_vrs(d: &[VarDecl]) -> bool {
     true
 }
 
-pub const fn same_str(a: &str, b: &str) -> bool {
-    let (a, b) = (a.as_bytes(), b.as_bytes());
-    if a.len() != b.len() {
-        return false;
-    }
-    let mut i = 0;
-    while i < a.len() {
-        if a[i] != b[i] {
-            return false;
-        }
-        i += 1;
-    }
-    true
-}
-
 /// What is wrong with the declarations of one field (the `width` variables from value reference `vr`:
 /// 1 for scalars, 3 for `Vec3`/`Diag3`, 4 for `Quat`) within the whole table `d`, as a code for the
 /// compile-time assertions `declare_variables!` generates (each names the field):
@@ -114,19 +100,19 @@ pub const fn field_problem(d: &[VarDecl], vr: u32, width: u32) -> u8 {
             if !crate::units::is_defined(a.unit) {
                 return 3;
             }
-            if !a.unit.is_empty() && !matches!(a.kind, super::VarKind::Real) {
+            if !a.unit.is_empty() && !matches!(a.kind, VarKind::Real) {
                 return 4;
             }
-            if let super::Start::Real(x) = a.start {
+            if let Start::Real(x) = a.start {
                 if !x.is_finite() {
                     return 8;
                 }
             }
-            if matches!(a.causality, super::Causality::Parameter) {
+            if matches!(a.causality, Causality::Parameter) {
                 if !a.bound.admits(a.start) {
                     return 5;
                 }
-            } else if !matches!(a.bound, super::Bound::Any) {
+            } else if !matches!(a.bound, Bound::Any) {
                 return 6;
             }
             if a.description.is_empty() {

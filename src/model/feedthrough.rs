@@ -35,8 +35,9 @@
 
 use std::marker::PhantomData;
 
-use super::declare::same_str;
-use super::{Causality, Feedthrough, Model, ModelEntry, VarDecl, Variables};
+use super::contract::{Model, Variables};
+use crate::catalogue::decl::{Causality, Feedthrough, VarDecl};
+use crate::text::same_str;
 
 /// Component suffixes of the vector kinds of `declare_variables!` (`Vec3`, `Diag3`, `Quat`).
 const SUFFIXES: [&str; 7] = ["x", "y", "z", "w", "xx", "yy", "zz"];
@@ -227,45 +228,10 @@ impl<M: Model> Checked<M> {
     pub const FEEDTHROUGH: () = check(M::INFO.name, M::INFO.feedthrough, <M::Vars as Variables>::DECLS);
 }
 
-/// The feed-through list of a [`Feedthrough::Some`] model with every name an FMI scalar name, in the
-/// order given (stems replaced by their components in declaration order, each input once per output
-/// entry); `None` for [`Feedthrough::None`] and [`Feedthrough::AllInputs`]. A name that matches no
-/// variable is kept as it is (so that the packaging tool can refuse it by name).
-pub fn scalar_list(entry: &ModelEntry) -> Option<Vec<(&'static str, Vec<&'static str>)>> {
-    let Feedthrough::Some(list) = entry.info.feedthrough else {
-        return None;
-    };
-    let expand = |name: &'static str, causality: Causality| -> Vec<&'static str> {
-        let found: Vec<&'static str> = entry
-            .decls
-            .iter()
-            .filter(|d| d.causality == causality && names(entry.decls, name, d))
-            .map(|d| d.name)
-            .collect();
-        if found.is_empty() {
-            vec![name]
-        } else {
-            found
-        }
-    };
-    let mut out = Vec::new();
-    for (o, ins) in list {
-        let mut inputs: Vec<&'static str> = Vec::new();
-        for i in ins.iter().flat_map(|i| expand(i, Causality::Input)) {
-            if !inputs.contains(&i) {
-                inputs.push(i);
-            }
-        }
-        for o in expand(o, Causality::Output) {
-            out.push((o, inputs.clone()));
-        }
-    }
-    Some(out)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::{scalar_list, ModelEntry};
     use crate::models::attitude::control::PdController;
     use crate::models::attitude::plant::AttitudePlant;
 

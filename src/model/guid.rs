@@ -18,7 +18,7 @@ fn compute(entry: &ModelEntry) -> [u8; GUID_LEN] {
             Feedthrough::None => "none".into(),
             Feedthrough::AllInputs => "all".into(),
             // FMI scalar names (a vector stem expanded), as the catalogue carries them
-            Feedthrough::Some(_) => format!("{:?}", super::feedthrough::scalar_list(entry).unwrap_or_default()),
+            Feedthrough::Some(_) => format!("{:?}", super::scalar_list(entry).unwrap_or_default()),
         },
     };
     let vars = entry.decls.iter().map(|d| VarRow {

@@ -3,7 +3,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{leaves, Causality, Experiment, Model, ModelInfo, ModelResult, SlotMut, Value, VarDecl, Variables};
+use super::contract::{Experiment, Model, ModelResult, SlotMut, Value, Variables};
+use super::leaves;
+use crate::catalogue::decl::{Causality, ModelInfo, VarDecl};
 
 /// Variables + internal state of one model. The state exists once the parameters have been applied
 /// (`initialize`); before that, outputs and steps are refused with a message.

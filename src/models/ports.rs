@@ -20,6 +20,22 @@ declare_variables! {
     }
 }
 
+declare_variables! {
+    /// The attitude estimate in (the Mekf's outputs), value references 0–6.
+    pub struct EstimateInputs {
+        0 => q_est: Quat = [1.0, 0.0, 0.0, 0.0], Input, "", "Estimated attitude quaternion (the Mekf's q_est; normalised here)";
+        4 => w_est: Vec3 = [0.0; 3], Input, "rad/s", "Estimated body rate (the Mekf's w_est)";
+    }
+}
+
+declare_variables! {
+    /// The commanded attitude in (the AttitudeCommand's outputs), value references 7–13.
+    pub struct CommandInputs {
+        7 => q_ref: Quat = [1.0, 0.0, 0.0, 0.0], Input, "", "Commanded attitude quaternion (the AttitudeCommand's q_ref; normalised here)";
+        11 => w_ref: Vec3 = [0.0; 3], Input, "rad/s", "Commanded body rate, commanded body axes (the AttitudeCommand's w_ref)";
+    }
+}
+
 /// Rejects a measured or commanded quaternion that is far from unit norm (wrong wiring, e.g. a
 /// quaternion port left unconnected at 0).
 pub fn check_unit_quaternions(p: &AttitudeControllerPorts) -> Result<(), String> {

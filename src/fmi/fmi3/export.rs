@@ -6,8 +6,9 @@
 //! variable type are in `export_values.rs`.
 //!
 //! Size: `__export_fmi3!` is longer than 80 lines because a `#[no_mangle]` symbol must be spelled out in
-//! the crate that links the library (the user's cdylib), one four-line wrapper per C function; each
-//! wrapper only forwards to the function of the same name in this folder, where the code is.
+//! the crate that links the library (the user's cdylib): one line per C function in a
+//! [`__fmi_forward!`](crate::__fmi_forward) table, each only forwarding to the function of the same name
+//! in this folder, where the code is; the instantiate functions, which pass the model list, are written out.
 
 /// Expands to the FMI 3.0 entry points for the model list `$models` (a `static [ModelEntry]` slice in
 /// scope). Used by [`export_fmus!`](crate::export_fmus) only.
@@ -25,13 +26,9 @@ macro_rules! __export_fmi3 {
             use $crate::fmi::fmi3::values as va3;
             type Inst3 = *mut c_void;
             type Log3 = Option<$crate::fmi::types::Log3Fn>;
-            #[no_mangle]
-            pub extern "C" fn fmi3GetVersion() -> *const c_char {
-                co3::fmi3GetVersion()
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3SetDebugLogging(c: Inst3, on: u8, n: usize, cats: *const *const c_char) -> c_int {
-                co3::fmi3SetDebugLogging(c, on, n, cats)
+            $crate::__fmi_forward! {
+                co3::fmi3GetVersion() -> *const c_char;
+                co3::fmi3SetDebugLogging(c: Inst3, on: u8, n: usize, cats: *const *const c_char) -> c_int;
             }
             #[no_mangle]
             pub extern "C" fn fmi3InstantiateCoSimulation(
@@ -76,295 +73,53 @@ macro_rules! __export_fmi3 {
             ) -> Inst3 {
                 me3::fmi3InstantiateModelExchange($models, name, token, resources, visible, logging_on, env, log)
             }
-            #[no_mangle]
-            pub extern "C" fn fmi3InstantiateScheduledExecution(
-                name: *const c_char,
-                token: *const c_char,
-                resources: *const c_char,
-                visible: u8,
-                logging_on: u8,
-                env: *mut c_void,
-                log: Log3,
-                clock_update: *const c_void,
-                lock: *const c_void,
-                unlock: *const c_void,
-            ) -> Inst3 {
-                un3::fmi3InstantiateScheduledExecution(
-                    name,
-                    token,
-                    resources,
-                    visible,
-                    logging_on,
-                    env,
-                    log,
-                    clock_update,
-                    lock,
-                    unlock,
-                )
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3FreeInstance(c: Inst3) {
-                co3::fmi3FreeInstance(c)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3EnterInitializationMode(
-                c: Inst3,
-                tol_defined: u8,
-                tol: f64,
-                start: f64,
-                stop_defined: u8,
-                stop: f64,
-            ) -> c_int {
-                co3::fmi3EnterInitializationMode(c, tol_defined, tol, start, stop_defined, stop)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3ExitInitializationMode(c: Inst3) -> c_int {
-                co3::fmi3ExitInitializationMode(c)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3EnterEventMode(c: Inst3) -> c_int {
-                me3::fmi3EnterEventMode(c)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3Terminate(c: Inst3) -> c_int {
-                co3::fmi3Terminate(c)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3Reset(c: Inst3) -> c_int {
-                co3::fmi3Reset(c)
+            $crate::__fmi_forward! {
+                un3::fmi3InstantiateScheduledExecution(name: *const c_char, token: *const c_char, resources: *const c_char, visible: u8, logging_on: u8, env: *mut c_void, log: Log3, clock_update: *const c_void, lock: *const c_void, unlock: *const c_void) -> Inst3;
+                co3::fmi3FreeInstance(c: Inst3);
+                co3::fmi3EnterInitializationMode(c: Inst3, tol_defined: u8, tol: f64, start: f64, stop_defined: u8, stop: f64) -> c_int;
+                co3::fmi3ExitInitializationMode(c: Inst3) -> c_int;
+                me3::fmi3EnterEventMode(c: Inst3) -> c_int;
+                co3::fmi3Terminate(c: Inst3) -> c_int;
+                co3::fmi3Reset(c: Inst3) -> c_int;
             }
             $crate::__export_fmi3_values!();
-            #[no_mangle]
-            pub extern "C" fn fmi3GetNumberOfVariableDependencies(c: Inst3, vr: u32, n: *mut usize) -> c_int {
-                st3::fmi3GetNumberOfVariableDependencies(c, vr, n)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetVariableDependencies(
-                c: Inst3,
-                dep: u32,
-                e1: *mut usize,
-                ind: *mut u32,
-                e2: *mut usize,
-                kinds: *mut c_int,
-                n: usize,
-            ) -> c_int {
-                st3::fmi3GetVariableDependencies(c, dep, e1, ind, e2, kinds, n)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetFMUState(c: Inst3, s: *mut *mut c_void) -> c_int {
-                st3::fmi3GetFMUState(c, s)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3SetFMUState(c: Inst3, s: *mut c_void) -> c_int {
-                st3::fmi3SetFMUState(c, s)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3FreeFMUState(c: Inst3, s: *mut *mut c_void) -> c_int {
-                st3::fmi3FreeFMUState(c, s)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3SerializedFMUStateSize(c: Inst3, s: *mut c_void, size: *mut usize) -> c_int {
-                st3::fmi3SerializedFMUStateSize(c, s, size)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3SerializeFMUState(c: Inst3, s: *mut c_void, buf: *mut u8, size: usize) -> c_int {
-                st3::fmi3SerializeFMUState(c, s, buf, size)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3DeserializeFMUState(
-                c: Inst3,
-                buf: *const u8,
-                size: usize,
-                s: *mut *mut c_void,
-            ) -> c_int {
-                st3::fmi3DeserializeFMUState(c, buf, size, s)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetDirectionalDerivative(
-                c: Inst3,
-                u: *const u32,
-                nu: usize,
-                k: *const u32,
-                nk: usize,
-                seed: *const f64,
-                ns: usize,
-                out: *mut f64,
-                no: usize,
-            ) -> c_int {
-                st3::fmi3GetDirectionalDerivative(c, u, nu, k, nk, seed, ns, out, no)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetAdjointDerivative(
-                c: Inst3,
-                u: *const u32,
-                nu: usize,
-                k: *const u32,
-                nk: usize,
-                seed: *const f64,
-                ns: usize,
-                out: *mut f64,
-                no: usize,
-            ) -> c_int {
-                un3::fmi3GetAdjointDerivative(c, u, nu, k, nk, seed, ns, out, no)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3EnterConfigurationMode(c: Inst3) -> c_int {
-                un3::fmi3EnterConfigurationMode(c)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3ExitConfigurationMode(c: Inst3) -> c_int {
-                un3::fmi3ExitConfigurationMode(c)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetIntervalDecimal(
-                c: Inst3,
-                vr: *const u32,
-                n: usize,
-                i: *mut f64,
-                q: *mut c_int,
-            ) -> c_int {
-                un3::fmi3GetIntervalDecimal(c, vr, n, i, q)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetIntervalFraction(
-                c: Inst3,
-                vr: *const u32,
-                n: usize,
-                k: *mut u64,
-                r: *mut u64,
-                q: *mut c_int,
-            ) -> c_int {
-                un3::fmi3GetIntervalFraction(c, vr, n, k, r, q)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetShiftDecimal(c: Inst3, vr: *const u32, n: usize, s: *mut f64) -> c_int {
-                un3::fmi3GetShiftDecimal(c, vr, n, s)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetShiftFraction(
-                c: Inst3,
-                vr: *const u32,
-                n: usize,
-                k: *mut u64,
-                r: *mut u64,
-            ) -> c_int {
-                un3::fmi3GetShiftFraction(c, vr, n, k, r)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3SetIntervalDecimal(c: Inst3, vr: *const u32, n: usize, i: *const f64) -> c_int {
-                un3::fmi3SetIntervalDecimal(c, vr, n, i)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3SetIntervalFraction(
-                c: Inst3,
-                vr: *const u32,
-                n: usize,
-                k: *const u64,
-                r: *const u64,
-            ) -> c_int {
-                un3::fmi3SetIntervalFraction(c, vr, n, k, r)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3SetShiftDecimal(c: Inst3, vr: *const u32, n: usize, s: *const f64) -> c_int {
-                un3::fmi3SetShiftDecimal(c, vr, n, s)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3SetShiftFraction(
-                c: Inst3,
-                vr: *const u32,
-                n: usize,
-                k: *const u64,
-                r: *const u64,
-            ) -> c_int {
-                un3::fmi3SetShiftFraction(c, vr, n, k, r)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3EvaluateDiscreteStates(c: Inst3) -> c_int {
-                me3::fmi3EvaluateDiscreteStates(c)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3UpdateDiscreteStates(
-                c: Inst3,
-                a: *mut u8,
-                b: *mut u8,
-                d: *mut u8,
-                e: *mut u8,
-                f: *mut u8,
-                t: *mut f64,
-            ) -> c_int {
-                me3::fmi3UpdateDiscreteStates(c, a, b, d, e, f, t)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3EnterContinuousTimeMode(c: Inst3) -> c_int {
-                me3::fmi3EnterContinuousTimeMode(c)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3CompletedIntegratorStep(c: Inst3, p: u8, e: *mut u8, t: *mut u8) -> c_int {
-                me3::fmi3CompletedIntegratorStep(c, p, e, t)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3SetTime(c: Inst3, t: f64) -> c_int {
-                me3::fmi3SetTime(c, t)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3SetContinuousStates(c: Inst3, x: *const f64, n: usize) -> c_int {
-                me3::fmi3SetContinuousStates(c, x, n)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetContinuousStateDerivatives(c: Inst3, x: *mut f64, n: usize) -> c_int {
-                me3::fmi3GetContinuousStateDerivatives(c, x, n)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetEventIndicators(c: Inst3, x: *mut f64, n: usize) -> c_int {
-                me3::fmi3GetEventIndicators(c, x, n)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetContinuousStates(c: Inst3, x: *mut f64, n: usize) -> c_int {
-                me3::fmi3GetContinuousStates(c, x, n)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetNominalsOfContinuousStates(c: Inst3, x: *mut f64, n: usize) -> c_int {
-                me3::fmi3GetNominalsOfContinuousStates(c, x, n)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetNumberOfEventIndicators(c: Inst3, n: *mut usize) -> c_int {
-                me3::fmi3GetNumberOfEventIndicators(c, n)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetNumberOfContinuousStates(c: Inst3, n: *mut usize) -> c_int {
-                me3::fmi3GetNumberOfContinuousStates(c, n)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3EnterStepMode(c: Inst3) -> c_int {
-                cs3::fmi3EnterStepMode(c)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3GetOutputDerivatives(
-                c: Inst3,
-                vr: *const u32,
-                n: usize,
-                order: *const i32,
-                v: *mut f64,
-                nv: usize,
-            ) -> c_int {
-                cs3::fmi3GetOutputDerivatives(c, vr, n, order, v, nv)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3DoStep(
-                c: Inst3,
-                t: f64,
-                h: f64,
-                no_prior: u8,
-                event: *mut u8,
-                terminate: *mut u8,
-                early: *mut u8,
-                last: *mut f64,
-            ) -> c_int {
-                cs3::fmi3DoStep(c, t, h, no_prior, event, terminate, early, last)
-            }
-            #[no_mangle]
-            pub extern "C" fn fmi3ActivateModelPartition(c: Inst3, clock: u32, t: f64) -> c_int {
-                un3::fmi3ActivateModelPartition(c, clock, t)
+            $crate::__fmi_forward! {
+                st3::fmi3GetNumberOfVariableDependencies(c: Inst3, vr: u32, n: *mut usize) -> c_int;
+                st3::fmi3GetVariableDependencies(c: Inst3, dep: u32, e1: *mut usize, ind: *mut u32, e2: *mut usize, kinds: *mut c_int, n: usize) -> c_int;
+                st3::fmi3GetFMUState(c: Inst3, s: *mut *mut c_void) -> c_int;
+                st3::fmi3SetFMUState(c: Inst3, s: *mut c_void) -> c_int;
+                st3::fmi3FreeFMUState(c: Inst3, s: *mut *mut c_void) -> c_int;
+                st3::fmi3SerializedFMUStateSize(c: Inst3, s: *mut c_void, size: *mut usize) -> c_int;
+                st3::fmi3SerializeFMUState(c: Inst3, s: *mut c_void, buf: *mut u8, size: usize) -> c_int;
+                st3::fmi3DeserializeFMUState(c: Inst3, buf: *const u8, size: usize, s: *mut *mut c_void) -> c_int;
+                st3::fmi3GetDirectionalDerivative(c: Inst3, u: *const u32, nu: usize, k: *const u32, nk: usize, seed: *const f64, ns: usize, out: *mut f64, no: usize) -> c_int;
+                un3::fmi3GetAdjointDerivative(c: Inst3, u: *const u32, nu: usize, k: *const u32, nk: usize, seed: *const f64, ns: usize, out: *mut f64, no: usize) -> c_int;
+                un3::fmi3EnterConfigurationMode(c: Inst3) -> c_int;
+                un3::fmi3ExitConfigurationMode(c: Inst3) -> c_int;
+                un3::fmi3GetIntervalDecimal(c: Inst3, vr: *const u32, n: usize, i: *mut f64, q: *mut c_int) -> c_int;
+                un3::fmi3GetIntervalFraction(c: Inst3, vr: *const u32, n: usize, k: *mut u64, r: *mut u64, q: *mut c_int) -> c_int;
+                un3::fmi3GetShiftDecimal(c: Inst3, vr: *const u32, n: usize, s: *mut f64) -> c_int;
+                un3::fmi3GetShiftFraction(c: Inst3, vr: *const u32, n: usize, k: *mut u64, r: *mut u64) -> c_int;
+                un3::fmi3SetIntervalDecimal(c: Inst3, vr: *const u32, n: usize, i: *const f64) -> c_int;
+                un3::fmi3SetIntervalFraction(c: Inst3, vr: *const u32, n: usize, k: *const u64, r: *const u64) -> c_int;
+                un3::fmi3SetShiftDecimal(c: Inst3, vr: *const u32, n: usize, s: *const f64) -> c_int;
+                un3::fmi3SetShiftFraction(c: Inst3, vr: *const u32, n: usize, k: *const u64, r: *const u64) -> c_int;
+                me3::fmi3EvaluateDiscreteStates(c: Inst3) -> c_int;
+                me3::fmi3UpdateDiscreteStates(c: Inst3, a: *mut u8, b: *mut u8, d: *mut u8, e: *mut u8, f: *mut u8, t: *mut f64) -> c_int;
+                me3::fmi3EnterContinuousTimeMode(c: Inst3) -> c_int;
+                me3::fmi3CompletedIntegratorStep(c: Inst3, p: u8, e: *mut u8, t: *mut u8) -> c_int;
+                me3::fmi3SetTime(c: Inst3, t: f64) -> c_int;
+                me3::fmi3SetContinuousStates(c: Inst3, x: *const f64, n: usize) -> c_int;
+                me3::fmi3GetContinuousStateDerivatives(c: Inst3, x: *mut f64, n: usize) -> c_int;
+                me3::fmi3GetEventIndicators(c: Inst3, x: *mut f64, n: usize) -> c_int;
+                me3::fmi3GetContinuousStates(c: Inst3, x: *mut f64, n: usize) -> c_int;
+                me3::fmi3GetNominalsOfContinuousStates(c: Inst3, x: *mut f64, n: usize) -> c_int;
+                me3::fmi3GetNumberOfEventIndicators(c: Inst3, n: *mut usize) -> c_int;
+                me3::fmi3GetNumberOfContinuousStates(c: Inst3, n: *mut usize) -> c_int;
+                cs3::fmi3EnterStepMode(c: Inst3) -> c_int;
+                cs3::fmi3GetOutputDerivatives(c: Inst3, vr: *const u32, n: usize, order: *const i32, v: *mut f64, nv: usize) -> c_int;
+                cs3::fmi3DoStep(c: Inst3, t: f64, h: f64, no_prior: u8, event: *mut u8, terminate: *mut u8, early: *mut u8, last: *mut f64) -> c_int;
+                un3::fmi3ActivateModelPartition(c: Inst3, clock: u32, t: f64) -> c_int;
             }
         };
     };

@@ -13,7 +13,7 @@ use super::common::{call3, mask3, Instance3};
 use crate::fmi::boundary::{out_ptr, slice, slice_mut};
 use crate::fmi::instance::{CallResult, Fail};
 use crate::fmi::state_calls;
-use crate::model::feedthrough::scalar_list;
+use crate::model::scalar_list;
 use crate::model::{Causality, Feedthrough, ModelEntry, STATE_VR_BASE};
 
 // ----- FMU state ------------------------------------------------------------------------------------

@@ -17,6 +17,18 @@ use crate::fmi::boundary::slice;
 use crate::fmi::instance::Fail;
 use crate::fmi::types::Log3Fn;
 
+/// Functions of the standard's signature `(instance, vr, n, …)` for a variable type the FMUs have none
+/// of: each refuses with `no_such_type` under its own name (`stringify!`), one table line each.
+macro_rules! no_such_type {
+    ($( $name:ident ( $( $arg:ident : $ty:ty ),* ) => $mask:expr, $what:literal; )*) => {
+        $(
+            pub extern "C" fn $name(c: Instance3, vr: *const u32, n: usize, $( $arg: $ty ),* ) -> c_int {
+                no_such_type(c, stringify!($name), $mask, $what, vr, n)
+            }
+        )*
+    };
+}
+
 pub extern "C" fn fmi3GetAdjointDerivative(
     c: Instance3,
     _u: *const u32,
@@ -91,97 +103,19 @@ other_types! {
     fmi3GetString, fmi3SetString, *const c_char, "String";
 }
 
-pub extern "C" fn fmi3GetBinary(
-    c: Instance3,
-    vr: *const u32,
-    n: usize,
-    _sizes: *mut usize,
-    _v: *mut *const u8,
-    _nv: usize,
-) -> c_int {
-    no_such_type(c, "fmi3GetBinary", mask3::GET, "Binary", vr, n)
-}
-
-pub extern "C" fn fmi3SetBinary(
-    c: Instance3,
-    vr: *const u32,
-    n: usize,
-    _sizes: *const usize,
-    _v: *const *const u8,
-    _nv: usize,
-) -> c_int {
-    no_such_type(c, "fmi3SetBinary", mask3::SET, "Binary", vr, n)
-}
-
-pub extern "C" fn fmi3GetClock(c: Instance3, vr: *const u32, n: usize, _v: *mut u8) -> c_int {
-    no_such_type(c, "fmi3GetClock", mask3::ANY, "Clock", vr, n)
-}
-
-pub extern "C" fn fmi3SetClock(c: Instance3, vr: *const u32, n: usize, _v: *const u8) -> c_int {
-    no_such_type(c, "fmi3SetClock", mask3::ANY, "Clock", vr, n)
-}
-
-pub extern "C" fn fmi3GetIntervalDecimal(
-    c: Instance3,
-    vr: *const u32,
-    n: usize,
-    _i: *mut f64,
-    _q: *mut c_int,
-) -> c_int {
-    no_such_type(c, "fmi3GetIntervalDecimal", mask3::ANY, "Clock", vr, n)
-}
-
-pub extern "C" fn fmi3GetIntervalFraction(
-    c: Instance3,
-    vr: *const u32,
-    n: usize,
-    _counters: *mut u64,
-    _r: *mut u64,
-    _q: *mut c_int,
-) -> c_int {
-    no_such_type(c, "fmi3GetIntervalFraction", mask3::ANY, "Clock", vr, n)
-}
-
-pub extern "C" fn fmi3GetShiftDecimal(c: Instance3, vr: *const u32, n: usize, _s: *mut f64) -> c_int {
-    no_such_type(c, "fmi3GetShiftDecimal", mask3::ANY, "Clock", vr, n)
-}
-
-pub extern "C" fn fmi3GetShiftFraction(
-    c: Instance3,
-    vr: *const u32,
-    n: usize,
-    _counters: *mut u64,
-    _r: *mut u64,
-) -> c_int {
-    no_such_type(c, "fmi3GetShiftFraction", mask3::ANY, "Clock", vr, n)
-}
-
-pub extern "C" fn fmi3SetIntervalDecimal(c: Instance3, vr: *const u32, n: usize, _i: *const f64) -> c_int {
-    no_such_type(c, "fmi3SetIntervalDecimal", mask3::ANY, "Clock", vr, n)
-}
-
-pub extern "C" fn fmi3SetIntervalFraction(
-    c: Instance3,
-    vr: *const u32,
-    n: usize,
-    _counters: *const u64,
-    _r: *const u64,
-) -> c_int {
-    no_such_type(c, "fmi3SetIntervalFraction", mask3::ANY, "Clock", vr, n)
-}
-
-pub extern "C" fn fmi3SetShiftDecimal(c: Instance3, vr: *const u32, n: usize, _s: *const f64) -> c_int {
-    no_such_type(c, "fmi3SetShiftDecimal", mask3::ANY, "Clock", vr, n)
-}
-
-pub extern "C" fn fmi3SetShiftFraction(
-    c: Instance3,
-    vr: *const u32,
-    n: usize,
-    _counters: *const u64,
-    _r: *const u64,
-) -> c_int {
-    no_such_type(c, "fmi3SetShiftFraction", mask3::ANY, "Clock", vr, n)
+no_such_type! {
+    fmi3GetBinary(_sizes: *mut usize, _v: *mut *const u8, _nv: usize) => mask3::GET, "Binary";
+    fmi3SetBinary(_sizes: *const usize, _v: *const *const u8, _nv: usize) => mask3::SET, "Binary";
+    fmi3GetClock(_v: *mut u8) => mask3::ANY, "Clock";
+    fmi3SetClock(_v: *const u8) => mask3::ANY, "Clock";
+    fmi3GetIntervalDecimal(_i: *mut f64, _q: *mut c_int) => mask3::ANY, "Clock";
+    fmi3GetIntervalFraction(_counters: *mut u64, _r: *mut u64, _q: *mut c_int) => mask3::ANY, "Clock";
+    fmi3GetShiftDecimal(_s: *mut f64) => mask3::ANY, "Clock";
+    fmi3GetShiftFraction(_counters: *mut u64, _r: *mut u64) => mask3::ANY, "Clock";
+    fmi3SetIntervalDecimal(_i: *const f64) => mask3::ANY, "Clock";
+    fmi3SetIntervalFraction(_counters: *const u64, _r: *const u64) => mask3::ANY, "Clock";
+    fmi3SetShiftDecimal(_s: *const f64) => mask3::ANY, "Clock";
+    fmi3SetShiftFraction(_counters: *const u64, _r: *const u64) => mask3::ANY, "Clock";
 }
 
 // ----- Scheduled Execution ---------------------------------------------------------------------------

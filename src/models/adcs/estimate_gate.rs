@@ -6,13 +6,12 @@ use serde::{Deserialize, Serialize};
 
 use crate::declare_variables;
 use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult};
+use crate::models::ports::{CommandInputs, EstimateInputs};
 
 declare_variables! {
     pub struct EstimateGateVars {
-        0 => q_est: Quat = [1.0, 0.0, 0.0, 0.0], Input, "", "Estimated attitude quaternion (the Mekf's q_est; normalised here)";
-        4 => w_est: Vec3 = [0.0; 3], Input, "rad/s", "Estimated body rate (the Mekf's w_est)";
-        7 => q_ref: Quat = [1.0, 0.0, 0.0, 0.0], Input, "", "Commanded attitude quaternion (the AttitudeCommand's q_ref; normalised here)";
-        11 => w_ref: Vec3 = [0.0; 3], Input, "rad/s", "Commanded body rate, commanded body axes (the AttitudeCommand's w_ref)";
+        estimate: EstimateInputs;
+        command: CommandInputs;
         14 => enable: Real = 0.0, Input, "", "Gate (ModeManager's controller_enable): >= 0.5 passes the estimate, else the reference";
         20 => q: Quat = [1.0, 0.0, 0.0, 0.0], Output, "", "Attitude quaternion for the controller's q input (unit norm)";
         24 => w: Vec3 = [0.0; 3], Output, "rad/s", "Body rate for the controller's w input";
@@ -70,10 +69,10 @@ input), the one passed on is normalised; its sign is kept.</p>",
     }
 
     fn outputs(&self, v: &mut EstimateGateVars, _t: f64) -> ModelResult {
-        let q_est = unit_quat("q_est", &v.q_est)?;
-        let q_ref = unit_quat("q_ref", &v.q_ref)?;
-        let w_est = finite_vec("w_est", &v.w_est)?;
-        let w_ref = finite_vec("w_ref", &v.w_ref)?;
+        let q_est = unit_quat("q_est", &v.estimate.q_est)?;
+        let q_ref = unit_quat("q_ref", &v.command.q_ref)?;
+        let w_est = finite_vec("w_est", &v.estimate.w_est)?;
+        let w_ref = finite_vec("w_ref", &v.command.w_ref)?;
         if !v.enable.is_finite() {
             return Err(format!("input enable = {} is not finite", v.enable));
         }
@@ -90,10 +89,10 @@ mod tests {
     fn gate() -> Fmu<EstimateGate> {
         let mut f = Fmu::<EstimateGate>::default();
         f.initialize(&Experiment::default()).unwrap();
-        f.v.q_est = Quaternion::new(2.0, 0.0, 0.0, 2.0); // 90 deg about z, norm 2*sqrt(2)
-        f.v.w_est = Vector3::new(0.1, -0.2, 0.3);
-        f.v.q_ref = Quaternion::new(0.0, 0.0, 3.0, 0.0); // 180 deg about y, norm 3
-        f.v.w_ref = Vector3::new(0.0, -0.001, 0.0);
+        f.v.estimate.q_est = Quaternion::new(2.0, 0.0, 0.0, 2.0); // 90 deg about z, norm 2*sqrt(2)
+        f.v.estimate.w_est = Vector3::new(0.1, -0.2, 0.3);
+        f.v.command.q_ref = Quaternion::new(0.0, 0.0, 3.0, 0.0); // 180 deg about y, norm 3
+        f.v.command.w_ref = Vector3::new(0.0, -0.001, 0.0);
         f
     }
 
@@ -118,11 +117,11 @@ mod tests {
     #[test]
     fn zero_or_non_finite_inputs_are_refused_by_name() {
         let mut f = gate();
-        f.v.q_est = Quaternion::new(0.0, 0.0, 0.0, 0.0);
+        f.v.estimate.q_est = Quaternion::new(0.0, 0.0, 0.0, 0.0);
         let e = f.outputs(0.0).unwrap_err();
         assert!(e.contains("q_est") && e.contains("norm 0"), "{e}");
         let mut f = gate();
-        f.v.w_ref.y = f64::NAN;
+        f.v.command.w_ref.y = f64::NAN;
         let e = f.outputs(0.0).unwrap_err();
         assert!(e.contains("w_ref") && e.contains("not finite"), "{e}");
     }

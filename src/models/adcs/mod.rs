@@ -10,6 +10,7 @@
 //! `m_cmd` 23–25.
 
 pub mod mode_codes;
+mod mode_log;
 pub mod modes;
 
 crate::fmus! {

@@ -8,8 +8,7 @@ use std::path::Path;
 
 use spacecraft_fmus::catalogue::{Catalogue, FamilyDescription, ModelDescription, VariableDescription};
 
-use crate::html::{bound_text, citation, cited_in, interfaces_text, start_text, VARIABLE_SECTIONS};
-use crate::xml::variability_str;
+use crate::html::{citation, cited_in, interfaces_text, variable_cells, VARIABLE_SECTIONS};
 
 fn cell(s: &str) -> String {
     s.replace('|', "\\|").replace('\n', " ")
@@ -23,18 +22,8 @@ fn variable_table(out: &mut String, title: &str, rows: &[&VariableDescription]) 
     out.push_str("| name | vr | type | variability | start | unit | admissible | meaning |\n");
     out.push_str("|---|---|---|---|---|---|---|---|\n");
     for d in rows {
-        let _ = writeln!(
-            out,
-            "| `{}` | {} | {:?} | {} | {} | {} | {} | {} |",
-            d.name,
-            d.vr,
-            d.kind,
-            variability_str(d.variability),
-            start_text(d),
-            cell(&d.unit),
-            cell(&bound_text(&d.bound)),
-            cell(&d.description)
-        );
+        let [name, rest @ ..] = variable_cells(d, cell);
+        let _ = writeln!(out, "| `{name}` | {} |", rest.join(" | "));
     }
     out.push('\n');
 }

@@ -38,6 +38,22 @@ pub(crate) fn html_escape(s: &str) -> String {
 }
 
 /// The start value as the tables show it (none where the description writes none).
+/// The cells of a variable's row in the documentation tables (the HTML page and the Markdown model pages):
+/// name, value reference, type, variability, start, unit, admissible values and meaning, the last three
+/// passed through the table's `escape`.
+pub(crate) fn variable_cells(d: &VariableDescription, escape: fn(&str) -> String) -> [String; 8] {
+    [
+        d.name.clone(),
+        d.vr.to_string(),
+        format!("{:?}", d.kind),
+        variability_str(d.variability).to_string(),
+        start_text(d),
+        escape(&d.unit),
+        escape(&bound_text(&d.bound)),
+        escape(&d.description),
+    ]
+}
+
 pub(crate) fn start_text(d: &VariableDescription) -> String {
     if d.has_start() {
         start_str(d.start)
@@ -122,17 +138,11 @@ pub fn documentation_html(cat: &Catalogue, m: &ModelDescription) -> String {
         }
         let _ = writeln!(h, "<h2>{title}</h2>\n<table>\n<tr><th>name</th><th>vr</th><th>type</th><th>variability</th><th>start</th><th>unit</th><th>admissible</th><th>meaning</th></tr>");
         for d in rows {
+            let [name, rest @ ..] = variable_cells(d, html_escape);
             let _ = writeln!(
                 h,
-                "<tr><td><code>{}</code></td><td>{}</td><td>{:?}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
-                d.name,
-                d.vr,
-                d.kind,
-                variability_str(d.variability),
-                start_text(d),
-                html_escape(&d.unit),
-                html_escape(&bound_text(&d.bound)),
-                html_escape(&d.description)
+                "<tr><td><code>{name}</code></td><td>{}</td></tr>",
+                rest.join("</td><td>")
             );
         }
         h.push_str("</table>\n");

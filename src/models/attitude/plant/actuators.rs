@@ -6,7 +6,8 @@ use nalgebra::{Matrix3, Vector3};
 
 use super::environment::Segment;
 use super::kinematics::{v3, State, HW, TW};
-use super::{AttitudePlant, AttitudePlantVars};
+use super::variables::AttitudePlantVars;
+use super::AttitudePlant;
 
 /// Actuator outputs at one instant.
 #[derive(Clone, Copy, Debug, Default)]

@@ -9,9 +9,12 @@
 //! documentation), `tests.rs`.
 
 mod actuators;
+mod attitude_output;
 mod environment;
 mod exchange;
+mod external;
 mod kinematics;
+mod projection;
 #[cfg(test)]
 mod tests;
 mod variables;
