@@ -193,7 +193,7 @@ def main(argv=None) -> int:
     r, wall = run("mission/wheel-fault", data)
     summary.append({"what": "mission/wheel-fault", "wall_s": wall, **fault_figure(r, out, plt)})
     runs = 6 if args.quick else args.runs
-    stop = mission.leo.ORBIT_PERIOD if args.quick else None
+    stop = float(round(mission.leo.ORBIT_PERIOD)) if args.quick else None  # a whole second: a multiple of the step
     controllers = dict(CONTROLLERS)
     if args.user:
         params = {k: float(v) for k, _, v in (p.partition("=") for p in args.user_param)}

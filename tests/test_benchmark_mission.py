@@ -2,8 +2,8 @@
 law of ``mission/tipoff`` over the same dispersed runs, ranked by the p95 time from separation to on target.
 
 * The p95 is the empirical quantile over every run (the smallest time t with at least 95 % of the runs on target
-  by t, computed here from its definition), a run that never gets there counting as not reached; ties within
-  1 s share a rank, checked on made-up times.
+  by t, computed here from its definition), a run that never gets there counting as not reached; ranks by the
+  p95 (equal within 1 s), then by the runs never on target, checked on made-up times.
 * A user's unit given by path takes the place beside the scenario's own PD; the PD's times are those of the
   scenario run directly (the engines' own run of the same draw, with the mission metric computed here from the
   logged truth), a unit that crashes loses its runs, not the benchmark, and ranks last.
@@ -57,7 +57,9 @@ def test_p95_counts_a_run_that_never_gets_there_and_ties_share_a_rank():
     for m in (c, d):
         m.runs = m.ok = 20
     na = bm.MissionEntry("E", "m", status="not designed for this plant: …")
-    assert bm.ranks([two, d, one, c, na]) == {"A": 1, "C": 1, "D": 3, "B": 4}
+    worse = bm.MissionEntry("F", "m", values=[math.inf] * 20)               # not reached either, 20 never
+    worse.runs = worse.ok = 20
+    assert bm.ranks([two, d, one, c, na, worse]) == {"A": 1, "C": 1, "D": 3, "B": 4, "F": 5}
 
 
 def test_the_mission_case_is_registered_for_the_attitude_family():

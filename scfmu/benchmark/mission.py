@@ -14,7 +14,8 @@ hand-over, the runs that never got on target and the runs whose mode chattered.
 * **Design envelopes**: the built-in controller the mission scenario was tuned with runs with that tuning; the
   others run as elsewhere in the benchmark (their re-tuning rule for this spacecraft, or listed as not designed
   for it); the unit under test runs with its ``--set``, ``--map`` and profile.
-* **Ties**: two p95 times within :data:`TIE_S` (the mode manager's sample period) share a rank.
+* **Ranks**: by the p95 time, then (equal p95 times, "not reached" included) by the number of runs never on
+  target; two p95 times within :data:`TIE_S` (the mode manager's sample period) are equal.
 """
 
 from __future__ import annotations
@@ -126,14 +127,15 @@ def run_pair(client, log, case, m: MissionEntry, c, folder: Path) -> None:
 
 
 def ranks(entries: list[MissionEntry]) -> dict:
-    """{controller: rank} by the p95 time (competition ranking; ties within TIE_S; not reached last)."""
+    """{controller: rank} by the p95 time, then by the number of runs never on target (competition ranking;
+    p95 times within TIE_S are equal; not reached after every time)."""
     ran = [m for m in entries if not m.status and m.runs]
-    p = {m.controller: m.p(95) for m in ran}
+    key = {m.controller: (m.p(95), m.never) for m in ran}
 
     def better(a, b):
-        return a < b and not (math.isfinite(a) and math.isfinite(b) and b - a <= TIE_S)
-    return {k: 1 + sum(1 for v in p.values() if better(v, p[k]) or (math.isfinite(v) and not math.isfinite(p[k])))
-            for k in p}
+        same = a[0] == b[0] or (math.isfinite(a[0]) and math.isfinite(b[0]) and abs(a[0] - b[0]) <= TIE_S)
+        return a[1] < b[1] if same else a[0] < b[0]
+    return {k: 1 + sum(1 for v in key.values() if better(v, key[k])) for k in key}
 
 
 def _s(v: float) -> str:
@@ -185,7 +187,7 @@ def section(out, case_, entries, ctx):
              f"Times from separation: to the mode manager's hand-over ({case.handover}) and to on target "
              f"({case.metric}); p95 and median over every run, a run that never got there or failed counted as not "
              f"reached (so the p95 is 'not reached' when more than 5 % never get there); ranked by the p95 to on "
-             f"target, equal within {TIE_S:g} s.")
+             f"target (equal within {TIE_S:g} s), then by the runs never on target.")
     md = ["## Mission: time to fine pointing", "", intro, "", "| " + " | ".join(HEAD) + " |",
           "|" + "---|" * len(HEAD)] + ["| " + " | ".join(r) + " |" for r in _rows(ms, unit, lambda x: f"**{x}**")]
     md += [""]
