@@ -76,7 +76,7 @@ def page(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("bm_mission")
     unit = fu.build_c_pd(tmp, "crash", fail_time=100.0)
     r = scfmu("benchmark", unit, "--family", "attitude", "--mission", "--mission-runs", 2, "--controllers",
-              "PdController", "--cases", "paper000/000-5", "--out", tmp / "out", "--workers", 2)
+              "PdController", "--cases", "paper000/000-5", "--out", tmp / "out", "--workers", 2, "--quick")
     assert r.returncode == 0, r.stderr[-2000:]
     with open(tmp / "out" / "mission.csv") as f:
         rows = {row["controller"]: row for row in csv.DictReader(f)}
