@@ -280,7 +280,7 @@ def _measure_text(c: str, base: dict, measured: list) -> str:
             f"among the numbers we have, so its own spread cannot set it): the measure is {k * at0:.1f} {unit} at the "
             f"defaults" + (f" and {'; '.join(parts)}" if parts else "")
             + f"; over the defaults and the counted readings the verdict would be confirmed for any threshold ≥ "
-            f"{hi:.1f} {unit}" + (f", depend on the reading between {lo:.1f} and {hi:.1f} {unit}" if hi > lo else "")
+            f"{hi:.1f} {unit}" + (f", depend on the reading between {lo:.1f} and {hi:.1f} {unit}" if f"{hi:.1f}" != f"{lo:.1f}" else "")
             + (f" and be not confirmed below {lo:.1f} {unit}." if lo > 0 else "."))
 
 
