@@ -33,8 +33,9 @@ from .constants import (DCM_READINGS, EFF, EFFORT_RATIO, EI, L_METHODS, L_RUNS, 
 from . import numbers as N
 from ...report import rules
 from .figures import fig_effort, fig_joint, fig_ranking, fig_robust, fig_sweep
-from .report_rules import (AGREEMENT, MEASURE, RULES, _fmt_cat, _spearman, below, c6_needed_ratio, holds_where, rule_c1,  # noqa: F401
-                           rule_c2, rule_c3, rule_c4, rule_c5, rule_c6, rule_c7, spread_c2, verdict)
+from .report_rules import (AGREEMENT, MEASURE, RULES, _at, _fmt_cat, _measure_text, _spearman, below,  # noqa: F401
+                           c6_needed_ratio, holds_where, rule_c1, rule_c2, rule_c3, rule_c4, rule_c5, rule_c6,
+                           rule_c7, spread_c2, verdict)
 
 
 # ----- sweeps -------------------------------------------------------------------------------------------------
@@ -261,29 +262,6 @@ def _sweeps(ctx: Context, base: dict, sws: list) -> tuple[dict, dict, list, dict
     return per_claim, away_of, needed, all_rows, measures
 
 
-def _value(v) -> str:
-    """A reading's value in the evidence text (a pair of the joint grid, an integer code, a number)."""
-    return _fmt_cat(v) if isinstance(v, (tuple, int, str)) else f"{v:.3g}"
-
-
-def _measure_text(c: str, base: dict, measured: list) -> str:
-    """The measure of a claim of ``MEASURE`` at the defaults and at every reading, and the thresholds for which
-    the verdict stands: the rule holds wherever the measure is ≤ the threshold, so the verdict over the counted
-    readings is confirmed for a threshold ≥ the largest counted measure and not confirmed below the smallest."""
-    fn, tol, k, unit = MEASURE[c]
-    at0 = fn(base)
-    counted = [at0] + [x for _, x, away in measured if not away]
-    parts = [f"{name}: {k * x:.1f} {unit}" + (" (moves the paper's own Table 3 numbers further away: not counted)"
-                                              if away else "") for name, x, away in measured]
-    lo, hi = k * min(counted), k * max(counted)
-    return (f" The threshold {k * tol:.0f} {unit} is a project choice (the paper's own small-command values are not "
-            f"among the numbers we have, so its own spread cannot set it): the measure is {k * at0:.1f} {unit} at the "
-            f"defaults" + (f" and {'; '.join(parts)}" if parts else "")
-            + f"; over the defaults and the counted readings the verdict would be confirmed for any threshold ≥ "
-            f"{hi:.1f} {unit}" + (f", depend on the reading between {lo:.1f} and {hi:.1f} {unit}" if f"{hi:.1f}" != f"{lo:.1f}" else "")
-            + (f" and be not confirmed below {lo:.1f} {unit}." if lo > 0 else "."))
-
-
 def _joint(ctx: Context, base: dict, sws: list, all_rows: dict, per_claim: dict, away_of: dict, needed: list):
     """The fuzzy PD's T_r and the adaptive-fuzzy λ-range scale evaluated together, from the same runs;
     appends to per_claim, away_of and needed, returns the figure."""
@@ -384,12 +362,6 @@ def _claim(c: str, rule, base: dict, per_claim: dict, away_of: dict, needed: lis
     return Claim(c, STATEMENTS[c], v, evidence, figures=[], sensitivity=sens, sensitive_to=flips + [
         f"{p} (flips it only while moving the paper's numbers away; not counted)" for p in flips_away],
         agreement=AGREEMENT[c](base) if c in AGREEMENT else None, chosen_support=chosen_support)
-
-
-def _at(param: str, values: list, most: int = 4) -> str:
-    """"param = a, b" for the values at which a reading flips a verdict (at most ``most`` named)."""
-    named = ", ".join(_value(v) for v in values[:most])
-    return f"{param} = {named}" + (f" … ({len(values)} values)" if len(values) > most else "")
 
 
 def _setup_and_notes(ctx: Context, base: dict, sws: list) -> tuple[str, str]:

@@ -184,6 +184,35 @@ def _fmt_cat(v) -> str:
     return "(" + ", ".join(f"{e:.3g}" for e in v) + ")" if isinstance(v, tuple) else str(v)
 
 
+def _value(v) -> str:
+    """A reading's value in the evidence text (a pair of the joint grid, an integer code, a number)."""
+    return _fmt_cat(v) if isinstance(v, (tuple, int, str)) else f"{v:.3g}"
+
+
+def _measure_text(c: str, base: dict, measured: list) -> str:
+    """The measure of a claim of ``MEASURE`` at the defaults and at every reading, and the thresholds for which
+    the verdict stands: the rule holds wherever the measure is ≤ the threshold, so the verdict over the counted
+    readings is confirmed for a threshold ≥ the largest counted measure and not confirmed below the smallest."""
+    fn, tol, k, unit = MEASURE[c]
+    at0 = fn(base)
+    counted = [at0] + [x for _, x, away in measured if not away]
+    parts = [f"{name}: {k * x:.1f} {unit}" + (" (moves the paper's own Table 3 numbers further away: not counted)"
+                                              if away else "") for name, x, away in measured]
+    lo, hi = k * min(counted), k * max(counted)
+    return (f" The threshold {k * tol:.0f} {unit} is a project choice (the paper's own small-command values are not "
+            f"among the numbers we have, so its own spread cannot set it): the measure is {k * at0:.1f} {unit} at the "
+            f"defaults" + (f" and {'; '.join(parts)}" if parts else "")
+            + f"; over the defaults and the counted readings the verdict would be confirmed for any threshold ≥ "
+            f"{hi:.1f} {unit}" + (f", depend on the reading between {lo:.1f} and {hi:.1f} {unit}" if f"{hi:.1f}" != f"{lo:.1f}" else "")
+            + (f" and be not confirmed below {lo:.1f} {unit}." if lo > 0 else "."))
+
+
+def _at(param: str, values: list, most: int = 4) -> str:
+    """"param = a, b" for the values at which a reading flips a verdict (at most ``most`` named)."""
+    named = ", ".join(_value(v) for v in values[:most])
+    return f"{param} = {named}" + (f" … ({len(values)} values)" if len(values) > most else "")
+
+
 def holds_where(param: str, values: list, holds: list[bool], fmt=lambda v: f"{v:.3g}", categorical=False) -> str:
     """A readable region from a sweep: contiguous runs of holding values (values sorted as given), or for a
     categorical reading the set of values where it holds."""
