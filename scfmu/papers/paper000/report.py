@@ -35,7 +35,7 @@ from ...report import rules
 from .figures import fig_effort, fig_joint, fig_ranking, fig_robust, fig_sweep
 from .report_rules import (AGREEMENT, MEASURE, RULES, _at, _fmt_cat, _measure_text, _spearman, below,  # noqa: F401
                            c6_needed_ratio, holds_where, rule_c1, rule_c2, rule_c3, rule_c4, rule_c5, rule_c6,
-                           rule_c7, spread_c2, verdict)
+                           rule_c7, spread_c2, _value, verdict)
 
 
 # ----- sweeps -------------------------------------------------------------------------------------------------
