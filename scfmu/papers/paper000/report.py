@@ -33,8 +33,9 @@ from .constants import (DCM_READINGS, EFF, EFFORT_RATIO, EI, L_METHODS, L_RUNS, 
 from . import numbers as N
 from ...report import rules
 from .figures import fig_effort, fig_joint, fig_ranking, fig_robust, fig_sweep
-from .report_rules import (AGREEMENT, RULES, _fmt_cat, _spearman, below, c6_needed_ratio, holds_where, rule_c1,  # noqa: F401
-                           rule_c2, rule_c3, rule_c4, rule_c5, rule_c6, rule_c7, verdict)
+from .report_rules import (AGREEMENT, MEASURE, RULES, _at, _fmt_cat, _measure_text, _spearman, below,  # noqa: F401
+                           c6_needed_ratio, holds_where, rule_c1, rule_c2, rule_c3, rule_c4, rule_c5, rule_c6,
+                           rule_c7, spread_c2, _value, verdict)
 
 
 # ----- sweeps -------------------------------------------------------------------------------------------------
@@ -212,12 +213,14 @@ RULE_TEXT = {
 }
 
 
-def _sweeps(ctx: Context, base: dict, sws: list) -> tuple[dict, dict, list, dict]:
+def _sweeps(ctx: Context, base: dict, sws: list) -> tuple[dict, dict, list, dict, dict]:
     """Every one-reading sweep: its runs, figure, and per claim the verdict at each value (with the table
     where the reading moves the verdict) and whether the value moves the paper's own numbers away. Returns
-    (per_claim, away_of, needed effort ratios, rows of each sweep)."""
+    (per_claim, away_of, needed effort ratios, rows of each sweep, measures: per claim of ``MEASURE`` its
+    measure at every value tried, (reading, measure, moves the paper's numbers away))."""
     per_claim: dict[str, list[tuple[dict, list[bool], Sensitivity]]] = {c: [] for c in RULES}
     away_of: dict[str, list[tuple[str, list, list[bool], list[bool]]]] = {c: [] for c in RULES}
+    measures: dict[str, list[tuple[str, float, bool]]] = {c: [] for c in MEASURE}
     needed = [(c6_needed_ratio(base), "the defaults")]
     all_rows = {}
     for idx, sw in enumerate(sws):
@@ -230,6 +233,11 @@ def _sweeps(ctx: Context, base: dict, sws: list) -> tuple[dict, dict, list, dict
                                    f"{sw['param']} = {_fmt_cat(v) if sw.get('categorical') else f'{v:.3g}'}"))
         holds = {c: evaluate_sweep(base, sw, rows, c) for c in sw["claims"]}
         away = away_sweep(base, sw, rows)
+        for c in (c for c in sw["claims"] if c in MEASURE):
+            for i, v in enumerate(sw["values"]):
+                if all(rr[i]["status"] == "ok" for rr in rows.values()):
+                    measures[c].append((f"{sw['param']} = {_value(v)}",
+                                        MEASURE[c][0]({**base, **{rid: rr[i] for rid, rr in rows.items()}}), away[i]))
         fig = fig_sweep(ctx, base, sw, idx, rows, holds)
         plotted = [r for r in sw["runs"] if r in L_RUNS]
         fmt = _fmt_cat if sw.get("categorical") else (lambda v: f"{v:.3g}")
@@ -251,7 +259,7 @@ def _sweeps(ctx: Context, base: dict, sws: list) -> tuple[dict, dict, list, dict
             per_claim[c].append((sw, h, s))
             away_of[c].append((sw["param"], list(sw["values"]), list(h), away))
 
-    return per_claim, away_of, needed, all_rows
+    return per_claim, away_of, needed, all_rows, measures
 
 
 def _joint(ctx: Context, base: dict, sws: list, all_rows: dict, per_claim: dict, away_of: dict, needed: list):
@@ -288,8 +296,14 @@ def _joint(ctx: Context, base: dict, sws: list, all_rows: dict, per_claim: dict,
     return jfig
 
 
-def _claim(c: str, rule, base: dict, per_claim: dict, away_of: dict, needed: list) -> Claim:
-    """The verdict of claim `c` with its evidence, sensitivities and the readings that flip it."""
+def _claim(c: str, rule, base: dict, per_claim: dict, away_of: dict, needed: list,
+           measures: dict | None = None) -> Claim:
+    """The verdict of claim `c` with its evidence, sensitivities and the readings that flip it. Readings that move
+    the paper's own Table 3 numbers further away are neither support nor counter-example
+    (``rules.combine_faithful``); readings a sweep lists under ``chosen`` (values picked after comparing with the
+    paper) are never evidence either, and a claim that holds only under one of them reads "not confirmed (holds
+    only under a chosen reading: …)" (``rules.combine_evidence``, ``Claim.chosen_support``), the rule of every
+    paper."""
     ok, why = rule(base)
     extra, sens = "", [s for _, _, s in per_claim[c]]
     swept = [x for _, h, _ in per_claim[c] for x in h]
@@ -320,16 +334,23 @@ def _claim(c: str, rule, base: dict, per_claim: dict, away_of: dict, needed: lis
     extra_n = len(swept) - sum(len(hs) for _, _, hs, _ in away_of[c])
     for k_, x in enumerate(swept[len(swept) - extra_n:]):
         readings[f"other reading {k_}"] = (bool(x), False)
-    v, _support, away_names = rules.combine_faithful(ok, readings)
+    _v, _support, away_names = rules.combine_faithful(ok, readings)
+    chosen = {f"{name} = {v_}" for (sw, _, _), (name, _, _, _) in zip(per_claim[c], away_of[c])
+              for v_ in sw.get("chosen", ())}
+    v, chosen_support = rules.combine_evidence(ok, {k: h for k, (h, a) in readings.items() if not a}, chosen)
+    if c in MEASURE:
+        extra += _measure_text(c, base, (measures or {}).get(c, []))
     away_params = sorted({name for name, vals, hs, aw in away_of[c] if any(h_ and a_ for h_, a_ in zip(hs, aw))})
     if away_params and not ok:
         extra += (" Readings under which it holds only by moving the paper's own Table 3 numbers further away "
                   f"(not counted as support): {', '.join(away_params)} ({len(away_names)} points).")
     # a reading flips the verdict when some value changes the rule's outcome; one that does so only at values
     # moving the paper's own numbers away is listed apart (combine_faithful leaves it out of the verdict)
-    fl = [(s.parameter, any(x != ok and not a for x, a in zip(h, aw)), any(x != ok for x in h))
-          for (sw, h, s), (_, _, _, aw) in zip(per_claim[c], away_of[c])]
-    flips, flips_away = [p for p, f, _ in fl if f], [p for p, f, any_ in fl if any_ and not f]
+    fl = [(s.parameter, any(x != ok and not a for x, a in zip(h, aw)), any(x != ok for x in h),
+           [v_ for v_, x, a in zip(vals, h, aw) if x != ok and a])
+          for (sw, h, s), (_, vals, _, aw) in zip(per_claim[c], away_of[c])]
+    flips, flips_away = [p for p, f, _, _ in fl if f], [p for p, f, any_, _ in fl if any_ and not f]
+    away_at = {p: vs for p, f, any_, vs in fl if any_ and not f}
     if c in ("C000-5", "C000-6") and (rule(base, "effort_sq")[0] != ok):
         flips.append("effort metric")
     if c == "C000-7" and rule(base, ("L",))[0] != ok:
@@ -337,10 +358,10 @@ def _claim(c: str, rule, base: dict, per_claim: dict, away_of: dict, needed: lis
     evidence = (f"Rule: {RULE_TEXT[c]} At the defaults it {'holds' if ok else 'fails'}: {why}.{extra} "
                 + (f"The verdict flips with: {', '.join(flips)}." if flips else "No counted reading changes it.")
                 + (f" It flips only at values that move the paper's own Table 3 numbers further away (listed, "
-                   f"not counted): {', '.join(flips_away)}." if flips_away else ""))
+                   f"not counted): {'; '.join(_at(p, away_at[p]) for p in flips_away)}." if flips_away else ""))
     return Claim(c, STATEMENTS[c], v, evidence, figures=[], sensitivity=sens, sensitive_to=flips + [
         f"{p} (flips it only while moving the paper's numbers away; not counted)" for p in flips_away],
-        agreement=AGREEMENT[c](base) if c in AGREEMENT else None)
+        agreement=AGREEMENT[c](base) if c in AGREEMENT else None, chosen_support=chosen_support)
 
 
 def _setup_and_notes(ctx: Context, base: dict, sws: list) -> tuple[str, str]:
@@ -386,11 +407,11 @@ def build(ctx: Context) -> PaperSection:
     base, ts = run_base(ctx)
     figs = [fig_ranking(ctx, base), fig_effort(ctx, base), fig_robust(ctx, ts)]
     sws = sweeps(ctx.quick)
-    per_claim, away_of, needed, all_rows = _sweeps(ctx, base, sws)
+    per_claim, away_of, needed, all_rows, measures = _sweeps(ctx, base, sws)
     jfig = _joint(ctx, base, sws, all_rows, per_claim, away_of, needed)
     figs.append(jfig)
 
-    claims = [_claim(c, rule, base, per_claim, away_of, needed) for c, rule in RULES.items()]
+    claims = [_claim(c, rule, base, per_claim, away_of, needed, measures) for c, rule in RULES.items()]
     claims[0].figures = [figs[0]]
     claims[3].figures = [figs[0]]
     claims[4].figures = [figs[1]]

@@ -36,10 +36,16 @@ def rule_c1(m: dict) -> tuple[bool, str]:
     return ok, f"quaternion {q:.1f} {_rel(q, d)} DCM {d:.1f} {_rel(d, e)} Euler {e:.1f} deg·s"
 
 
+def spread_c2(m: dict) -> float:
+    """C000-2's measure: the relative spread (max − min)/min of EULERINT over the small-command runs."""
+    v = [m[k][EI] for k in S_RUNS if k in m]
+    return (max(v) - min(v)) / min(v)
+
+
 def rule_c2(m: dict) -> tuple[bool, str]:
     """C000-2: small command, every method within TOL_SMALL of each other (relative spread of EULERINT)."""
     v = [m[k][EI] for k in S_RUNS if k in m]
-    spread = (max(v) - min(v)) / min(v)
+    spread = spread_c2(m)
     return spread <= TOL_SMALL, f"small command: EULERINT {min(v):.2f} … {max(v):.2f} deg·s, spread {100 * spread:.1f} % " \
                                 f"(rule ≤ {100 * TOL_SMALL:.0f} %)"
 
@@ -154,6 +160,12 @@ def c6_needed_ratio(m: dict, effort: str = EFF) -> float:
 # at rounding level the claim holds by construction, decided from these numbers)
 AGREEMENT = {"C000-3": agreement_c3}
 
+# the claims whose rule compares one measure with a project-chosen threshold: (measure, threshold, unit factor,
+# unit); the report states the measure at the defaults and at every reading, and the thresholds for which the
+# verdict stands, so a reader can judge the threshold (C000-2: the paper prints no small-command values that
+# could calibrate "about the same")
+MEASURE = {"C000-2": (spread_c2, TOL_SMALL, 100.0, "%")}
+
 RULES = {"C000-1": rule_c1, "C000-2": rule_c2, "C000-3": rule_c3, "C000-4": rule_c4, "C000-5": rule_c5,
          "C000-6": rule_c6, "C000-7": rule_c7}
 
@@ -170,6 +182,35 @@ def verdict(at_default: bool, swept: list[bool]) -> str:
 
 def _fmt_cat(v) -> str:
     return "(" + ", ".join(f"{e:.3g}" for e in v) + ")" if isinstance(v, tuple) else str(v)
+
+
+def _value(v) -> str:
+    """A reading's value in the evidence text (a pair of the joint grid, an integer code, a number)."""
+    return _fmt_cat(v) if isinstance(v, (tuple, int, str)) else f"{v:.3g}"
+
+
+def _measure_text(c: str, base: dict, measured: list) -> str:
+    """The measure of a claim of ``MEASURE`` at the defaults and at every reading, and the thresholds for which
+    the verdict stands: the rule holds wherever the measure is ≤ the threshold, so the verdict over the counted
+    readings is confirmed for a threshold ≥ the largest counted measure and not confirmed below the smallest."""
+    fn, tol, k, unit = MEASURE[c]
+    at0 = fn(base)
+    counted = [at0] + [x for _, x, away in measured if not away]
+    parts = [f"{name}: {k * x:.1f} {unit}" + (" (moves the paper's own Table 3 numbers further away: not counted)"
+                                              if away else "") for name, x, away in measured]
+    lo, hi = k * min(counted), k * max(counted)
+    return (f" The threshold {k * tol:.0f} {unit} is a project choice (the paper's own small-command values are not "
+            f"among the numbers we have, so its own spread cannot set it): the measure is {k * at0:.1f} {unit} at the "
+            f"defaults" + (f" and {'; '.join(parts)}" if parts else "")
+            + f"; over the defaults and the counted readings the verdict would be confirmed for any threshold ≥ "
+            f"{hi:.1f} {unit}" + (f", depend on the reading between {lo:.1f} and {hi:.1f} {unit}" if f"{hi:.1f}" != f"{lo:.1f}" else "")
+            + (f" and be not confirmed below {lo:.1f} {unit}." if lo > 0 else "."))
+
+
+def _at(param: str, values: list, most: int = 4) -> str:
+    """"param = a, b" for the values at which a reading flips a verdict (at most ``most`` named)."""
+    named = ", ".join(_value(v) for v in values[:most])
+    return f"{param} = {named}" + (f" … ({len(values)} values)" if len(values) > most else "")
 
 
 def holds_where(param: str, values: list, holds: list[bool], fmt=lambda v: f"{v:.3g}", categorical=False) -> str:

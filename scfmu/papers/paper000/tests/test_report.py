@@ -196,6 +196,9 @@ def test_quick_build(tmp_path):
     # reading 2 (doubled gain) breaks C000-2 but also moves the large-command DCM EULERINT away from the paper's
     # 161.5 deg·s: such a reading is left out of the verdict
     assert by["C000-2"].verdict == CONFIRMED and s2.holds_where.startswith("PdController.dcm_error ∈ {0, 1, 3, 4, 5}")
+    # … and the evidence names the excluded reading and the thresholds for which the verdict stands
+    assert "not counted): PdController.dcm_error = 2" in by["C000-2"].evidence and not by["C000-2"].chosen_support
+    assert "confirmed for any threshold ≥" in by["C000-2"].evidence
     # issue 14's contradictions under today's defaults: the large-slew ranking depends on a reading
     assert by["C000-4"].verdict == DEPENDS and "AdaptiveFuzzyController λ-range scale s" in by["C000-4"].sensitive_to
     # the DCM readings 4 and 5 make C000-1 hold, reading 0 (default) does not
@@ -224,3 +227,43 @@ def test_c6_needed_ratio():
     assert p.c6_needed_ratio(m) == pytest.approx(1100 / 770)
     m["000-10L"] = row(150.0)  # fuzzy above MRAC: no threshold helps
     assert math.isinf(p.c6_needed_ratio(m))
+
+
+def _claim_c2(m: dict, holds: list, away: list, chosen=()):
+    """C000-2's claim as build() decides it, with the six DCM error law readings of the sweep given by hand
+    (holds, moves the paper's numbers away, at dcm_error = 0 … 5; the measured spread 2.3 % at the counted ones
+    and 76 % at the doubled-gain reading 2, as the runs give)."""
+    sw = dict(param="PdController.dcm_error", values=list(range(6)), chosen=list(chosen))
+    s = p.Sensitivity(sw["param"], sw["values"], 0, "")
+    per_claim = {c: [] for c in p.RULES}
+    away_of = {c: [] for c in p.RULES}
+    per_claim["C000-2"].append((sw, holds, s))
+    away_of["C000-2"].append((sw["param"], sw["values"], holds, away))
+    measures = {"C000-2": [(f"{sw['param']} = {v}", 0.023 if h else 0.76, a)
+                           for v, h, a in zip(sw["values"], holds, away)]}
+    return p._claim("C000-2", p.RULES["C000-2"], m, per_claim, away_of, [], measures)
+
+
+def test_c2_every_dcm_reading_follows_the_evidence_rule():
+    """Our runs: C000-2 holds at the defaults and under every DCM error reading except 2 (twice the gain), which
+    moves the large-command DCM EULERINT further from the paper's 161.5 deg·s and so is neither support nor
+    counter-example (confirmed, the excluded reading named). Broken on purpose: if that reading did not move the
+    paper's numbers away it would count and the verdict would depend on the reading; if the defaults failed and
+    the reading were one chosen after comparing with the paper, the claim would hold only under a chosen reading
+    (not confirmed, said so) – the rule of every paper (rules.combine_evidence)."""
+    m = paper_like()
+    holds = [True, True, False, True, True, True]
+    away = [False, False, True, False, False, False]
+    c = _claim_c2(m, holds, away)
+    assert c.verdict == CONFIRMED and not c.chosen_support
+    assert "PdController.dcm_error = 2" in c.evidence and "not counted" in c.evidence
+    assert "confirmed for any threshold ≥ 2.3 %" in c.evidence and "= 2: 76.0 %" in c.evidence
+    # broken: the doubled-gain reading no longer moves the paper's numbers away → it counts
+    assert _claim_c2(m, holds, [False] * 6).verdict == DEPENDS
+    # broken: the defaults fail (spread 20 %), only reading 2 holds, and it is a chosen reading → never evidence
+    m["000-1"] = row(16.5 / 1.2)
+    c = _claim_c2(m, [False, False, True, False, False, False], [False] * 6, chosen=[2])
+    assert c.verdict == NOT_CONFIRMED and c.chosen_support == ["PdController.dcm_error = 2"]
+    assert c.verdict_text == "not confirmed (holds only under a chosen reading: PdController.dcm_error = 2)"
+    # … while, not chosen, the same reading makes it depend on the reading
+    assert _claim_c2(m, [False, False, True, False, False, False], [False] * 6).verdict == DEPENDS
