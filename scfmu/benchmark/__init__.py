@@ -309,5 +309,5 @@ def _run_pair(client, log, e: Entry, case, sc, c, folder: Path) -> None:
         + (f"; {e.config}" if e.envelope == "retuned" else ""))
 
 
-add_warning(engineering.saturation_warnings)
-add_section(mission_runs.section)  # scfmu benchmark --mission  # time in actuator saturation (scfmu.benchmark.engineering)
+add_warning(engineering.saturation_warnings)  # time in actuator saturation (scfmu.benchmark.engineering)
+add_section(mission_runs.section)  # scfmu benchmark --mission
