@@ -49,8 +49,8 @@ def reference_master(scenario, path_of=None, model_exchange=frozenset()) -> tupl
     plan = as_plan(scenario, path_of, model_exchange)
     fmus = build_fmus(plan)
     # the plan's wiring (explicit exceptions included) replaces the master's own name matching
-    sim = CoSimulation(list(fmus.values()), unconnected={n for f in fmus.values() for n in f.inputs()})
-    sim.links = [_Link(fmus[g.dst], list(g.dst_names), fmus[g.src], list(g.src_names)) for g in plan.groups]
+    sim = CoSimulation(list(fmus.values()),
+                       links=[_Link(fmus[g.dst], list(g.dst_names), fmus[g.src], list(g.src_names)) for g in plan.groups])
     log = {key: (fmus[g.inst], var) for g in plan.log for key, var in zip(g.keys, g.names)}
     log = {k: log[k] for k in plan.scenario.log}
     return sim, fmus, log

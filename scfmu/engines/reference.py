@@ -29,13 +29,17 @@ class _Link:
 
 @dataclass
 class CoSimulation:
-    """FMUs in Gauss-Seidel order, wired by port name."""
+    """FMUs in Gauss-Seidel order, wired by port name, or by ``links`` when given (a plan's wiring: then no
+    name is matched, so two units with an output of the same name, such as a plant's and an estimate gate's
+    ``w_x``, do not make an input ambiguous)."""
 
     fmus: list[Fmu]
     unconnected: set[str] = field(default_factory=set)
-    links: list[_Link] = field(init=False)
+    links: list[_Link] | None = None
 
     def __post_init__(self):
+        if self.links is not None:
+            return
         self.links = []
         for dst in self.fmus:
             by_src: dict[int, _Link] = {}
