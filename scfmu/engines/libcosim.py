@@ -94,15 +94,21 @@ def run_libcosim(scenario: Scenario) -> dict:
     wall = time.perf_counter() - t
     out = {"wall_s": wall}
     for key, inst, var in scenario.log_items():
-        out[key] = obs.last_real_values(idx[inst], [mds[inst][var].valueReference])[0]
+        out[key] = _last(obs, idx[inst], mds[inst][var])
     return out
+
+
+def _last(obs, i: int, v):
+    """The last value of variable ``v`` (a model-description variable) of slave ``i``, read by its type."""
+    read = {"Integer": obs.last_integer_values, "Boolean": obs.last_boolean_values}.get(v.type, obs.last_real_values)
+    return read(i, [v.valueReference])[0]
 
 
 def run_libcosim_ssp(ssp_path, stop_time: float | None = None, series=()) -> dict:
     """Runs an ``.ssp`` written by ``scfmu.ssp`` on libcosim's own SSP loader (components, parameter
     bindings and connections all come from the archive; the fixed step from the scfmu annotation).
-    Returns the final value of every logged key of the scenario, like :func:`run_libcosim` (Integer outputs
-    read as integers); ``series``: logged keys also recorded at every step by libcosim's time-series observer,
+    Returns the final value of every logged key of the scenario, like :func:`run_libcosim` (each read by its
+    type); ``series``: logged keys also recorded at every step by libcosim's time-series observer,
     returned as ``out["series"][key] = (times [s], values)`` (the values after each step, step 1 on)."""
     import shutil
 
@@ -140,8 +146,7 @@ def run_libcosim_ssp(ssp_path, stop_time: float | None = None, series=()) -> dic
             raise RuntimeError("libcosim: simulate_until failed")
         out = {}
         for key, (i, v) in items.items():
-            read = obs.last_integer_values if v.type == "Integer" else obs.last_real_values
-            out[key] = read(i, [v.valueReference])[0]
+            out[key] = _last(obs, i, v)
         if ts is not None:
             out["series"] = {key: _samples(ts, *items[key], n) for key in series}
         return out
