@@ -29,11 +29,10 @@ from pathlib import Path
 import numpy as np
 
 from scfmu import campaign
-from scfmu.campaign.cli import parse_random
+from scfmu.campaign.cli import dispersed_sets
 from scfmu.engines import simulate
 from scfmu.metrics import to_body
 from scfmu.papers.mission import metrics, scenarios as mission
-from scfmu.registry import REGISTRY
 from scfmu.results import write_parquet
 
 CONTROLLERS = {"PD": ("PdController", {}), "LQR": ("LqrController", {})}
@@ -120,9 +119,7 @@ def campaign_rows(label: str, model: str, params: dict, runs: int, stop: float |
     if model != "PdController":
         sc = sc.with_models({"controller": model})
         sc.component("controller").params.update(params)
-    space = parse_random([f"{k}={v}" for k, v in {**REGISTRY.dispersions_of("mission/tipoff"),
-                                                  **{p: "int:1:2147483647" for p in sc.seed_params}}.items()])
-    sets = campaign.random_sample(space, runs, seed=0)
+    sets = dispersed_sets(sc, runs)
     c = campaign.Campaign(sc, sets, [None], engine="auto")
     t0 = time.perf_counter()
     table = campaign.run(c, data / f"campaign_{label}", n_workers=workers, progress=True)

@@ -103,6 +103,19 @@ def parse_random(items: list[str]) -> dict:
     return space
 
 
+def dispersed(sc) -> dict:
+    """The scenario's registered dispersions and a draw of every seed parameter per run, in the syntax of
+    ``--random`` (``{"instance.parameter": "DIST:A:B"}``)."""
+    seeds = {p: f"int:{SEED_RANGE[0] + 1}:{SEED_RANGE[1]}" for p in sc.seed_params}
+    return {**REGISTRY.dispersions_of(sc.name), **seeds}
+
+
+def dispersed_sets(sc, n: int, seed: int = 0) -> list[dict]:
+    """n override sets drawn from :func:`dispersed` (one generator seeded ``seed``): the runs of
+    ``--runs n``, and the same draws for every controller put in the scenario."""
+    return campaign.random_sample(parse_random([f"{k}={v}" for k, v in dispersed(sc).items()]), n, seed=seed)
+
+
 def runs_space(sc, args) -> list[str]:
     """``--runs N``: the scenario's registered dispersions, each run's own draw of every seed parameter
     (recorded in its row), then the user's ``--random`` axes (which replace a dispersion of the same name)."""
@@ -114,8 +127,7 @@ def runs_space(sc, args) -> list[str]:
     if args.seeds:
         raise UsageError(f"--seeds {args.seeds!r}: not with --runs, which draws each run's seeds "
                          f"({', '.join(sc.seed_params)})")
-    seeds = {p: f"int:{SEED_RANGE[0] + 1}:{SEED_RANGE[1]}" for p in sc.seed_params}
-    return [f"{k}={v}" for k, v in {**disp, **seeds}.items()] + list(args.random)
+    return [f"{k}={v}" for k, v in dispersed(sc).items()] + list(args.random)
 
 
 def build(args) -> campaign.Campaign:
