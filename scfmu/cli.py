@@ -6,7 +6,7 @@ Subcommands (each has ``--help``):
   scenarios [PATTERN]     the registered scenarios, with descriptions
   campaign SCENARIO ...   many runs on Dask: grids, random samples, seeds; Parquet + figures
   benchmark [FMU]         your controller beside the papers' ones on a family's scenarios (HTML + Markdown)
-  export ssp|loop [NAME]  SSP 1.0 files or loop FMUs (one container FMU per closed loop)
+  export ssp|loop [NAME]  SSP files (1.0; --ssp-version 2.0) or loop FMUs (one container FMU per closed loop)
   report [--quick]        the reproduction report of every paper (HTML + Markdown)
   paper NNN COMMAND ...   a paper's own experiments (tuning, sweeps, cases): `scfmu paper` lists them
   check FMU [--quick]     conformance and robustness gauntlet for any FMI 2.0/3.0 FMU (table, HTML, JSON)
@@ -58,6 +58,7 @@ def _scenarios(argv) -> int:
 
 def _export(argv) -> int:
     from .export import KINDS, export
+    from .scenario.ssp2 import Refused
     from .scenario import options
     ap = argparse.ArgumentParser(prog="scfmu export", description="Write SSP 1.0 files or loop FMUs of scenarios "
                                  "(default: the standard set the plug-ins export) and validate each. With --fmu, "
@@ -72,7 +73,13 @@ def _export(argv) -> int:
     ap.add_argument("--map", action="append", default=[], metavar="INSTANCE.THEIRS=OURS", help="rename a unit's port")
     ap.add_argument("--set", action="append", default=[], metavar="INSTANCE.VAR=VALUE", help="parameter or input")
     ap.add_argument("--profile", action="append", default=[], metavar="[INSTANCE=]FILE", help="unit profile (TOML)")
+    ap.add_argument("--ssp-version", default="1.0", metavar="{1.0,2.0}",
+                    help="SSP version of the files (ssp only): 1.0 (default; FMI 1.0/2.0 units) or 2.0 (FMI 3.0 units too)")
     a = ap.parse_args(argv)
+    if a.ssp_version not in ("1.0", "2.0") or (a.ssp_version != "1.0" and a.kind != "ssp"):
+        print(f"scfmu export: --ssp-version {a.ssp_version}: allowed: 1.0 or 2.0, with `scfmu export ssp`",
+              file=sys.stderr)
+        return 2
     out = a.out or ("fmus/ssp" if a.kind == "ssp" else "fmus/loops")
     items = a.names or None
     if a.fmu or a.map or a.set or a.profile or any(n.endswith((".toml", ".json")) for n in a.names):
@@ -90,9 +97,12 @@ def _export(argv) -> int:
             print(f"scfmu export: {e.one_line()}", file=sys.stderr)
             return 2
     try:
-        export(a.kind, out, items, platform=a.platform)
+        export(a.kind, out, items, platform=a.platform, ssp_version=a.ssp_version)
     except KeyError as e:  # an unknown scenario name or prefix (the message names the known ones)
         print(f"scfmu export: {e.args[0] if e.args else e}", file=sys.stderr)
+        return 2
+    except Refused as e:  # what the SSP version asked for cannot hold (FMI 3.0 units in SSP 1.0)
+        print(f"scfmu export: {e}", file=sys.stderr)
         return 2
     except (RuntimeError, ValueError) as e:
         print(f"scfmu export: {e}", file=sys.stderr)

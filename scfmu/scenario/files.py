@@ -139,9 +139,31 @@ def _model(model: str, where: str, base: Path | None) -> str:
     return str(p)
 
 
+def load_ssp(path: str | Path) -> Scenario:
+    """Reads an SSP 1.0 or 2.0 file (:func:`scfmu.scenario.ssp.read_ssp`) into a scenario whose units are the
+    FMUs unpacked from it (a temporary folder removed when the program ends), so any engine runs it."""
+    import atexit
+    import shutil
+    import tempfile
+    import zipfile
+    from xml.etree.ElementTree import ParseError
+    from .ssp import read_ssp
+    work = tempfile.mkdtemp(prefix="scfmu-ssp-")
+    atexit.register(shutil.rmtree, work, True)
+    try:
+        sc, fmus = read_ssp(path, work)
+    except (ValueError, KeyError, AttributeError, TypeError, OSError, ParseError, zipfile.BadZipFile) as e:
+        raise ScenarioFileError(f"{path}: not an SSP file this package reads ({type(e).__name__}: {e})") from None
+    for c in sc.components:
+        c.model = str(fmus[c.model])
+    return sc
+
+
 def load(path: str | Path) -> Scenario:
-    """Reads a scenario file (``.toml`` or ``.json``)."""
+    """Reads a scenario file (``.toml`` or ``.json``; an ``.ssp`` file: :func:`load_ssp`)."""
     path = Path(path)
+    if path.suffix.lower() == ".ssp":
+        return load_ssp(path)
     try:
         text = path.read_text()
     except OSError as e:
@@ -183,4 +205,4 @@ def dumps_json(sc: Scenario) -> str:
 
 
 def is_scenario_file(text: str) -> bool:
-    return text.lower().endswith((".toml", ".json")) and Path(text).is_file()
+    return text.lower().endswith((".toml", ".json", ".ssp")) and Path(text).is_file()

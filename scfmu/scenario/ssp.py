@@ -1,4 +1,9 @@
-"""SSP 1.0 system files (``.ssp``) written from a :class:`~scfmu.scenario.Scenario`, and read back.
+"""SSP 1.0 and 2.0 system files (``.ssp``) written from a :class:`~scfmu.scenario.Scenario`, and read back.
+
+SSP 1.0 is the default (FMI 1.0/2.0 units only; FMI 3.0 units are refused); ``version="2.0"`` writes an
+SSP 2.0 file, which may hold FMI 3.0 units (ours from ``fmus/fmi3/``, or anyone's given by path), with the
+connector types, clocks and array dimensions :mod:`scfmu.scenario.ssp2` describes. Both are laid out as
+below and :func:`read_ssp` reads both (told apart by the root's ``version``).
 
 One scenario declaration is the only source of the wiring: :func:`write_ssp` resolves
 it with :meth:`Scenario.wiring` (the same call the masters use) and writes
@@ -40,6 +45,7 @@ from fmpy import read_model_description
 from ..fmu import fmu_path, is_path
 from .model import Component, Scenario
 from .resolve import resolve
+from .ssp2 import Refused, check_version, connector_extras, connector_type, fmi3_path, structure_problems, value_tag
 
 SSD_NS = "http://ssp-standard.org/SSP1/SystemStructureDescription"
 SSC_NS = "http://ssp-standard.org/SSP1/SystemStructureCommon"
@@ -86,6 +92,13 @@ def _type_elem(parent, ns: str, vtype: str, **attrs):
     return ET.SubElement(parent, _q(ns, tag), {k: v for k, v in attrs.items()})
 
 
+def _base_type(vtype: str) -> str:
+    """The FMI 2.0 type an FMI 3.0 type is written as (Float64 -> Real, Int32 -> Integer)."""
+    if vtype.startswith("Float"):
+        return "Real"
+    return "Integer" if vtype.startswith(("Int", "UInt")) else vtype
+
+
 def _value_text(vtype: str, value) -> str:
     if vtype == "Real":
         return repr(float(value))  # shortest round-trip text: read back bit-identical
@@ -98,12 +111,13 @@ def _value_text(vtype: str, value) -> str:
     raise ValueError(f"unsupported variable type {vtype}")
 
 
-def _ssv(values: list[tuple[str, str, object]], name: str) -> bytes:
-    root = ET.Element(_q("ssv", "ParameterSet"), {"version": "1.0", "name": name})
+def _ssv(values: list[tuple[str, str, object]], name: str, version: str = "1.0", fmi: int = 2) -> bytes:
+    root = ET.Element(_q("ssv", "ParameterSet"), {"version": version, "name": name})
     params = ET.SubElement(root, _q("ssv", "Parameters"))
     for vname, vtype, value in values:
         p = ET.SubElement(params, _q("ssv", "Parameter"), {"name": vname})
-        _type_elem(p, "ssv", vtype, value=_value_text(vtype, value))
+        tag = value_tag(vtype, fmi)
+        ET.SubElement(p, _q("ssv", tag), {"value": _value_text(_base_type(vtype), value)})
     ET.indent(root)
     return ET.tostring(root, encoding="UTF-8", xml_declaration=True)
 
@@ -114,9 +128,11 @@ def resource_name(model: str) -> str:
     return Path(model).name if is_path(model) else f"{model}.fmu"
 
 
-def write_ssp(scenario: Scenario, path: str | Path, path_of=None) -> Path:
-    """Writes ``scenario`` as an SSP 1.0 archive at ``path``; FMUs from ``path_of(model)`` (default
-    ``fmus/<Model>.fmu``, or the model's own path). Returns the path."""
+def write_ssp(scenario: Scenario, path: str | Path, path_of=None, version: str = "1.0") -> Path:
+    """Writes ``scenario`` as an SSP ``version`` ("1.0", the default, or "2.0": FMI 3.0 units, clocks,
+    :mod:`scfmu.scenario.ssp2`) archive at ``path``; FMUs from ``path_of(model)`` (default
+    ``fmus/<Model>.fmu``; for 2.0 ``fmus/fmi3/<Model>.fmu``; or the model's own path). Returns the path."""
+    check_version(version)
     if path_of is None:
         scenario = resolve(scenario)
     path = Path(path)
@@ -124,14 +140,15 @@ def write_ssp(scenario: Scenario, path: str | Path, path_of=None) -> Path:
     if bad or len({c.name for c in scenario.components}) != len(scenario.components):
         raise ValueError(f"scenario {scenario.name}: instance names must be unique identifiers (letters, digits, _) "
                          f"for SSP importers; got {[c.name for c in scenario.components]}")
-    path_of = path_of or fmu_path
+    path_of = path_of or (fmi3_path if version == "2.0" else fmu_path)
     mds = {c.model: read_model_description(str(path_of(c.model))) for c in scenario.components}
-    refuse_fmi3(scenario, mds)
+    if version == "1.0":
+        refuse_fmi3(scenario, mds)
     root = ET.Element(_q("ssd", "SystemStructureDescription"),
-                      {"version": "1.0", "name": identifier(file_stem(scenario.name)), "generationTool": "scfmu.ssp",
+                      {"version": version, "name": identifier(file_stem(scenario.name)), "generationTool": "scfmu.ssp",
                        "description": scenario.description or scenario.name})
     system = ET.SubElement(root, _q("ssd", "System"), {"name": "loop"})
-    ssv_files = _system(system, scenario, mds)
+    ssv_files = _system(system, scenario, mds, version)
     _experiment(root, scenario)
     ET.indent(root)
     ssd = ET.tostring(root, encoding="UTF-8", xml_declaration=True)
@@ -156,18 +173,22 @@ def refuse_fmi3(scenario: Scenario, mds: dict) -> None:
     schemas and reads SSP 1.0 only."""
     fmi3 = [c.name for c in scenario.components if mds[c.model].fmiVersion.startswith("3")]
     if fmi3:
-        raise ValueError(f"{', '.join(fmi3)}: FMI 3.0 units cannot be written to an SSP 1.0 file (SSP 1.0 defines "
-                         f"FMU components for FMI 1.0 and 2.0 only; FMI 3.0 came with SSP 2.0): use the unit's "
-                         f"FMI 2.0 FMU, or a loop FMU (scfmu export loop)")
+        raise Refused(f"{', '.join(fmi3)}: FMI 3.0 units cannot be written to an SSP 1.0 file (SSP 1.0 defines "
+                         f"FMU components for FMI 1.0 and 2.0 only; FMI 3.0 came with SSP 2.0): write an SSP 2.0 "
+                         f"file (--ssp-version 2.0), use the unit's FMI 2.0 FMU, or a loop FMU (scfmu export loop)")
 
 
-def _system(system, scenario: Scenario, mds: dict) -> dict:
+def _fmi(md) -> int:
+    return int(md.fmiVersion.split(".")[0])
+
+
+def _system(system, scenario: Scenario, mds: dict, version: str = "1.0") -> dict:
     """Fills the ``ssd:System``: elements with connectors and parameter bindings, connections and the
     OMSimulator master annotation. Returns the ``.ssv`` files (archive name -> bytes)."""
     vars_of = {c.name: {v.name: v for v in mds[c.model].modelVariables} for c in scenario.components}
-    ports = {c.name: ([v.name for v in mds[c.model].modelVariables if v.causality == "input"],
-                      [v.name for v in mds[c.model].modelVariables if v.causality == "output"])
-             for c in scenario.components}
+    ports = {c.name: ([v.name for v in mds[c.model].modelVariables if v.causality == "input" and v.type != "Clock"],
+                      [v.name for v in mds[c.model].modelVariables if v.causality == "output" and v.type != "Clock"])
+             for c in scenario.components}  # clocks are connectors of a 2.0 file, never wired by name
     links = scenario.wiring(ports)
     fixed = {}
     for q, value in scenario.inputs.items():
@@ -188,7 +209,11 @@ def _system(system, scenario: Scenario, mds: dict) -> dict:
         for v in mds[c.model].modelVariables:
             if v.causality in ("input", "output"):
                 conn = ET.SubElement(conns, _q("ssd", "Connector"), {"name": v.name, "kind": v.causality})
-                _type_elem(conn, "ssc", v.type)
+                if version == "1.0":
+                    _type_elem(conn, "ssc", v.type)
+                else:
+                    connector_type(conn, SSC_NS, v, _fmi(mds[c.model]))
+                    connector_extras(conn, v, mds[c.model])
         values = []
         for k, value in c.params.items():
             if k not in vars_of[c.name]:
@@ -197,7 +222,7 @@ def _system(system, scenario: Scenario, mds: dict) -> dict:
         values += [(k, vars_of[c.name][k].type, value) for k, value in fixed.get(c.name, [])]
         if values:
             src = f"resources/{c.name}.ssv"
-            ssv_files[src] = _ssv(values, c.name)
+            ssv_files[src] = _ssv(values, c.name, version, _fmi(mds[c.model]))
             binds = ET.SubElement(comp, _q("ssd", "ParameterBindings"))
             ET.SubElement(binds, _q("ssd", "ParameterBinding"),
                           {"source": src, "type": "application/x-ssp-parameter-set"})
@@ -237,11 +262,16 @@ def _experiment(root, scenario: Scenario) -> None:
 
 
 def _typed(elem, ns: str):
-    for tag, conv in (("Real", float), ("Integer", int), ("Boolean", lambda s: s in ("true", "1"))):
-        e = elem.find(f"{ns}:{tag}", NS)
-        if e is not None:
-            return conv(e.get("value"))
-    raise ValueError(f"parameter {elem.get('name')}: no Real/Integer/Boolean value")
+    """The value of an SSV parameter: SSP 1.0's Real/Integer/Boolean or SSP 2.0's FMI 3.0 types (scalars)."""
+    from .ssp2 import FLOATS, INTEGERS
+    for tags, conv in ((FLOATS, float), (INTEGERS, int), (("Boolean",), lambda s: s in ("true", "1"))):
+        for tag in tags:
+            e = elem.find(f"{ns}:{tag}", NS)
+            if e is not None:
+                if len(e.get("value").split()) != 1:
+                    raise ValueError(f"parameter {elem.get('name')}: array values are not supported")
+                return conv(e.get("value"))
+    raise ValueError(f"parameter {elem.get('name')}: no float, integer or Boolean value")
 
 
 def read_ssp(path: str | Path, workdir: str | Path | None = None) -> tuple[Scenario, dict]:
@@ -253,6 +283,9 @@ def read_ssp(path: str | Path, workdir: str | Path | None = None) -> tuple[Scena
     from ..fmu import safe_extract  # the archive limits of FMUs hold for an SSP and the FMUs inside it
     workdir = Path(safe_extract(path, workdir))
     root = ET.parse(workdir / "SystemStructure.ssd").getroot()
+    if root.tag != _q("ssd", "SystemStructureDescription") or root.get("version") not in ("1.0", "2.0"):
+        raise ValueError(f"{path}: not an SSP 1.0 or 2.0 system structure (root {root.tag}, version "
+                         f"{root.get('version')!r}; allowed: version 1.0 or 2.0 in the SSP namespace)")
     system = root.find("ssd:System", NS)
     components, fixed, files = [], {}, {}
     for c in system.findall("ssd:Elements/ssd:Component", NS):
@@ -275,13 +308,30 @@ def read_ssp(path: str | Path, workdir: str | Path | None = None) -> tuple[Scena
     connections = {f"{e.get('endElement')}.{e.get('endConnector')}": f"{e.get('startElement')}.{e.get('startConnector')}"
                    for e in system.findall("ssd:Connections/ssd:Connection", NS)}
     exp = root.find("ssd:DefaultExperiment", NS)
-    master = exp.find(f"ssd:Annotations/ssc:Annotation[@type='{ANNOTATION_TYPE}']/scfmu:Master", NS)
-    meta = json.loads(master.text)
-    sc = Scenario(name=meta["name"], components=components, start_time=float(exp.get("startTime")),
-                  stop_time=float(exp.get("stopTime")), step=float(master.get("stepSize")), log=meta["log"],
+    master = None if exp is None else \
+        exp.find(f"ssd:Annotations/ssc:Annotation[@type='{ANNOTATION_TYPE}']/scfmu:Master", NS)
+    meta = json.loads(master.text) if master is not None else _foreign_meta(root, system, path)
+    step = master.get("stepSize") if master is not None else meta["step"]
+    sc = Scenario(name=meta["name"], components=components, start_time=float(exp.get("startTime", 0.0)),
+                  stop_time=float(exp.get("stopTime")), step=float(step), log=meta["log"],
                   connections=connections, unconnected=["*"], inputs=fixed, auto_connect=False,
                   seed_params=meta["seed_params"], metrics=meta["metrics"], description=root.get("description", ""))
     return sc, files
+
+
+def _foreign_meta(root, system, path) -> dict:
+    """The master settings of an SSP file another tool wrote (no annotation of this package): the step from
+    libcosim's or OMSimulator's annotation, every connected output logged as ``instance.output``."""
+    steps = [e.get("baseStepSize") for e in root.iter(_q("osp", "FixedStepAlgorithm"))]
+    steps += [e.get("stepSize") for e in system.iter(_q("oms", "FixedStepMaster"))]
+    steps = [s for s in steps if s]
+    if not steps or root.find("ssd:DefaultExperiment", NS) is None:
+        raise ValueError(f"{path}: no communication step (none of the libcosim, OMSimulator or scfmu annotations) "
+                         f"or no DefaultExperiment stop time; allowed: an SSP file with one of them")
+    outs = dict.fromkeys(f"{e.get('startElement')}.{e.get('startConnector')}"
+                         for e in system.findall("ssd:Connections/ssd:Connection", NS))
+    return {"name": root.get("name"), "step": steps[0], "log": {k: k for k in outs}, "metrics": "",
+            "seed_params": []}
 
 
 def schema_dir() -> Path:
@@ -289,10 +339,23 @@ def schema_dir() -> Path:
     return Path(fmpy.__file__).parent / "ssp" / "schema"
 
 
+def ssp_version(path: str | Path) -> str:
+    """The ``version`` attribute of the archive's ``SystemStructure.ssd``."""
+    with zipfile.ZipFile(path) as z:
+        if "SystemStructure.ssd" not in z.namelist():
+            return ""
+        return ET.fromstring(z.read("SystemStructure.ssd")).get("version", "")
+
+
 def validate_ssp(path: str | Path) -> list[str]:
     """Problems found by validating the archive's ``.ssd`` (SSP 1.0 SystemStructureDescription.xsd) and
-    ``.ssv`` files (SystemStructureParameterValues.xsd) with lxml; empty when valid."""
+    ``.ssv`` files (SystemStructureParameterValues.xsd) with lxml; empty when valid. An SSP 2.0 file:
+    :func:`scfmu.scenario.ssp2.structure_problems`, and the official 2.0 schemas when ``SCFMU_SSP2_SCHEMA``
+    names a folder holding them."""
     from lxml import etree
+    if ssp_version(path) == "2.0":
+        from .ssp2 import schema_dir as schema2, xsd_problems
+        return structure_problems(path) + (xsd_problems(path, schema2()) if schema2() else [])
     schemas = {ext: etree.XMLSchema(file=str(schema_dir() / f)) for ext, f in
                ((".ssd", "SystemStructureDescription.xsd"), (".ssv", "SystemStructureParameterValues.xsd"))}
     problems = []
