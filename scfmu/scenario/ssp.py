@@ -45,7 +45,8 @@ from fmpy import read_model_description
 from ..fmu import fmu_path, is_path
 from .model import Component, Scenario
 from .resolve import resolve
-from .ssp2 import Refused, check_version, connector_extras, connector_type, fmi3_path, structure_problems, value_tag
+from .ssp2 import (Refused, check_version, connector_extras, connector_type, fmi3_path, size_variables,
+                   structure_problems, value_tag)
 
 SSD_NS = "http://ssp-standard.org/SSP1/SystemStructureDescription"
 SSC_NS = "http://ssp-standard.org/SSP1/SystemStructureCommon"
@@ -214,6 +215,10 @@ def _system(system, scenario: Scenario, mds: dict, version: str = "1.0") -> dict
                 else:
                     connector_type(conn, SSC_NS, v, _fmi(mds[c.model]))
                     connector_extras(conn, v, mds[c.model])
+        if version == "2.0":
+            for v in size_variables(mds[c.model]):  # the sizes named by sizeConnector are connectors too
+                connector_type(ET.SubElement(conns, _q("ssd", "Connector"), {"name": v.name, "kind": v.causality}),
+                               SSC_NS, v, 3)
         values = []
         for k, value in c.params.items():
             if k not in vars_of[c.name]:

@@ -116,6 +116,15 @@ def connector_extras(conn, v, md) -> None:
         ET.SubElement(conn, f"{{{SSD}}}Clock", {"name": name})
 
 
+def size_variables(md) -> list:
+    """The variables holding the size of an input's or output's array dimension (structural parameters):
+    a 2.0 connector names them by ``sizeConnector``, so they get connectors of their own."""
+    by_vr = {x.valueReference: x for x in md.modelVariables}
+    vrs = dict.fromkeys(d.valueReference for v in md.modelVariables if v.causality in ("input", "output")
+                        for d in (getattr(v, "dimensions", None) or []) if d.start is None)
+    return [by_vr[vr] for vr in vrs if vr in by_vr and by_vr[vr].causality not in ("input", "output")]
+
+
 def value_tag(vtype: str, fmi: int) -> str:
     """The SSV element of a parameter of type ``vtype``: FMI 2.0 units keep the 1.0 names (an enumeration is
     an Integer), FMI 3.0 ones their own type."""
@@ -154,7 +163,8 @@ def _elem_problems(root, where: str) -> list[str]:
     out = []
     for e in root.iter():
         name = _local(e.tag)
-        for a in REQUIRED_ATTRS.get(name, ()):
+        required = () if name == "Clock" and e.tag != f"{{{SSD}}}Clock" else REQUIRED_ATTRS.get(name, ())
+        for a in required:  # (ssc:Clock, the connector type, has no required attribute; ssd:Clock needs a name)
             if e.get(a) is None:
                 out.append(f"{where}: {name} {e.get('name', '')!r} lacks the required attribute {a}")
         if name in ("SystemStructureDescription", "ParameterSet") and e.get("version") not in VERSIONS:
