@@ -172,6 +172,34 @@ def test_scfmu_run_reads_an_ssp_2_0_file(exported, tmp_path):
         np.testing.assert_array_equal(csv[k], ref[k], err_msg=k)
 
 
+def test_scfmu_run_reads_an_ssp_1_0_file(tmp_path):
+    shipped = fmu_dir() / "ssp" / "default.ssp"
+    if not shipped.exists():
+        pytest.fail(f"{shipped} missing: run scripts/build_fmus.sh")
+    r = scfmu("run", shipped, "--t-end", 1, "--out", tmp_path / "run")
+    assert r.returncode == 0, r.stderr
+    csv = np.genfromtxt(tmp_path / "run" / "default.csv", delimiter=",", names=True)
+    ref = run_reference(scenarios.get("default", stop_time=1.0))
+    for k in ("q_w", "w_x", "eulerint_deg_s"):
+        np.testing.assert_array_equal(csv[k], ref[k], err_msg=k)
+
+
+def test_a_file_without_our_annotation_takes_the_tool_step(exported, tmp_path):
+    """Another tool's file (no scfmu annotation): the step from libcosim's annotation, every connected
+    output logged by its qualified name."""
+    root, _ = ssd_of(exported)
+    text = ET.tostring(root)
+    i = text.index(b'<ssc:Annotation type="com.github.spacecraft-fmus.scfmu"')
+    j = text.index(b"</ssc:Annotation>", i) + len(b"</ssc:Annotation>")
+    foreign = tmp_path / "foreign.ssp"
+    with zipfile.ZipFile(exported) as z, zipfile.ZipFile(foreign, "w") as out:
+        for n in z.namelist():
+            out.writestr(n, text[:i] + text[j:] if n == "SystemStructure.ssd" else z.read(n))
+    sc, _ = ssp.read_ssp(foreign, tmp_path / "x")
+    assert sc.step == 0.01 and sc.name == "default" and sc.stop_time == scenarios.get("default").stop_time
+    assert "controller.torque_cmd_x" in sc.log and sc.log["controller.torque_cmd_x"] == "controller.torque_cmd_x"
+
+
 def test_a_users_fmi3_unit_in_an_ssp_2_0_file(tmp_path):
     theirs = tmp_path / "TheirController.fmu"
     theirs.write_bytes(fmi3("PdController").read_bytes())
