@@ -300,3 +300,24 @@ def test_clocked_unit_gets_clock_connectors(tmp_path):
         assert ssp2.xsd_problems(path, ssp2.schema_dir()) == []
     sc2, _ = ssp.read_ssp(path, tmp_path / "x")  # read back: parameters typed, the connection explicit
     assert sc2.components[0].params == {"k": 2.5, "mode": 3} and sc2.connections == {"b.u": "a.y"}
+
+
+def test_libcosim_reads_ssp_2_0_with_fmi2_units_and_refuses_fmi3_units(exported, tmp_path):
+    """The measurement behind the docs' table: libcosim 0.0.6 runs a 2.0 file whose units are FMI 2.0 ones
+    (the same final values as the 1.0 file), and refuses one with FMI 3.0 units (no crash)."""
+    pytest.importorskip("libcosimpy")
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy._internal import get_last_error_message
+    from scfmu.engines.libcosim import run_libcosim_ssp
+    sc = scenarios.get("default")
+    fmi2 = sc.with_models({c.name: str(fmu_dir() / f"{c.model}.fmu") for c in sc.components})
+    for c, o in zip(fmi2.components, sc.components):
+        c.params = dict(o.params)
+    v2 = ssp.write_ssp(fmi2, tmp_path / "fmi2_in_2_0.ssp", version="2.0")
+    v1 = ssp.write_ssp(sc, tmp_path / "fmi2_in_1_0.ssp")
+    assert ssp.ssp_version(v2) == "2.0" and ssp.validate_ssp(v2) == []
+    a, b = run_libcosim_ssp(v2, stop_time=0.5), run_libcosim_ssp(v1, stop_time=0.5)
+    assert a == b and a["eulerint_deg_s"] > 0
+    with pytest.raises(AssertionError):
+        CosimExecution.from_ssp_file(str(exported), step_size=10_000_000)
+    assert "connector type" in get_last_error_message()
