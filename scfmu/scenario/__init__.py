@@ -1,6 +1,6 @@
 """Scenarios: a closed loop declared once as plain data (:class:`Scenario`), looked up by name in the
 registry that the paper plug-ins fill (:func:`get`, :func:`names`), read from and written to files
-(:mod:`scfmu.scenario.ssp` for SSP 1.0)."""
+(:mod:`scfmu.scenario.ssp` for SSP 1.0 and 2.0)."""
 
 from __future__ import annotations
 
