@@ -89,7 +89,7 @@ def connector_type(parent, ns: str, v, fmi: int):
     """The type child of a 2.0 connector for FMU variable ``v`` (of an FMI ``fmi`` unit): the variable's own
     type; None (type left to the FMU, as the standard allows) for an enumeration."""
     vtype = v.type
-    if fmi == 2 and vtype == "Enumeration":
+    if fmi < 3 and vtype == "Enumeration":
         vtype = "Integer"  # as in the 1.0 files
     if vtype == "Enumeration" or vtype not in TYPES:
         return None
@@ -126,9 +126,9 @@ def size_variables(md) -> list:
 
 
 def value_tag(vtype: str, fmi: int) -> str:
-    """The SSV element of a parameter of type ``vtype``: FMI 2.0 units keep the 1.0 names (an enumeration is
+    """The SSV element of a parameter of type ``vtype``: FMI 1.0/2.0 units keep the 1.0 names (an enumeration is
     an Integer), FMI 3.0 ones their own type."""
-    if fmi == 2:
+    if fmi < 3:
         return {"Real": "Real", "Integer": "Integer", "Boolean": "Boolean", "Enumeration": "Integer"}[vtype]
     if vtype in FLOATS + INTEGERS + ("Boolean",):
         return vtype
