@@ -11,8 +11,9 @@
 //! for k = 0..=n_steps, t_k = t0 + k·dt: propagate, log row k (one get per run of consecutive logged
 //! values of the same FMU and type, straight into the output row for Real), and, for k < n_steps, step
 //! every FMU from t_k to t_k + dt in order: `doStep` of a Co-Simulation unit, or, for a Model Exchange
-//! unit, the integration of its continuous states by the embedded Dormand–Prince 5(4) solver
-//! ([`me`]) with its time events, state events, `completedIntegratorStep` and event iteration.
+//! unit, the integration of its continuous states by the engines' Model Exchange stepper (the crate
+//! `scfmu_fmi_stepper`: Dormand–Prince 5(4) or RK4 per unit, with its time events, state events,
+//! `completedIntegratorStep` and event iteration), over the unit's Model Exchange slots as its typed table.
 //! It stops at the first status above `max_ok` and reports it with the step index.
 //!
 //! Values: Real are `f64`, Integer `i32`, Boolean `i32` 0/1 in the work buffers (FMI 3.0's one-byte
@@ -26,7 +27,8 @@ use std::ffi::c_void;
 use std::mem::transmute;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
-pub mod me;
+use scfmu_fmi_stepper::Stop;
+
 mod setup;
 use setup::Setup;
 
@@ -92,8 +94,8 @@ pub const F_ENTER_CONT_MODE: usize = 15; // fmi2EnterContinuousTimeMode / fmi3En
 pub const INFO_FIELDS: usize = 4;
 /// Entries per FMU in `me_params` (Model Exchange units; ignored otherwise): relative tolerance,
 /// absolute tolerance, next time event after initialization (NaN: none), method (0: Dormand–Prince 5(4)
-/// adaptive, 1: classic Runge–Kutta 4 with a fixed step), the fixed step's largest size (RK4; 0: the
-/// communication step).
+/// adaptive, 1: classic Runge–Kutta 4 with a fixed step), the largest step (the fixed step's size, and a
+/// bound on the adaptive steps; 0: the communication step for RK4, no bound for Dormand–Prince).
 pub const ME_FIELDS: usize = 5;
 
 type Gs2F64 = unsafe extern "C" fn(*mut c_void, *const u32, usize, *mut f64) -> i32;
@@ -329,6 +331,15 @@ impl Fmu {
     }
 }
 
+/// The status and phase of a Model Exchange step that stopped.
+fn fail_of(stop: Stop) -> Fail {
+    match stop {
+        Stop::Failed(st) => (st, PHASE_STEP),
+        Stop::Terminate => (3, PHASE_TERMINATE),
+        Stop::Solver => (3, PHASE_SOLVER),
+    }
+}
+
 unsafe fn run(a: &Args, where_: &mut [i64; 3]) -> i32 {
     let Setup {
         mut fmus,
@@ -383,7 +394,7 @@ unsafe fn run(a: &Args, where_: &mut [i64; 3]) -> i32 {
             for (i, (f, solver)) in fmus.iter_mut().zip(solvers.iter_mut()).enumerate() {
                 let r = match solver {
                     None => f.do_step(t, a.dt),
-                    Some(s) => s.step(f, t, a.t0 + ((k + 1) as f64) * a.dt),
+                    Some((unit, s)) => s.step(unit, t, a.t0 + ((k + 1) as f64) * a.dt).map_err(fail_of),
                 };
                 match r {
                     Ok(st) => check!(st, k, PHASE_STEP, i),
