@@ -99,7 +99,7 @@ impl Unit for Toy {
         if let Some((_, e)) = self.ball {
             if self.x[0] <= 0.0 && self.x[1] < 0.0 {
                 self.event_times.push(self.t); // a bounce (the rise through 0 after it is an event too)
-                self.x[1] = -e * self.x[1];
+                self.x[1] *= -e;
             }
         } else if let Some(level) = self.level {
             if self.x[0] <= level {
