@@ -5,6 +5,8 @@
 //!
 //! * [`fmi`]: the unit's Model Exchange functions, typed once per FMI version (2.0 and 3.0), loaded from
 //!   the unit's shared library ([`dynlib`]) or taken from pointers the caller already has;
+//! * [`values`]: the value getters and setters and `doStep` of a unit, typed once per FMI version (the
+//!   compiled loop's propagation and its Co-Simulation units);
 //! * [`Stepper`]: one integrator family of explicit Runge–Kutta methods over one set of work vectors,
 //!   chosen per unit ([`Method`]): the Dormand–Prince 5(4) pair ([`tableau`]) with local extrapolation,
 //!   adaptive steps under `rtol`/`atol` (Hairer, Nørsett & Wanner's first step, SciPy's `RK45` step-size
@@ -29,6 +31,7 @@ pub mod fmi;
 mod rk4;
 mod stepper;
 pub mod tableau;
+pub mod values;
 
 #[cfg(test)]
 mod tests;

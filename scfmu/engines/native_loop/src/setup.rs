@@ -129,13 +129,7 @@ unsafe fn unit(
     if needed.iter().any(|&s| table[s].is_null()) {
         return Err(ERR_NULL);
     }
-    let fmu = Fmu {
-        comp: comps[i],
-        v3: version == 3,
-        fns: table,
-        scratch: Vec::new(),
-        tmp: Vec::new(),
-    };
+    let fmu = Fmu::new(comps[i], version == 3, table);
     if interface != 1 {
         return Ok((fmu, None));
     }
