@@ -243,3 +243,20 @@ fn a_step_event_runs_the_event_iteration_and_termination_stops_at_that_time() {
     assert_eq!(r, Err(Stop::Terminate));
     assert!(st.t >= 0.3 && st.t <= 0.4 + 1e-12, "{}", st.t);
 }
+
+#[cfg(unix)]
+#[test]
+fn a_library_without_the_model_exchange_functions_names_the_first_missing_one() {
+    use crate::{dynlib, Table};
+    let libm = if cfg!(target_os = "macos") {
+        "/usr/lib/libSystem.B.dylib"
+    } else {
+        "libm.so.6"
+    };
+    let h = dynlib::open(libm).expect("the C math library");
+    // SAFETY: the table is not built (the first function is missing), so nothing is called
+    let e = unsafe { Table::load(h, true) }.err().expect("no FMI functions in libm");
+    assert_eq!(e, "the unit's library has no fmi3SetTime");
+    // SAFETY: as above
+    assert!(unsafe { Table::from_slots(false, [std::ptr::null(); 9]) }.is_none());
+}
