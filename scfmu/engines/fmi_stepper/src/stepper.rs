@@ -212,8 +212,9 @@ impl Stepper {
             if rounds > MAX_STEPS_PER_INTERVAL {
                 return Err(Stop::Solver); // events that never let the time advance
             }
+            // a time event before t_end (one already due, or overdue when a caller skipped it: at once)
             let t_stop = match self.next_event {
-                Some(te) if te < t_end - eps && te > t - eps => te.max(t),
+                Some(te) if te < t_end - eps => te.max(t),
                 _ => t_end,
             };
             // ----- integrate from t to t_stop, or to the first state event / event request
@@ -246,7 +247,7 @@ impl Stepper {
                     break;
                 }
             }
-            let at_time_event = self.next_event.is_some_and(|te| (t - te).abs() <= eps);
+            let at_time_event = self.next_event.is_some_and(|te| te <= t + eps);
             if stop_event || at_time_event {
                 w = w.max(self.event_at(u, t)?);
             }

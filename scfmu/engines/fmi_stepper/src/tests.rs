@@ -229,6 +229,23 @@ fn a_time_event_between_communication_points_is_taken_at_its_time() {
 }
 
 #[test]
+fn an_overdue_time_event_is_taken_at_once() {
+    // the unit's next event time lies before the step's start (a caller that skipped it): taken at t = 0.5
+    let mut u = Toy::decay(1.0, 1.0);
+    (u.a2, u.t_event) = (3.0, Some(0.2));
+    let mut st = Stepper::new(1, 0, settings(Method::DormandPrince, 1e-11, 0.0), Some(0.2));
+    st.step(&mut u, 0.5, 1.0).unwrap();
+    assert_eq!(u.event_times, vec![0.5]);
+    // x(0.5) = 1 (the unit's state where the stepper starts), then the new rate: x(1) = e^{-3·0.5}
+    let exact = (-1.5f64).exp();
+    assert!(
+        (st.states()[0] - exact).abs() < 1e-9 * exact,
+        "{} vs {exact}",
+        st.states()[0]
+    );
+}
+
+#[test]
 fn a_step_event_runs_the_event_iteration_and_termination_stops_at_that_time() {
     let mut u = Toy::decay(1.0, 1.0);
     u.step_event = Some(0.5);
