@@ -1,8 +1,8 @@
-//! The Dormand–Prince 5(4) Butcher tableau (Dormand & Prince 1980, "RK5(4)7M"), written once for every
-//! integrator of the project: the plants' own adaptive integrator (`integrate`), the Co-Simulation face
-//! of a Model Exchange unit (`scfmu/engines/me_cs`) and the compiled loop's Model Exchange solver
-//! (`scfmu/engines/native_loop`). The two engine crates are separate libraries that do not depend on this
-//! crate; they include this one file of constants with `#[path]`, so it must stay free of any `use`.
+//! The Dormand–Prince 5(4) Butcher tableau (Dormand & Prince 1980, "RK5(4)7M") of the plants' own adaptive
+//! integrator (`integrate`). The engines' Model Exchange stepper (`scfmu/engines/fmi_stepper`, used by the
+//! Co-Simulation face and the compiled loop) holds the engines' table: a user's model crate depends on this
+//! runtime by path with a lock file of its own, and the runtime must not link the engines' library loader,
+//! so neither crate depends on the other. Both tables are tested the same way.
 //!
 //! Seven stages in first-same-as-last form: stage 7 is evaluated at the new fifth-order point, at the
 //! end of the step (`C[6] = 1`), and is stage 1 of the next step. The unit tests check the tableau

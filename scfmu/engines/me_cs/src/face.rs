@@ -1,18 +1,20 @@
 //! The version-neutral bodies of the Co-Simulation entry points. [`crate::fmi2`] and [`crate::fmi3`] are
 //! thin C-ABI wrappers: each exports its version's symbols, translates that version's types and arguments
 //! (statuses, `fmi2Boolean`/`bool`, the output flags of `fmi3DoStep`) and calls the functions here, which
-//! hold the instance handling, the solver and the rules every version shares. What a body needs from the
-//! version's Model Exchange unit is the trait [`Face`] (beyond the solver's [`Unit`]).
+//! hold the instance handling, the stepper and the rules every version shares. What a body needs from the
+//! version's Model Exchange unit beyond its function table (the stepper's [`MeUnit`]) is the trait [`Face`].
 //!
 //! The macros [`call`], [`forward`] and [`refuse`] write the pass-through and the refused functions of
 //! both versions.
 
 use std::ffi::{c_char, c_void};
 
-use crate::{instance, load, Config, Instance, Solver, Unit, ERROR, MAGIC};
+use scfmu_fmi_stepper::{MeUnit, Stepper, Stop};
+
+use crate::{instance, load, table, Config, Instance, ERROR, MAGIC};
 
 /// One FMI version's Model Exchange unit as the shared entry points use it.
-pub trait Face: Unit + Sized {
+pub trait Face: Sized {
     /// The FMI 3.0 binary folder names ([`load`]).
     const V3: bool;
     /// The unit's instance `inner` (a pointer its own library handed out).
@@ -39,6 +41,9 @@ pub unsafe fn instantiate<U: Face>(location: *const c_char, create: impl FnOnce(
     let Ok(mut cfg) = load(location, U::V3) else {
         return std::ptr::null_mut();
     };
+    let Ok(table) = table(U::V3) else {
+        return std::ptr::null_mut();
+    };
     let inner = create();
     if inner.is_null() {
         return std::ptr::null_mut();
@@ -51,11 +56,18 @@ pub unsafe fn instantiate<U: Face>(location: *const c_char, create: impl FnOnce(
     let w = Instance {
         magic: MAGIC,
         inner,
-        solver: Solver::new(cfg),
+        unit: MeUnit { comp: inner, table },
+        stepper: stepper(&cfg),
+        cfg,
         start_time: 0.0,
         terminated: false,
     };
     Box::into_raw(Box::new(w)) as *mut c_void
+}
+
+/// A fresh stepper for the settings `cfg` (the initial event iteration gives the next time event).
+fn stepper(cfg: &Config) -> Stepper {
+    Stepper::new(cfg.states, cfg.event_indicators, cfg.settings(), None)
 }
 
 /// Frees the unit and the wrapper instance `c` (nothing for a pointer this library did not hand out).
@@ -79,7 +91,7 @@ pub unsafe fn with_unit(c: *mut c_void, f: impl FnOnce(*mut c_void) -> i32) -> i
     f(w.inner)
 }
 
-/// Records the experiment's start time (where the solver starts) and passes the call on with `f`.
+/// Records the experiment's start time (where the stepper starts) and passes the call on with `f`.
 ///
 /// # Safety
 /// `c` is null or a pointer handed out by [`instantiate`].
@@ -100,25 +112,25 @@ pub unsafe fn exit_initialization_mode<U: Face>(c: *mut c_void) -> i32 {
     if st > 1 {
         return st;
     }
-    w.solver.t = w.start_time;
-    match w.solver.event_iteration(&mut unit, true) {
-        Ok(false) => st,
-        Ok(true) => {
+    w.stepper.t = w.start_time;
+    match w.stepper.event_iteration(&mut w.unit, true) {
+        Ok(_) => st,
+        Err(Stop::Terminate) => {
             w.terminated = true;
             ERROR
         }
-        Err((s, _)) => s,
+        Err(Stop::Failed(s)) => s,
+        Err(Stop::Solver) => ERROR,
     }
 }
 
-/// A fresh solver (same settings) and the unit's `Reset`.
+/// A fresh stepper (same settings) and the unit's `Reset`.
 ///
 /// # Safety
 /// `c` is null or a pointer handed out by [`instantiate`].
 pub unsafe fn reset<U: Face>(c: *mut c_void) -> i32 {
     let Some(w) = instance(c) else { return ERROR };
-    let cfg = w.solver.cfg.clone();
-    w.solver = Solver::new(cfg);
+    w.stepper = stepper(&w.cfg);
     w.terminated = false;
     U::of(w.inner).reset()
 }
@@ -130,26 +142,26 @@ pub enum Step {
     Refused,
     /// Integrated to t + h.
     Reached,
-    /// Integrated until the unit asked to terminate (at the solver's time).
+    /// Integrated until the unit asked to terminate (at the stepper's time).
     Terminated,
     /// The unit failed: the status to return (ERROR or worse).
     Failed(i32),
 }
 
 /// Integrates the unit of `w` from `t` to `t + h` with its inputs held (see the crate documentation); the
-/// time reached is then `w.solver.t` (unless refused).
-pub fn do_step<U: Face>(w: &mut Instance, t: f64, h: f64) -> Step {
+/// time reached is then `w.stepper.t` (unless refused).
+pub fn do_step(w: &mut Instance, t: f64, h: f64) -> Step {
     if w.terminated || h.is_nan() || h <= 0.0 || !t.is_finite() {
         return Step::Refused;
     }
-    w.solver.t = t;
-    match w.solver.advance(&mut U::of(w.inner), t + h) {
-        Ok(false) => Step::Reached,
-        Ok(true) => {
+    match w.stepper.step(&mut w.unit, t, t + h) {
+        Ok(_) => Step::Reached,
+        Err(Stop::Terminate) => {
             w.terminated = true;
             Step::Terminated
         }
-        Err((s, _)) => Step::Failed(s.max(ERROR)),
+        Err(Stop::Failed(s)) => Step::Failed(s.max(ERROR)),
+        Err(Stop::Solver) => Step::Failed(ERROR),
     }
 }
 

@@ -5,91 +5,11 @@
 use std::ffi::{c_char, c_void};
 
 use crate::face::{self, call, forward, refuse, Face, Step};
-use crate::{instance, me, Unit, DISCARD, ERROR, OK};
+use crate::{instance, me, DISCARD, ERROR, OK};
 
 type Comp = *mut c_void;
 
-#[repr(C)]
-#[derive(Default)]
-struct EventInfo {
-    new_discrete_states_needed: i32,
-    terminate_simulation: i32,
-    nominals_changed: i32,
-    values_changed: i32,
-    next_event_time_defined: i32,
-    next_event_time: f64,
-}
-
 struct Me2(Comp);
-
-impl Unit for Me2 {
-    fn set_time(&mut self, t: f64) -> i32 {
-        call!(fmi2SetTime, (Comp, f64), self.0, t)
-    }
-    fn set_states(&mut self, x: &[f64]) -> i32 {
-        call!(
-            fmi2SetContinuousStates,
-            (Comp, *const f64, usize),
-            self.0,
-            x.as_ptr(),
-            x.len()
-        )
-    }
-    fn get_states(&mut self, x: &mut [f64]) -> i32 {
-        call!(
-            fmi2GetContinuousStates,
-            (Comp, *mut f64, usize),
-            self.0,
-            x.as_mut_ptr(),
-            x.len()
-        )
-    }
-    fn derivatives(&mut self, dx: &mut [f64]) -> i32 {
-        call!(
-            fmi2GetDerivatives,
-            (Comp, *mut f64, usize),
-            self.0,
-            dx.as_mut_ptr(),
-            dx.len()
-        )
-    }
-    fn indicators(&mut self, z: &mut [f64]) -> i32 {
-        if z.is_empty() {
-            return OK;
-        }
-        call!(
-            fmi2GetEventIndicators,
-            (Comp, *mut f64, usize),
-            self.0,
-            z.as_mut_ptr(),
-            z.len()
-        )
-    }
-    fn completed(&mut self) -> (i32, bool, bool) {
-        let (mut enter, mut term) = (0i32, 0i32);
-        let st = call!(
-            fmi2CompletedIntegratorStep,
-            (Comp, i32, *mut i32, *mut i32),
-            self.0,
-            1,
-            &mut enter,
-            &mut term
-        );
-        (st, enter != 0, term != 0)
-    }
-    fn enter_event_mode(&mut self) -> i32 {
-        call!(fmi2EnterEventMode, (Comp), self.0)
-    }
-    fn update(&mut self) -> (i32, bool, bool, Option<f64>) {
-        let mut e = EventInfo::default();
-        let st = call!(fmi2NewDiscreteStates, (Comp, *mut EventInfo), self.0, &mut e);
-        let next = (e.next_event_time_defined != 0).then_some(e.next_event_time);
-        (st, e.new_discrete_states_needed != 0, e.terminate_simulation != 0, next)
-    }
-    fn enter_continuous_mode(&mut self) -> i32 {
-        call!(fmi2EnterContinuousTimeMode, (Comp), self.0)
-    }
-}
 
 impl Face for Me2 {
     const V3: bool = false;
@@ -186,7 +106,7 @@ pub unsafe extern "C" fn fmi2Reset(c: Comp) -> i32 {
 #[no_mangle]
 pub unsafe extern "C" fn fmi2DoStep(c: Comp, t: f64, h: f64, _no_set_prior: i32) -> i32 {
     let Some(w) = instance(c) else { return ERROR };
-    match face::do_step::<Me2>(w, t, h) {
+    match face::do_step(w, t, h) {
         Step::Refused => ERROR,
         Step::Reached => OK,
         Step::Terminated => DISCARD,
@@ -209,7 +129,7 @@ forward! {
     fmi2GetDirectionalDerivative(u: *const u32, nu: usize, k: *const u32, nk: usize, dv: *const f64, df: *mut f64);
 }
 
-// The solver's state is not part of an FMU state, and the Co-Simulation extras are not offered.
+// The stepper's state is not part of an FMU state, and the Co-Simulation extras are not offered.
 refuse! {
     fmi2GetFMUstate(s: *mut *mut c_void);
     fmi2SetFMUstate(s: *mut c_void);

@@ -6,90 +6,12 @@
 use std::ffi::{c_char, c_void};
 
 use crate::face::{self, call, forward, refuse, Face, Step};
-use crate::{instance, me, Config, Unit, ERROR, OK};
+use crate::{instance, me, Config, ERROR, OK};
 
 type Inst = *mut c_void;
 type Vr = *const u32;
 
 struct Me3(Inst);
-
-impl Unit for Me3 {
-    fn set_time(&mut self, t: f64) -> i32 {
-        call!(fmi3SetTime, (Inst, f64), self.0, t)
-    }
-    fn set_states(&mut self, x: &[f64]) -> i32 {
-        call!(
-            fmi3SetContinuousStates,
-            (Inst, *const f64, usize),
-            self.0,
-            x.as_ptr(),
-            x.len()
-        )
-    }
-    fn get_states(&mut self, x: &mut [f64]) -> i32 {
-        call!(
-            fmi3GetContinuousStates,
-            (Inst, *mut f64, usize),
-            self.0,
-            x.as_mut_ptr(),
-            x.len()
-        )
-    }
-    fn derivatives(&mut self, dx: &mut [f64]) -> i32 {
-        call!(
-            fmi3GetContinuousStateDerivatives,
-            (Inst, *mut f64, usize),
-            self.0,
-            dx.as_mut_ptr(),
-            dx.len()
-        )
-    }
-    fn indicators(&mut self, z: &mut [f64]) -> i32 {
-        if z.is_empty() {
-            return OK;
-        }
-        call!(
-            fmi3GetEventIndicators,
-            (Inst, *mut f64, usize),
-            self.0,
-            z.as_mut_ptr(),
-            z.len()
-        )
-    }
-    fn completed(&mut self) -> (i32, bool, bool) {
-        let (mut enter, mut term) = (false, false);
-        let st = call!(
-            fmi3CompletedIntegratorStep,
-            (Inst, bool, *mut bool, *mut bool),
-            self.0,
-            true,
-            &mut enter,
-            &mut term
-        );
-        (st, enter, term)
-    }
-    fn enter_event_mode(&mut self) -> i32 {
-        call!(fmi3EnterEventMode, (Inst), self.0)
-    }
-    fn update(&mut self) -> (i32, bool, bool, Option<f64>) {
-        let (mut more, mut term, mut nom, mut val, mut def, mut next) = (false, false, false, false, false, 0.0f64);
-        let st = call!(
-            fmi3UpdateDiscreteStates,
-            (Inst, *mut bool, *mut bool, *mut bool, *mut bool, *mut bool, *mut f64),
-            self.0,
-            &mut more,
-            &mut term,
-            &mut nom,
-            &mut val,
-            &mut def,
-            &mut next
-        );
-        (st, more, term, def.then_some(next))
-    }
-    fn enter_continuous_mode(&mut self) -> i32 {
-        call!(fmi3EnterContinuousTimeMode, (Inst), self.0)
-    }
-}
 
 impl Face for Me3 {
     const V3: bool = true;
@@ -250,9 +172,9 @@ pub unsafe extern "C" fn fmi3DoStep(
             *p = false;
         }
     }
-    let r = face::do_step::<Me3>(w, t, h);
+    let r = face::do_step(w, t, h);
     if r != Step::Refused && !last.is_null() {
-        *last = w.solver.t;
+        *last = w.stepper.t;
     }
     match r {
         Step::Refused => ERROR,
@@ -310,7 +232,7 @@ forward! {
 }
 
 // Model Exchange and Scheduled Execution functions (this face is Co-Simulation), event mode, output
-// derivatives, clocks' intervals and FMU states (the solver's state is not part of one): not offered.
+// derivatives, clocks' intervals and FMU states (the stepper's state is not part of one): not offered.
 refuse! {
     fmi3EnterEventMode();
     fmi3GetFMUState(s: *mut St);

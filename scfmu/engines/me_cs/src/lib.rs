@@ -5,20 +5,23 @@
 //!
 //! It exports the FMI 2.0 Co-Simulation functions ([`fmi2`], for an FMI 2.0 Model Exchange unit) and the
 //! FMI 3.0 ones ([`fmi3`], for an FMI 3.0 unit): one thin C-ABI file per version, translating its types and
-//! arguments, over one version-neutral body of every entry point ([`face`]). At instantiation it reads `scfmu_me_cs.txt` from the
-//! unit's resources folder (the Model Exchange model identifier, the numbers of states and event indicators,
-//! the method and its tolerances), opens the unit's own library `binaries/<platform>/<identifier>` and
-//! instantiates it as Model Exchange. Getters, setters and the other common functions are forwarded; a
-//! communication step `doStep(t, h)` integrates the continuous states with the inputs held ([`Solver`]):
+//! arguments, over one version-neutral body of every entry point ([`face`]). At instantiation it reads
+//! `scfmu_me_cs.txt` from the unit's resources folder (the Model Exchange model identifier, the numbers of
+//! states and event indicators, the method and its tolerances), opens the unit's own library
+//! `binaries/<platform>/<identifier>`, loads its Model Exchange function table and instantiates it as
+//! Model Exchange. Getters, setters and the other common functions are forwarded; a communication step
+//! `doStep(t, h)` integrates the continuous states with the inputs held, by the engines' Model Exchange
+//! stepper (the crate `scfmu_fmi_stepper`, the one the compiled loop uses too):
 //!
 //! * method `RK4`: the classic Runge–Kutta 4 with a fixed step (the communication step, or `max_step` when
 //!   smaller); any other method: Dormand–Prince 5(4) with local extrapolation and adaptive steps under
-//!   `rtol`/`atol` (the compiled engine's choice for a method it does not have, too);
+//!   `rtol`/`atol` (and at most `max_step` when one is set);
 //! * after every accepted step `completedIntegratorStep`; a sign change of an event indicator (a state
-//!   event) is located by bisection on re-integrated partial steps to 1e-12 relative in time; at a time
-//!   event (`nextEventTime`), a state event or when the unit asks, the event iteration (`enterEventMode`,
-//!   `newDiscreteStates` / `updateDiscreteStates` until no update is needed), then continuous-time mode again
-//!   with the states re-read.
+//!   event) is located by bisection on the step to 1e-12 relative in time (the state inside the step: the
+//!   continuous extension of Dormand–Prince, a re-integrated partial step of RK4); at a time event
+//!   (`nextEventTime`), a state event or when the unit asks, the event iteration (`enterEventMode`,
+//!   `newDiscreteStates` / `updateDiscreteStates` until no update is needed), then continuous-time mode
+//!   again with the states re-read.
 //!
 //! One wrapped unit per copy of this library (a copy lives in each wrapped FMU), so the unit's library
 //! handle and its function pointers are process-wide statics of the copy.
@@ -29,13 +32,11 @@ use std::ffi::{c_char, c_void, CStr};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
-mod dynlib;
+use scfmu_fmi_stepper::{dynlib, MeUnit, Method, Settings, Stepper, Table};
+
 pub mod face;
 pub mod fmi2;
 pub mod fmi3;
-mod solver;
-
-pub use solver::Solver;
 
 pub const OK: i32 = 0;
 pub const WARNING: i32 = 1;
@@ -58,6 +59,16 @@ pub struct Config {
 }
 
 impl Config {
+    /// The stepper's settings.
+    pub fn settings(&self) -> Settings {
+        Settings {
+            method: if self.rk4 { Method::Rk4 } else { Method::DormandPrince },
+            rtol: self.rtol,
+            atol: self.atol,
+            max_step: self.max_step,
+        }
+    }
+
     pub fn parse(text: &str) -> Result<Config, String> {
         let mut c = Config {
             model_identifier: String::new(),
@@ -211,26 +222,25 @@ macro_rules! me {
     }};
 }
 
-/// What the solver needs from a Model Exchange unit (FMI 2.0 or 3.0), statuses as ints.
-pub trait Unit {
-    fn set_time(&mut self, t: f64) -> i32;
-    fn set_states(&mut self, x: &[f64]) -> i32;
-    fn get_states(&mut self, x: &mut [f64]) -> i32;
-    fn derivatives(&mut self, dx: &mut [f64]) -> i32;
-    fn indicators(&mut self, z: &mut [f64]) -> i32;
-    /// `completedIntegratorStep`: (status, enter event mode, terminate).
-    fn completed(&mut self) -> (i32, bool, bool);
-    fn enter_event_mode(&mut self) -> i32;
-    /// One `newDiscreteStates` / `updateDiscreteStates`: (status, more needed, terminate, next event time).
-    fn update(&mut self) -> (i32, bool, bool, Option<f64>);
-    fn enter_continuous_mode(&mut self) -> i32;
+/// The Model Exchange function table of the library [`load`] opened (FMI 3.0 names when `v3`).
+pub fn table(v3: bool) -> Result<Table, String> {
+    let h = LIB.load(Ordering::SeqCst);
+    if h == 0 {
+        return Err("the unit's library is not open".into());
+    }
+    // SAFETY: the handle is the unit's library, opened by `load`; an FMU's functions of the standard's
+    // names have the standard's signatures
+    unsafe { Table::load(h as *mut c_void, v3) }
 }
 
-/// A wrapper instance (both versions): the unit's instance and the solver.
+/// A wrapper instance (both versions): the unit's instance (with its function table), its settings and
+/// the stepper.
 pub struct Instance {
     pub magic: u64,
     pub inner: *mut c_void,
-    pub solver: Solver,
+    pub unit: MeUnit,
+    pub cfg: Config,
+    pub stepper: Stepper,
     pub start_time: f64,
     pub terminated: bool,
 }

@@ -11,8 +11,9 @@
 //! for k = 0..=n_steps, t_k = t0 + k·dt: propagate, log row k (one get per run of consecutive logged
 //! values of the same FMU and type, straight into the output row for Real), and, for k < n_steps, step
 //! every FMU from t_k to t_k + dt in order: `doStep` of a Co-Simulation unit, or, for a Model Exchange
-//! unit, the integration of its continuous states by the embedded Dormand–Prince 5(4) solver
-//! ([`me`]) with its time events, state events, `completedIntegratorStep` and event iteration.
+//! unit, the integration of its continuous states by the engines' Model Exchange stepper (the crate
+//! `scfmu_fmi_stepper`: Dormand–Prince 5(4) or RK4 per unit, with its time events, state events,
+//! `completedIntegratorStep` and event iteration), over the unit's Model Exchange slots as its typed table.
 //! It stops at the first status above `max_ok` and reports it with the step index.
 //!
 //! Values: Real are `f64`, Integer `i32`, Boolean `i32` 0/1 in the work buffers (FMI 3.0's one-byte
@@ -23,10 +24,11 @@
 //! the first call, and the body runs under `catch_unwind`).
 
 use std::ffi::c_void;
-use std::mem::transmute;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
-pub mod me;
+use scfmu_fmi_stepper::values::{Values, VALUE_FUNCTIONS};
+use scfmu_fmi_stepper::Stop;
+
 mod setup;
 use setup::Setup;
 
@@ -86,35 +88,30 @@ pub const F_COMPLETED_STEP: usize = 12; // fmi2CompletedIntegratorStep / fmi3Com
 pub const F_ENTER_EVENT_MODE: usize = 13; // fmi2EnterEventMode / fmi3EnterEventMode
 pub const F_UPDATE_DISCRETE: usize = 14; // fmi2NewDiscreteStates / fmi3UpdateDiscreteStates
 pub const F_ENTER_CONT_MODE: usize = 15; // fmi2EnterContinuousTimeMode / fmi3EnterContinuousTimeMode
+                                         // the first seven slots are the stepper crate's value table, in its order (values::VALUE_FUNCTIONS)
+const _: () = assert!(F_DO_STEP - F_GET_REAL + 1 == VALUE_FUNCTIONS.len());
 
 /// Entries per FMU in `info`: FMI major version (2 or 3), interface (0 Co-Simulation, 1 Model
 /// Exchange), number of continuous states, number of event indicators.
 pub const INFO_FIELDS: usize = 4;
 /// Entries per FMU in `me_params` (Model Exchange units; ignored otherwise): relative tolerance,
 /// absolute tolerance, next time event after initialization (NaN: none), method (0: Dormand–Prince 5(4)
-/// adaptive, 1: classic Runge–Kutta 4 with a fixed step), the fixed step's largest size (RK4; 0: the
-/// communication step).
+/// adaptive, 1: classic Runge–Kutta 4 with a fixed step), the largest step (the fixed step's size, and a
+/// bound on the adaptive steps; 0: the communication step for RK4, no bound for Dormand–Prince).
 pub const ME_FIELDS: usize = 5;
-
-type Gs2F64 = unsafe extern "C" fn(*mut c_void, *const u32, usize, *mut f64) -> i32;
-type Gs2I32 = unsafe extern "C" fn(*mut c_void, *const u32, usize, *mut i32) -> i32;
-type Gs3F64 = unsafe extern "C" fn(*mut c_void, *const u32, usize, *mut f64, usize) -> i32;
-type Gs3I32 = unsafe extern "C" fn(*mut c_void, *const u32, usize, *mut i32, usize) -> i32;
-type Gs3Bool = unsafe extern "C" fn(*mut c_void, *const u32, usize, *mut bool, usize) -> i32;
-type Step2 = unsafe extern "C" fn(*mut c_void, f64, f64, i32) -> i32;
-type Step3 = unsafe extern "C" fn(*mut c_void, f64, f64, bool, *mut bool, *mut bool, *mut bool, *mut f64) -> i32;
 
 #[no_mangle]
 pub extern "C" fn scfmu_loop_version() -> u32 {
     ABI_VERSION
 }
 
-/// One FMU of the loop: its instance, version and function table.
+/// One FMU of the loop: its instance, version and function table (the value functions and `doStep`
+/// typed by the stepper crate's [`Values`]).
 pub struct Fmu {
     pub comp: *mut c_void,
     pub v3: bool,
     pub fns: [*const c_void; FN_SLOTS],
-    scratch: Vec<bool>,
+    values: Values,
     tmp: Vec<i32>,
 }
 
@@ -123,54 +120,37 @@ pub type Fail = (i32, i64);
 
 impl Fmu {
     /// # Safety
-    /// The slot must hold the function of that slot (FMI 2.0 or 3.0 signature per `v3`).
-    pub unsafe fn reals(&mut self, set: bool, vr: *const u32, n: usize, buf: *mut f64) -> i32 {
-        let f = self.fns[if set { F_SET_REAL } else { F_GET_REAL }];
-        if self.v3 {
-            transmute::<*const c_void, Gs3F64>(f)(self.comp, vr, n, buf, n)
-        } else {
-            transmute::<*const c_void, Gs2F64>(f)(self.comp, vr, n, buf)
+    /// `fns` holds the functions of its slots (FMI 2.0 or 3.0 signatures per `v3`, null where not given)
+    /// for the instance `comp`.
+    pub unsafe fn new(comp: *mut c_void, v3: bool, fns: [*const c_void; FN_SLOTS]) -> Fmu {
+        let mut slots = [std::ptr::null(); 7];
+        slots.copy_from_slice(&fns[F_GET_REAL..=F_DO_STEP]);
+        Fmu {
+            comp,
+            v3,
+            fns,
+            values: Values::from_slots(comp, v3, slots),
+            tmp: Vec::new(),
         }
+    }
+
+    /// # Safety
+    /// `vr` and `buf` point to `n` elements each.
+    pub unsafe fn reals(&mut self, set: bool, vr: *const u32, n: usize, buf: *mut f64) -> i32 {
+        self.values.reals(set, vr, n, buf)
     }
 
     unsafe fn ints(&mut self, set: bool, vr: *const u32, n: usize, buf: *mut i32) -> i32 {
-        let f = self.fns[if set { F_SET_INT } else { F_GET_INT }];
-        if self.v3 {
-            transmute::<*const c_void, Gs3I32>(f)(self.comp, vr, n, buf, n)
-        } else {
-            transmute::<*const c_void, Gs2I32>(f)(self.comp, vr, n, buf)
-        }
+        self.values.ints(set, vr, n, buf)
     }
 
     unsafe fn bools(&mut self, set: bool, vr: *const u32, n: usize, buf: *mut i32) -> i32 {
-        let f = self.fns[if set { F_SET_BOOL } else { F_GET_BOOL }];
-        if !self.v3 {
-            return transmute::<*const c_void, Gs2I32>(f)(self.comp, vr, n, buf);
-        }
-        self.scratch.resize(n, false);
-        let vals = std::slice::from_raw_parts_mut(buf, n);
-        if set {
-            for (s, v) in self.scratch.iter_mut().zip(vals.iter()) {
-                *s = *v != 0;
-            }
-        }
-        let st = transmute::<*const c_void, Gs3Bool>(f)(self.comp, vr, n, self.scratch.as_mut_ptr(), n);
-        if !set {
-            for (v, s) in vals.iter_mut().zip(self.scratch.iter()) {
-                *v = *s as i32;
-            }
-        }
-        st
+        self.values.bools(set, vr, n, buf)
     }
 
     /// `doStep(t, h)` of a Co-Simulation unit; an FMI 3.0 request to terminate is `(3, PHASE_TERMINATE)`.
-    unsafe fn do_step(&mut self, t: f64, h: f64) -> Result<i32, Fail> {
-        let f = self.fns[F_DO_STEP];
-        if !self.v3 {
-            return Ok(transmute::<*const c_void, Step2>(f)(self.comp, t, h, 1));
-        }
-        let (mut ev, mut term, mut early, mut last) = (false, false, false, 0.0f64);
-        let st = transmute::<*const c_void, Step3>(f)(self.comp, t, h, true, &mut ev, &mut term, &mut early, &mut last);
+    fn do_step(&mut self, t: f64, h: f64) -> Result<i32, Fail> {
+        let (st, term) = self.values.do_step(t, h);
         if st <= 1 && term {
             return Err((3, PHASE_TERMINATE));
         }
@@ -329,6 +309,15 @@ impl Fmu {
     }
 }
 
+/// The status and phase of a Model Exchange step that stopped.
+fn fail_of(stop: Stop) -> Fail {
+    match stop {
+        Stop::Failed(st) => (st, PHASE_STEP),
+        Stop::Terminate => (3, PHASE_TERMINATE),
+        Stop::Solver => (3, PHASE_SOLVER),
+    }
+}
+
 unsafe fn run(a: &Args, where_: &mut [i64; 3]) -> i32 {
     let Setup {
         mut fmus,
@@ -383,7 +372,7 @@ unsafe fn run(a: &Args, where_: &mut [i64; 3]) -> i32 {
             for (i, (f, solver)) in fmus.iter_mut().zip(solvers.iter_mut()).enumerate() {
                 let r = match solver {
                     None => f.do_step(t, a.dt),
-                    Some(s) => s.step(f, t, a.t0 + ((k + 1) as f64) * a.dt),
+                    Some((unit, s)) => s.step(unit, t, a.t0 + ((k + 1) as f64) * a.dt).map_err(fail_of),
                 };
                 match r {
                     Ok(st) => check!(st, k, PHASE_STEP, i),

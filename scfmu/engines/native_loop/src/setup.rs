@@ -2,7 +2,15 @@
 //! (null pointers, sizes, value-reference and buffer ranges, the function slots each unit needs) before
 //! the first FMI call, and turned into the units, their solvers, the propagation plan and the log groups.
 
+use scfmu_fmi_stepper::{MeUnit, Method, Settings, Stepper, Table};
+
 use super::*;
+
+// the nine Model Exchange slots are consecutive, in the order of the stepper's table (fmi::ME_FUNCTIONS)
+const _: () = assert!(F_ENTER_CONT_MODE - F_SET_TIME + 1 == scfmu_fmi_stepper::fmi::ME_FUNCTIONS.len());
+
+/// A Model Exchange unit's stepper, with the unit as its typed function table.
+pub(crate) type MeStepper = (MeUnit, Stepper);
 
 const CS_SLOTS: [usize; 3] = [F_GET_REAL, F_SET_REAL, F_DO_STEP];
 const ME_SLOTS: [usize; 11] = [
@@ -22,7 +30,7 @@ const ME_SLOTS: [usize; 11] = [
 /// What [`run`](super::run) executes: built only from arguments that passed every check.
 pub(crate) struct Setup<'a> {
     pub fmus: Vec<Fmu>,
-    pub solvers: Vec<Option<me::Solver>>,
+    pub solvers: Vec<Option<MeStepper>>,
     pub plan: Vec<Op>,
     pub groups: Vec<LogGroup>,
     pub vrs: &'a [u32],
@@ -66,7 +74,7 @@ pub(crate) unsafe fn setup(a: &Args) -> Result<Setup<'_>, i32> {
         &[]
     };
     let mut fmus = Vec::with_capacity(n_fmus);
-    let mut solvers: Vec<Option<me::Solver>> = Vec::with_capacity(n_fmus);
+    let mut solvers: Vec<Option<MeStepper>> = Vec::with_capacity(n_fmus);
     for i in 0..n_fmus {
         let (fmu, solver) = unit(i, comps, info, fns, me_params)?;
         fmus.push(fmu);
@@ -99,14 +107,14 @@ pub(crate) unsafe fn setup(a: &Args) -> Result<Setup<'_>, i32> {
 }
 
 /// Unit `i`: its instance, FMI version and function table (every slot its interface calls present) and,
-/// for a Model Exchange unit, its solver from the unit's row of `me_params`.
+/// for a Model Exchange unit, its stepper from the unit's row of `me_params`.
 unsafe fn unit(
     i: usize,
     comps: &[*mut c_void],
     info: &[usize],
     fns: &[*const c_void],
     me_params: &[f64],
-) -> Result<(Fmu, Option<me::Solver>), i32> {
+) -> Result<(Fmu, Option<MeStepper>), i32> {
     let inf = &info[i * INFO_FIELDS..(i + 1) * INFO_FIELDS];
     let (version, interface, nx, nz) = (inf[0], inf[1], inf[2], inf[3]);
     if comps[i].is_null() {
@@ -121,13 +129,7 @@ unsafe fn unit(
     if needed.iter().any(|&s| table[s].is_null()) {
         return Err(ERR_NULL);
     }
-    let fmu = Fmu {
-        comp: comps[i],
-        v3: version == 3,
-        fns: table,
-        scratch: Vec::new(),
-        tmp: Vec::new(),
-    };
+    let fmu = Fmu::new(comps[i], version == 3, table);
     if interface != 1 {
         return Ok((fmu, None));
     }
@@ -135,11 +137,23 @@ unsafe fn unit(
     if !(p[0] > 0.0 && p[1] > 0.0) || !(p[3] == 0.0 || p[3] == 1.0) || !(p[4] >= 0.0) {
         return Err(ERR_SIZE);
     }
-    let mut s = me::Solver::new(nx, nz, p[0], p[1], if p[2].is_nan() { None } else { Some(p[2]) });
-    if p[3] == 1.0 {
-        s.fixed_rk4(p[4]);
-    }
-    Ok((fmu, Some(s)))
+    let settings = Settings {
+        method: if p[3] == 1.0 {
+            Method::Rk4
+        } else {
+            Method::DormandPrince
+        },
+        rtol: p[0],
+        atol: p[1],
+        max_step: p[4],
+    };
+    // the Model Exchange slots F_SET_TIME..=F_ENTER_CONT_MODE are the stepper's table, in its order
+    let mut slots = [std::ptr::null(); 9];
+    slots.copy_from_slice(&fmu.fns[F_SET_TIME..=F_ENTER_CONT_MODE]);
+    let table = Table::from_slots(fmu.v3, slots).ok_or(ERR_NULL)?;
+    let unit = MeUnit { comp: fmu.comp, table };
+    let next = if p[2].is_nan() { None } else { Some(p[2]) };
+    Ok((fmu, Some((unit, Stepper::new(nx, nz, settings, next)))))
 }
 
 /// One propagation operation (kind, unit, value-reference offset, count, buffer offset), range-checked.

@@ -1,26 +1,24 @@
-//! The Dormand–Prince 5(4) pair for a Model Exchange unit (see the parent module): adaptive steps with
-//! local extrapolation, first-same-as-last stage, the fourth-order continuous extension for state events
-//! (the method of SciPy's `RK45`, written here from the published coefficients).
+//! The Dormand–Prince 5(4) pair (crate documentation): adaptive steps with local extrapolation,
+//! first-same-as-last stage, the fourth-order continuous extension as the state between the step's ends
+//! for the event location (the method of SciPy's `RK45`, written here from the published coefficients).
 
-use super::Solver;
-use crate::{Fail, Fmu, PHASE_SOLVER};
-
-// Dormand–Prince 5(4): nodes, stage coefficients, 5th-order weights, error weights, dense output; the one
-// tableau of the project (this crate does not depend on it, so the file of constants is included).
-#[allow(dead_code)]
-#[path = "../../../../../src/math/dopri_tableau.rs"]
-mod dopri_tableau;
-use dopri_tableau::{A, B, C, E, P};
+use crate::stepper::Stepper;
+use crate::tableau::{A, B, C, E, P};
+use crate::{Stop, Unit};
 
 const SAFETY: f64 = 0.9;
 const MIN_FACTOR: f64 = 0.2;
 const MAX_FACTOR: f64 = 10.0;
 
-impl Solver {
+impl Stepper {
     /// Starting step size (Hairer, Nørsett & Wanner's heuristic, as in SciPy).
-    pub(super) unsafe fn initial_step(&mut self, f: &Fmu, t: f64, span: f64) -> Result<f64, Fail> {
+    pub(crate) fn initial_step<U: Unit>(&mut self, u: &mut U, t: f64, span: f64) -> Result<f64, Stop> {
         let n = self.nx;
-        let scale: Vec<f64> = self.x.iter().map(|v| self.atol + v.abs() * self.rtol).collect();
+        let scale: Vec<f64> = self
+            .x
+            .iter()
+            .map(|v| self.settings.atol + v.abs() * self.settings.rtol)
+            .collect();
         let rms = |v: &[f64]| (v.iter().zip(&scale).map(|(a, s)| (a / s) * (a / s)).sum::<f64>() / n as f64).sqrt();
         let d0 = rms(&self.x);
         let d1 = rms(&self.k[0]);
@@ -31,7 +29,7 @@ impl Solver {
         }
         let mut f1 = vec![0.0; n];
         let y = self.y.clone();
-        self.rhs(f, t + h0, &y, &mut f1)?;
+        self.rhs(u, t + h0, &y, &mut f1)?;
         let diff: Vec<f64> = f1.iter().zip(&self.k[0]).map(|(a, b)| a - b).collect();
         let d2 = rms(&diff) / h0;
         let h1 = if d1 <= 1e-15 && d2 <= 1e-15 {
@@ -39,7 +37,16 @@ impl Solver {
         } else {
             (0.01 / d1.max(d2)).powf(1.0 / 5.0)
         };
-        Ok((100.0 * h0).min(h1).min(span))
+        Ok(self.capped((100.0 * h0).min(h1).min(span)))
+    }
+
+    /// `h` at most the settings' `max_step` (when one is set).
+    fn capped(&self, h: f64) -> f64 {
+        if self.settings.max_step > 0.0 {
+            h.min(self.settings.max_step)
+        } else {
+            h
+        }
     }
 
     /// The continuous extension at t0 + θ·h into `xi`.
@@ -57,15 +64,15 @@ impl Solver {
 
     /// One accepted Dormand–Prince 5(4) step from (t, x) (k1 = f(t, x) in `k[0]`) towards `t_stop`; a state
     /// event found in it ends the step there. (new time, status, enter event mode).
-    pub(super) unsafe fn dp_advance(
+    pub(crate) fn dp_advance<U: Unit>(
         &mut self,
-        f: &Fmu,
+        u: &mut U,
         t: f64,
         t_stop: f64,
         eps: f64,
-    ) -> Result<(f64, i32, bool), Fail> {
+    ) -> Result<(f64, i32, bool), Stop> {
         self.at = None;
-        let (h, mut w) = self.dp_attempts(f, t, t_stop, eps)?;
+        let (h, mut w) = self.dp_attempts(u, t, t_stop, eps)?;
         self.accepted += 1;
         // ----- state events: a sign change of an indicator over [t, t + h]
         let mut t_new = if (t + h - t_stop).abs() <= eps { t_stop } else { t + h };
@@ -73,17 +80,17 @@ impl Solver {
         if self.nz > 0 {
             // the unit is at (t + h, x_new) after the last stage
             let mut zn = std::mem::take(&mut self.z_new);
-            w = w.max(self.indicators(f, &mut zn)?);
+            w = w.max(self.indicators(u, &mut zn)?);
             self.z_new = zn;
             crossed = self.z.iter().zip(&self.z_new).any(|(a, b)| (*a > 0.0) != (*b > 0.0));
         }
         if crossed {
-            let (hi, st) = self.dp_locate(f, t, h, eps)?;
+            let (hi, st) = self.locate(u, t, h, eps, Self::dp_state_at)?;
             w = w.max(st);
             self.dense(h, hi);
             std::mem::swap(&mut self.x_new, &mut self.xi);
             t_new = t + hi * h;
-            w = w.max(self.set(f, t_new, &self.x_new)?);
+            w = w.max(self.set(u, t_new, &self.x_new)?);
         }
         std::mem::swap(&mut self.x, &mut self.x_new);
         if !crossed && t_new == t + h {
@@ -95,15 +102,16 @@ impl Solver {
                 std::mem::swap(&mut self.z, &mut self.z_new);
             }
         }
-        let (enter, st) = self.completed(f)?;
+        self.t = t_new;
+        let (enter, st) = self.completed(u)?;
         Ok((t_new, w.max(st), crossed || enter))
     }
 
     /// Dormand–Prince 5(4) attempts from (t, x) until one meets the tolerance: the stages in `k`, the new
     /// point in `x_new`, the next step size proposal in `self.h`. (accepted step size, status).
-    unsafe fn dp_attempts(&mut self, f: &Fmu, t: f64, t_stop: f64, eps: f64) -> Result<(f64, i32), Fail> {
+    fn dp_attempts<U: Unit>(&mut self, u: &mut U, t: f64, t_stop: f64, eps: f64) -> Result<(f64, i32), Stop> {
         let mut w = 0;
-        let mut h = self.h.min(t_stop - t);
+        let mut h = self.capped(self.h).min(t_stop - t);
         if t + h > t_stop - eps {
             h = t_stop - t;
         }
@@ -113,9 +121,9 @@ impl Solver {
         // stages 2..6 and the new point (FSAL: stage 7 = f(t + h, x_new))
         loop {
             if h < h_min.min(t_stop - t) {
-                return Err((3, PHASE_SOLVER));
+                return Err(Stop::Solver);
             }
-            w = w.max(self.dp_stages(f, t, h)?);
+            w = w.max(self.dp_stages(u, t, h)?);
             // the error estimate h·Σ_j E_j k_j (E[1] = 0: that term would add a zero)
             let [k0, _, k2, k3, k4, k5, k6] = &self.k;
             combine(
@@ -149,7 +157,7 @@ impl Solver {
     }
 
     /// Stages 2..7 of a Dormand–Prince step of size h from (t, x): `k[1..7]`, the 5th-order point `x_new`.
-    unsafe fn dp_stages(&mut self, f: &Fmu, t: f64, h: f64) -> Result<i32, Fail> {
+    fn dp_stages<U: Unit>(&mut self, u: &mut U, t: f64, h: f64) -> Result<i32, Stop> {
         let mut w = 0;
         for s in 1..6 {
             let c: [f64; 6] = std::array::from_fn(|j| h * A[s][j]);
@@ -168,7 +176,7 @@ impl Solver {
             }
             let y = std::mem::take(&mut self.y);
             let mut ks = std::mem::take(&mut self.k[s]);
-            let r = self.rhs(f, t + C[s] * h, &y, &mut ks);
+            let r = self.rhs(u, t + C[s] * h, &y, &mut ks);
             self.y = y;
             self.k[s] = ks;
             w = w.max(r?);
@@ -184,36 +192,16 @@ impl Solver {
         // FSAL stage f(t + h, x_new): the unit's time is already t + h (stage 6, C[5] = 1)
         let mut k6 = std::mem::take(&mut self.k[6]);
         let r = self
-            .set_states_only(f, &self.x_new)
-            .and_then(|a| self.derivatives_here(f, &mut k6).map(|b| a.max(b)));
+            .set_states_only(u, &self.x_new)
+            .and_then(|a| self.derivatives_here(u, &mut k6).map(|b| a.max(b)));
         self.k[6] = k6;
         Ok(w.max(r?))
     }
 
-    /// A sign change of an indicator over the accepted step [t, t + h]: bisection on the continuous
-    /// extension to `eps`. (θ past the crossing, status).
-    unsafe fn dp_locate(&mut self, f: &Fmu, t: f64, h: f64, eps: f64) -> Result<(f64, i32), Fail> {
-        let mut w = 0;
-        let (mut lo, mut hi) = (0.0f64, 1.0f64);
-        for _ in 0..200 {
-            if (hi - lo) * h <= eps {
-                break;
-            }
-            let mid = 0.5 * (lo + hi);
-            self.dense(h, mid);
-            let xi = std::mem::take(&mut self.xi);
-            w = w.max(self.set(f, t + mid * h, &xi)?);
-            self.xi = xi;
-            let mut zi = std::mem::take(&mut self.zi);
-            w = w.max(self.indicators(f, &mut zi)?);
-            self.zi = zi;
-            if self.z.iter().zip(&self.zi).any(|(a, b)| (*a > 0.0) != (*b > 0.0)) {
-                hi = mid;
-            } else {
-                lo = mid;
-            }
-        }
-        Ok((hi, w))
+    /// The continuous extension at t + θ·h into `xi` (the state the event location bisects on).
+    fn dp_state_at<U: Unit>(&mut self, _u: &mut U, _t: f64, h: f64, theta: f64) -> Result<i32, Stop> {
+        self.dense(h, theta);
+        Ok(0)
     }
 
     fn norm(&self, err: &[f64], a: &[f64], b: &[f64]) -> f64 {
@@ -222,7 +210,7 @@ impl Solver {
         }
         let mut s = 0.0;
         for ((e, a), b) in err.iter().zip(a).zip(b) {
-            let e = e / (self.atol + self.rtol * a.abs().max(b.abs()));
+            let e = e / (self.settings.atol + self.settings.rtol * a.abs().max(b.abs()));
             s += e * e;
         }
         (s / self.nx as f64).sqrt()
