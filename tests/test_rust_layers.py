@@ -1,5 +1,5 @@
-"""The Rust import rules, read from the code's own paths: in every crate under src/ (the runtime crate
-`src/` with the models, `src/cdylib`, `src/package/src`) every `crate::…`, `super::…` and `self::…` path
+"""The Rust import rules, read from the code's own paths: in every crate of the repository (the runtime crate
+`src/` with the models, `src/cdylib`, `src/package/src`, and scfmu's engine crates under `scfmu/engines/`) every `crate::…`, `super::…` and `self::…` path
 and every path through a child module (`declare::concat` in `model/mod.rs`) names a module file; the graph
 of those references between files has no circle anywhere (no file circle), and in the FMI layer
 (src/fmi/) FMI 3.0 files never reference FMI 2.0 files (nor the other way round). Brace imports
@@ -16,8 +16,10 @@ from pathlib import Path
 
 
 SRC = Path(__file__).resolve().parents[1] / "src"
+ENGINES = SRC.parent / "scfmu" / "engines"  # scfmu's own Rust crates: the compiled loop, the ME wrapper, the stepper
 # (crate root, folders below it that are other crates)
-CRATES = [(SRC, ("cdylib", "package")), (SRC / "cdylib", ()), (SRC / "package" / "src", ())]
+CRATES = [(SRC, ("cdylib", "package")), (SRC / "cdylib", ()), (SRC / "package" / "src", ())] + [
+    (c.parent / "src", ()) for c in sorted(ENGINES.glob("*/Cargo.toml"))]
 BRACES = re.compile(r"(?<!\$)\b((?:crate|super|self)(?:::\w+)*)::\{([^{}]*)\}")  # `use super::{a, b::c}`
 PATH = re.compile(r"(?<!\$)\b(crate(?:::\w+)+|super(?:::\w+)+|self::\{[^}]*\}|self(?:::\w+)+)")
 CHILD = re.compile(r"(?<![\w:$])(\w+)::")  # `declare::concat`: a path through a child module
@@ -131,15 +133,17 @@ def violations(root: Path, other_crates=()) -> list[str]:
 def test_no_file_circle_in_any_crate_and_no_import_across_fmi_versions():
     found = {str(root.relative_to(SRC.parent)): violations(root, other) for root, other in CRATES}
     assert all(v == [] for v in found.values()), found
+    assert len(CRATES) == 6, [str(r) for r, _ in CRATES]  # src, cdylib, package + native_loop, me_cs, fmi_stepper
 
 
 def test_the_whole_crate_is_read():
-    """Every file under src/ belongs to one crate's graph, models and the FMI layer included."""
+    """Every file under src/ and of the engine crates belongs to one crate's graph, models and the FMI layer included."""
     read = set()
     for root, other in CRATES:
         read |= set(modules(root, other).values())
     # not read: the packager's main.rs and its integration tests (each a crate of its own, test-only)
     every = {p for p in SRC.rglob("*.rs") if p.parent != SRC / "package" / "tests"} - {SRC / "package" / "src" / "main.rs"}
+    every |= set(ENGINES.glob("*/src/**/*.rs"))
     assert every == read
     graph = edges(SRC, ("cdylib", "package"))
     assert ("models", "attitude", "plant", "environment") in graph[("models", "attitude", "plant")]

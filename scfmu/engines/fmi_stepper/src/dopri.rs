@@ -4,7 +4,7 @@
 
 use crate::stepper::Stepper;
 use crate::tableau::{A, B, C, E, P};
-use crate::{Stop, Unit};
+use crate::unit::{Stop, Unit};
 
 const SAFETY: f64 = 0.9;
 const MIN_FACTOR: f64 = 0.2;

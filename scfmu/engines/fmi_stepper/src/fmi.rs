@@ -6,7 +6,8 @@
 use std::ffi::c_void;
 use std::mem::transmute;
 
-use crate::{dynlib, Unit, OK};
+use crate::dynlib;
+use crate::unit::{Unit, OK};
 
 /// An instance of the unit (`fmi2Component` / `fmi3Instance`).
 pub type Comp = *mut c_void;

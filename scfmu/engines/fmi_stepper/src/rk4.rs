@@ -3,7 +3,7 @@
 //! partial step (one RK4 step of θh from the step's start).
 
 use crate::stepper::Stepper;
-use crate::{Stop, Unit};
+use crate::unit::{Stop, Unit};
 
 impl Stepper {
     /// One RK4 step of size h from (t, self.x) with k1 = self.k[0] into `self.x_new` (uses k[1..4], y).

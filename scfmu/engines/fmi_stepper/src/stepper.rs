@@ -1,7 +1,7 @@
 //! The stepper's state and one communication step (see the crate documentation): the pieces between
 //! events, the event iteration, and the one event-location method.
 
-use crate::{Method, Settings, Stop, Unit};
+use crate::unit::{Method, Settings, Stop, Unit, WARNING};
 
 const MAX_STEPS_PER_INTERVAL: usize = 1_000_000;
 const MAX_EVENT_ITERATIONS: usize = 1000;
@@ -10,7 +10,7 @@ const MAX_BISECTIONS: usize = 200;
 
 /// A status above fmi2Warning / fmi3Warning stops the step.
 pub(crate) fn ok(st: i32) -> Result<i32, Stop> {
-    if st > crate::WARNING {
+    if st > WARNING {
         Err(Stop::Failed(st))
     } else {
         Ok(st)

@@ -6,7 +6,7 @@
 use std::ffi::c_void;
 
 use crate::fmi::Comp;
-use crate::ERROR;
+use crate::unit::ERROR;
 
 type Get2<T> = unsafe extern "C" fn(Comp, *const u32, usize, *mut T) -> i32;
 type Set2<T> = unsafe extern "C" fn(Comp, *const u32, usize, *const T) -> i32;
