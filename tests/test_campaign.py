@@ -136,8 +136,8 @@ def test_compiled_nonfinite_logged_value_raises(monkeypatch):
     proto = CFUNCTYPE(c_int, c_void_p, c_void_p, c_size_t, c_void_p)
     keep = []
 
-    def raw(slave, name, argtypes, restype=c_int):
-        f = real_raw(slave, name, argtypes, restype)
+    def raw(slave, name):
+        f = real_raw(slave, name)
         if name != "fmi2GetReal" or slave.instanceName != "metrics":
             return f
         calls = [0]

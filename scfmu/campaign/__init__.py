@@ -183,9 +183,8 @@ class _CtrlCWatcher:
             try:
                 os.close(self.w)
                 signal.signal(signal.SIGINT, signal.SIG_DFL)
-                if sys.platform.startswith("linux"):  # prctl(PR_SET_PDEATHSIG, SIGKILL)
-                    import ctypes
-                    ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGKILL), 0, 0, 0)
+                from ..binding import die_with_parent
+                die_with_parent()  # Linux: SIGKILL when this process's parent ends (prctl PR_SET_PDEATHSIG)
                 if os.getppid() == parent:
                     os.read(r, 1)
             finally:

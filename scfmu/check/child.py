@@ -38,11 +38,8 @@ def _die_with_parent() -> None:
     parent = os.environ.get("SCFMU_CHECK_PARENT", "")
     if not parent.isdigit() or not sys.platform.startswith("linux"):
         return
-    import ctypes
-    import signal
-    try:
-        ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGKILL), 0, 0, 0)
-    except (OSError, AttributeError):
+    from ..binding import die_with_parent
+    if not die_with_parent():
         return
     if os.getppid() != int(parent):  # the parent ended before the line above took effect
         os._exit(3)

@@ -3,20 +3,17 @@
 Every call goes through :meth:`Lib.call`, which records it as one line of a C-like call list
 (``fmi2DoStep(c1, 0.0, 0.01, fmi2True) -> fmi2OK``) in the current :class:`Trace`; the trace is also
 written, unbuffered, to a file descriptor so that the parent still has the calls when the FMU kills the
-child. The signatures are declared here from the standards' C headers (fmpy's wrappers raise on error
-statuses and cannot pass NULL pointers, which the gauntlet needs)."""
+child. The signatures come from :mod:`scfmu.binding` (fmpy's wrappers raise on error statuses and cannot
+pass NULL pointers, which the gauntlet needs)."""
 
 from __future__ import annotations
 
-import ctypes
 import math
 import os
-from ctypes import (CFUNCTYPE, POINTER, Structure, c_bool, c_char_p, c_double, c_float, c_int, c_int32, c_int64,
-                    c_size_t, c_uint8, c_uint32, c_void_p)
 
-STATUS2 = ("fmi2OK", "fmi2Warning", "fmi2Discard", "fmi2Error", "fmi2Fatal", "fmi2Pending")
-STATUS3 = ("fmi3OK", "fmi3Warning", "fmi3Discard", "fmi3Error", "fmi3Fatal")
-OK, WARNING, DISCARD, ERROR, FATAL = 0, 1, 2, 3, 4
+from .. import binding
+from ..binding import (DISCARD, ERROR, FATAL, OK, STATUS2, STATUS3, TYPES2, TYPES3, WARNING,  # noqa: F401
+                       Callbacks2, EventInfo2)
 
 
 class Trace:
@@ -66,109 +63,12 @@ def fmt(v) -> str:
     return str(v)
 
 
-# ----------------------------------------------------------------------------------------- FMI 2.0 types
-class EventInfo2(Structure):
-    _fields_ = [("newDiscreteStatesNeeded", c_int), ("terminateSimulation", c_int),
-                ("nominalsOfContinuousStatesChanged", c_int), ("valuesOfContinuousStatesChanged", c_int),
-                ("nextEventTimeDefined", c_int), ("nextEventTime", c_double)]
-
-
-LOGGER2 = CFUNCTYPE(None, c_void_p, c_char_p, c_int, c_char_p, c_char_p)
-ALLOC2 = CFUNCTYPE(c_void_p, c_size_t, c_size_t)
-FREE2 = CFUNCTYPE(None, c_void_p)
-STEPFINISHED2 = CFUNCTYPE(None, c_void_p, c_int)
-
-
-class Callbacks2(Structure):
-    _fields_ = [("logger", LOGGER2), ("allocateMemory", ALLOC2), ("freeMemory", FREE2),
-                ("stepFinished", STEPFINISHED2), ("componentEnvironment", c_void_p)]
-
-
-LOG3 = CFUNCTYPE(None, c_void_p, c_int, c_char_p, c_char_p)
-
-P = c_void_p
-VRS = POINTER(c_uint32)
-SIGS2 = {
-    "fmi2Instantiate": (P, [c_char_p, c_int, c_char_p, c_char_p, POINTER(Callbacks2), c_int, c_int]),
-    "fmi2FreeInstance": (None, [P]),
-    "fmi2SetupExperiment": (c_int, [P, c_int, c_double, c_double, c_int, c_double]),
-    "fmi2EnterInitializationMode": (c_int, [P]),
-    "fmi2ExitInitializationMode": (c_int, [P]),
-    "fmi2Terminate": (c_int, [P]),
-    "fmi2Reset": (c_int, [P]),
-    "fmi2GetReal": (c_int, [P, VRS, c_size_t, POINTER(c_double)]),
-    "fmi2SetReal": (c_int, [P, VRS, c_size_t, POINTER(c_double)]),
-    "fmi2GetInteger": (c_int, [P, VRS, c_size_t, POINTER(c_int)]),
-    "fmi2SetInteger": (c_int, [P, VRS, c_size_t, POINTER(c_int)]),
-    "fmi2GetBoolean": (c_int, [P, VRS, c_size_t, POINTER(c_int)]),
-    "fmi2SetBoolean": (c_int, [P, VRS, c_size_t, POINTER(c_int)]),
-    "fmi2DoStep": (c_int, [P, c_double, c_double, c_int]),
-    "fmi2GetFMUstate": (c_int, [P, POINTER(c_void_p)]),
-    "fmi2SetFMUstate": (c_int, [P, c_void_p]),
-    "fmi2FreeFMUstate": (c_int, [P, POINTER(c_void_p)]),
-    "fmi2SerializedFMUstateSize": (c_int, [P, c_void_p, POINTER(c_size_t)]),
-    "fmi2SerializeFMUstate": (c_int, [P, c_void_p, POINTER(c_uint8), c_size_t]),
-    "fmi2DeSerializeFMUstate": (c_int, [P, POINTER(c_uint8), c_size_t, POINTER(c_void_p)]),
-    "fmi2EnterEventMode": (c_int, [P]),
-    "fmi2NewDiscreteStates": (c_int, [P, POINTER(EventInfo2)]),
-    "fmi2EnterContinuousTimeMode": (c_int, [P]),
-    "fmi2CompletedIntegratorStep": (c_int, [P, c_int, POINTER(c_int), POINTER(c_int)]),
-    "fmi2SetTime": (c_int, [P, c_double]),
-    "fmi2SetContinuousStates": (c_int, [P, POINTER(c_double), c_size_t]),
-    "fmi2GetDerivatives": (c_int, [P, POINTER(c_double), c_size_t]),
-    "fmi2GetContinuousStates": (c_int, [P, POINTER(c_double), c_size_t]),
-}
-B = c_bool
-PB = POINTER(c_bool)
-SIGS3 = {
-    "fmi3InstantiateCoSimulation": (P, [c_char_p, c_char_p, c_char_p, B, B, B, B, VRS, c_size_t, c_void_p, LOG3,
-                                        c_void_p]),
-    "fmi3InstantiateModelExchange": (P, [c_char_p, c_char_p, c_char_p, B, B, c_void_p, LOG3]),
-    "fmi3FreeInstance": (None, [P]),
-    "fmi3EnterInitializationMode": (c_int, [P, B, c_double, c_double, B, c_double]),
-    "fmi3ExitInitializationMode": (c_int, [P]),
-    "fmi3Terminate": (c_int, [P]),
-    "fmi3Reset": (c_int, [P]),
-    "fmi3GetFloat64": (c_int, [P, VRS, c_size_t, POINTER(c_double), c_size_t]),
-    "fmi3SetFloat64": (c_int, [P, VRS, c_size_t, POINTER(c_double), c_size_t]),
-    "fmi3GetFloat32": (c_int, [P, VRS, c_size_t, POINTER(c_float), c_size_t]),
-    "fmi3SetFloat32": (c_int, [P, VRS, c_size_t, POINTER(c_float), c_size_t]),
-    "fmi3GetInt32": (c_int, [P, VRS, c_size_t, POINTER(c_int32), c_size_t]),
-    "fmi3SetInt32": (c_int, [P, VRS, c_size_t, POINTER(c_int32), c_size_t]),
-    "fmi3GetInt64": (c_int, [P, VRS, c_size_t, POINTER(c_int64), c_size_t]),
-    "fmi3SetInt64": (c_int, [P, VRS, c_size_t, POINTER(c_int64), c_size_t]),
-    "fmi3GetBoolean": (c_int, [P, VRS, c_size_t, PB, c_size_t]),
-    "fmi3SetBoolean": (c_int, [P, VRS, c_size_t, PB, c_size_t]),
-    "fmi3DoStep": (c_int, [P, c_double, c_double, B, PB, PB, PB, POINTER(c_double)]),
-    "fmi3GetFMUState": (c_int, [P, POINTER(c_void_p)]),
-    "fmi3SetFMUState": (c_int, [P, c_void_p]),
-    "fmi3FreeFMUState": (c_int, [P, POINTER(c_void_p)]),
-    "fmi3SerializedFMUStateSize": (c_int, [P, c_void_p, POINTER(c_size_t)]),
-    "fmi3SerializeFMUState": (c_int, [P, c_void_p, POINTER(c_uint8), c_size_t]),
-    "fmi3DeserializeFMUState": (c_int, [P, POINTER(c_uint8), c_size_t, POINTER(c_void_p)]),
-    "fmi3EnterEventMode": (c_int, [P]),
-    "fmi3UpdateDiscreteStates": (c_int, [P, PB, PB, PB, PB, PB, POINTER(c_double)]),
-    "fmi3EnterContinuousTimeMode": (c_int, [P]),
-    "fmi3CompletedIntegratorStep": (c_int, [P, B, PB, PB]),
-    "fmi3SetTime": (c_int, [P, c_double]),
-    "fmi3SetContinuousStates": (c_int, [P, POINTER(c_double), c_size_t]),
-    "fmi3GetContinuousStateDerivatives": (c_int, [P, POINTER(c_double), c_size_t]),
-    "fmi3GetContinuousStates": (c_int, [P, POINTER(c_double), c_size_t]),
-}
-
-# the typed getters/setters by (version, type name): (suffix, ctypes element type)
-TYPES2 = {"Real": ("Real", c_double), "Integer": ("Integer", c_int), "Boolean": ("Boolean", c_int)}
-TYPES3 = {"Float64": ("Float64", c_double), "Float32": ("Float32", c_float), "Int32": ("Int32", c_int32),
-          "Int64": ("Int64", c_int64), "Boolean": ("Boolean", c_bool)}
-
-
 class Lib:
     """One loaded FMU binary with traced calls. `version` is 2 or 3."""
 
     def __init__(self, path: str, version: int, trace: Trace):
         self.path, self.version, self.trace = path, version, trace
-        self.cdll = ctypes.CDLL(path, mode=os.RTLD_NOW | os.RTLD_LOCAL)
-        self.sigs = SIGS2 if version == 2 else SIGS3
+        self.library = binding.load(path)
         self.status_names = STATUS2 if version == 2 else STATUS3
         self._fns: dict = {}
         self.names: dict = {}  # instance pointer -> c1, c2, ...
@@ -186,10 +86,9 @@ class Lib:
     def fn(self, name: str):
         f = self._fns.get(name)
         if f is None:
-            f = getattr(self.cdll, name)
-            res, args = self.sigs[name]
-            f.restype, f.argtypes = res, args
-            self._fns[name] = f
+            if not name.startswith(f"fmi{self.version}"):
+                raise AttributeError(f"{name} is not an FMI {self.version}.0 function")
+            f = self._fns[name] = binding.bind(self.library, name)
         return f
 
     def handle_name(self, h) -> str:
@@ -206,9 +105,10 @@ class Lib:
         self.mark = len(self.log)
         self.trace.add(text + " ...")  # written before the call: a crash or a hang leaves the call in the trace
         r = f(*args)
-        if f.restype is None:
+        res = binding.SIGNATURES[name][0]
+        if res is None:
             self.trace.done(text)
-        elif f.restype is c_int:
+        elif res is not binding.P:  # a status
             s = self.status_names[r] if 0 <= r < len(self.status_names) else f"<invalid status {r}>"
             self.trace.done(f"{text} -> {s}")
         else:
@@ -216,8 +116,6 @@ class Lib:
         return r
 
     def unload(self) -> None:
-        import _ctypes
-        handle = self.cdll._handle
+        lib, self.library = self.library, None
         self._fns.clear()
-        self.cdll = None
-        _ctypes.dlclose(handle)
+        binding.unload(lib)

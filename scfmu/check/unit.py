@@ -11,14 +11,9 @@ import ctypes
 import math
 from ctypes import byref, c_bool, c_double, c_int, c_size_t, c_uint8, c_uint32, c_void_p
 
-from .fmi import (ERROR, OK, WARNING, LOG3, LOGGER2, ALLOC2, FREE2, STEPFINISHED2, Callbacks2, EventInfo2,
-                  Lib, TYPES2, TYPES3, Trace)
-
-_libc = ctypes.CDLL(None)
-_libc.calloc.restype = c_void_p
-_libc.calloc.argtypes = [c_size_t, c_size_t]
-_libc.free.argtypes = [c_void_p]
-_libc.free.restype = None
+from .. import binding
+from ..binding import LOG3, EventInfo2
+from .fmi import ERROR, OK, WARNING, Lib, TYPES2, TYPES3, Trace
 
 
 MAX_SUBSTEPS = 50  # Euler sub-steps per Model Exchange step of the checker
@@ -53,22 +48,10 @@ class Unit:
 
     # ------------------------------------------------------------------ callbacks
     def _make_callbacks(self):
-        def log2(_env, _name, status, category, message):
-            self.messages.append((int(status), (message or b"").decode(errors="replace")))
+        def log(status, message):
+            self.messages.append((status, message))
 
-        def log3(_env, status, category, message):
-            self.messages.append((int(status), (message or b"").decode(errors="replace")))
-
-        if self.v == 2:
-            cb = Callbacks2()
-            cb.logger = LOGGER2(log2)
-            cb.allocateMemory = ALLOC2(lambda n, s: _libc.calloc(n, s))
-            cb.freeMemory = FREE2(lambda p: _libc.free(p))
-            cb.stepFinished = STEPFINISHED2(0)
-            cb.componentEnvironment = None
-            self.callbacks = cb
-        else:
-            self.callbacks = LOG3(log3)
+        self.callbacks = binding.callbacks2(log) if self.v == 2 else binding.logger3(log)
 
     # ------------------------------------------------------------------ life cycle
     def new(self, token: str | None = None, name: str | None = None, null_callbacks: bool = False,

@@ -13,9 +13,11 @@ from __future__ import annotations
 
 import ctypes
 import functools
-from ctypes import c_bool, c_double, c_int, c_int32, c_size_t, c_void_p
+from ctypes import c_bool, c_double, c_int32
 
-STATUS = {0: "OK", 1: "Warning", 2: "Discard", 3: "Error", 4: "Fatal", 5: "Pending"}
+from .. import binding
+from ..binding import STATUS  # noqa: F401
+
 C_TYPES = {"Real": c_double, "Integer": c_int32, "Boolean": c_int32}  # buffer element per scenario type
 
 
@@ -28,34 +30,16 @@ class SimulationError(RuntimeError):
         self.time = time
 
 
-def raw_fn(slave, name: str, argtypes, restype=c_int):
-    """A fresh ctypes function pointer to ``name`` of the unit's library (fmpy's own, cached ones keep
-    their argtypes and error checks)."""
-    f = slave.dll[name]
-    f.argtypes = argtypes
-    f.restype = restype
-    return f
-
-
-def component_ptr(slave) -> int:
-    """The instance pointer of an fmpy slave/model as an int."""
-    c = slave.component
-    return c if isinstance(c, int) else ctypes.cast(c, c_void_p).value
+def raw_fn(slave, name: str):
+    """A fresh function object for ``name`` of the unit's library with its raw signature
+    (:func:`scfmu.binding.bind`: pointers as ints; fmpy's own, cached ones keep their argtypes and error
+    checks)."""
+    return binding.bind(slave.dll, name, raw=True)
 
 
 def fmu_messages(fmus: dict, min_status: int = 2) -> list[str]:
     """``"instance: message"`` for every logged message of at least ``min_status`` (Discard)."""
     return [f"{name}: {text}" for name, f in fmus.items() for status, _c, text in f.messages if status >= min_status]
-
-
-_GS = [c_void_p, c_void_p, c_size_t, c_void_p]
-_GS3 = [c_void_p, c_void_p, c_size_t, c_void_p, c_size_t]
-NAMES = {2: {"get": {"Real": "fmi2GetReal", "Integer": "fmi2GetInteger", "Boolean": "fmi2GetBoolean"},
-             "set": {"Real": "fmi2SetReal", "Integer": "fmi2SetInteger", "Boolean": "fmi2SetBoolean"},
-             "step": "fmi2DoStep"},
-         3: {"get": {"Real": "fmi3GetFloat64", "Integer": "fmi3GetInt32", "Boolean": "fmi3GetBoolean"},
-             "set": {"Real": "fmi3SetFloat64", "Integer": "fmi3SetInt32", "Boolean": "fmi3SetBoolean"},
-             "step": "fmi3DoStep"}}
 
 
 def raw_calls(fmu) -> "RawCalls":
@@ -81,22 +65,17 @@ class RawCalls:
         sl = fmu.slave
         self.fmu = fmu
         self.fmi = fmu.fmi
-        self.comp = component_ptr(sl)
-        names = NAMES[self.fmi]
+        self.comp = binding.instance_address(sl)
+        names = binding.ACCESSORS[self.fmi]
         self.fn = {}
-        gs = _GS if self.fmi == 2 else _GS3
         for kind in ("get", "set"):
             for t, n in names[kind].items():
                 try:
-                    self.fn[f"{kind}:{t}"] = raw_fn(sl, n, gs)
+                    self.fn[f"{kind}:{t}"] = raw_fn(sl, n)
                 except AttributeError:  # a unit without Integer/Boolean functions (never linked to)
                     pass
         if fmu.interface == "cs":
-            if self.fmi == 2:
-                self.fn["step"] = raw_fn(sl, "fmi2DoStep", [c_void_p, c_double, c_double, c_int])
-            else:
-                self.fn["step"] = raw_fn(sl, "fmi3DoStep", [c_void_p, c_double, c_double, c_bool, c_void_p,
-                                                            c_void_p, c_void_p, c_void_p])
+            self.fn["step"] = raw_fn(sl, names["step"])
         self.get = {t: self._accessor("get", t) for t in C_TYPES if f"get:{t}" in self.fn}
         self.set = {t: self._accessor("set", t) for t in C_TYPES if f"set:{t}" in self.fn}
         self.step = self._stepper() if fmu.interface == "cs" else self._me_stepper()

@@ -32,16 +32,16 @@ otherwise.
 
 from __future__ import annotations
 
-import ctypes
 import platform
 import sys
 from importlib import resources
-from ctypes import POINTER, c_double, c_int, c_int64, c_size_t, c_uint, c_uint32, c_void_p
+from ctypes import c_double, c_int64, c_size_t, c_uint, c_void_p
 from pathlib import Path
 
 import numpy as np
 
-from .calls import SimulationError, fmu_messages, raw_fn
+from .. import binding
+from .calls import SimulationError, fmu_messages
 from .instances import as_plan, build_fmus, initialize_fmus
 from .lean import LeanMaster
 
@@ -103,21 +103,7 @@ def _lib():
         lib = None
         path = library_path()
         if path is not None:
-            try:
-                cand = ctypes.CDLL(str(path))
-                cand.scfmu_loop_version.restype = c_uint32
-                cand.scfmu_loop_version.argtypes = []
-                if cand.scfmu_loop_version() == ABI_VERSION:
-                    f = cand.scfmu_loop_run
-                    f.restype = c_int
-                    f.argtypes = ([c_size_t, c_void_p, c_void_p, c_void_p, c_void_p,  # FMUs
-                                   c_size_t, c_void_p, c_size_t, c_void_p, c_size_t, c_size_t,  # ops, buffers
-                                   c_size_t, c_void_p, c_void_p, c_void_p,  # logged triples
-                                   c_size_t, c_double, c_double, c_void_p, c_size_t,  # steps, time, output
-                                   c_int, POINTER(c_int64)])
-                    lib = cand
-            except (OSError, AttributeError):
-                lib = None
+            lib = binding.load_loop(str(path), ABI_VERSION)
         _LIB.append(lib)
     return _LIB[0]
 
@@ -143,12 +129,8 @@ def _fn_address(calls, slot: int, name: str) -> int | None:
     for get/set/step, else the unit's exported function (None when it exports none by that name)."""
     if slot < len(_SLOT_KEYS):
         f = calls.fn.get(_SLOT_KEYS[slot])
-    else:
-        try:
-            f = raw_fn(calls.fmu.slave, name, None)
-        except AttributeError:  # e.g. no event indicator function in a unit that has none to report
-            f = None
-    return None if f is None else ctypes.cast(f, c_void_p).value
+        return None if f is None else binding.function_address(f)
+    return binding.address(calls.fmu.slave.dll, name)  # None e.g. for event indicators a unit does not have
 
 
 class CompiledLoop(LeanMaster):

@@ -26,7 +26,7 @@ import numpy as np
 
 from ..fmu import Fmu
 from ..scenario.plan import Plan
-from .calls import C_TYPES, STATUS as _STATUS, RawCalls, SimulationError, fmu_messages, raw_calls, raw_fn  # noqa: F401
+from .calls import C_TYPES, STATUS as _STATUS, RawCalls, SimulationError, fmu_messages, raw_calls  # noqa: F401
 from .instances import as_plan, build_fmus, initialize_fmus, ports_of  # noqa: F401
 
 

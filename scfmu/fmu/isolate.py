@@ -24,7 +24,6 @@ import pickle
 import select
 import shutil
 import signal
-import sys
 import tempfile
 import time
 from typing import Any, Callable
@@ -112,11 +111,7 @@ def _detach(parent: int, scratch: str) -> None:
     faulthandler.disable()
     for name in FATAL_SIGNALS:  # after a fork the forking thread is the child's main thread: allowed
         signal.signal(getattr(signal, name), signal.SIG_DFL)
-    if sys.platform.startswith("linux"):  # prctl(PR_SET_PDEATHSIG = 1, SIGKILL)
-        import ctypes
-        try:
-            ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGKILL), 0, 0, 0)
-        except (OSError, AttributeError):
-            pass
+    from ..binding import die_with_parent
+    die_with_parent()  # Linux: SIGKILL when the parent ends (prctl PR_SET_PDEATHSIG)
     if os.getppid() != parent:  # the parent died before the line above took effect
         os._exit(3)

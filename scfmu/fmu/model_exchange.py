@@ -4,9 +4,9 @@ points, time and state events."""
 
 from __future__ import annotations
 
-from ctypes import POINTER, c_double
-
 import numpy as np
+
+from ..binding import as_doubles
 
 
 class ModelExchange:
@@ -28,24 +28,24 @@ class ModelExchange:
     def _states(self) -> np.ndarray:
         x = np.zeros(self.nx)
         if self.nx:
-            self.slave.getContinuousStates(x.ctypes.data_as(POINTER(c_double)), self.nx)
+            self.slave.getContinuousStates(as_doubles(x), self.nx)
         return x
 
     def _rhs(self, t: float, x: np.ndarray) -> np.ndarray:
         x = np.ascontiguousarray(x, dtype=float)
         self.slave.setTime(t)
-        self.slave.setContinuousStates(x.ctypes.data_as(POINTER(c_double)), self.nx)
+        self.slave.setContinuousStates(as_doubles(x), self.nx)
         dx = np.zeros(self.nx)
         if self.fmi == 2:
-            self.slave.getDerivatives(dx.ctypes.data_as(POINTER(c_double)), self.nx)
+            self.slave.getDerivatives(as_doubles(dx), self.nx)
         else:
-            self.slave.getContinuousStateDerivatives(dx.ctypes.data_as(POINTER(c_double)), self.nx)
+            self.slave.getContinuousStateDerivatives(as_doubles(dx), self.nx)
         return dx
 
     def _indicators(self) -> np.ndarray:
         z = np.zeros(self.nz)
         if self.nz:
-            self.slave.getEventIndicators(z.ctypes.data_as(POINTER(c_double)), self.nz)
+            self.slave.getEventIndicators(as_doubles(z), self.nz)
         return z
 
     def _state_events(self):
