@@ -139,18 +139,18 @@ fn an_error_terminates_and_reset_recovers() {
         "{}",
         last(&log)
     );
-    let inst = crate::fmi::boundary::instance_of(c, true).unwrap();
+    let inst = crate::fmi::boundary::instance_of(c, &FMI3).unwrap();
     assert_eq!(inst.run.fsm, FsmState::Terminated);
     assert_eq!(fmi3EnterInitializationMode(c, 0, 0.0, 0.0, 0, 0.0), ERROR);
     assert!(last(&log).contains("not allowed in state Terminated"), "{}", last(&log));
     assert_eq!(fmi3Reset(c), OK);
     assert_eq!(
-        crate::fmi::boundary::instance_of(c, true).unwrap().run.fsm,
+        crate::fmi::boundary::instance_of(c, &FMI3).unwrap().run.fsm,
         FsmState::Instantiated
     );
     // an FMI 2.0 function does not know an FMI 3.0 instance, and the other way round
     assert_eq!(crate::fmi::fmi2::fmi2EnterInitializationMode(c), ERROR);
-    assert!(crate::fmi::boundary::instance_of(c, false).is_none());
+    assert!(crate::fmi::boundary::instance_of(c, &crate::fmi::fmi2::FMI2).is_none());
     fmi3FreeInstance(c);
 }
 
