@@ -182,3 +182,59 @@ def test_the_rule_catches_a_circle_and_a_cross_version_import(tmp_path):
         "// super::Model\nmacro_rules! m { () => { $crate::model::Model } }\n"
         "#[cfg(test)]\nmod tests {\n    use super::super::Model;\n}\n")
     assert "model -> model::declare -> model" not in violations(tmp_path), violations(tmp_path)
+
+
+# ----- the version-neutral core ------------------------------------------------------------------------
+
+FMI = SRC / "fmi"
+ROOMS = ("fmi2", "fmi3")
+# a version's name: the C prefixes and names of one version (fmi2DoStep, Fmi3, fmi3::…), or the
+# standard's name with its version in a string ("FMI 2.0")
+VERSION_NAME = re.compile(r"fmi[23]|fmi ?[23]\.\d", re.IGNORECASE)
+# the only code lines of the core that may spell one: the layer's root declares its two rooms
+CORE_ALLOWED = {("mod.rs", "pub mod fmi2;"), ("mod.rs", "pub mod fmi3;")}
+
+
+def version_names_in_core(fmi: Path) -> list[str]:
+    """The code lines (comments left out, unit tests included) of the core, every file of the FMI layer
+    outside the rooms fmi2/ and fmi3/, that name an FMI version, as `file:line: text`."""
+    found = []
+    for p in sorted(fmi.rglob("*.rs")):
+        rel = p.relative_to(fmi)
+        if rel.parts[0] in ROOMS:
+            continue
+        for n, line in enumerate(p.read_text().splitlines(), 1):
+            code = re.sub(r"//.*", "", line).strip()
+            if VERSION_NAME.search(code) and (rel.as_posix(), code) not in CORE_ALLOWED:
+                found.append(f"{rel.as_posix()}:{n}: {code}")
+    return found
+
+
+def test_the_fmi_core_names_no_fmi_version():
+    """Issue 47, item 3: the states, failures and messages of the core are version-neutral; which
+    interface an instance serves it knows only through the Dialect its room gives it, and the rooms word
+    its failures. No identifier or string of the core names fmi2/fmi3 or "FMI 2.0"/"FMI 3.0"."""
+    assert (FMI / "types.rs").exists() and (FMI / "instance" / "mod.rs").exists()
+    assert version_names_in_core(FMI) == []
+
+
+def test_the_core_rule_catches_a_version_name(tmp_path):
+    """The check can fail: a function name in a string, a room's path, a version in a message and a
+    variant named after a version are found; the same in a comment, the rooms' own files and the root's
+    `pub mod fmi2;` are not."""
+    import shutil
+    fmi = tmp_path / "fmi"
+    shutil.copytree(FMI, fmi)
+    assert version_names_in_core(fmi) == []
+    planted = {
+        "instance/me.rs": 'const F: &str = "fmi2SetContinuousStates";',
+        "boundary.rs": "use crate::fmi::fmi3::common::FMI3;",
+        "state.rs": 'const V: &str = "FMI 3.0";',
+        "types.rs": "pub enum L { Fmi2(u8) }",
+    }
+    for rel, line in planted.items():
+        (fmi / rel).write_text((fmi / rel).read_text() + "\n// fmi2DoStep in a comment\n" + line + "\n")
+    (fmi / "fmi2" / "common.rs").write_text((fmi / "fmi2" / "common.rs").read_text() + '\nconst G: &str = "fmi2X";\n')
+    found = version_names_in_core(fmi)
+    assert sorted(f.split(":")[0] for f in found) == sorted(planted), found
+    assert all(f.endswith(planted[f.split(":")[0]]) for f in found), found

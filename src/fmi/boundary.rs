@@ -1,9 +1,9 @@
-//! The C boundary both FMI versions stand on: the table of live instances (a handle from the master is
+//! The C boundary both interfaces stand on: the table of live instances (a handle from the master is
 //! a token, never an address, mapped to an instance only while that instance lives), the panic guard (a
 //! panic inside a call becomes a logged fatal status, never an unwind across `extern "C"`), borrowing of C arrays and
 //! out-pointers with the argument named in the error, the model lookup by GUID / instantiation token,
-//! and one instantiate for every interface (FMI 2.0 CS/ME, FMI 3.0 CS/ME). Nothing here knows an FMI
-//! function name beyond what the caller passes in.
+//! and one instantiate for every interface (Co-Simulation and Model Exchange of either version). Nothing
+//! here knows an FMI function name beyond what the caller passes in (its name, its [`Dialect`]).
 
 use std::cell::{Cell, RefCell};
 use std::ffi::{c_char, c_int, c_void, CStr, CString};
@@ -13,11 +13,11 @@ use super::instance::{CallResult, Fail, Instance, Logger};
 use super::library_path::own_library_stem;
 use super::live::{Handles, KIND_INSTANCE};
 use super::state::Snapshot;
-use super::types::Status;
+use super::types::{Dialect, Status};
 use crate::model::guid::guid;
 use crate::model::ModelEntry;
 
-/// What the master holds for an instance: `fmi2Component` / `fmi3Instance`.
+/// What the master holds for an instance (the standards' component or instance pointer).
 pub type Handle = *mut c_void;
 
 // ----- live instances ----------------------------------------------------------------------------
@@ -27,17 +27,17 @@ pub type Handle = *mut c_void;
 static LIVE: Handles<Instance> = Handles::new(KIND_INSTANCE);
 
 /// The instance behind a handle if it is a live token of this library and was created through the
-/// FMI version asked for (`fmi3`: by an `fmi3Instantiate*` function); an FMI 2.0 instance is foreign to
-/// the FMI 3.0 functions and the other way round. A null, foreign or freed handle gives None, also
+/// interface asked for (the room's `dialect`); an instance of one interface is foreign to the other's
+/// functions. A null, foreign or freed handle gives None, also
 /// after its memory or slot went to a new instance (and the call returns an error status: there is no
 /// logger to tell). Nothing is read behind a handle before the table has mapped it to a live instance;
 /// on every FMI call, so without a lock.
-pub fn instance_of<'a>(c: Handle, fmi3: bool) -> Option<&'a mut Instance> {
+pub fn instance_of<'a>(c: Handle, dialect: &'static Dialect) -> Option<&'a mut Instance> {
     let p = LIVE.get(c as usize)?;
     // SAFETY: the table maps a live token only to the instance registered under it by `register`,
     // which `free_instance` takes out of the table before freeing it.
     let inst = unsafe { &mut *p };
-    (inst.fmi3 == fmi3).then_some(inst)
+    std::ptr::eq(inst.dialect, dialect).then_some(inst)
 }
 
 /// Registers a new instance under a new token (installing the panic hook with the first one).
@@ -51,10 +51,10 @@ fn register(inst: Box<Instance>) -> Result<Handle, String> {
         })
 }
 
-/// Frees an instance of the given FMI version (and its FMU states); anything else is ignored.
-pub fn free_instance(c: Handle, fmi3: bool) {
-    if instance_of(c, fmi3).is_none() {
-        return; // null, not ours, freed or of the other FMI version: nothing to free, nothing to log to
+/// Frees an instance of the given interface (and its FMU states); anything else is ignored.
+pub fn free_instance(c: Handle, dialect: &'static Dialect) {
+    if instance_of(c, dialect).is_none() {
+        return; // null, not ours, freed or of the other interface: nothing to free, nothing to log to
     }
     let Some(p) = LIVE.remove(c as usize) else {
         return; // freed by another thread in between
@@ -186,33 +186,34 @@ pub fn c_str<'a>(p: *const c_char, what: &str) -> Result<&'a CStr, String> {
 /// The model a library holding `all` instantiates: the one whose name is the library's file name
 /// (`binaries/<platform>/<Model>.<ext>`) if there is one, which must then have the requested GUID;
 /// else the one with the requested GUID.
-fn find_model(all: &'static [ModelEntry], requested: &str) -> Result<&'static ModelEntry, String> {
+/// (`token`: the name of the argument that carries the GUID, for the messages)
+fn find_model(all: &'static [ModelEntry], requested: &str, token: &str) -> Result<&'static ModelEntry, String> {
     if let Some(expected) = own_library_stem().and_then(|stem| all.iter().find(|e| e.info.name == stem)) {
         let want = guid(expected);
         return if requested == want.as_str() {
             Ok(expected)
         } else {
-            Err(format!("fmuGUID {requested} does not match {}'s GUID {want} (modelDescription.xml and binary are from different builds)", expected.info.name))
+            Err(format!("{token} {requested} does not match {}'s GUID {want} (modelDescription.xml and binary are from different builds)", expected.info.name))
         };
     }
     all.iter()
         .find(|e| guid(e).as_str() == requested)
-        .ok_or_else(|| format!("fmuGUID {requested} matches no model in this binary"))
+        .ok_or_else(|| format!("{token} {requested} matches no model in this binary"))
 }
 
-/// What an `fmi2Instantiate` / `fmi3Instantiate*` call asks for, in the version's own words.
+/// What an instantiate call of a room asks for, in the room's own words.
 pub struct Request<'a> {
-    /// The C function, for the log (`fmi2Instantiate`, `fmi3InstantiateCoSimulation`, ...).
+    /// The C function, for the log.
     pub func: &'static str,
     pub models: &'static [ModelEntry],
     pub instance_name: *const c_char,
+    /// The GUID the master expects (under the dialect's `token_argument` name).
     pub token: *const c_char,
-    /// The token argument's name in this version (`fmuGUID`, `instantiationToken`).
-    pub token_name: &'static str,
     pub logger: Logger,
     pub env: *mut c_void,
     pub logging_on: bool,
-    pub fmi3: bool,
+    /// The room's interface: the instance serves it alone.
+    pub dialect: &'static Dialect,
     pub model_exchange: bool,
     /// The version's own argument checks, run after the instance name is checked.
     pub check_arguments: &'a dyn Fn() -> Result<(), String>,
@@ -229,19 +230,20 @@ pub fn instantiate(req: Request) -> Handle {
             return Err("instanceName is empty".into());
         }
         (req.check_arguments)()?;
-        let requested = c_str(req.token, req.token_name)?.to_string_lossy();
-        let entry = find_model(req.models, &requested).map_err(|e| e.replace("fmuGUID", req.token_name))?;
+        let token = req.dialect.token_argument;
+        let requested = c_str(req.token, token)?.to_string_lossy();
+        let entry = find_model(req.models, &requested, token)?;
         if let Some(why) = (req.refuse_model)(entry) {
             return Err(why);
         }
         let mut inst = Box::new(Instance::new(
             name.to_owned(),
             entry,
+            req.dialect,
             req.logger,
             req.env,
             req.logging_on,
         ));
-        inst.fmi3 = req.fmi3;
         inst.model_exchange = req.model_exchange;
         inst.trace(|| {
             format!(
@@ -266,8 +268,8 @@ pub fn instantiate(req: Request) -> Handle {
 pub fn log_without_instance(logger: Logger, env: *mut c_void, instance_name: *const c_char, func: &str, message: &str) {
     match logger {
         Logger::None => {}
-        Logger::Fmi2(log) => {
-            // the FMI 2.0 logger takes a printf format: escape '%'
+        Logger::Printf(log) => {
+            // this logger takes a printf format: escape '%'
             let text =
                 CString::new(format!("{func}: {message}").replace('%', "%%").replace('\0', "")).unwrap_or_default();
             let name = if instance_name.is_null() {
@@ -286,7 +288,7 @@ pub fn log_without_instance(logger: Logger, env: *mut c_void, instance_name: *co
                 )
             };
         }
-        Logger::Fmi3(log) => {
+        Logger::Text(log) => {
             let text = CString::new(format!("{func}: {message}").replace('\0', "")).unwrap_or_default();
             // SAFETY: master-provided callback with valid NUL-terminated strings.
             unsafe { log(env, Status::Error as c_int, c"logStatusError".as_ptr(), text.as_ptr()) };
@@ -295,10 +297,10 @@ pub fn log_without_instance(logger: Logger, env: *mut c_void, instance_name: *co
 }
 
 /// The `#[no_mangle] extern "C"` wrappers of [`export_fmus!`](crate::export_fmus), one table line per C
-/// function (`c2::fmi2GetReal(c: Component, vr: *const u32, n: usize, v: *mut f64) -> c_int;`): each
+/// function (`module::Name(c: Handle, vr: *const u32, n: usize, v: *mut f64) -> c_int;`): each
 /// wrapper has the standard name and signature and only forwards its arguments to the function of the
-/// same name in the module given, where the code is. Shared by `__export_fmi2!`, `__export_fmi3!` and
-/// `__export_fmi3_values!`, expanded in the crate that links the library. Not meant to be used on its own.
+/// same name in the module given, where the code is. Shared by the export macros of both rooms,
+/// expanded in the crate that links the library. Not meant to be used on its own.
 #[doc(hidden)]
 #[macro_export]
 macro_rules! __fmi_forward {

@@ -1,4 +1,4 @@
-//! Where this shared library lives on disk, so `fmi2Instantiate` can tell which model a
+//! Where this shared library lives on disk, so an instantiate call can tell which model a
 //! `binaries/<platform>/<Model>.<ext>` file is for and name it in a GUID error. Found from the address
 //! of one of the library's own functions: `dladdr` on Unix, `GetModuleHandleExW` + `GetModuleFileNameW`
 //! on Windows (declared here rather than through a bindings crate).
@@ -29,7 +29,7 @@ fn own_library_path() -> Option<std::path::PathBuf> {
     Some(std::path::PathBuf::from(path))
 }
 
-/// Full path of this DLL (Windows): the module that contains `fmi2Instantiate`, then its file name.
+/// Full path of this DLL (Windows): the module that contains this function, then its file name.
 #[cfg(windows)]
 fn own_library_path() -> Option<std::path::PathBuf> {
     use std::os::windows::ffi::OsStringExt;

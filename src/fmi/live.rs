@@ -1,4 +1,4 @@
-//! The handles handed to the master (`fmi2Component` / `fmi3Instance`, `fmi2FMUstate` / `fmi3FMUState`)
+//! The handles handed to the master (instances and FMU states, in either interface)
 //! are tokens, never addresses, and no token is ever handed out twice while the library is loaded.
 //!
 //! Why not addresses: a check of a handle against the set of live addresses refuses a freed object only

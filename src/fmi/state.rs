@@ -1,8 +1,8 @@
-//! FMU state snapshots (`fmi2GetFMUstate` & co.) and their byte format.
+//! FMU state snapshots (the bodies of both rooms' FMU-state calls) and their byte format.
 //!
 //! Every snapshot handed to the master is recorded in a process-wide table under a token that is never
 //! handed out twice (`live.rs` says why not its address: a freed state's address goes to the next one),
-//! with its owning instance, so a foreign, freed or corrupted `fmi2FMUstate` handle is refused with an
+//! with its owning instance, so a foreign, freed or corrupted FMU-state handle is refused with an
 //! error, also after its memory went to a new state; the master never holds an address of ours. Every
 //! read or write of a snapshot happens while that table's lock is held, so instances on different
 //! threads never touch a snapshot at the same time (FMI allows independent instances on independent
@@ -16,32 +16,34 @@ use std::sync::{Mutex, MutexGuard};
 
 use serde::{Deserialize, Serialize};
 
-use super::instance::{CallResult, Fail, Instance, Run};
+use super::instance::{CallResult, Fail, Instance, Reason, Run};
 use super::live::{BuildAddrHasher, Serials, KIND_STATE};
-use super::types::FsmState;
+use super::types::{Dialect, FsmState};
 use crate::model::DynModel;
 
 const MAGIC: &[u8; 8] = b"SCFMUST\0";
-// 2: the run carries the time of the last event (Model Exchange); 3: the FMI version of the instance
-const FORMAT_VERSION: u32 = 3;
+// 2: the run carries the time of the last event (Model Exchange); 3: the FMI version of the instance;
+// 4: the states of the version-neutral state machine, the interface recorded by its name
+const FORMAT_VERSION: u32 = 4;
 const HEADER: usize = 16;
 const TRAILER: usize = 4;
 
 pub struct Snapshot {
     pub model_name: &'static str,
-    /// Taken by an FMI 3.0 instance (restored only into one: a state belongs to the interface version
-    /// that made it, see `docs/hardening.md`).
-    pub fmi3: bool,
+    /// The interface of the instance that took it (restored only into an instance of the same: a state
+    /// belongs to the interface version that made it, see `docs/hardening.md`).
+    pub dialect: &'static Dialect,
     pub run: Run,
     pub model: Box<dyn DynModel>,
-    /// Bytes computed by `fmi2SerializedFMUstateSize`, reused by `fmi2SerializeFMUstate`.
+    /// Bytes computed by the serialized-size call, reused by the serialize call that follows.
     pub serialized: Option<Vec<u8>>,
 }
 
 #[derive(Serialize, Deserialize)]
 struct Payload {
     model_name: String,
-    fmi3: bool,
+    /// the `version` of the dialect of the instance that took it
+    interface: String,
     guid: String,
     run: Run,
     model: Vec<u8>,
@@ -70,26 +72,22 @@ fn release_if_empty(table: &mut Table) {
     }
 }
 
-/// A state taken through one FMI version is refused by the other version's calls.
-fn check_version(state_fmi3: bool, inst_fmi3: bool, what: &str) -> CallResult {
-    if state_fmi3 == inst_fmi3 {
+/// A state taken through one interface is refused by the other interface's calls.
+fn check_version(taken_by: &str, inst: &Instance, what: &'static str) -> CallResult {
+    if taken_by == inst.dialect.version {
         return Ok(());
     }
-    let v = |fmi3: bool| if fmi3 { "FMI 3.0" } else { "FMI 2.0" };
-    Err(Fail::error(format!(
-        "{what} was taken by an {} instance; this instance runs {} (a state is restored only through the interface version that took it)",
-        v(state_fmi3),
-        v(inst_fmi3)
-    )))
+    Err(Fail::error(Reason::OtherInterface {
+        what,
+        taken_by: taken_by.to_string(),
+    }))
 }
 
 /// A state taken in a Model Exchange mode is refused by a Co-Simulation instance and the reverse (at
 /// restore and already at deserialize, so that an accepted serialized state can always be set).
 fn check_kind(run: &Run, inst: &Instance) -> CallResult {
     let me_state = matches!(run.fsm, FsmState::EventMode | FsmState::ContinuousTimeMode);
-    if (me_state && !inst.model_exchange)
-        || (inst.model_exchange && matches!(run.fsm, FsmState::StepComplete | FsmState::StepFailed))
-    {
+    if (me_state && !inst.model_exchange) || (inst.model_exchange && run.fsm == FsmState::StepMode) {
         let kind = |me: bool| if me { "Model Exchange" } else { "Co-Simulation" };
         return Err(Fail::error(format!(
             "FMU state was taken from a {} instance; this instance runs {}",
@@ -104,7 +102,7 @@ impl Snapshot {
     pub fn capture(inst: &Instance) -> Snapshot {
         Snapshot {
             model_name: inst.entry.info.name,
-            fmi3: inst.fmi3,
+            dialect: inst.dialect,
             run: inst.run,
             model: inst.model.clone_box(),
             serialized: None,
@@ -118,7 +116,7 @@ impl Snapshot {
                 self.model_name, inst.entry.info.name
             )));
         }
-        check_version(self.fmi3, inst.fmi3, "FMU state")?;
+        check_version(self.dialect.version, inst, "FMU state")?;
         check_kind(&self.run, inst)?;
         inst.model = self.model.clone_box();
         inst.run = self.run;
@@ -165,7 +163,7 @@ impl Snapshot {
         Ok(())
     }
 
-    /// Frees every snapshot created by the given instance (called by fmi2FreeInstance).
+    /// Frees every snapshot created by the given instance (called when the instance is freed).
     pub fn free_all_of(owner: usize) {
         let mut table = live();
         let mine: Vec<usize> = table
@@ -185,7 +183,7 @@ impl Snapshot {
     pub fn to_bytes(&self, guid: &str) -> CallResult<Vec<u8>> {
         let payload = Payload {
             model_name: self.model_name.to_string(),
-            fmi3: self.fmi3,
+            interface: self.dialect.version.to_string(),
             guid: guid.to_string(),
             run: self.run,
             model: self
@@ -250,7 +248,7 @@ impl Snapshot {
                 p.model_name, inst.entry.info.name
             )));
         }
-        check_version(p.fmi3, inst.fmi3, "serialized state")?;
+        check_version(&p.interface, inst, "serialized state")?;
         if p.guid != guid {
             return Err(Fail::error(format!(
                 "serialized state was written by a different version of {} (GUID {})",
@@ -274,7 +272,7 @@ impl Snapshot {
             .map_err(|e| Fail::error(format!("serialized state is invalid: {e}")))?;
         Ok(Snapshot {
             model_name: inst.entry.info.name,
-            fmi3: p.fmi3,
+            dialect: inst.dialect,
             run: p.run,
             model,
             serialized: None,

@@ -1,6 +1,6 @@
-//! The bodies of the FMU-state C functions, shared by FMI 2.0 (`fmi2/state.rs`) and FMI 3.0
-//! (`fmi3/state.rs`): each C function checks its pointers, then calls one of these inside its own
-//! `call`/`call3` (state machine, panic guard, logging).
+//! The bodies of the FMU-state C functions, shared by both rooms (their `state.rs`): each C function
+//! checks its pointers, then calls one of these inside its room's call wrapper (state machine, panic
+//! guard, logging).
 
 use std::ffi::c_void;
 
@@ -22,17 +22,17 @@ fn store(snap: Snapshot, slot: &mut *mut c_void, owner: usize) -> CallResult {
     }
 }
 
-/// `fmi2GetFMUstate` / `fmi3GetFMUState`.
+/// Get FMU state.
 pub(crate) fn get(inst: &Instance, slot: &mut *mut c_void, owner: usize) -> CallResult {
     store(Snapshot::capture(inst), slot, owner)
 }
 
-/// `fmi2SetFMUstate` / `fmi3SetFMUState`.
+/// Set FMU state.
 pub(crate) fn set(inst: &mut Instance, state: *mut c_void) -> CallResult {
     Snapshot::with_handle(state as usize, |snap| snap.restore_into(inst))
 }
 
-/// `fmi2FreeFMUstate` / `fmi3FreeFMUState`: freeing NULL is a no-op.
+/// Free FMU state: freeing NULL is a no-op.
 pub(crate) fn free(slot: &mut *mut c_void) -> CallResult {
     if slot.is_null() {
         return Ok(());
@@ -42,7 +42,7 @@ pub(crate) fn free(slot: &mut *mut c_void) -> CallResult {
     Ok(())
 }
 
-/// `fmi2SerializedFMUstateSize` / `fmi3SerializedFMUStateSize`: serializes once and keeps the bytes
+/// Serialized FMU state size: serializes once and keeps the bytes
 /// for the serialize call that follows.
 pub(crate) fn serialized_size(inst: &Instance, state: *mut c_void, out: &mut usize) -> CallResult {
     Snapshot::with_handle(state as usize, |snap| {
@@ -53,7 +53,7 @@ pub(crate) fn serialized_size(inst: &Instance, state: *mut c_void, out: &mut usi
     })
 }
 
-/// `fmi2SerializeFMUstate` / `fmi3SerializeFMUState` into the master's buffer of `size` bytes, which
+/// Serialize FMU state into the master's buffer of `size` bytes, which
 /// `buffer` borrows once the size is known to match (`size_function` names the size call in the message).
 pub(crate) fn serialize<'a>(
     inst: &Instance,
@@ -78,7 +78,7 @@ pub(crate) fn serialize<'a>(
     })
 }
 
-/// `fmi2DeSerializeFMUstate` / `fmi3DeserializeFMUState`: a validated state into `*slot`.
+/// Deserialize FMU state: a validated state into `*slot`.
 pub(crate) fn deserialize(inst: &Instance, bytes: &[u8], slot: &mut *mut c_void, owner: usize) -> CallResult {
     let snap = Snapshot::from_bytes(bytes, inst, &guid(inst.entry))?;
     store(snap, slot, owner)

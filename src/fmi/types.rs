@@ -1,11 +1,12 @@
-//! The C-level vocabulary both FMI versions share: the status codes, the two logger callback types,
-//! the states of the state machine (one enum for FMI 2.0 and 3.0, Co-Simulation and Model Exchange)
-//! with their bit masks, and the log categories every model description declares. Nothing here calls
-//! anything: every other file of the FMI layer may use it.
+//! The C-level vocabulary both interfaces share: the status codes, the two shapes of logger callback,
+//! the states of the one state machine every instance runs (Co-Simulation and Model Exchange alike)
+//! with their bit masks, the log categories every model description declares, and [`Dialect`]: how the
+//! room that created an instance names things. Nothing here calls anything: every other file of the
+//! FMI layer may use it.
 
 use std::ffi::{c_char, c_int, c_void};
 
-/// `fmi2Status`.
+/// The status a C function returns (the same codes in both versions; `Pending` is never returned).
 #[repr(i32)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Status {
@@ -17,8 +18,9 @@ pub enum Status {
     Pending = 5,
 }
 
-/// `fmi2CallbackLogger`: a C-variadic function; we always pass a fully formatted message.
-pub type LoggerFn = unsafe extern "C" fn(
+/// A logger that takes the instance name and a printf format: a C-variadic function; we always pass a
+/// fully formatted message (with '%' escaped).
+pub type PrintfLogFn = unsafe extern "C" fn(
     env: *mut c_void,
     instance_name: *const c_char,
     status: c_int,
@@ -27,11 +29,11 @@ pub type LoggerFn = unsafe extern "C" fn(
     ...
 );
 
-/// `fmi3LogMessageCallback`: not variadic, the message is plain text (not a printf format).
-pub type Log3Fn =
+/// A logger that takes plain text and no instance name: not variadic, the message is not a format.
+pub type TextLogFn =
     unsafe extern "C" fn(env: *mut c_void, status: c_int, category: *const c_char, message: *const c_char);
 
-/// Log categories declared in every modelDescription and accepted by `fmi2SetDebugLogging`.
+/// Log categories declared in every modelDescription and accepted by the debug-logging call.
 pub const LOG_CATEGORIES: &[(&str, &str)] = &[
     ("logStatusWarning", "Warnings (always forwarded to the logger)"),
     ("logStatusError", "Errors (always forwarded to the logger)"),
@@ -44,21 +46,26 @@ pub const LOG_CATEGORIES: &[(&str, &str)] = &[
     ("logAll", "All of the above"),
 ];
 
-/// States of the FMI 2.0 Co-Simulation state machine (section 4.2.4). `StepInProgress` and
-/// `StepCanceled` cannot be reached: `fmi2DoStep` never returns `fmi2Pending`.
+/// Where an instance is in its life. These are the states both standards share; each room says which
+/// of its functions may be called in which of them (its masks) and names them in its own words.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum FsmState {
+    /// Created; the experiment and the parameters may be set.
     Instantiated,
+    /// Parameters and start values are being set; outputs may be read.
     InitializationMode,
-    StepComplete,
-    StepFailed,
-    StepCanceled,
+    /// Co-Simulation, between two steps: the instance steps on the master's request.
+    StepMode,
+    /// Stopped normally; values may still be read.
     Terminated,
+    /// A call failed so that the instance cannot go on (a failed step, a non-finite output); a room
+    /// whose standard has no such state treats it as Terminated.
     Error,
+    /// A panic was caught: only freeing the instance is honoured.
     Fatal,
-    /// Model Exchange (FMI 2.0 section 3.2.3): event mode (after initialization and at events).
+    /// Model Exchange: after initialization and at events, where discrete states are updated.
     EventMode,
-    /// Model Exchange: continuous-time mode (the importer's solver integrates).
+    /// Model Exchange: the importer's solver integrates the continuous states.
     ContinuousTimeMode,
 }
 
@@ -68,8 +75,7 @@ impl FsmState {
     }
 }
 
-/// The set of states (as bits) in which a function may be called: the masks of `fmi2::common::mask`,
-/// `fmi3::common::mask3` and `fmi3::common::mask3me`.
+/// The set of states (as bits) in which a function may be called: the masks the rooms declare.
 pub const fn mask_of(states: &[FsmState]) -> u16 {
     let mut bits = 0;
     let mut i = 0;
@@ -78,4 +84,34 @@ pub const fn mask_of(states: &[FsmState]) -> u16 {
         i += 1;
     }
     bits
+}
+
+/// The arrays of the Model Exchange calls whose names differ between the interfaces.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Arg {
+    /// the continuous states
+    States,
+    /// their nominal values
+    Nominals,
+    /// the state derivatives
+    Derivatives,
+}
+
+/// The interface an instance serves, as the room that created it describes it: the one value through
+/// which the shared code knows the interface. Each room has one static `Dialect`; an instance holds a
+/// reference to it, the handle lookup compares it, an FMU state records its `version`, and every
+/// failure the shared code reports is worded with its names (`fail::Reason::render`).
+pub struct Dialect {
+    /// The interface's name in messages (the standard and its version), also recorded in a serialized FMU state.
+    pub version: &'static str,
+    /// The instantiate argument that carries the model's GUID.
+    pub token_argument: &'static str,
+    /// The call that sets start time, stop time and tolerance.
+    pub setup_experiment: &'static str,
+    /// The Model Exchange call that sets the continuous states.
+    pub set_continuous_states: &'static str,
+    /// The name of an array argument of the Model Exchange calls (with its `[]`).
+    pub argument: fn(Arg) -> &'static str,
+    /// The standard's name of a state.
+    pub state_name: fn(FsmState) -> &'static str,
 }

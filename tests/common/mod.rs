@@ -5,8 +5,8 @@
 use std::ffi::{c_char, c_int, c_void, CStr, CString};
 use std::sync::Mutex;
 
+use spacecraft_fmus::fmi::fmi2::LoggerFn;
 use spacecraft_fmus::fmi::fmi2::*;
-use spacecraft_fmus::fmi::types::LoggerFn;
 use spacecraft_fmus::model::guid::guid;
 use spacecraft_fmus::registry;
 

@@ -1,6 +1,7 @@
 //! FMI 2.0, the part every FMI 2.0 function shares (Co-Simulation and Model Exchange alike): the C
-//! types of `fmi2Functions.h` this layer needs, the state table (`mask`), [`call`] (instance lookup,
-//! state check, panic guard, logging), `fmi2Instantiate` and the life-cycle and value functions.
+//! types of `fmi2Functions.h` this layer needs, the room's [`FMI2`] dialect (its names of the shared
+//! states, arguments and calls), the state table (`mask`), [`call`] (instance lookup, state check, panic
+//! guard, logging), `fmi2Instantiate` and the life-cycle and value functions.
 //! Each C function checks its pointers, then runs inside [`call`]; every failure becomes a status plus
 //! a logger message naming the function and the reason.
 //!
@@ -13,12 +14,43 @@
 use std::ffi::{c_char, c_int, c_void, CStr};
 
 use crate::fmi::boundary::{self, guarded, instance_of, slice, slice_mut, Request};
-use crate::fmi::instance::{CallResult, Fail, Instance, Logger};
-use crate::fmi::types::{FsmState, LoggerFn, Status};
+use crate::fmi::instance::{CallResult, Fail, Instance, Logger, Reason};
+use crate::fmi::types::{Arg, Dialect, FsmState, Status};
 use crate::model::{ModelEntry, Value, VarKind};
 
 /// `fmi2Component`.
 pub type Component = *mut c_void;
+
+/// `fmi2CallbackLogger`.
+pub use crate::fmi::types::PrintfLogFn as LoggerFn;
+
+/// FMI 2.0 in the words of the shared code: what its instances are called and how their failures read.
+pub static FMI2: Dialect = Dialect {
+    version: "FMI 2.0",
+    token_argument: "fmuGUID",
+    setup_experiment: "fmi2SetupExperiment",
+    set_continuous_states: "fmi2SetContinuousStates",
+    argument: |a| match a {
+        Arg::States => "x[]",
+        Arg::Nominals => "x_nominal[]",
+        Arg::Derivatives => "derivatives[]",
+    },
+    state_name,
+};
+
+/// FMI 2.0 name of a state (Co-Simulation section 4.2.4, Model Exchange section 3.2.3).
+pub fn state_name(s: FsmState) -> &'static str {
+    match s {
+        FsmState::Instantiated => "Instantiated",
+        FsmState::InitializationMode => "InitializationMode",
+        FsmState::StepMode => "StepComplete",
+        FsmState::Terminated => "Terminated",
+        FsmState::Error => "Error",
+        FsmState::Fatal => "Fatal",
+        FsmState::EventMode => "EventMode",
+        FsmState::ContinuousTimeMode => "ContinuousTimeMode",
+    }
+}
 
 const TYPES_PLATFORM: &CStr = c"default";
 const VERSION: &CStr = c"2.0";
@@ -33,16 +65,16 @@ pub struct CallbackFunctions {
     pub component_environment: *mut c_void,
 }
 
-/// Sets of states in which a function may be called (FMI 2.0.4, CS state table).
+/// Sets of states in which a function may be called (FMI 2.0.4, CS state table; `StepMode` is
+/// StepComplete: StepFailed, StepCanceled and StepInProgress are never entered, as `fmi2DoStep` never
+/// returns fmi2Discard or fmi2Pending).
 pub mod mask {
     use crate::fmi::types::mask_of as m;
     use crate::fmi::types::FsmState::*;
     pub const SET_DEBUG_LOGGING: u16 = m(&[
         Instantiated,
         InitializationMode,
-        StepComplete,
-        StepFailed,
-        StepCanceled,
+        StepMode,
         Terminated,
         Error,
         EventMode,
@@ -52,13 +84,11 @@ pub mod mask {
     pub const SETUP_EXPERIMENT: u16 = m(&[Instantiated]);
     pub const ENTER_INITIALIZATION_MODE: u16 = m(&[Instantiated]);
     pub const EXIT_INITIALIZATION_MODE: u16 = m(&[InitializationMode]);
-    pub const TERMINATE: u16 = m(&[StepComplete, StepFailed, EventMode, ContinuousTimeMode]);
+    pub const TERMINATE: u16 = m(&[StepMode, EventMode, ContinuousTimeMode]);
     pub const RESET: u16 = FREE_INSTANCE;
     pub const GET: u16 = m(&[
         InitializationMode,
-        StepComplete,
-        StepFailed,
-        StepCanceled,
+        StepMode,
         Terminated,
         Error,
         EventMode,
@@ -67,17 +97,17 @@ pub mod mask {
     pub const SET: u16 = m(&[
         Instantiated,
         InitializationMode,
-        StepComplete,
+        StepMode,
         EventMode,
         ContinuousTimeMode,
     ]);
     pub const FMU_STATE: u16 = FREE_INSTANCE;
     pub const DIRECTIONAL_DERIVATIVE: u16 = GET;
-    pub const SET_INPUT_DERIVATIVES: u16 = m(&[Instantiated, InitializationMode, StepComplete]);
-    pub const GET_OUTPUT_DERIVATIVES: u16 = m(&[StepComplete, StepFailed, StepCanceled, Terminated, Error]);
-    pub const DO_STEP: u16 = m(&[StepComplete]);
+    pub const SET_INPUT_DERIVATIVES: u16 = m(&[Instantiated, InitializationMode, StepMode]);
+    pub const GET_OUTPUT_DERIVATIVES: u16 = m(&[StepMode, Terminated, Error]);
+    pub const DO_STEP: u16 = m(&[StepMode]);
     pub const CANCEL_STEP: u16 = 0; // StepInProgress only, which this FMU never enters
-    pub const GET_STATUS: u16 = m(&[StepComplete, StepFailed, Terminated]);
+    pub const GET_STATUS: u16 = m(&[StepMode, Terminated]);
     // Model Exchange (FMI 2.0.4, ME state table)
     pub const SET_TIME: u16 = m(&[EventMode, ContinuousTimeMode]);
     pub const SET_CONTINUOUS_STATES: u16 = m(&[ContinuousTimeMode]);
@@ -100,7 +130,7 @@ pub mod status_kind {
 /// Runs an instance call: state check, panic guard, logging of failures.
 #[inline(always)]
 pub(crate) fn call(c: Component, func: &str, allowed: u16, f: impl FnOnce(&mut Instance) -> CallResult) -> c_int {
-    let Some(inst) = instance_of(c, false) else {
+    let Some(inst) = instance_of(c, &FMI2) else {
         return Status::Error as c_int;
     };
     if allowed & inst.run.fsm.bit() == 0 {
@@ -113,7 +143,7 @@ pub(crate) fn call(c: Component, func: &str, allowed: u16, f: impl FnOnce(&mut I
             func,
             &Fail {
                 status,
-                reason: format!("not allowed in state {:?} (illegal call sequence)", inst.run.fsm),
+                reason: Reason::IllegalCall(inst.run.fsm),
             },
         );
         return status as c_int;
@@ -130,7 +160,7 @@ pub(crate) fn call(c: Component, func: &str, allowed: u16, f: impl FnOnce(&mut I
                 func,
                 &Fail {
                     status: Status::Fatal,
-                    reason: format!("internal error (panic): {panic}"),
+                    reason: format!("internal error (panic): {panic}").into(),
                 },
             );
             Status::Fatal as c_int
@@ -172,11 +202,10 @@ pub fn fmi2Instantiate(
         models,
         instance_name,
         token: fmu_guid,
-        token_name: "fmuGUID",
-        logger: functions.logger.map_or(Logger::None, Logger::Fmi2),
+        logger: functions.logger.map_or(Logger::None, Logger::Printf),
         env: functions.component_environment,
         logging_on: logging_on != 0,
-        fmi3: false,
+        dialect: &FMI2,
         model_exchange: fmu_type == 0,
         check_arguments: &|| match fmu_type {
             0 | 1 => Ok(()),
@@ -196,7 +225,7 @@ pub fn fmi2Instantiate(
 }
 
 pub extern "C" fn fmi2FreeInstance(c: Component) {
-    boundary::free_instance(c, false)
+    boundary::free_instance(c, &FMI2)
 }
 
 pub extern "C" fn fmi2SetDebugLogging(
@@ -367,67 +396,4 @@ pub extern "C" fn fmi2SetString(c: Component, vr: *const u32, n: usize, value: *
             ))),
         }
     })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use std::ffi::CString;
-    use std::sync::Mutex as StdMutex;
-
-    type Log = StdMutex<Vec<(c_int, String)>>;
-
-    unsafe extern "C" fn record(
-        env: *mut c_void,
-        _n: *const c_char,
-        status: c_int,
-        _c: *const c_char,
-        msg: *const c_char,
-    ) {
-        let log = unsafe { &*(env as *const Log) };
-        log.lock()
-            .unwrap()
-            .push((status, unsafe { CStr::from_ptr(msg) }.to_string_lossy().into_owned()));
-    }
-
-    /// A panic inside a call becomes fmi2Fatal with a logged message, and the instance refuses
-    /// everything afterwards except fmi2FreeInstance.
-    #[test]
-    fn panic_is_caught_logged_and_fatal() {
-        let log: Box<Log> = Box::new(StdMutex::new(vec![]));
-        // SAFETY: non-variadic callee with the fixed arguments of fmi2CallbackLogger (see tests/common).
-        let logger: LoggerFn = unsafe { std::mem::transmute(record as unsafe extern "C" fn(_, _, _, _, _)) };
-        let cb = CallbackFunctions {
-            logger: Some(logger),
-            allocate_memory: None,
-            free_memory: None,
-            step_finished: None,
-            component_environment: &*log as *const Log as *mut c_void,
-        };
-        let entry = crate::registry::find("AttitudeMetrics").unwrap();
-        let g = CString::new(crate::model::guid::guid(entry).as_str()).unwrap();
-        let c = fmi2Instantiate(
-            crate::registry::ALL,
-            c"p".as_ptr(),
-            1,
-            g.as_ptr(),
-            std::ptr::null(),
-            &cb,
-            0,
-            0,
-        );
-        assert!(!c.is_null());
-        let st = call(c, "fmi2Probe", mask::SETUP_EXPERIMENT, |_| {
-            panic!("deliberate test panic")
-        });
-        assert_eq!(st, Status::Fatal as c_int);
-        let (status, msg) = log.lock().unwrap().last().cloned().unwrap();
-        assert_eq!(status, Status::Fatal as c_int);
-        assert!(
-            msg.contains("fmi2Probe") && msg.contains("deliberate test panic"),
-            "{msg}"
-        );
-        assert_eq!(fmi2EnterInitializationMode(c), Status::Fatal as c_int);
-        fmi2FreeInstance(c);
-    }
 }

@@ -6,7 +6,7 @@ use std::ffi::c_int;
 
 use super::common::{call, mask, Component};
 use crate::fmi::boundary::{out_ptr, slice, slice_mut};
-use crate::fmi::instance::{CallResult, Fail, Instance};
+use crate::fmi::instance::{CallResult, Fail, Instance, Reason};
 use crate::fmi::types::FsmState;
 
 /// `fmi2GetDerivatives` (FMI 2.0 ME state table): event, continuous-time, terminated and error state,
@@ -32,12 +32,11 @@ pub struct EventInfo2 {
 #[inline(always)]
 fn me_call(c: Component, func: &str, allowed: u16, f: impl FnOnce(&mut Instance) -> CallResult) -> c_int {
     call(c, func, mask::SET_DEBUG_LOGGING, |inst| {
-        inst.require_model_exchange()?;
+        if !inst.model_exchange {
+            return Err(Fail::error("this instance was instantiated for Co-Simulation (fmuType fmi2CoSimulation); Model Exchange functions are not available"));
+        }
         if allowed & inst.run.fsm.bit() == 0 {
-            return Err(Fail::error(format!(
-                "not allowed in state {:?} (illegal call sequence)",
-                inst.run.fsm
-            )));
+            return Err(Fail::error(Reason::IllegalCall(inst.run.fsm)));
         }
         f(inst)
     })

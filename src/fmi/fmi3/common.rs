@@ -4,8 +4,9 @@
 //! 3.0's error rule (a function that returns `fmi3Error` puts the instance into Terminated, FMI 3.0
 //! section 2.3.1), and the life-cycle functions of both interfaces.
 //!
-//! States are mapped onto [`FsmState`]: Instantiated, InitializationMode, Step Mode (`StepComplete`),
-//! Event Mode and Continuous-Time Mode (Model Exchange instances only), Terminated and Fatal.
+//! The shared states are FMI 3.0's own: Instantiated, Initialization Mode, Step Mode, Event Mode and
+//! Continuous-Time Mode (Model Exchange instances only), Terminated and Fatal; the shared Error state is
+//! Terminated here. [`FMI3`] names them, and the arguments and calls the shared failures mention.
 //! Configuration, Intermediate Update and Reconfiguration Mode are never entered (no structural
 //! parameters, no intermediate update), nor is Event Mode by a Co-Simulation instance
 //! (`hasEventMode = false`). `fmi3Boolean` arguments are read as bytes (any non-zero byte is true), so
@@ -20,12 +21,29 @@
 use std::ffi::{c_char, c_int, c_void, CStr};
 
 use crate::fmi::boundary::{self, c_str, guarded, instance_of, slice, Request};
-use crate::fmi::instance::{CallResult, Fail, Instance, Logger};
-use crate::fmi::types::{FsmState, Log3Fn, Status};
+use crate::fmi::instance::{CallResult, Fail, Instance, Logger, Reason};
+use crate::fmi::types::{Arg, Dialect, FsmState, Status};
 use crate::model::ModelEntry;
 
 /// `fmi3Instance`.
 pub type Instance3 = *mut c_void;
+
+/// `fmi3LogMessageCallback`.
+pub use crate::fmi::types::TextLogFn as Log3Fn;
+
+/// FMI 3.0 in the words of the shared code: what its instances are called and how their failures read.
+pub static FMI3: Dialect = Dialect {
+    version: "FMI 3.0",
+    token_argument: "instantiationToken",
+    setup_experiment: "fmi3EnterInitializationMode",
+    set_continuous_states: "fmi3SetContinuousStates",
+    argument: |a| match a {
+        Arg::States => "continuousStates[]",
+        Arg::Nominals => "nominals[]",
+        Arg::Derivatives => "derivatives[]",
+    },
+    state_name,
+};
 
 /// Value reference of the independent variable `time` in every FMI 3.0 model description. Declared
 /// variables may not use it (a `VarIndex` would need 2^31 slots anyway). `i32::MAX` rather than
@@ -43,37 +61,26 @@ pub mod mask3 {
     pub const ANY: u16 = m(&[
         Instantiated,
         InitializationMode,
-        StepComplete,
+        StepMode,
         Terminated,
         EventMode,
         ContinuousTimeMode,
     ]);
     pub const ENTER_INITIALIZATION_MODE: u16 = m(&[Instantiated]);
     pub const EXIT_INITIALIZATION_MODE: u16 = m(&[InitializationMode]);
-    pub const TERMINATE: u16 = m(&[StepComplete, EventMode, ContinuousTimeMode]);
-    pub const GET: u16 = m(&[
-        InitializationMode,
-        StepComplete,
-        Terminated,
-        EventMode,
-        ContinuousTimeMode,
-    ]);
+    pub const TERMINATE: u16 = m(&[StepMode, EventMode, ContinuousTimeMode]);
+    pub const GET: u16 = m(&[InitializationMode, StepMode, Terminated, EventMode, ContinuousTimeMode]);
     pub const SET: u16 = m(&[
         Instantiated,
         InitializationMode,
-        StepComplete,
+        StepMode,
         EventMode,
         ContinuousTimeMode,
     ]);
-    pub const DIRECTIONAL_DERIVATIVE: u16 = m(&[
-        InitializationMode,
-        StepComplete,
-        Terminated,
-        EventMode,
-        ContinuousTimeMode,
-    ]);
-    pub const DO_STEP: u16 = m(&[StepComplete]);
-    pub const OUTPUT_DERIVATIVES: u16 = m(&[StepComplete, Terminated]);
+    pub const DIRECTIONAL_DERIVATIVE: u16 =
+        m(&[InitializationMode, StepMode, Terminated, EventMode, ContinuousTimeMode]);
+    pub const DO_STEP: u16 = m(&[StepMode]);
+    pub const OUTPUT_DERIVATIVES: u16 = m(&[StepMode, Terminated]);
 }
 
 /// Sets of states in which an FMI 3.0 Model Exchange function may be called.
@@ -103,12 +110,12 @@ pub mod mask3me {
 /// instance to Terminated, a panic to Fatal.
 #[inline(always)]
 pub fn call3(c: Instance3, func: &str, allowed: u16, f: impl FnOnce(&mut Instance) -> CallResult) -> c_int {
-    let Some(inst) = instance_of(c, true) else {
+    let Some(inst) = instance_of(c, &FMI3) else {
         return Status::Error as c_int;
     };
     if inst.run.fsm == FsmState::Error {
-        // FMI 2.0's error state (a step or output failure inside the shared Instance code, or an FMU
-        // state serialized by an FMI 2.0 instance) is FMI 3.0's Terminated
+        // the shared Error state (a step or output failure inside the shared Instance code) is
+        // FMI 3.0's Terminated
         inst.run.fsm = FsmState::Terminated;
     }
     if allowed & inst.run.fsm.bit() != 0 {
@@ -121,7 +128,7 @@ pub fn call3(c: Instance3, func: &str, allowed: u16, f: impl FnOnce(&mut Instanc
                 func,
                 Fail {
                     status: Status::Fatal,
-                    reason: format!("internal error (panic): {panic}"),
+                    reason: format!("internal error (panic): {panic}").into(),
                 },
             ),
         };
@@ -131,15 +138,12 @@ pub fn call3(c: Instance3, func: &str, allowed: u16, f: impl FnOnce(&mut Instanc
     } else {
         Status::Error
     };
-    let reason = format!(
-        "not allowed in state {} (illegal call sequence)",
-        state_name(inst.run.fsm)
-    );
+    let reason = Reason::IllegalCall(inst.run.fsm);
     failed3(inst, func, Fail { status, reason })
 }
 
 /// A failed FMI 3.0 call: `fmi3Error` moves the instance to Terminated, `fmi3Fatal` to Fatal; the reason is
-/// logged in FMI 3.0 terms; returns the status.
+/// logged in FMI 3.0 terms (the instance's dialect is [`FMI3`]); returns the status.
 #[cold]
 #[inline(never)]
 fn failed3(inst: &mut Instance, func: &str, fail: Fail) -> c_int {
@@ -148,17 +152,7 @@ fn failed3(inst: &mut Instance, func: &str, fail: Fail) -> c_int {
         Status::Error => inst.run.fsm = FsmState::Terminated,
         _ => {}
     }
-    let reason = fail
-        .reason
-        .replace("fmi2SetupExperiment", "fmi3EnterInitializationMode")
-        .replace("fmi2SetContinuousStates", "fmi3SetContinuousStates");
-    inst.log_fail(
-        func,
-        &Fail {
-            status: fail.status,
-            reason,
-        },
-    );
+    inst.log_fail(func, &fail);
     fail.status as c_int
 }
 
@@ -167,7 +161,7 @@ pub fn state_name(s: FsmState) -> &'static str {
     match s {
         FsmState::Instantiated => "Instantiated",
         FsmState::InitializationMode => "Initialization Mode",
-        FsmState::StepComplete | FsmState::StepFailed | FsmState::StepCanceled => "Step Mode",
+        FsmState::StepMode => "Step Mode",
         FsmState::Terminated | FsmState::Error => "Terminated",
         FsmState::Fatal => "Fatal",
         FsmState::EventMode => "Event Mode",
@@ -178,7 +172,7 @@ pub fn state_name(s: FsmState) -> &'static str {
 /// An error message through the master's FMI 3.0 logger when there is no instance to log with.
 pub fn log_without_instance3(logger: Option<Log3Fn>, env: *mut c_void, func: &str, message: &str) {
     boundary::log_without_instance(
-        logger.map_or(Logger::None, Logger::Fmi3),
+        logger.map_or(Logger::None, Logger::Text),
         env,
         std::ptr::null(),
         func,
@@ -194,7 +188,7 @@ pub fn refuse(c: Instance3, func: &str, allowed: u16, why: &str) -> c_int {
 /// Whether `c` is a live FMI 3.0 Model Exchange instance (the functions both interfaces share pick their
 /// rules by it; anything else goes the Co-Simulation way, which refuses unknown pointers).
 pub fn is_model_exchange(c: Instance3) -> bool {
-    instance_of(c, true).is_some_and(|inst| inst.model_exchange)
+    instance_of(c, &FMI3).is_some_and(|inst| inst.model_exchange)
 }
 
 /// Refuses a Co-Simulation function on a Model Exchange instance (used inside the CS functions).
@@ -214,7 +208,7 @@ pub extern "C" fn fmi3GetVersion() -> *const c_char {
 }
 
 pub extern "C" fn fmi3FreeInstance(c: Instance3) {
-    boundary::free_instance(c, true)
+    boundary::free_instance(c, &FMI3)
 }
 
 pub extern "C" fn fmi3SetDebugLogging(
@@ -308,11 +302,10 @@ pub fn request3(
         models,
         instance_name,
         token,
-        token_name: "instantiationToken",
-        logger: log_message.map_or(Logger::None, Logger::Fmi3),
+        logger: log_message.map_or(Logger::None, Logger::Text),
         env,
         logging_on: logging_on != 0,
-        fmi3: true,
+        dialect: &FMI3,
         model_exchange: false,
         check_arguments: &|| Ok(()),
         refuse_model: &|_| None,

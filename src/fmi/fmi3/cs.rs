@@ -9,10 +9,9 @@
 
 use std::ffi::{c_char, c_int, c_void};
 
-use super::common::{call3, mask3, refuse, request3, require_co_simulation, state_name, Instance3};
+use super::common::{call3, mask3, refuse, request3, require_co_simulation, Instance3, Log3Fn, FMI3};
 use crate::fmi::boundary::{self, out_ptr, slice, Request};
-use crate::fmi::instance::Fail;
-use crate::fmi::types::Log3Fn;
+use crate::fmi::instance::{Fail, Reason};
 use crate::model::ModelEntry;
 
 /// `fmi3InstantiateCoSimulation` for a library holding `models`: the model is picked by the library's
@@ -55,7 +54,7 @@ pub fn fmi3InstantiateCoSimulation(
                         "requiredIntermediateVariables[]",
                     )
                 }
-                .map_err(|f| f.reason)?;
+                .map_err(|f| f.reason.render(&FMI3))?;
                 return Err(format!("requiredIntermediateVariables {vrs:?}: this FMU provides no intermediate update (providesIntermediateUpdate = false)"));
             }
             Ok(())
@@ -77,10 +76,7 @@ pub extern "C" fn fmi3DoStep(
     call3(c, "fmi3DoStep", mask3::ANY, |inst| {
         require_co_simulation(inst)?;
         if mask3::DO_STEP & inst.run.fsm.bit() == 0 {
-            return Err(Fail::error(format!(
-                "not allowed in state {} (illegal call sequence)",
-                state_name(inst.run.fsm)
-            )));
+            return Err(Fail::error(Reason::IllegalCall(inst.run.fsm)));
         }
         inst.trace(|| format!("fmi3DoStep(currentCommunicationPoint={t}, communicationStepSize={h})"));
         let ev = out_ptr(event_handling_needed, "eventHandlingNeeded")?;

@@ -25,7 +25,7 @@ macro_rules! __export_fmi3 {
             use $crate::fmi::fmi3::unsupported as un3;
             use $crate::fmi::fmi3::values as va3;
             type Inst3 = *mut c_void;
-            type Log3 = Option<$crate::fmi::types::Log3Fn>;
+            type Log3 = Option<$crate::fmi::fmi3::common::Log3Fn>;
             $crate::__fmi_forward! {
                 co3::fmi3GetVersion() -> *const c_char;
                 co3::fmi3SetDebugLogging(c: Inst3, on: u8, n: usize, cats: *const *const c_char) -> c_int;

@@ -20,10 +20,9 @@
 
 use std::ffi::{c_char, c_int, c_void};
 
-use super::common::{call3, is_model_exchange, mask3, mask3me, refuse, request3, state_name, Instance3};
+use super::common::{call3, is_model_exchange, mask3, mask3me, refuse, request3, Instance3, Log3Fn};
 use crate::fmi::boundary::{self, out_ptr, slice, slice_mut, Request};
-use crate::fmi::instance::{CallResult, Fail, Instance};
-use crate::fmi::types::Log3Fn;
+use crate::fmi::instance::{CallResult, Fail, Instance, Reason};
 use crate::model::ModelEntry;
 
 /// Why a Model Exchange function is refused on an instance that is not a Model Exchange instance.
@@ -47,10 +46,7 @@ fn me3(c: Instance3, func: &str, allowed: u16, f: impl FnOnce(&mut Instance) -> 
             return Err(Fail::error(not_me_reason(inst)));
         }
         if allowed & inst.run.fsm.bit() == 0 {
-            return Err(Fail::error(format!(
-                "not allowed in state {} (illegal call sequence)",
-                state_name(inst.run.fsm)
-            )));
+            return Err(Fail::error(Reason::IllegalCall(inst.run.fsm)));
         }
         f(inst)
     })
@@ -169,14 +165,14 @@ pub extern "C" fn fmi3SetTime(c: Instance3, t: f64) -> c_int {
 pub extern "C" fn fmi3SetContinuousStates(c: Instance3, x: *const f64, n: usize) -> c_int {
     me3(c, "fmi3SetContinuousStates", mask3me::CONTINUOUS_TIME_MODE, |inst| {
         let x = unsafe { slice(x, n, "continuousStates[]")? };
-        inst.set_continuous_states(x).map_err(rename_x("continuousStates[]"))
+        inst.set_continuous_states(x)
     })
 }
 
 pub extern "C" fn fmi3GetContinuousStates(c: Instance3, x: *mut f64, n: usize) -> c_int {
     me3(c, "fmi3GetContinuousStates", mask3me::GET_ME_VALUES, |inst| {
         let x = unsafe { slice_mut(x, n, "continuousStates[]")? };
-        inst.get_continuous_states(x).map_err(rename_x("continuousStates[]"))
+        inst.get_continuous_states(x)
     })
 }
 
@@ -190,7 +186,7 @@ pub extern "C" fn fmi3GetContinuousStateDerivatives(c: Instance3, dx: *mut f64, 
 pub extern "C" fn fmi3GetNominalsOfContinuousStates(c: Instance3, x: *mut f64, n: usize) -> c_int {
     me3(c, "fmi3GetNominalsOfContinuousStates", mask3me::GET_ME_VALUES, |inst| {
         let x = unsafe { slice_mut(x, n, "nominals[]")? };
-        inst.get_nominals(x).map_err(rename_x("nominals[]"))
+        inst.get_nominals(x)
     })
 }
 
@@ -213,17 +209,6 @@ pub extern "C" fn fmi3GetNumberOfEventIndicators(c: Instance3, n: *mut usize) ->
         *out_ptr(n, "nEventIndicators")? = 0; // no state events: time events only
         Ok(())
     })
-}
-
-/// The shared Model Exchange methods name the FMI 2.0 arguments (`x[]`, `x_nominal[]`): give the FMI 3.0 names.
-fn rename_x(name: &'static str) -> impl Fn(Fail) -> Fail {
-    move |f| Fail {
-        status: f.status,
-        reason: f
-            .reason
-            .replace("x_nominal[]", name)
-            .replace("x[", &name[..name.len() - 1]),
-    }
 }
 
 // ----- functions both interfaces export, with the Model Exchange rules on an ME instance ---------------

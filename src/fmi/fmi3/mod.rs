@@ -1,9 +1,10 @@
-//! FMI 3.0: one room over the shared C boundary, the same instances as FMI 2.0. `common` holds what
-//! every FMI 3.0 function shares (state tables, `call3`, `time`, life cycle); `values` get/set for both
-//! interfaces; `cs` Co-Simulation, `me` Model Exchange (and the functions both interfaces export with
-//! ME rules); `state` FMU states, directional derivatives and variable dependencies; `unsupported` the
-//! functions of features these FMUs do not declare; `export` (and `export_values`) the `#[no_mangle]` wrappers. The files
-//! import `common`, the boundary and the instance, never each other, and nothing here imports FMI 2.0.
+//! FMI 3.0: one room over the version-neutral core, the same instances as FMI 2.0. `common` holds what
+//! every FMI 3.0 function shares (the `FMI3` dialect, state tables, `call3`, `time`, life cycle); `values`
+//! get/set for both interfaces; `cs` Co-Simulation, `me` Model Exchange (and the functions both interfaces
+//! export with ME rules); `state` FMU states, directional derivatives and variable dependencies;
+//! `unsupported` the functions of features these FMUs do not declare; `export` (and `export_values`) the
+//! `#[no_mangle]` wrappers. The files import `common`, the boundary and the instance, never each other, and
+//! nothing here imports FMI 2.0.
 
 pub mod common;
 pub mod cs;

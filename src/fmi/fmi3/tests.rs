@@ -7,7 +7,8 @@ use std::sync::Mutex;
 
 use super::*;
 use crate::export::*;
-use crate::fmi::types::{FsmState, Status};
+use crate::fmi::instance::Reason;
+use crate::fmi::types::{Arg, FsmState, Status};
 
 declare_variables! {
     /// Variables of a switchable gain.
@@ -139,18 +140,18 @@ fn an_error_terminates_and_reset_recovers() {
         "{}",
         last(&log)
     );
-    let inst = crate::fmi::boundary::instance_of(c, true).unwrap();
+    let inst = crate::fmi::boundary::instance_of(c, &FMI3).unwrap();
     assert_eq!(inst.run.fsm, FsmState::Terminated);
     assert_eq!(fmi3EnterInitializationMode(c, 0, 0.0, 0.0, 0, 0.0), ERROR);
     assert!(last(&log).contains("not allowed in state Terminated"), "{}", last(&log));
     assert_eq!(fmi3Reset(c), OK);
     assert_eq!(
-        crate::fmi::boundary::instance_of(c, true).unwrap().run.fsm,
+        crate::fmi::boundary::instance_of(c, &FMI3).unwrap().run.fsm,
         FsmState::Instantiated
     );
     // an FMI 2.0 function does not know an FMI 3.0 instance, and the other way round
     assert_eq!(crate::fmi::fmi2::fmi2EnterInitializationMode(c), ERROR);
-    assert!(crate::fmi::boundary::instance_of(c, false).is_none());
+    assert!(crate::fmi::boundary::instance_of(c, &crate::fmi::fmi2::FMI2).is_none());
     fmi3FreeInstance(c);
 }
 
@@ -168,4 +169,99 @@ fn a_panic_is_fatal_and_only_free_instance_is_honoured() {
     );
     assert_eq!(fmi3Reset(c), Status::Fatal as c_int);
     fmi3FreeInstance(c);
+}
+
+/// Issue 47, item 3: the failures of the version-neutral core read in FMI 3.0's names, through a real
+/// call (FMI 2.0's: `fmi2/tests.rs`), and every typed reason in the names of each version (below).
+#[test]
+fn the_cores_failures_read_in_fmi3_words() {
+    let log: Box<Log> = Box::default();
+    let c = new(&log);
+    assert_eq!(fmi3EnterInitializationMode(c, 0, 0.0, 0.0, 1, 1.0), OK);
+    assert_eq!(fmi3ExitInitializationMode(c), OK);
+    assert_eq!(step(c, 0.0, 2.0), ERROR);
+    let want = "t: fmi3DoStep: step to 2 goes beyond stopTime 1 set in fmi3EnterInitializationMode";
+    assert_eq!(last(&log), want);
+    fmi3FreeInstance(c);
+}
+
+/// Every typed reason of the core in the names of each version.
+#[test]
+fn every_reason_reads_in_each_versions_words() {
+    let fmi2 = &crate::fmi::fmi2::FMI2;
+    let restored = "(a state is restored only through the interface version that took it)";
+    // (reason, in FMI 2.0's words, in FMI 3.0's words)
+    let cases = [
+        (
+            Reason::IllegalCall(FsmState::StepMode),
+            "not allowed in state StepComplete (illegal call sequence)",
+            "not allowed in state Step Mode (illegal call sequence)",
+        ),
+        (
+            Reason::FixedParameter {
+                name: "gain",
+                state: FsmState::Error,
+            },
+            "parameter gain is fixed and cannot be set after initialization (state Error)",
+            "parameter gain is fixed and cannot be set after initialization (state Terminated)",
+        ),
+        (
+            Reason::StateByValue { name: "s" },
+            "s is a continuous state: set it with fmi2SetContinuousStates (Model Exchange)",
+            "s is a continuous state: set it with fmi3SetContinuousStates (Model Exchange)",
+        ),
+        (
+            Reason::Length {
+                arg: Arg::Nominals,
+                n: 3,
+                model: "M",
+                states: 4,
+            },
+            "x_nominal[] has 3 elements, but M has 4 continuous states",
+            "nominals[] has 3 elements, but M has 4 continuous states",
+        ),
+        (
+            Reason::Length {
+                arg: Arg::States,
+                n: 3,
+                model: "M",
+                states: 4,
+            },
+            "x[] has 3 elements, but M has 4 continuous states",
+            "continuousStates[] has 3 elements, but M has 4 continuous states",
+        ),
+        (
+            Reason::NonFiniteState {
+                k: 5,
+                name: "s",
+                value: f64::NAN,
+            },
+            "x[5] (s) = NaN is not finite",
+            "continuousStates[5] (s) = NaN is not finite",
+        ),
+        (
+            Reason::BeyondStopTime { end: 2.5, stop: 2.0 },
+            "step to 2.5 goes beyond stopTime 2 set in fmi2SetupExperiment",
+            "step to 2.5 goes beyond stopTime 2 set in fmi3EnterInitializationMode",
+        ),
+    ];
+    for (reason, in2, in3) in cases {
+        assert_eq!(
+            (reason.render(fmi2), reason.render(&FMI3)),
+            (in2.to_string(), in3.to_string())
+        );
+    }
+    let other = |v: &str| Reason::OtherInterface {
+        what: "FMU state",
+        taken_by: v.into(),
+    };
+    let (a, b) = (other("FMI 3.0").render(fmi2), other("FMI 2.0").render(&FMI3));
+    assert_eq!(
+        a,
+        format!("FMU state was taken by an FMI 3.0 instance; this instance runs FMI 2.0 {restored}")
+    );
+    assert_eq!(
+        b,
+        format!("FMU state was taken by an FMI 2.0 instance; this instance runs FMI 3.0 {restored}")
+    );
 }

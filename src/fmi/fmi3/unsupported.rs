@@ -12,10 +12,9 @@
 
 use std::ffi::{c_char, c_int, c_void};
 
-use super::common::{call3, log_without_instance3, mask3, refuse, Instance3};
+use super::common::{call3, log_without_instance3, mask3, refuse, Instance3, Log3Fn};
 use crate::fmi::boundary::slice;
 use crate::fmi::instance::Fail;
-use crate::fmi::types::Log3Fn;
 
 /// Functions of the standard's signature `(instance, vr, n, …)` for a variable type the FMUs have none
 /// of: each refuses with `no_such_type` under its own name (`stringify!`), one table line each.

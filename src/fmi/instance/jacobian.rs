@@ -1,8 +1,8 @@
-//! `fmi2GetDirectionalDerivative` / `fmi3GetDirectionalDerivative`: partial derivatives by central
+//! Directional derivatives (the body of both rooms' call): partial derivatives by central
 //! differences on a copy of the model at the current time and inputs; the instance itself is not
 //! touched. Outputs with respect to inputs on every instance; on a Model Exchange instance also the
 //! state derivatives as unknowns and the continuous states as knowns (the Jacobian ∂ẋ/∂x an implicit
-//! solver asks for; FMI 2.0 section 3.2.2, FMI 3.0 section 2.2.11).
+//! solver asks for).
 
 use super::{CallResult, Fail, Instance, LayerVar};
 use crate::model::{Causality, SlotMut, Value, VarKind};

@@ -1,5 +1,6 @@
-//! Logging of an instance: messages to the master's callback (FMI 2.0 or 3.0 signature), filtered by
-//! the debug-logging switch and the enabled categories of `fmi2SetDebugLogging`/`fmi3SetDebugLogging`.
+//! Logging of an instance: messages to the master's callback (either shape of [`Logger`]), filtered by
+//! the debug-logging switch and the categories enabled by the room's debug-logging call; failures are
+//! worded by the instance's dialect.
 
 use std::ffi::{c_int, CString};
 
@@ -21,10 +22,10 @@ impl Instance {
         let cat = CString::new(category).unwrap_or_default();
         match self.logger {
             Logger::None => {}
-            Logger::Fmi2(logger) => {
+            Logger::Printf(logger) => {
                 // The message is a printf format for C loggers: escape '%'; interior NULs cannot pass.
                 let text = CString::new(message.replace('%', "%%").replace('\0', "")).unwrap_or_default();
-                // SAFETY: the logger is the master's callback with the fmi2CallbackLogger signature; all
+                // SAFETY: the logger is the master's callback with the `PrintfLogFn` signature; all
                 // strings are valid NUL-terminated for the duration of the call.
                 unsafe {
                     logger(
@@ -36,11 +37,11 @@ impl Instance {
                     )
                 };
             }
-            Logger::Fmi3(logger) => {
-                // FMI 3.0 messages are plain text (no printf format) and carry no instance name: prefix it.
+            Logger::Text(logger) => {
+                // plain text (no printf format) that carries no instance name: prefix it
                 let text = CString::new(format!("{}: {}", self.name.to_string_lossy(), message).replace('\0', ""))
                     .unwrap_or_default();
-                // SAFETY: the master's fmi3LogMessageCallback; strings valid for the duration of the call.
+                // SAFETY: the master's `TextLogFn` callback; strings valid for the duration of the call.
                 unsafe { logger(self.env, status as c_int, cat.as_ptr(), text.as_ptr()) };
             }
         }
@@ -52,7 +53,11 @@ impl Instance {
             Status::Error => "logStatusError",
             _ => "logStatusWarning",
         };
-        self.log(fail.status, category, &format!("{func}: {}", fail.reason));
+        self.log(
+            fail.status,
+            category,
+            &format!("{func}: {}", fail.reason.render(self.dialect)),
+        );
     }
 
     pub fn trace(&self, message: impl FnOnce() -> String) {

@@ -1,11 +1,11 @@
-//! Model Exchange on an [`Instance`] (FMI 2.0 chapter 3): time, continuous states, derivatives, the
+//! Model Exchange on an [`Instance`], the same in both standards: time, continuous states, derivatives, the
 //! event iteration and the mode switches. The importer's solver integrates; the model gives ẋ, its
 //! time events and, where it keeps an invariant (a unit quaternion), a projection at events.
 
-use super::{CallResult, Fail, Instance, LayerVar};
-use crate::fmi::types::FsmState;
+use super::{CallResult, Fail, Instance, LayerVar, Reason};
+use crate::fmi::types::{Arg, FsmState};
 
-/// What `fmi2NewDiscreteStates` reports (the fields of `fmi2EventInfo`).
+/// What one pass of the event iteration reports (each room copies it into its own arguments).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct EventInfo {
     pub new_discrete_states_needed: bool,
@@ -31,24 +31,17 @@ impl Instance {
         }
     }
 
-    fn check_len(&self, what: &str, n: usize) -> CallResult {
-        let nx = self.n_states();
-        if n != nx {
-            return Err(Fail::error(format!(
-                "{what} has {n} elements, but {} has {nx} continuous states",
-                self.entry.info.name
-            )));
+    fn check_len(&self, arg: Arg, n: usize) -> CallResult {
+        let states = self.n_states();
+        if n != states {
+            return Err(Fail::error(Reason::Length {
+                arg,
+                n,
+                model: self.entry.info.name,
+                states,
+            }));
         }
         Ok(())
-    }
-
-    /// Refuses a Model Exchange call on a Co-Simulation instance.
-    pub fn require_model_exchange(&self) -> CallResult {
-        if self.model_exchange {
-            Ok(())
-        } else {
-            Err(Fail::error("this instance was instantiated for Co-Simulation (fmuType fmi2CoSimulation); Model Exchange functions are not available"))
-        }
     }
 
     pub fn set_time(&mut self, t: f64) -> CallResult {
@@ -59,7 +52,7 @@ impl Instance {
             crate::math::sample_grid::check_time("time", t, period).map_err(Fail::error)?;
         }
         // A solver may evaluate behind an accepted point, but never before the last event (event
-        // instants increase, FMI 2.0 section 3.1): checked against the event itself (up to round-off),
+        // instants increase): checked against the event itself (up to round-off),
         // in event mode too, so that no sequence of small steps back walks past it.
         if t < self.run.event_time - 1e-9 * self.run.event_time.abs().max(1.0) {
             return Err(Fail::error(format!(
@@ -73,12 +66,10 @@ impl Instance {
     }
 
     pub fn set_continuous_states(&mut self, x: &[f64]) -> CallResult {
-        self.check_len("x[]", x.len())?;
-        if let Some((k, v)) = first_non_finite(x) {
-            return Err(Fail::error(format!(
-                "x[{k}] ({}) = {v} is not finite",
-                self.entry.state_decls()[k].name
-            )));
+        self.check_len(Arg::States, x.len())?;
+        if let Some((k, value)) = first_non_finite(x) {
+            let name = self.entry.state_decls()[k].name;
+            return Err(Fail::error(Reason::NonFiniteState { k, name, value }));
         }
         self.model.set_states(x).map_err(Fail::error)?;
         self.run.outputs_dirty = true;
@@ -86,13 +77,13 @@ impl Instance {
     }
 
     pub fn get_continuous_states(&mut self, x: &mut [f64]) -> CallResult {
-        self.check_len("x[]", x.len())?;
+        self.check_len(Arg::States, x.len())?;
         self.ensure_initialized()?;
         self.model.get_states(x).map_err(Fail::error)
     }
 
     pub fn get_nominals(&mut self, x: &mut [f64]) -> CallResult {
-        self.check_len("x_nominal[]", x.len())?;
+        self.check_len(Arg::Nominals, x.len())?;
         x.fill(1.0);
         Ok(())
     }
@@ -117,7 +108,7 @@ impl Instance {
     }
 
     pub fn get_derivatives(&mut self, dx: &mut [f64]) -> CallResult {
-        self.check_len("derivatives[]", dx.len())?;
+        self.check_len(Arg::Derivatives, dx.len())?;
         self.derivatives_into(dx)
     }
 

@@ -1,7 +1,8 @@
-//! One FMU instance: state machine, initialization and stepping. Called only from the FMI 2.0 and 3.0
-//! functions (`fmi2/`, `fmi3/`), after their null and state checks; `logging.rs` adds the logging,
-//! `values.rs` value access with the causality/variability rules, `me.rs` the Model Exchange methods and
-//! `jacobian.rs` the directional derivatives (each an `impl Instance` over this file's types).
+//! One FMU instance: state machine, initialization and stepping. Called only from the rooms of the two
+//! interfaces, after their null and state checks; `logging.rs` adds the logging, `values.rs` value access
+//! with the causality/variability rules, `me.rs` the Model Exchange methods and `jacobian.rs` the
+//! directional derivatives (each an `impl Instance` over this file's types). The instance knows the
+//! interface it serves only through its [`Dialect`], which words its failures.
 
 use std::collections::HashSet;
 use std::ffi::{c_void, CString};
@@ -13,41 +14,20 @@ mod logging;
 pub mod me;
 mod values;
 
-use crate::fmi::types::{FsmState, Log3Fn, LoggerFn, Status, LOG_CATEGORIES};
+pub use crate::fmi::fail::{CallResult, Fail, Reason};
+use crate::fmi::types::{Dialect, FsmState, PrintfLogFn, Status, TextLogFn, LOG_CATEGORIES};
 use crate::math::sample_grid;
 
-/// The master's logger: FMI 2.0 (`fmi2CallbackLogger`) or FMI 3.0 (`fmi3LogMessageCallback`).
+/// The master's logger, by the shape of its callback.
 #[derive(Clone, Copy)]
 pub enum Logger {
     None,
-    Fmi2(LoggerFn),
-    Fmi3(Log3Fn),
+    /// Takes the instance name and a printf format.
+    Printf(PrintfLogFn),
+    /// Takes plain text (the instance name is prefixed to it).
+    Text(TextLogFn),
 }
 use crate::model::{DynModel, Experiment, ModelEntry, VarDecl, VarKind, TOLERANCE_MAX, TOLERANCE_MIN};
-
-/// Failure of an FMI call: the status to return and the reason to log.
-#[derive(Debug)]
-pub struct Fail {
-    pub status: Status,
-    pub reason: String,
-}
-
-impl Fail {
-    pub fn error(reason: impl Into<String>) -> Self {
-        Fail {
-            status: Status::Error,
-            reason: reason.into(),
-        }
-    }
-    pub fn discard(reason: impl Into<String>) -> Self {
-        Fail {
-            status: Status::Discard,
-            reason: reason.into(),
-        }
-    }
-}
-
-pub type CallResult<T = ()> = Result<T, Fail>;
 
 /// Index of declarations by (kind, value reference): value references are small integers, so a
 /// vector per kind is the fastest lookup for the per-step get/set calls.
@@ -129,13 +109,12 @@ impl Run {
         {
             return Err(format!("experiment {e:?} is not valid"));
         }
-        // only the states in which fmi2GetFMUstate can be called on this FMU (StepFailed and
-        // StepCanceled are never entered: fmi2DoStep never returns fmi2Pending or fmi2Discard)
+        // only the states in which an FMU state can be taken (Fatal is not one)
         if !matches!(
             self.fsm,
             FsmState::Instantiated
                 | FsmState::InitializationMode
-                | FsmState::StepComplete
+                | FsmState::StepMode
                 | FsmState::Terminated
                 | FsmState::Error
                 | FsmState::EventMode
@@ -168,9 +147,9 @@ pub struct Instance {
     pub entry: &'static ModelEntry,
     logger: Logger,
     env: *mut c_void,
-    /// Created by `fmi3InstantiateCoSimulation` (FMI 3.0 calls only) rather than `fmi2Instantiate`.
-    pub fmi3: bool,
-    /// Instantiated as Model Exchange (`fmi2Instantiate` with fmuType fmi2ModelExchange).
+    /// The interface that created the instance: only its calls reach it, and it words the failures.
+    pub dialect: &'static Dialect,
+    /// Instantiated as Model Exchange (else Co-Simulation).
     pub model_exchange: bool,
     debug_logging: bool,
     categories: HashSet<&'static str>,
@@ -180,13 +159,20 @@ pub struct Instance {
 }
 
 impl Instance {
-    pub fn new(name: CString, entry: &'static ModelEntry, logger: Logger, env: *mut c_void, logging_on: bool) -> Self {
+    pub fn new(
+        name: CString,
+        entry: &'static ModelEntry,
+        dialect: &'static Dialect,
+        logger: Logger,
+        env: *mut c_void,
+        logging_on: bool,
+    ) -> Self {
         Instance {
             name,
             entry,
             logger,
             env,
-            fmi3: false,
+            dialect,
             model_exchange: false,
             debug_logging: logging_on,
             categories: LOG_CATEGORIES.iter().map(|(n, _)| *n).collect(),
@@ -225,12 +211,9 @@ impl Instance {
         if let Some(tol) = tolerance {
             let used = self.run.exp.tolerance_or_default();
             if used != tol {
-                return Err(Fail {
-                    status: Status::Warning,
-                    reason: format!(
-                        "tolerance {tol:e} is outside [{TOLERANCE_MIN:e}, {TOLERANCE_MAX:e}], the range the adaptive integrators honour; {used:e} is used (the experiment is set up)"
-                    ),
-                });
+                return Err(Fail::warning(format!(
+                    "tolerance {tol:e} is outside [{TOLERANCE_MIN:e}, {TOLERANCE_MAX:e}], the range the adaptive integrators honour; {used:e} is used (the experiment is set up)"
+                )));
             }
         }
         Ok(())
@@ -276,7 +259,7 @@ impl Instance {
         self.run.fsm = if self.model_exchange {
             FsmState::EventMode
         } else {
-            FsmState::StepComplete
+            FsmState::StepMode
         };
         self.run.event_time = self.run.time;
         warning.map_or(Ok(()), Err)
@@ -295,10 +278,7 @@ impl Instance {
         }
         if let Some(stop) = self.run.exp.stop_time {
             if t + h > stop + 1e-9 * stop.abs().max(1.0) {
-                return Err(Fail::error(format!(
-                    "step to {} goes beyond stopTime {stop} set in fmi2SetupExperiment",
-                    t + h
-                )));
+                return Err(Fail::error(Reason::BeyondStopTime { end: t + h, stop }));
             }
         }
         if let Some(period) = self.model.time_grid() {

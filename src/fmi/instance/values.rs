@@ -1,9 +1,9 @@
-//! Value access of an instance with the causality/variability rules of FMI 2.0 section 4.2.4 (and the
-//! same rules for FMI 3.0): atomic sets, lazy outputs, and the Model Exchange variables the layer adds
+//! Value access of an instance with the causality/variability rules both standards share (which variable
+//! may be set in which state): atomic sets, lazy outputs, and the Model Exchange variables the layer adds
 //! (continuous states and their derivatives at reserved value references), which value access refuses
 //! to set.
 
-use super::{CallResult, Fail, Instance, LayerVar};
+use super::{CallResult, Fail, Instance, LayerVar, Reason};
 use crate::fmi::types::{FsmState, Status};
 use crate::model::{
     Causality, SlotMut, Value, VarDecl, VarKind, Variability, DERIVATIVE_VR_BASE, RESERVED_VR_START, STATE_VR_BASE,
@@ -44,7 +44,7 @@ impl Instance {
         })
     }
 
-    /// Whether a variable may be set in the current state (FMI 2.0 section 4.2.4 rules).
+    /// Whether a variable may be set in the current state.
     fn check_settable(&self, d: &VarDecl) -> CallResult {
         let init = matches!(self.run.fsm, FsmState::Instantiated | FsmState::InitializationMode);
         let ok = match (d.causality, d.variability) {
@@ -59,13 +59,13 @@ impl Instance {
             return Ok(());
         }
         Err(Fail::error(match d.causality {
-            Causality::Parameter => format!(
-                "parameter {} is fixed and cannot be set after initialization (state {:?})",
-                d.name, self.run.fsm
-            ),
-            Causality::Output => format!("{} is an output and cannot be set", d.name),
-            Causality::CalculatedParameter => format!("{} is a calculated parameter and cannot be set", d.name),
-            _ => format!("{} ({:?}, {:?}) cannot be set", d.name, d.causality, d.variability),
+            Causality::Parameter => Reason::FixedParameter {
+                name: d.name,
+                state: self.run.fsm,
+            },
+            Causality::Output => format!("{} is an output and cannot be set", d.name).into(),
+            Causality::CalculatedParameter => format!("{} is a calculated parameter and cannot be set", d.name).into(),
+            _ => format!("{} ({:?}, {:?}) cannot be set", d.name, d.causality, d.variability).into(),
         }))
     }
 
@@ -79,10 +79,10 @@ impl Instance {
                     let (LayerVar::State(k) | LayerVar::Derivative(k)) = var;
                     let name = self.entry.state_decls()[k].name;
                     return Err(Fail::error(match var {
-                        LayerVar::State(_) => format!(
-                            "{name} is a continuous state: set it with fmi2SetContinuousStates (Model Exchange)"
-                        ),
-                        LayerVar::Derivative(_) => format!("der({name}) is a state derivative and cannot be set"),
+                        LayerVar::State(_) => Reason::StateByValue { name },
+                        LayerVar::Derivative(_) => {
+                            format!("der({name}) is a state derivative and cannot be set").into()
+                        }
                     }));
                 }
             }
@@ -175,14 +175,11 @@ impl Instance {
                         _ => {}
                     }
                 }
-                Err(Fail {
-                    status: Status::Warning,
-                    reason: format!(
-                        "outputs not computed in Initialization Mode from the inputs set so far ({reason}); \
-                         they keep their previous values until the inputs are consistent, and a step with these \
-                         inputs is refused"
-                    ),
-                })
+                Err(Fail::warning(format!(
+                    "outputs not computed in Initialization Mode from the inputs set so far ({reason}); \
+                     they keep their previous values until the inputs are consistent, and a step with these \
+                     inputs is refused"
+                )))
             }
         }
     }
@@ -208,13 +205,10 @@ impl Instance {
                         // initialization reads, then transfers, then reads again): the same tolerance as
                         // for the outputs, a derivative the inputs do not yet allow reads as 0
                         Err(f) if self.run.fsm == FsmState::InitializationMode => {
-                            warning.get_or_insert(Fail {
-                                status: Status::Warning,
-                                reason: format!(
-                                    "{}; read as 0 until the inputs are consistent in Initialization Mode",
-                                    f.reason
-                                ),
-                            });
+                            warning.get_or_insert(Fail::warning(Reason::Then(
+                                Box::new(f.reason),
+                                "; read as 0 until the inputs are consistent in Initialization Mode",
+                            )));
                             0.0
                         }
                         Err(f) => return Err(f),
