@@ -151,7 +151,7 @@ def model_edit_problems(src: Path) -> list[str]:
     blind = []
     for entry in MODEL_BLIND:
         p = src.parent / entry
-        blind += [p] if p.is_file() else sorted(x for x in p.rglob("*.rs") if not x.stem.endswith("_tests"))
+        blind += [p] if p.is_file() else sorted(x for x in p.rglob("*.rs") if not (x.stem.endswith("_tests") or x.name == "tests.rs"))
     for p in blind:
         code = _code(p.read_text())
         named = sorted(n for n in models if re.search(rf"\b{n}\b", code))
