@@ -17,7 +17,7 @@ import time
 import numpy as np
 
 from ..scenario.model import Scenario
-from .instances import as_plan
+from .instances import apply_params, as_plan
 
 NS = 10**9
 
@@ -67,20 +67,18 @@ def run_libcosim(scenario: Scenario) -> dict:
             raise RuntimeError(f"libcosim cannot load {u.name} ({u.path}): {_last_error()}")
         idx[u.name] = ex.add_local_slave(slave)
         mds[u.name] = u.vars
-    for c in scenario.components:
-        for k, v in c.params.items():
-            var = mds[c.name][k]
-            if var.type == "Integer":
-                ok = ex.integer_initial_value(idx[c.name], var.valueReference, int(v))
-            elif var.type == "Boolean":
-                ok = ex.boolean_initial_value(idx[c.name], var.valueReference, bool(v))
-            else:
-                ok = ex.real_initial_value(idx[c.name], var.valueReference, float(v))
-            if not ok:
-                raise RuntimeError(f"libcosim: cannot set {c.name}.{k}")
-    for q, v in scenario.inputs.items():
-        inst, _, var = q.partition(".")
-        ex.real_initial_value(idx[inst], mds[inst][var].valueReference, float(v))
+    def initial_values(inst):
+        init = {"Real": ex.real_initial_value, "Integer": ex.integer_initial_value,
+                "Boolean": ex.boolean_initial_value}
+
+        def set_values(fmi_type, vrs, values):
+            for vr, v in zip(vrs, values):
+                if not init[fmi_type](idx[inst], vr, {"Real": float, "Integer": int, "Boolean": bool}[fmi_type](v)):
+                    raise RuntimeError(f"libcosim: cannot set {inst} value reference {vr}")
+        return set_values
+    for u in plan.units:
+        apply_params(plan.params[u.name], initial_values(u.name))
+        apply_params(plan.inputs[u.name], initial_values(u.name))
     connect = {"Real": ex.connect_real_variables, "Integer": ex.connect_integer_variables,
                "Boolean": ex.connect_boolean_variables}
     for g in plan.groups:
