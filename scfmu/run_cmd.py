@@ -140,6 +140,24 @@ def choose_folder(base: Path, ident: dict, chosen: bool) -> tuple[Path, str | No
     return p, f"note: {base} holds another run; this one is written to {p}"
 
 
+OPTIONS_HELP = """The command-line options that choose and change a scenario, shared by ``scfmu run`` and ``scfmu campaign``:
+
+  SCENARIO                     a registered name, or a scenario file (.toml / .json)
+  --fmu INSTANCE=PATH          put any FMI 2.0 or 3.0 FMU, Co-Simulation or Model Exchange (or another model
+                               name) in that place; the old model's parameters are dropped (one notice
+                               lists them)
+  --map INSTANCE.THEIRS=OURS   the unit's port THEIRS plays the scenario's port OURS; a vector stem renames
+                               every element (--map controller.omega=w); a parameter THEIRS takes the
+                               place's slot value OURS (--map controller.J1=inertia_xx)
+  --profile [INSTANCE=]FILE    the unit's profile (TOML: [params] J1 = "inertia_xx", [ports], unused = [...]);
+                               INSTANCE defaults to the one given with --fmu
+  --strict                     refuse to run when a slot value of the place reaches no parameter of the unit
+  --set INSTANCE.VAR=VALUE     a parameter or fixed input
+  --params FILE                more --set values from a TOML or JSON table {"instance.var": value}
+  --t-end, --dt                stop time and communication step
+"""
+
+
 def add_scenario_arguments(ap: argparse.ArgumentParser) -> None:
     """The options that choose and change a scenario (``scfmu run`` and ``scfmu campaign``); read them back
     with :func:`run_changes`."""
@@ -169,7 +187,7 @@ def run_changes(args) -> options.RunChanges:
 
 
 def _parser() -> argparse.ArgumentParser:
-    ap = argparse.ArgumentParser(prog="scfmu run", description=__doc__ + "\n" + options.__doc__,
+    ap = argparse.ArgumentParser(prog="scfmu run", description=__doc__ + "\n" + OPTIONS_HELP,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     add_scenario_arguments(ap)
     ap.add_argument("--engine", default=None, choices=ENGINES,

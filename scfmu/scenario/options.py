@@ -1,23 +1,9 @@
-"""The changes a user makes to a scenario (:class:`RunChanges`, plain data) and :func:`build`, the scenario
-they describe; the command lines of ``scfmu run``, ``scfmu campaign`` and ``scfmu export`` fill a
-:class:`RunChanges` from their options (the argparse definitions live there, :mod:`scfmu.run_cmd`):
-
-  SCENARIO                     a registered name, or a scenario file (.toml / .json)
-  --fmu INSTANCE=PATH          put any FMI 2.0 or 3.0 FMU, Co-Simulation or Model Exchange (or another model
-                               name) in that place; the old model's parameters are dropped (one notice
-                               lists them)
-  --map INSTANCE.THEIRS=OURS   the unit's port THEIRS plays the scenario's port OURS; a vector stem renames
-                               every element (--map controller.omega=w); a parameter THEIRS takes the
-                               place's slot value OURS (--map controller.J1=inertia_xx)
-  --profile [INSTANCE=]FILE    the unit's profile (TOML: [params] J1 = "inertia_xx", [ports], unused = [...]);
-                               INSTANCE defaults to the one given with --fmu
-  --strict                     refuse to run when a slot value of the place reaches no parameter of the unit
-  --set INSTANCE.VAR=VALUE     a parameter or fixed input
-  --params FILE                more --set values from a TOML or JSON table {"instance.var": value}
-  --t-end, --dt                stop time and communication step
-
-The timing and the values are checked once, when the scenario's plan is built
-(:func:`scfmu.scenario.plan.build_plan`, the pre-flight :func:`scfmu.scenario.check.check`).
+"""The changes a user makes to a scenario, as plain data (:class:`RunChanges`: the scenario by name or
+file, units swapped in, port maps, profiles, values, stop time and step), and :func:`build`, the scenario
+they describe. The command lines of ``scfmu run``, ``scfmu campaign`` and ``scfmu export`` fill a
+:class:`RunChanges` from their options; the argparse definitions live there (:mod:`scfmu.run_cmd`,
+``add_scenario_arguments``). The timing and the values are checked once, when the scenario's plan is built
+(:func:`scfmu.scenario.plan.build_plan`; the pre-flight :func:`scfmu.scenario.check.check`).
 """
 
 from __future__ import annotations
