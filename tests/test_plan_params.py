@@ -74,3 +74,20 @@ def test_the_set_value_reaches_the_unit_and_the_preflight_hands_on_its_plan():
     finally:
         for f in fmus.values():
             f.close()
+
+
+def test_the_preflight_instantiates_each_unit_once(monkeypatch):
+    """Four units in run 000-6: four instantiations before the run (it used to be seven: each unit bare,
+    then the three given parameters again in their trial)."""
+    import fmpy.fmi2 as fmi2
+    made = []
+    real = fmi2.FMU2Slave.instantiate
+
+    def counted(self, *a, **k):
+        made.append(self.instanceName)
+        return real(self, *a, **k)
+    monkeypatch.setattr(fmi2.FMU2Slave, "instantiate", counted)
+    sc = get("default")
+    rep = check(sc.with_overrides({"controller.wn": 2}))
+    assert rep.errors == []
+    assert sorted(made) == sorted(c.name for c in sc.components) and len(made) == 4
