@@ -31,6 +31,7 @@ connected or logged (a :class:`PlanError` says which port and why). The pre-flig
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -38,7 +39,7 @@ from ..fmu import described, fmu_path, scalar_type
 from .model import Scenario
 from .resolve import resolve
 from .settings import Setting, apply_params, values  # noqa: F401  (a plan's settings; re-exported)
-from .values import timing_problems
+from .values import max_rows, timing_problems
 
 LINK_TYPES = ("Real", "Integer", "Boolean")
 # solvers of a Model Exchange instance: SciPy solve_ivp's methods (the compiled engine runs its own
@@ -141,9 +142,10 @@ class Plan:
 
     @property
     def n_steps(self) -> int:
-        """The communication steps of the run (worked out once, when the timing was checked)."""
+        """The communication steps of the run (the timing was checked when the plan was built)."""
         if self.steps is None:
-            self.steps = self.scenario.n_steps
+            sc = self.scenario
+            self.steps = int(round((sc.stop_time - sc.start_time) / sc.step))
         return self.steps
 
     @property
@@ -199,20 +201,16 @@ def link_problem(u_dst: Unit, di: str, u_src: Unit, so: str) -> str | None:
 
 
 def timing_problem(sc: Scenario, log_every: int | None = 1, log_hint: bool = True) -> str | None:
-    """Why the scenario's times cannot run (None when they can): finite, bounded (steps, and with
-    ``log_every`` the logged rows, :func:`scfmu.scenario.values.timing_problems`), the stop time a whole
-    number of steps after the start (:attr:`Scenario.n_steps`). The one timing check."""
-    problems = timing_problems(sc.start_time, sc.stop_time, sc.step, log_every=None)
-    if problems:
-        return problems[0]
+    """Why the scenario's times cannot run (None when they can): finite, bounded in steps, the stop time a
+    whole number of steps after the start (:attr:`Scenario.n_steps`), and with ``log_every`` bounded in
+    logged rows (:func:`scfmu.scenario.values.timing_problems` words each refusal). The one timing check."""
     try:
         sc.n_steps
     except ValueError as e:
         return str(e)
-    if log_every is not None:
-        problems = timing_problems(sc.start_time, sc.stop_time, sc.step, log_every=log_every, log_hint=log_hint)
-        if problems:
-            return problems[0]
+    n = (float(sc.stop_time) - float(sc.start_time)) / float(sc.step)  # (the rows as timing_problems counts them)
+    if log_every is not None and (2 if int(log_every) <= 0 else math.ceil(n / int(log_every)) + 1) > max_rows():
+        return timing_problems(sc.start_time, sc.stop_time, sc.step, log_every=log_every, log_hint=log_hint)[0]
     return None
 
 

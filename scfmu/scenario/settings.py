@@ -51,13 +51,13 @@ def values(plan, raw: Scenario, origins: dict) -> None:
     plan.params, plan.inputs, plan.problems[:], plan.input_problems[:] = {}, {}, [], []
     for c in sc.components:
         u = plan.unit(c.name)
-        params = [n for n, v in u.vars.items() if v.causality == "parameter"]
         out = plan.params[c.name] = []
         for k, val in c.params.items():
             v = u.vars.get(k)
             if v is None or v.causality != "parameter":
                 problems.append(f"{c.name} ({c.model}): no parameter {k!r}"
-                                + (f" ({k!r} is its {v.causality})" if v is not None else did_you_mean(k, params)))
+                                + (f" ({k!r} is its {v.causality})" if v is not None else did_you_mean(
+                                    k, [n for n, x in u.vars.items() if x.causality == "parameter"])))
                 continue
             problem = value_problem(f"{c.name}.{k}", v, val)
             if problem:
