@@ -38,6 +38,20 @@ def _last_error() -> str:
         return f"(no message: {e})"
 
 
+def _initial_values(ex, slave: int, inst: str, settings):
+    """``set_values`` of :func:`~scfmu.scenario.plan.apply_params` for a libcosim slave: its initial values."""
+    init = {"Real": (ex.real_initial_value, float), "Integer": (ex.integer_initial_value, int),
+            "Boolean": (ex.boolean_initial_value, bool)}
+    names = {s.vr: s.name for s in settings}
+
+    def set_values(fmi_type, vrs, values):
+        fn, conv = init[fmi_type]
+        for vr, v in zip(vrs, values):
+            if not fn(slave, vr, conv(v)):
+                raise RuntimeError(f"libcosim: cannot set {inst}.{names[vr]}")
+    return set_values
+
+
 def run_libcosim(scenario: Scenario) -> dict:
     """Runs the scenario (or its plan) to its stop time; returns the final value of every logged key plus
     ``wall_s`` (the simulate_until call only). Co-Simulation units only (libcosim hosts no Model Exchange
@@ -67,18 +81,9 @@ def run_libcosim(scenario: Scenario) -> dict:
             raise RuntimeError(f"libcosim cannot load {u.name} ({u.path}): {_last_error()}")
         idx[u.name] = ex.add_local_slave(slave)
         mds[u.name] = u.vars
-    def initial_values(inst):
-        init = {"Real": ex.real_initial_value, "Integer": ex.integer_initial_value,
-                "Boolean": ex.boolean_initial_value}
-
-        def set_values(fmi_type, vrs, values):
-            for vr, v in zip(vrs, values):
-                if not init[fmi_type](idx[inst], vr, {"Real": float, "Integer": int, "Boolean": bool}[fmi_type](v)):
-                    raise RuntimeError(f"libcosim: cannot set {inst} value reference {vr}")
-        return set_values
-    for u in plan.units:
-        apply_params(plan.params[u.name], initial_values(u.name))
-        apply_params(plan.inputs[u.name], initial_values(u.name))
+    for u in plan.units:  # parameters, then fixed inputs, as initial values (one function, every engine)
+        for settings in (plan.params[u.name], plan.inputs[u.name]):
+            apply_params(settings, _initial_values(ex, idx[u.name], u.name, settings))
     connect = {"Real": ex.connect_real_variables, "Integer": ex.connect_integer_variables,
                "Boolean": ex.connect_boolean_variables}
     for g in plan.groups:
