@@ -46,9 +46,12 @@ def test_a_set_value_is_one_setting_with_its_reference_type_and_origin():
 
 
 def test_values_are_checked_once_when_the_plan_is_built():
-    plan = build_plan(get("default").with_overrides({"controller.error_law": 1.5, "controller.nosuch": 1.0}))
-    assert any(p.startswith("controller.error_law = 1.5: not a whole number") for p in plan.problems)
-    assert any("no parameter 'nosuch'" in p for p in plan.problems)
+    plan = build_plan(get("default").with_overrides({"controller.error_law": 1.5}))
+    assert len(plan.problems) == 1 and plan.problems[0].startswith("controller.error_law = 1.5: not a whole number")
+    with pytest.raises(KeyError, match="PdController has no parameter 'nosuch'"):  # no engine can set it
+        build_plan(get("default").with_overrides({"controller.nosuch": 1.0}))
+    rep = check(get("default").with_overrides({"controller.nosuch": 1.0}), instantiate=False)  # the pre-flight's words
+    assert rep.errors == ["controller (PdController): no parameter 'nosuch'"]
     with pytest.raises(PlanError, match="not a positive multiple of step = 0.07"):
         build_plan(get("default", step=0.07))
 

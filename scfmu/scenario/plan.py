@@ -16,7 +16,8 @@ model description once, then fixes everything the engines need:
   ``inputs``: the fixed inputs, written after initialization, the same way. Every engine sets them through
   one function (:func:`apply_params`);
 * ``problems`` and ``input_problems``: what is wrong with the values (a parameter or fixed input the unit
-  does not have, a value outside its declared type or bounds), in the pre-flight's words; the pre-flight
+  does not have, a value outside its declared type or bounds), in the pre-flight's words (a name no unit
+  has is a ``KeyError`` of :func:`build_plan`); the pre-flight
   (:mod:`scfmu.scenario.check`) reports them, an engine lets the unit refuse a value itself.
 
 The timing (start, stop, step, the logged rows) is checked here too (:func:`timing_problem`), before
@@ -117,6 +118,7 @@ class Plan:
     inputs: dict = field(default_factory=dict)  # instance -> [Setting], fixed inputs (after initialization)
     problems: list = field(default_factory=list)  # what is wrong with the parameters (the pre-flight's errors)
     input_problems: list = field(default_factory=list)  # what is wrong with the fixed inputs (the same)
+    unknown: list = field(default_factory=list)  # names the units do not have (build_plan: a KeyError)
     log_every: int | None = 1  # the logging grid the timing was checked for
     steps: int | None = None  # the communication steps (n_steps)
 
@@ -238,6 +240,8 @@ def build_plan(scenario: Scenario, path_of=None, model_exchange=frozenset(), res
         plan = _build(sc, paths, model_exchange)
         remember(plan, paths, model_exchange)
     values(plan, scenario, origins or {})
+    if plan.unknown:  # a value no unit can take (the pre-flight words it, with the closest names)
+        raise KeyError(plan.unknown[0])
     plan.log_every = log_every
     return plan
 

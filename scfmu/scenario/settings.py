@@ -46,9 +46,11 @@ def _origin(raw: Scenario, c, k: str, origins: dict) -> str:
 
 
 def values(plan, raw: Scenario, origins: dict) -> None:
-    """The plan's parameter and fixed-input settings and the problems of their values."""
+    """The plan's parameter and fixed-input settings and the problems of their values. A variable the unit
+    has but may not be set so (an output, a parameter given as a fixed input) is still a setting: the unit
+    refuses it with its own message; a name the unit does not have is in ``plan.unknown`` too."""
     sc, problems = plan.scenario, plan.problems
-    plan.params, plan.inputs, plan.problems[:], plan.input_problems[:] = {}, {}, [], []
+    plan.params, plan.inputs, plan.problems[:], plan.input_problems[:], plan.unknown[:] = {}, {}, [], [], []
     for c in sc.components:
         u = plan.unit(c.name)
         out = plan.params[c.name] = []
@@ -58,10 +60,13 @@ def values(plan, raw: Scenario, origins: dict) -> None:
                 problems.append(f"{c.name} ({c.model}): no parameter {k!r}"
                                 + (f" ({k!r} is its {v.causality})" if v is not None else did_you_mean(
                                     k, [n for n, x in u.vars.items() if x.causality == "parameter"])))
-                continue
-            problem = value_problem(f"{c.name}.{k}", v, val)
-            if problem:
-                problems.append(problem)
+                if v is None:
+                    plan.unknown.append(f"{c.model} has no parameter {k!r}")
+                    continue
+            else:
+                problem = value_problem(f"{c.name}.{k}", v, val)
+                if problem:
+                    problems.append(problem)
             out.append(Setting(k, v.valueReference, _fmi_type(v, u.fmi), val, _origin(raw, c, k, origins)))
         for theirs in c.ports:
             if theirs not in u.vars:
@@ -74,10 +79,13 @@ def values(plan, raw: Scenario, origins: dict) -> None:
         v = u.vars.get(var) if u is not None else None
         if v is None or v.causality != "input":
             plan.input_problems.append(f"fixed input {q}: {inst} has no input {var!r}")
-            continue
-        problem = value_problem(f"fixed input {q}", v, val)
-        if problem:
-            plan.input_problems.append(problem)
+            if v is None:
+                plan.unknown.append(f"{u.model if u is not None else inst} has no variable {var!r}")
+                continue
+        else:
+            problem = value_problem(f"fixed input {q}", v, val)
+            if problem:
+                plan.input_problems.append(problem)
         plan.inputs[inst].append(Setting(var, v.valueReference, _fmi_type(v, u.fmi), val,
                                          origins.get(q, origins.get(f"input:{q}", "scenario"))))
 
