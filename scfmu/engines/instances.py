@@ -1,6 +1,7 @@
 """Instantiating and initializing the units of a plan, the same way for every engine that holds the
-instances itself (reference, lean, compiled), and :func:`apply_params`, the one function through which
-every engine (those, native, libcosim) sets a plan's parameters and fixed inputs."""
+instances itself (reference, lean, compiled). A plan's parameters and fixed inputs are set through
+:func:`~scfmu.scenario.settings.apply_params` (imported here for every engine: native, libcosim too), with
+:func:`fmu_setter` for an instance."""
 
 from __future__ import annotations
 
