@@ -86,15 +86,18 @@ def _export(argv) -> int:
         if len(a.names) != 1:
             print("scfmu export: --fmu/--map/--set and scenario files take exactly one scenario", file=sys.stderr)
             return 2
-        ns = argparse.Namespace(scenario=a.names[0], fmu=a.fmu, map=a.map, set=a.set, params=None, t_end=None, dt=None,
-                                profile=a.profile)
-        items = [options.build(ns, notice=lambda t: print(t, file=sys.stderr))]
+        changes = options.RunChanges(a.names[0], fmu=a.fmu, map=a.map, set=a.set, profile=a.profile)
+        items = [options.build(changes, notice=lambda t: print(t, file=sys.stderr))]
         options.binding_report(items[0], "scfmu export", False, lambda t: print(t, file=sys.stderr))
         from .scenario.check import IncompatibleUnit, require
+        from .scenario.plan import PlanError
         try:  # names, values against the declared types and bounds (no run)
             require(items[0], instantiate=False, warn=lambda t: print(f"warning: {t}", file=sys.stderr))
         except IncompatibleUnit as e:
             print(f"scfmu export: {e.one_line()}", file=sys.stderr)
+            return 2
+        except PlanError as e:  # a scenario file's times
+            print(f"scfmu export: {e}", file=sys.stderr)
             return 2
     try:
         export(a.kind, out, items, platform=a.platform, ssp_version=a.ssp_version)

@@ -19,12 +19,12 @@ import sys
 
 from .engines import ENGINES, SimulationError, simulate
 from .fmu import is_path
-from .scenario.plan import PlanError, build_plan
+from .scenario.plan import PlanError
 from .results import write_csv
 from .scenario import options
 from .fmu import FmuError
 from .scenario.check import IncompatibleUnit, require
-from .scenario.values import UsageError, bounded_int, timing_problems
+from .scenario.values import UsageError, bounded_int
 from .scenario.ssp import file_stem
 
 ANGLES = ("roll", "pitch", "yaw")
@@ -140,10 +140,56 @@ def choose_folder(base: Path, ident: dict, chosen: bool) -> tuple[Path, str | No
     return p, f"note: {base} holds another run; this one is written to {p}"
 
 
+OPTIONS_HELP = """The command-line options that choose and change a scenario, shared by ``scfmu run`` and ``scfmu campaign``:
+
+  SCENARIO                     a registered name, or a scenario file (.toml / .json)
+  --fmu INSTANCE=PATH          put any FMI 2.0 or 3.0 FMU, Co-Simulation or Model Exchange (or another model
+                               name) in that place; the old model's parameters are dropped (one notice
+                               lists them)
+  --map INSTANCE.THEIRS=OURS   the unit's port THEIRS plays the scenario's port OURS; a vector stem renames
+                               every element (--map controller.omega=w); a parameter THEIRS takes the
+                               place's slot value OURS (--map controller.J1=inertia_xx)
+  --profile [INSTANCE=]FILE    the unit's profile (TOML: [params] J1 = "inertia_xx", [ports], unused = [...]);
+                               INSTANCE defaults to the one given with --fmu
+  --strict                     refuse to run when a slot value of the place reaches no parameter of the unit
+  --set INSTANCE.VAR=VALUE     a parameter or fixed input
+  --params FILE                more --set values from a TOML or JSON table {"instance.var": value}
+  --t-end, --dt                stop time and communication step
+"""
+
+
+def add_scenario_arguments(ap: argparse.ArgumentParser) -> None:
+    """The options that choose and change a scenario (``scfmu run`` and ``scfmu campaign``); read them back
+    with :func:`run_changes`."""
+    ap.add_argument("scenario", help="scenario name (`scfmu scenarios` lists them) or a .toml/.json scenario file")
+    ap.add_argument("--fmu", action="append", default=[], metavar="INSTANCE=PATH",
+                    help="use this FMU (a path to any FMI 2.0 or 3.0 FMU, Co-Simulation or Model Exchange, or a model "
+                         "name) for INSTANCE (repeatable)")
+    ap.add_argument("--map", action="append", default=[], metavar="INSTANCE.THEIRS=OURS",
+                    help="the unit's port (or vector stem) THEIRS plays the scenario's port OURS; a parameter "
+                         "THEIRS takes the place's slot value OURS (repeatable)")
+    ap.add_argument("--profile", action="append", default=[], metavar="[INSTANCE=]FILE",
+                    help="unit profile (TOML) binding the unit's parameters to the place's slot values")
+    ap.add_argument("--strict", action="store_true",
+                    help="refuse to run when a slot value (e.g. the nominal inertia) reaches no parameter of a unit")
+    ap.add_argument("--set", action="append", default=[], metavar="INSTANCE.VAR=VALUE",
+                    help="parameter or fixed input for every run (repeatable)")
+    ap.add_argument("--params", metavar="FILE", help="TOML or JSON table of INSTANCE.VAR = value")
+    ap.add_argument("--t-end", type=float, help="override the scenario's stop time [s]")
+    ap.add_argument("--dt", type=float, help="override the scenario's communication step [s]")
+
+
+def run_changes(args) -> options.RunChanges:
+    """The plain :class:`~scfmu.scenario.options.RunChanges` of parsed scenario options."""
+    return options.RunChanges(args.scenario, fmu=list(args.fmu), map=list(args.map), profile=list(args.profile),
+                              set=list(args.set), params=args.params, strict=args.strict, t_end=args.t_end,
+                              dt=args.dt)
+
+
 def _parser() -> argparse.ArgumentParser:
-    ap = argparse.ArgumentParser(prog="scfmu run", description=__doc__ + "\n" + options.__doc__,
+    ap = argparse.ArgumentParser(prog="scfmu run", description=__doc__ + "\n" + OPTIONS_HELP,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    options.add_arguments(ap)
+    add_scenario_arguments(ap)
     ap.add_argument("--engine", default=None, choices=ENGINES,
                     help="engine (all give bit-identical results on Co-Simulation units); default native, or, "
                          "when a unit runs as Model Exchange, compiled (else lean)")
@@ -203,26 +249,23 @@ def _write(sc, r, args, out: Path, ident: dict, unbound: list, plan=None) -> Non
 
 def main(argv=None) -> int:
     args = _parser().parse_args(argv)
-    sc = options.build(args, notice=lambda t: print(t, file=sys.stderr))
+    changes = run_changes(args)
+    sc = options.build(changes, notice=lambda t: print(t, file=sys.stderr))
     bounded_int("--log-every", args.log_every, 1, 10 ** 9)
     if args.log_every != 1 and args.engine not in (None, "native"):
         raise UsageError(f"--log-every {args.log_every}: allowed only with --engine native (the {args.engine} "
                          f"engine logs every step)")
-    problems = timing_problems(sc.start_time, sc.stop_time, sc.step, log_every=args.log_every,
-                               log_hint=args.engine in (None, "native"))
-    if problems:
-        raise UsageError(problems[0])
-    try:
-        require(sc, warn=lambda t: print(f"warning: {t}", file=sys.stderr))
+    try:  # the pre-flight builds the plan (timing, units, wiring, values: once) and tries the units
+        plan = require(sc, warn=lambda t: print(f"warning: {t}", file=sys.stderr), log_every=args.log_every,
+                       log_hint=args.engine in (None, "native"), origins=changes.origins()).plan
     except IncompatibleUnit as e:
         print(f"scfmu run: {e.one_line()}", file=sys.stderr)
         return 2
-    unbound = options.binding_report(sc, "scfmu run", args.strict, lambda t: print(t, file=sys.stderr))
-    try:
-        plan = build_plan(sc)
     except (PlanError, KeyError, ValueError) as e:
         print(f"scfmu run: {e}", file=sys.stderr)
         return 2
+    unbound = options.binding_report(plan.scenario, "scfmu run", args.strict, lambda t: print(t, file=sys.stderr),
+                                     resolved=True)
     if args.engine is None:
         args.engine = "native"
         if plan.model_exchange:  # native nests a Model Exchange unit as its Co-Simulation face (scfmu.engines.

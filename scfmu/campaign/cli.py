@@ -32,7 +32,9 @@ from ..registry import REGISTRY
 from ..scenario import options
 from ..scenario.check import IncompatibleUnit, override_problems, require
 from ..scenario.options import value
-from ..scenario.values import UsageError, bounded_float, bounded_int, did_you_mean, timing_problems
+from ..scenario.plan import timing_problem
+from ..scenario.values import UsageError, bounded_float, bounded_int, did_you_mean
+from ..run_cmd import add_scenario_arguments, run_changes
 from . import plots as campaign_plots
 
 
@@ -131,7 +133,7 @@ def runs_space(sc, args) -> list[str]:
 
 
 def build(args) -> campaign.Campaign:
-    sc = options.build(args, notice=lambda t: print(t, file=sys.stderr))
+    sc = options.build(run_changes(args), notice=lambda t: print(t, file=sys.stderr))
     bounded_int("--samples", args.samples, 1, MAX_RUNS)
     bounded_int("--ts-every", args.ts_every, 1, 10 ** 9)
     bounded_int("--log-every", args.log_every, 1, 10 ** 9)
@@ -140,9 +142,9 @@ def build(args) -> campaign.Campaign:
     if args.chunk is not None:
         bounded_int("--chunk", args.chunk, 1, 10 ** 6)
     bounded_float("--timeout", args.timeout, 0.0, 10 ** 7)
-    problems = timing_problems(sc.start_time, sc.stop_time, sc.step, log_every=args.log_every)
-    if problems:
-        raise UsageError(problems[0])
+    why = timing_problem(sc, log_every=args.log_every)  # the plan's one timing check, before any run
+    if why:
+        raise UsageError(why)
     sets = [{}]
     if args.list:
         try:
@@ -186,7 +188,7 @@ def _parser() -> argparse.ArgumentParser:
     """The command line of ``scfmu campaign``: the scenario options, the parameter sets, seeds, engine, Dask
     and output options."""
     ap = argparse.ArgumentParser(prog="scfmu campaign", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    options.add_arguments(ap)
+    add_scenario_arguments(ap)
     ap.add_argument("--grid", action="append", default=[], metavar="INST.VAR=V1,V2,...", help="grid axis (repeatable)")
     ap.add_argument("--random", action="append", default=[], metavar="INST.VAR=DIST:A:B", help="random axis (repeatable)")
     ap.add_argument("--samples", type=int, default=100, help="number of random samples (with --random)")

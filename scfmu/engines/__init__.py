@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..scenario.model import Scenario  # noqa: F401  (re-exported)
-from ..scenario.plan import Plan, PlanError, build_plan  # noqa: F401  (PlanError re-exported)
+from ..scenario.plan import Plan, PlanError, build_plan, timing_problem  # noqa: F401  (PlanError re-exported)
 from .calls import SimulationError
 from .instances import as_plan, build_fmus, ports_of  # noqa: F401
 from .lean import LeanMaster
@@ -154,13 +154,15 @@ def simulate(scenario, engine: str = "native", *, fmus: dict | None = None, over
     engine = resolve_engine(engine)
     if engine not in ENGINES:
         raise ValueError(f"engine {engine!r}: expected one of {ENGINES} or 'auto'")
-    from ..scenario.values import timing_problems  # bounded before any engine allocates its rows
-    sc = scenario.scenario if isinstance(scenario, Plan) else scenario
-    problems = timing_problems(sc.start_time, sc.stop_time, sc.step,
-                               log_every=kw.get("log_every", 1) if engine == "native" else 1)
-    if problems:
-        raise ValueError(problems[0])
-    plan = scenario if isinstance(scenario, Plan) else build_plan(scenario, model_exchange=model_exchange)
+    log_every = kw.get("log_every", 1) if engine == "native" else 1
+    if isinstance(scenario, Plan):  # its timing was checked when it was built; a coarser log grid has fewer rows
+        plan = scenario
+        if log_every != plan.log_every:  # (the rows bounded before an engine allocates them)
+            why = timing_problem(plan.scenario, log_every)
+            if why:
+                raise PlanError(why)
+    else:  # the timing, the logged rows among it, is checked before any engine allocates its rows
+        plan = build_plan(scenario, model_exchange=model_exchange, log_every=log_every)
     if engine == "reference":
         out = run_reference(plan)
     elif engine == "lean":

@@ -1,11 +1,13 @@
 """Instantiating and initializing the units of a plan, the same way for every engine that holds the
-instances itself (reference, lean, compiled)."""
+instances itself (reference, lean, compiled). A plan's parameters and fixed inputs are set through
+:func:`~scfmu.scenario.settings.apply_params` (imported here for every engine: native, libcosim too), with
+:func:`fmu_setter` for an instance."""
 
 from __future__ import annotations
 
 from ..fmu import Fmu, unpacked
 from ..scenario.model import Scenario
-from ..scenario.plan import Plan, build_plan
+from ..scenario.plan import Plan, apply_params, build_plan  # noqa: F401  (apply_params: every engine's)
 from .calls import SimulationError
 
 
@@ -42,15 +44,21 @@ def build_fmus(plan, path_of=None, reuse: bool = False, model_exchange=frozenset
     return fmus
 
 
+def fmu_setter(f: Fmu):
+    """``set_values`` of :func:`apply_params` for an :class:`~scfmu.fmu.Fmu` (its by-reference setter)."""
+    return f.set_refs
+
+
 def initialize_fmus(fmus: dict[str, Fmu], plan) -> None:
     """Initializes instantiated (or reset) FMUs: set-up, parameters in initialization mode, then the
-    fixed ``inputs``. Raises SimulationError when an FMU refuses to initialize."""
-    scenario: Scenario = plan.scenario if isinstance(plan, Plan) else plan
+    fixed ``inputs`` (both through :func:`apply_params`). Raises SimulationError when an FMU refuses to
+    initialize."""
+    plan = as_plan(plan)
+    scenario: Scenario = plan.scenario
     for c in scenario.components:
         f = fmus[c.name]
         f.enter_initialization_mode(scenario.start_time)
-        for k, v in c.params.items():
-            f.set(k, v)
+        apply_params(plan.params[c.name], fmu_setter(f))
         try:
             f.exit_initialization_mode()
         except Exception as e:
@@ -58,9 +66,8 @@ def initialize_fmus(fmus: dict[str, Fmu], plan) -> None:
             what = "fmi2ExitInitializationMode" if f.fmi == 2 else "fmi3ExitInitializationMode"
             raise SimulationError("fmu_error", f"{c.name} ({c.model}): {what} failed"
                                   + (f": {msgs}" if msgs else (f": {e}" if f.interface == "me" else ""))) from None
-    for q, value in scenario.inputs.items():
-        inst, _, var = q.partition(".")
-        fmus[inst].set(var, value)
+    for c in scenario.components:
+        apply_params(plan.inputs[c.name], fmu_setter(fmus[c.name]))
 
 
 def ports_of(fmus: dict[str, Fmu]) -> dict[str, tuple[list[str], list[str]]]:

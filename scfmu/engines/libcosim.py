@@ -17,7 +17,7 @@ import time
 import numpy as np
 
 from ..scenario.model import Scenario
-from .instances import as_plan
+from .instances import apply_params, as_plan
 
 NS = 10**9
 
@@ -36,6 +36,20 @@ def _last_error() -> str:
         return get_last_error_message() or "(no message)"
     except Exception as e:  # a libcosimpy without it
         return f"(no message: {e})"
+
+
+def _initial_values(ex, slave: int, inst: str, settings):
+    """``set_values`` of :func:`~scfmu.scenario.plan.apply_params` for a libcosim slave: its initial values."""
+    init = {"Real": (ex.real_initial_value, float), "Integer": (ex.integer_initial_value, int),
+            "Boolean": (ex.boolean_initial_value, bool)}
+    names = {s.vr: s.name for s in settings}
+
+    def set_values(fmi_type, vrs, values):
+        fn, conv = init[fmi_type]
+        for vr, v in zip(vrs, values):
+            if not fn(slave, vr, conv(v)):
+                raise RuntimeError(f"libcosim: cannot set {inst}.{names[vr]}")
+    return set_values
 
 
 def run_libcosim(scenario: Scenario) -> dict:
@@ -67,20 +81,9 @@ def run_libcosim(scenario: Scenario) -> dict:
             raise RuntimeError(f"libcosim cannot load {u.name} ({u.path}): {_last_error()}")
         idx[u.name] = ex.add_local_slave(slave)
         mds[u.name] = u.vars
-    for c in scenario.components:
-        for k, v in c.params.items():
-            var = mds[c.name][k]
-            if var.type == "Integer":
-                ok = ex.integer_initial_value(idx[c.name], var.valueReference, int(v))
-            elif var.type == "Boolean":
-                ok = ex.boolean_initial_value(idx[c.name], var.valueReference, bool(v))
-            else:
-                ok = ex.real_initial_value(idx[c.name], var.valueReference, float(v))
-            if not ok:
-                raise RuntimeError(f"libcosim: cannot set {c.name}.{k}")
-    for q, v in scenario.inputs.items():
-        inst, _, var = q.partition(".")
-        ex.real_initial_value(idx[inst], mds[inst][var].valueReference, float(v))
+    for u in plan.units:  # parameters, then fixed inputs, as initial values (one function, every engine)
+        for settings in (plan.params[u.name], plan.inputs[u.name]):
+            apply_params(settings, _initial_values(ex, idx[u.name], u.name, settings))
     connect = {"Real": ex.connect_real_variables, "Integer": ex.connect_integer_variables,
                "Boolean": ex.connect_boolean_variables}
     for g in plan.groups:

@@ -54,7 +54,7 @@ from . import cache
 from .cache import CACHE
 from .calls import SimulationError, raw_calls
 from .cs_face import cs_face, wrapper_identity
-from .instances import as_plan
+from .instances import apply_params, as_plan, fmu_setter
 
 _KINDS = ("parameter", "calculatedParameter", "input", "output")
 LAYOUT = 5  # version of the container layout below (part of the cache key)
@@ -318,18 +318,17 @@ class NativeLoop:
         sc, f = self.scenario, self.fmu
         sl = f.slave
         f.enter_initialization_mode(sc.start_time)
+        # the container knows each unit's variable as "instance.name", under a value reference of its own
+        def ref(inst):
+            return lambda s: f.var(f"{inst}.{s.name}").valueReference
         for c in sc.components:
-            for k, v in c.params.items():
-                try:
-                    f.set(f"{c.name}.{k}", v)
-                except KeyError:
-                    raise KeyError(f"{c.model} has no parameter {k!r}") from None
+            apply_params(self.plan.params[c.name], fmu_setter(f), ref(c.name))
         try:
             sl.exitInitializationMode()
         except Exception:
             self._fail("exitInitializationMode")
-        for q, v in sc.inputs.items():
-            f.set(q, v)
+        for c in sc.components:
+            apply_params(self.plan.inputs[c.name], fmu_setter(f), ref(c.name))
         # repeat the Gauss–Seidel propagation now that every instance has left initialization mode
         plan = _PLANS.get(self._path)
         if plan is None:  # the same for every run of this container (its key includes the wiring)
@@ -369,7 +368,7 @@ class NativeLoop:
 
     def run(self) -> dict[str, np.ndarray]:
         sc = self.scenario
-        n, dt, t0 = sc.n_steps, sc.step, sc.start_time
+        n, dt, t0 = self.plan.n_steps, sc.step, sc.start_time
         m = self.log_every
         if m <= 0:
             ks = [0, n]

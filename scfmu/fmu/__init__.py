@@ -320,6 +320,19 @@ class Fmu(ModelExchange):
             else:
                 raise TypeError(f"{name}: unsupported type {v.type}" + (" (an array)" if v.dimensions else ""))
 
+    def set_refs(self, fmi_type: str, vrs: list[int], values) -> None:
+        """Sets variables of one scenario type (Real, Integer, Boolean) by value reference: a plan's settings,
+        whose names, types and C ranges :func:`scfmu.scenario.plan.apply_params` checked."""
+        with self._fmu_errors():
+            if fmi_type == "Real":
+                (self.slave.setReal if self.fmi == 2 else self.slave.setFloat64)(vrs, [float(x) for x in values])
+            elif fmi_type == "Integer":
+                (self.slave.setInteger if self.fmi == 2 else self.slave.setInt32)(vrs, [int(x) for x in values])
+            elif fmi_type == "Boolean":
+                self.slave.setBoolean(vrs, [bool(x) for x in values])
+            else:
+                raise TypeError(f"value references {vrs}: unsupported type {fmi_type}")
+
     def get(self, name: str):
         v = self.var(name)
         t = scalar_type(v)

@@ -21,7 +21,7 @@ from fmpy import read_model_description
 
 from ..fmu import ArchiveError, described, fmu_path, inspect_archive
 from .model import Scenario
-from .plan import Unit, link_problem
+from .plan import Plan, PlanError, apply_params, link_problem, plan_units, remember, timing_problem, values, wire
 from .resolve import resolve
 from .values import did_you_mean, value_problem
 
@@ -44,6 +44,7 @@ class IncompatibleUnit(ValueError):
 class Report:
     errors: list = field(default_factory=list)
     warnings: list = field(default_factory=list)
+    plan: object = None  # the scenario's plan when there is no error (scfmu.scenario.plan.Plan)
 
     @property
     def ok(self) -> bool:
@@ -125,55 +126,60 @@ def check_unit(model: str, instantiate: bool = True, interface: str = "") -> tup
     return md, []
 
 
-def check(scenario: Scenario, instantiate: bool = True) -> Report:
+def check(scenario: Scenario, instantiate: bool = True, log_every: int | None = None,
+          origins: dict | None = None, log_hint: bool = True) -> Report:
+    """Builds the scenario's plan (:mod:`scfmu.scenario.plan`: resolved once, each unit's description read
+    once, the values checked once) and reports what stops it, in the pre-flight's words (with the closest
+    ``--map`` names for inputs left without a source, and units of measure compared across each link);
+    with ``instantiate`` every unit is instantiated once: the units given values in a trial initialization
+    with them, the others bare. ``rep.plan`` is the plan when there is no error. A timing the run cannot
+    have (``log_every``: the logged rows too) raises :class:`~scfmu.scenario.plan.PlanError`."""
+    why = timing_problem(scenario, log_every, log_hint)
+    if why:
+        raise PlanError(why)
     rep = Report()
     mds = {}
     for c in scenario.components:
         if c.model in mds:
             continue
-        md, errs = check_unit(c.model, instantiate, c.interface)
+        md, errs = check_unit(c.model, False, c.interface)
         rep.errors += errs
         mds[c.model] = md if not errs else None
     if rep.errors:
         return rep
     sc = resolve_safely(scenario, rep)
-    vars_of = {c.name: {v.name: v for v in mds[c.model].modelVariables} for c in sc.components}
-    for c in sc.components:
-        params = [n for n, v in vars_of[c.name].items() if v.causality == "parameter"]
-        for k, val in c.params.items():
-            v = vars_of[c.name].get(k)
-            if v is None or v.causality != "parameter":
-                rep.errors.append(f"{c.name} ({c.model}): no parameter {k!r}"
-                                  + (f" ({k!r} is its {v.causality})" if v is not None else did_you_mean(k, params)))
-                continue
-            problem = value_problem(f"{c.name}.{k}", v, val)
-            if problem:
-                rep.errors.append(problem)
-        for theirs in c.ports:
-            if theirs not in vars_of[c.name]:
-                rep.errors.append(f"{c.name} ({c.model}): port map names {theirs!r}, which the unit does not have "
-                                  f"(neither a port, a vector stem {theirs}_x…, nor a parameter)")
+    paths = [fmu_path(c.model) for c in sc.components]
+    try:
+        units = plan_units(sc, paths)
+    except PlanError as e:
+        rep.errors.append(str(e))
+        return rep
+    plan = Plan(sc, units, [], [], [])
+    values(plan, scenario, origins or {})
+    rep.errors += plan.problems
     if rep.errors:
         return rep
-    ports = {c.name: ([n for n, v in vars_of[c.name].items() if v.causality == "input"],
-                      [n for n, v in vars_of[c.name].items() if v.causality == "output"]) for c in sc.components}
-    problems = sc.wiring_problems(ports)
-    if problems:
+    vars_of = {u.name: u.vars for u in units}
+    ports = plan.ports()
+    try:  # the wiring, worked out once; when it fails, every reason and the closest names
+        links = sc.wiring(ports)
+    except (KeyError, ValueError):
+        problems = sc.wiring_problems(ports)
+        if not problems:
+            raise
         rep.errors += [f"wiring: {x}" for x in problems]
         hint = suggest_maps(sc, vars_of, mds)
         if hint:
             rep.errors.append("wiring: closest names: " + " ".join(hint))
         return rep
-    links = sc.wiring(ports)
-    units = {c.name: _unit_of(c, mds[c.model], vars_of[c.name]) for c in sc.components}
     for d, di, s, so in links:
         vd, vs = vars_of[d][di], vars_of[s][so]
         what = f"{s}.{so} -> {d}.{di}"
-        why = link_problem(units[d], di, units[s], so)
+        why = link_problem(plan.unit(d), di, plan.unit(s), so)
         if why:
             rep.errors.append(f"{what}: {why}")
             continue
-        ud, us = _unit(mds[sc.component(d).model], vd), _unit(mds[sc.component(s).model], vs)
+        ud, us = _unit(None, vd), _unit(None, vs)
         if ud and us and ud != us:
             rep.errors.append(f"{what}: unit {us!r} does not match {ud!r}")
         elif bool(ud) != bool(us):  # one side without a unit (both without: a dimensionless signal)
@@ -182,17 +188,16 @@ def check(scenario: Scenario, instantiate: bool = True) -> Report:
     for key, inst, var in sc.log_items():
         if inst in vars_of and var not in vars_of[inst]:
             rep.errors.append(f"logged signal {key!r}: {inst} has no variable {var!r}")
-    for q, val in sc.inputs.items():
-        inst, _, var = q.partition(".")
-        v = vars_of.get(inst, {}).get(var)
-        if v is None or v.causality != "input":
-            rep.errors.append(f"fixed input {q}: {inst} has no input {var!r}")
-        else:
-            problem = value_problem(f"fixed input {q}", v, val)
-            if problem:
-                rep.errors.append(problem)
-    if not rep.errors and instantiate:
-        rep.errors += trial_initialization(sc, rep.warnings)
+    rep.errors += plan.input_problems
+    if rep.errors:
+        return rep
+    done = wire(sc, units, links)  # the rest of the plan (link groups, logged signals): PlanError, KeyError
+    done.params, done.inputs, done.log_every = plan.params, plan.inputs, log_every
+    remember(done, paths)
+    if instantiate:
+        rep.errors += trial_initialization(done, rep.warnings)
+    if not rep.errors:
+        rep.plan = done
     return rep
 
 
@@ -268,53 +273,77 @@ def suggest_maps(sc: Scenario, vars_of: dict, mds: dict) -> list[str]:
     return out
 
 
-def _unit_of(c, md, variables) -> Unit:
-    return Unit(c.name, c.model, None, md, int(str(md.fmiVersion)[0]), c.interface or "cs", {}, variables)
-
-
 TRIAL_TIMEOUT = 60.0  # [s] wall time of the trial initialization of a unit given as a file
 
 
-def _trial(c, start_time: float) -> str | None:
-    """The error of initializing component ``c`` alone with its parameters when it initializes with its
-    defaults (None when it takes them, or when it refuses its defaults too: not the values' fault)."""
+@dataclass
+class Trial:
+    """A unit of the plan to try alone, with the settings it is given."""
+    name: str
+    model: str
+    path: Path
+    fmi: int
+    interface: str
+    settings: list
+
+
+def _trial(u: Trial, start_time: float) -> str | None:
+    """The error of instantiating unit ``u`` alone, or of initializing it with its ``settings`` when it
+    initializes with its defaults (None when it takes them, or when it refuses its defaults too: not the
+    values' fault)."""
     from ..fmu import Fmu
-    path = fmu_path(c.model)
+    settings = u.settings
     try:
-        Fmu(c.model, params=c.params, name=c.name, start_time=start_time, path=path).close()
+        f = Fmu(u.model, name=u.name, start_time=start_time, path=u.path, initialize=False, interface=u.interface)
+    except Exception as e:
+        return f"{u.model}: fmi{u.fmi}Instantiate failed: {e}"
+    try:
+        if not settings:
+            return None
+        f.enter_initialization_mode(start_time)
+        apply_params(settings, f.set_refs)
+        f.exit_initialization_mode()
         return None
     except Exception as e:
         refused = e
+    finally:
+        f.close()
     try:  # the same unit with its defaults: does it refuse the scenario's values, or everything?
-        Fmu(c.model, name=c.name, start_time=start_time, path=path).close()
+        Fmu(u.model, name=u.name, start_time=start_time, path=u.path, interface=u.interface).close()
     except Exception:
         return None  # the run reports it
     msg = getattr(refused, "log", None)
-    return (f"{c.name} ({Path(str(c.model)).name}) refuses the parameters it is given: "
+    return (f"{u.name} ({Path(str(u.model)).name}) refuses the parameters it is given: "
             + (" | ".join(msg) if msg else str(refused)))
 
 
-def trial_initialization(sc: Scenario, warnings: list | None = None) -> list[str]:
-    """Each instance that is given parameters is instantiated and initialized alone with them (the calls
-    every engine makes); when it refuses them but initializes with its defaults, the unit's own log
-    message is the error (e.g. an exclusive bound the model description cannot declare). A unit given as
-    a file is tried in a child process (``TRIAL_TIMEOUT``): a crash or a hang there is a warning (the runs,
-    isolated, report it), not the end of this process."""
+def trial_initialization(plan: Plan, warnings: list | None = None) -> list[str]:
+    """Each unit of the plan is instantiated once: alone, and when it is given parameters initialized with
+    them (through :func:`~scfmu.scenario.plan.apply_params`, as every engine sets them); when it refuses
+    them but initializes with its defaults, the unit's own log message is the error (e.g. an exclusive bound
+    the model description cannot declare). A model used by several instances is instantiated bare once. A
+    unit given as a file is tried in a child process (``TRIAL_TIMEOUT``): a crash or a hang there is a
+    warning (the runs, isolated, report it), not the end of this process."""
     from ..fmu import is_path, isolate
-    errors = []
-    for c in sc.components:
-        if not c.params:
-            continue
-        if is_path(c.model) and isolate.available():
-            kind, result = isolate.in_child(lambda c=c: _trial(c, sc.start_time), TRIAL_TIMEOUT)
+    errors, bare = [], set()
+    sc = plan.scenario
+    for u in plan.units:
+        settings = plan.params.get(u.name, [])
+        if not settings:
+            if u.model in bare:
+                continue
+            bare.add(u.model)
+        t = Trial(u.name, u.model, u.path, u.fmi, u.interface, settings)
+        if is_path(u.model) and isolate.available():
+            kind, result = isolate.in_child(lambda t=t: _trial(t, sc.start_time), TRIAL_TIMEOUT)
             if kind != "ok":
                 if warnings is not None:
-                    warnings.append(f"{c.name} ({Path(str(c.model)).name}): its trial initialization "
+                    warnings.append(f"{u.name} ({Path(str(u.model)).name}): its trial initialization "
                                     + (f"did not end within {TRIAL_TIMEOUT:g} s" if kind == "timeout" else
                                        f"crashed ({result})") + "; the runs will report it")
                 continue
         else:
-            result = _trial(c, sc.start_time)
+            result = _trial(t, sc.start_time)
         if result:
             errors.append(result)
     return errors
@@ -364,10 +393,11 @@ def resolve_safely(scenario: Scenario, rep: Report) -> Scenario:
         return scenario
 
 
-def require(scenario: Scenario, instantiate: bool = True, warn=None) -> Report:
-    """Runs :func:`check`; raises :class:`IncompatibleUnit` listing every error; passes warnings to
-    ``warn(text)`` (default: nothing)."""
-    rep = check(scenario, instantiate)
+def require(scenario: Scenario, instantiate: bool = True, warn=None, **plan) -> Report:
+    """Runs :func:`check` (``plan``: its ``log_every``, ``origins``, ``log_hint``); raises
+    :class:`IncompatibleUnit` listing every error; passes warnings to ``warn(text)`` (default: nothing).
+    The report's ``plan`` is the scenario's plan, ready for an engine."""
+    rep = check(scenario, instantiate, **plan)
     if warn is not None:
         for w in rep.warnings:
             warn(w)

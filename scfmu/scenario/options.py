@@ -1,18 +1,9 @@
-"""The command-line options that choose and change a scenario, shared by ``scfmu run`` and ``scfmu campaign``:
-
-  SCENARIO                     a registered name, or a scenario file (.toml / .json)
-  --fmu INSTANCE=PATH          put any FMI 2.0 or 3.0 FMU, Co-Simulation or Model Exchange (or another model
-                               name) in that place; the old model's parameters are dropped (one notice
-                               lists them)
-  --map INSTANCE.THEIRS=OURS   the unit's port THEIRS plays the scenario's port OURS; a vector stem renames
-                               every element (--map controller.omega=w); a parameter THEIRS takes the
-                               place's slot value OURS (--map controller.J1=inertia_xx)
-  --profile [INSTANCE=]FILE    the unit's profile (TOML: [params] J1 = "inertia_xx", [ports], unused = [...]);
-                               INSTANCE defaults to the one given with --fmu
-  --strict                     refuse to run when a slot value of the place reaches no parameter of the unit
-  --set INSTANCE.VAR=VALUE     a parameter or fixed input
-  --params FILE                more --set values from a TOML or JSON table {"instance.var": value}
-  --t-end, --dt                stop time and communication step
+"""The changes a user makes to a scenario, as plain data (:class:`RunChanges`: the scenario by name or
+file, units swapped in, port maps, profiles, values, stop time and step), and :func:`build`, the scenario
+they describe. The command lines of ``scfmu run``, ``scfmu campaign`` and ``scfmu export`` fill a
+:class:`RunChanges` from their options; the argparse definitions live there (:mod:`scfmu.run_cmd`,
+``add_scenario_arguments``). The timing and the values are checked once, when the scenario's plan is built
+(:func:`scfmu.scenario.plan.build_plan`; the pre-flight :func:`scfmu.scenario.check.check`).
 """
 
 from __future__ import annotations
@@ -22,11 +13,12 @@ import math
 import sys
 import tomllib
 import zipfile
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import files, profile
 from .model import Scenario
-from .values import UsageError, did_you_mean, parse_cli, timing_problems
+from .values import UsageError, did_you_mean, parse_cli
 from ..registry import REGISTRY
 
 
@@ -80,23 +72,29 @@ def fmu_file(option: str, text: str) -> str:
     return str(p.resolve())
 
 
-def add_arguments(ap) -> None:
-    ap.add_argument("scenario", help="scenario name (`scfmu scenarios` lists them) or a .toml/.json scenario file")
-    ap.add_argument("--fmu", action="append", default=[], metavar="INSTANCE=PATH",
-                    help="use this FMU (a path to any FMI 2.0 or 3.0 FMU, Co-Simulation or Model Exchange, or a model "
-                         "name) for INSTANCE (repeatable)")
-    ap.add_argument("--map", action="append", default=[], metavar="INSTANCE.THEIRS=OURS",
-                    help="the unit's port (or vector stem) THEIRS plays the scenario's port OURS; a parameter "
-                         "THEIRS takes the place's slot value OURS (repeatable)")
-    ap.add_argument("--profile", action="append", default=[], metavar="[INSTANCE=]FILE",
-                    help="unit profile (TOML) binding the unit's parameters to the place's slot values")
-    ap.add_argument("--strict", action="store_true",
-                    help="refuse to run when a slot value (e.g. the nominal inertia) reaches no parameter of a unit")
-    ap.add_argument("--set", action="append", default=[], metavar="INSTANCE.VAR=VALUE",
-                    help="parameter or fixed input for every run (repeatable)")
-    ap.add_argument("--params", metavar="FILE", help="TOML or JSON table of INSTANCE.VAR = value")
-    ap.add_argument("--t-end", type=float, help="override the scenario's stop time [s]")
-    ap.add_argument("--dt", type=float, help="override the scenario's communication step [s]")
+@dataclass
+class RunChanges:
+    """What the user changes in a scenario: ``scenario`` (a registered name or a scenario file), units
+    (``fmu``: ``INSTANCE=PATH``), port maps (``map``), unit profiles (``profile``), values (``set``:
+    ``INSTANCE.VAR=VALUE``; ``params``: a TOML/JSON file of them), ``strict`` binding, and the stop time
+    ``t_end`` and step ``dt`` [s] (None: the scenario's)."""
+
+    scenario: str
+    fmu: list = field(default_factory=list)
+    map: list = field(default_factory=list)
+    profile: list = field(default_factory=list)
+    set: list = field(default_factory=list)
+    params: str | None = None
+    strict: bool = False
+    t_end: float | None = None
+    dt: float | None = None
+
+    def origins(self) -> dict:
+        """``{"instance.name": "--set" | "--params"}``: where each value the user gives comes from (the
+        plan's :class:`~scfmu.scenario.plan.Setting` origin)."""
+        out = {k: "--params" for k in (load_params(self.params) if self.params else {})}
+        out.update({k: "--set" for k in pairs(self.set, "--set")})
+        return out
 
 
 def load_params(path: str) -> dict:
@@ -122,9 +120,10 @@ def load_params(path: str) -> dict:
     return flat
 
 
-def build(args, notice=print) -> Scenario:
-    """The scenario the options describe; ``notice(text)`` gets the parameters a swap dropped. A user's
-    mistake raises :class:`~scfmu.scenario.values.UsageError` (one line; ``scfmu`` exits 2)."""
+def build(args: RunChanges, notice=print) -> Scenario:
+    """The scenario the changes describe; ``notice(text)`` gets the parameters a swap dropped. A user's
+    mistake raises :class:`~scfmu.scenario.values.UsageError` (one line; ``scfmu`` exits 2). Its timing
+    and values are checked when its plan is built."""
     if files.is_scenario_file(args.scenario):
         try:
             sc = files.load(args.scenario)
@@ -144,13 +143,6 @@ def build(args, notice=print) -> Scenario:
     for opt, v in (("--t-end", args.t_end), ("--dt", args.dt)):
         if v is not None and not math.isfinite(v):
             raise UsageError(f"{opt} {v}: not finite; allowed: a finite number of seconds")
-    problems = timing_problems(sc.start_time, sc.stop_time, sc.step, log_every=None)
-    if problems:
-        raise UsageError(problems[0])
-    try:
-        sc.n_steps
-    except ValueError as e:
-        raise UsageError(str(e)) from None
     models = {}
     for inst, target in pairs(args.fmu, "--fmu").items():
         if "/" in target or target.endswith(".fmu"):
@@ -166,7 +158,7 @@ def build(args, notice=print) -> Scenario:
     for inst, names in dropped.items():
         notice(f"notice: {inst} is now {Path(models[inst]).name}; the parameters of its old model are not "
                f"passed on: {', '.join(names)} (set the new unit's own with --set {inst}.NAME=VALUE)")
-    for item in getattr(args, "profile", None) or []:
+    for item in args.profile:
         inst, sep, path = item.partition("=")
         if not sep:
             inst, path = "", item
@@ -202,11 +194,12 @@ def build(args, notice=print) -> Scenario:
     return sc
 
 
-def binding_report(sc: Scenario, prog: str, strict: bool, warn) -> list[str]:
+def binding_report(sc: Scenario, prog: str, strict: bool, warn, resolved: bool = False) -> list[str]:
     """The slot values that reach no parameter of a swapped unit, each passed to ``warn("warning: …")``;
-    with ``strict`` raises SystemExit(2) with one line naming the first (and how many more)."""
+    with ``strict`` raises SystemExit(2) with one line naming the first (and how many more). ``resolved``:
+    ``sc`` is already resolved (a plan's scenario)."""
     from .resolve import unbound_slots
-    texts = [u.text() for u in unbound_slots(sc)]
+    texts = [u.text() for u in unbound_slots(sc, resolved=resolved)]
     if strict and texts:
         _fail(f"{prog}: --strict: {texts[0]}" + (f" (and {len(texts) - 1} more)" if len(texts) > 1 else ""))
     for t in texts:

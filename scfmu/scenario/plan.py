@@ -10,7 +10,18 @@ model description once, then fixes everything the engines need:
 * ``groups``: the links grouped by destination (in component order), then by source (in order of first
   appearance among the destination's inputs) and type, with the value references of both ends: one
   get of the source and one set of the destination per group;
-* ``log``: the logged signals grouped by instance (in order of first appearance) and type.
+* ``log``: the logged signals grouped by instance (in order of first appearance) and type;
+* ``params``: per instance, the parameters to set in initialization mode, each a :class:`Setting` (value
+  reference, FMI type, value, where it came from: the scenario, ``--set``, a binding, a slot value, a seed);
+  ``inputs``: the fixed inputs, written after initialization, the same way. Every engine sets them through
+  one function (:func:`apply_params`);
+* ``problems`` and ``input_problems``: what is wrong with the values (a parameter or fixed input the unit
+  does not have, a value outside its declared type or bounds), in the pre-flight's words (a name no unit
+  has is a ``KeyError`` of :func:`build_plan`); the pre-flight
+  (:mod:`scfmu.scenario.check`) reports them, an engine lets the unit refuse a value itself.
+
+The timing (start, stop, step, the logged rows) is checked here too (:func:`timing_problem`), before
+anything is read.
 
 One rule decides which connections are allowed (:data:`LINK_TYPES`): Real, Integer and Boolean, the
 two ends of the same type. FMI 3.0 ``Float64``, ``Int32`` and ``Boolean`` are the scenario's Real,
@@ -21,12 +32,15 @@ connected or logged (a :class:`PlanError` says which port and why). The pre-flig
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..fmu import described, fmu_path, scalar_type
 from .model import Scenario
 from .resolve import resolve
+from .settings import Setting, apply_params, values  # noqa: F401  (a plan's settings; re-exported)
+from .values import max_rows, timing_problems
 
 LINK_TYPES = ("Real", "Integer", "Boolean")
 # solvers of a Model Exchange instance: SciPy solve_ivp's methods (the compiled engine runs its own
@@ -100,6 +114,13 @@ class Plan:
     links: list[tuple[str, str, str, str]]
     groups: list[LinkGroup]
     log: list[LogGroup]
+    params: dict = field(default_factory=dict)  # instance -> [Setting], parameters (initialization mode)
+    inputs: dict = field(default_factory=dict)  # instance -> [Setting], fixed inputs (after initialization)
+    problems: list = field(default_factory=list)  # what is wrong with the parameters (the pre-flight's errors)
+    input_problems: list = field(default_factory=list)  # what is wrong with the fixed inputs (the same)
+    unknown: list = field(default_factory=list)  # names the units do not have (build_plan: a KeyError)
+    log_every: int | None = 1  # the logging grid the timing was checked for
+    steps: int | None = None  # the communication steps (n_steps)
 
     def unit(self, name: str) -> Unit:
         for u in self.units:
@@ -123,7 +144,11 @@ class Plan:
 
     @property
     def n_steps(self) -> int:
-        return self.scenario.n_steps
+        """The communication steps of the run (the timing was checked when the plan was built)."""
+        if self.steps is None:
+            sc = self.scenario
+            self.steps = int(round((sc.stop_time - sc.start_time) / sc.step))
+        return self.steps
 
     @property
     def model_exchange(self) -> frozenset:
@@ -177,11 +202,31 @@ def link_problem(u_dst: Unit, di: str, u_src: Unit, so: str) -> str | None:
     return None
 
 
-def build_plan(scenario: Scenario, path_of=None, model_exchange=frozenset(), resolved: bool = False) -> Plan:
+def timing_problem(sc: Scenario, log_every: int | None = 1, log_hint: bool = True) -> str | None:
+    """Why the scenario's times cannot run (None when they can): finite, bounded in steps, the stop time a
+    whole number of steps after the start (:attr:`Scenario.n_steps`), and with ``log_every`` bounded in
+    logged rows (:func:`scfmu.scenario.values.timing_problems` words each refusal). The one timing check."""
+    try:
+        sc.n_steps
+    except ValueError as e:
+        return str(e)
+    n = (float(sc.stop_time) - float(sc.start_time)) / float(sc.step)  # (the rows as timing_problems counts them)
+    if log_every is not None and (2 if int(log_every) <= 0 else math.ceil(n / int(log_every)) + 1) > max_rows():
+        return timing_problems(sc.start_time, sc.stop_time, sc.step, log_every=log_every, log_hint=log_hint)[0]
+    return None
+
+
+def build_plan(scenario: Scenario, path_of=None, model_exchange=frozenset(), resolved: bool = False,
+               log_every: int | None = 1, origins: dict | None = None, log_hint: bool = True) -> Plan:
     """The plan of a scenario (see the module docstring). ``path_of(model)`` gives a model's FMU file
     (default :func:`scfmu.fmu.fmu_path`); the instances named in ``model_exchange`` (and those whose
     ``Component.interface`` is ``"me"``, or that offer Model Exchange only) run as Model Exchange
-    units. ``resolved``: the scenario is already resolved."""
+    units. ``resolved``: the scenario is already resolved. ``log_every``: the run logs every n-th step
+    (bounds the logged rows; None: not counted). ``origins``: ``{"instance.name": origin}`` of values the
+    caller changed (``--set``, ``--params``); the others are told apart by the scenario."""
+    why = timing_problem(scenario, log_every, log_hint)
+    if why:
+        raise PlanError(why)
     unknown = set(model_exchange) - {c.name for c in scenario.components}
     if unknown:
         raise KeyError(f"model_exchange names no instance of {scenario.name}: {sorted(unknown)}")
@@ -190,11 +235,14 @@ def build_plan(scenario: Scenario, path_of=None, model_exchange=frozenset(), res
     sig = _signature(sc, paths, model_exchange)
     hit = _SKELETONS.get(sig)
     if hit is not None:  # the same structure as a plan made before (e.g. the runs of a campaign)
-        return Plan(sc, *hit)
-    plan = _build(sc, paths, model_exchange)
-    if len(_SKELETONS) > 256:
-        _SKELETONS.clear()
-    _SKELETONS[sig] = (plan.units, plan.links, plan.groups, plan.log)
+        plan = Plan(sc, *hit)
+    else:
+        plan = _build(sc, paths, model_exchange)
+        remember(plan, paths, model_exchange)
+    values(plan, scenario, origins or {})
+    if plan.unknown:  # a value no unit can take (the pre-flight words it, with the closest names)
+        raise KeyError(plan.unknown[0])
+    plan.log_every = log_every
     return plan
 
 
@@ -214,7 +262,8 @@ def _signature(sc: Scenario, paths, model_exchange) -> tuple:
             sc.auto_connect, tuple(sc.log.items()), frozenset(model_exchange))
 
 
-def _build(sc: Scenario, paths, model_exchange) -> Plan:
+def plan_units(sc: Scenario, paths, model_exchange=frozenset()) -> list[Unit]:
+    """The units of a resolved scenario: each FMU's model description read once (cached per process)."""
     units = []
     for c, p in zip(sc.components, paths):
         md = described(p)
@@ -224,8 +273,26 @@ def _build(sc: Scenario, paths, model_exchange) -> Plan:
         itf = _interface(c, md, model_exchange)
         units.append(Unit(c.name, c.model, p, md, fmi, itf, solver_of(c) if itf == "me" else {},
                           {v.name: v for v in md.modelVariables}))
+    return units
+
+
+def _build(sc: Scenario, paths, model_exchange) -> Plan:
+    return wire(sc, plan_units(sc, paths, model_exchange))
+
+
+def remember(plan: Plan, paths, model_exchange=frozenset()) -> None:
+    """Keeps a plan's structure for the next plan of the same structure (built by the pre-flight)."""
+    if len(_SKELETONS) > 256:
+        _SKELETONS.clear()
+    _SKELETONS[_signature(plan.scenario, paths, model_exchange)] = (plan.units, plan.links, plan.groups, plan.log)
+
+
+def wire(sc: Scenario, units: list[Unit], links=None) -> Plan:
+    """The plan of a resolved scenario's units: its wiring (``links``, when the caller computed it), link
+    groups and logged signals; a :class:`PlanError` names a connection or logged signal no engine can make."""
     by_name = {u.name: u for u in units}
-    links = sc.wiring({u.name: (u.inputs, u.outputs) for u in units})
+    if links is None:
+        links = sc.wiring({u.name: (u.inputs, u.outputs) for u in units})
     problems = []
     for d, di, s, so in links:
         why = link_problem(by_name[d], di, by_name[s], so)

@@ -190,14 +190,14 @@ def _start(v):
         return str(st)
 
 
-def unbound_slots(scenario: Scenario, instances=None) -> list[Unbound]:
+def unbound_slots(scenario: Scenario, instances=None, resolved: bool = False) -> list[Unbound]:
     """The slot values of the swapped instances, of the units given as files and of those with a profile (or
     of ``instances``) that their units do not receive:
     no parameter of that name, not read by a binding (``bind``, ``--map`` of a parameter), not listed in
     ``unused``. Reads the units' model descriptions; an instance whose unit cannot be read is skipped
-    (the pre-flight check reports it)."""
+    (the pre-flight check reports it). ``resolved``: the scenario is already resolved (a plan's)."""
     try:
-        s = resolve(scenario)
+        s = scenario if resolved else resolve(scenario)
     except Exception:  # a wrong binding is reported by the pre-flight check
         s = scenario
     out = []
