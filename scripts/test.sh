@@ -10,4 +10,4 @@ scripts/lint.sh   # cargo fmt --check, cargo clippy -D warnings, ruff check
 cargo test --release --locked
 # free space where the tests write (a full disk shows up as odd failures: say it in the log first)
 df -Ph "${TMPDIR:-/tmp}" . | awk 'NR > 1 {print "test.sh: " $4 " free on " $6 " (" $1 ")"}'
-.venv/bin/python -m pytest -q   # testpaths (pyproject.toml): tests/, the papers' own tests under scfmu/, the family tests under src/models/
+.venv/bin/python -m pytest -q -n 2 --dist loadfile   # two processes, a test file each (pytest-xdist); testpaths (pyproject.toml): tests/, the papers' own tests under scfmu/, the family tests under src/models/

@@ -214,6 +214,8 @@ def test_limits_travel_with_a_campaigns_runs_to_the_worker(bomb, monkeypatch):
     monkeypatch.delenv("SCFMU_FMU_MAX_RATIO")  # the worker's own environment says nothing
     try:
         row, _ = campaign.run_one(spec)
+        # the run's limits held for the run only: this process is back to its environment's
+        assert fmu_mod.archive_limits() == fmu_mod.ArchiveLimits.from_env() and fmu_mod.archive_limits().max_ratio != 300
     finally:
         fmu_mod.set_archive_limits(None)
     assert row["status"] != "ok" and "at most 300" in row["message"], row

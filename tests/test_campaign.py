@@ -425,3 +425,25 @@ def test_campaign_metrics_equal_those_of_a_full_log_reference_run(name, t, overr
     for k in cols:
         a, b = row[k], float(want.get(k, np.nan))
         assert np.array(a).view(np.int64) == np.array(b).view(np.int64) or (np.isnan(a) and np.isnan(b)), (k, a, b)
+
+
+def test_a_local_cluster_leaves_port_8787_alone(tmp_path):
+    """Another Dask on the machine (a second campaign, a notebook's cluster) holds the usual dashboard port:
+    the local cluster takes a free port instead and Dask prints no port warning into the run's messages."""
+    import socket
+    import warnings
+    holder = socket.socket()
+    try:
+        holder.bind(("127.0.0.1", 8787))
+        holder.listen(1)
+    except OSError:
+        holder.close()
+        pytest.skip("port 8787 is taken by something else already")
+    try:
+        with warnings.catch_warnings(record=True) as seen:
+            warnings.simplefilter("always")
+            rows = rows_of(campaign.run(small_campaign(t=1.0), tmp_path, n_workers=1, progress=False))
+    finally:
+        holder.close()
+    assert len(rows) == 16  # the campaign ran
+    assert not [w for w in seen if "8787" in str(w.message)], [str(w.message) for w in seen]

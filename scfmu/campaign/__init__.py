@@ -155,6 +155,10 @@ def _client(scheduler: str | None, n_workers: int | None):
     try:
         cluster = LocalCluster(n_workers=n_workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
                                dashboard_address=None, host="127.0.0.1",
+                               # no dashboard; the scheduler's HTTP routes on a free local port, not 8787:
+                               # a second campaign (or any Dask) on the machine holds 8787, and Dask would
+                               # print a port warning into the command's one-line messages
+                               scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
                                silence_logs=logging.CRITICAL)
     finally:
         if main:

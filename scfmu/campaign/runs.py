@@ -56,15 +56,22 @@ def run_one(spec: dict, fmu_dir: str | None = None, blobs: dict | None = None) -
     that crashes or hangs costs that run only (status ``crash`` or ``timeout``)."""
     if os.environ.get("SCFMU_CRASH_TEST_RUN") == str(spec["run"]):  # test hook: a worker that dies mid-run
         os._exit(70)
+    # the client's archive limits hold for this run only: a run in the client's own process (a local
+    # campaign, a notebook) must not freeze them for whatever that process extracts afterwards
+    limits, before = spec.get("archive_limits"), None
     try:
-        if spec.get("archive_limits"):
-            fmu_access.set_archive_limits(spec["archive_limits"])
-        spec = _materialize(spec, blobs)
-    except Exception as e:
-        return _failed_row(spec, "error", f"{type(e).__name__}: {e}"), None
-    if spec.get("isolate") and isolate.available():
-        return _run_isolated(spec, fmu_dir)
-    return _run_body(spec, fmu_dir)
+        try:
+            if limits:
+                before = fmu_access.set_archive_limits(limits)
+            spec = _materialize(spec, blobs)
+        except Exception as e:
+            return _failed_row(spec, "error", f"{type(e).__name__}: {e}"), None
+        if spec.get("isolate") and isolate.available():
+            return _run_isolated(spec, fmu_dir)
+        return _run_body(spec, fmu_dir)
+    finally:
+        if limits:
+            fmu_access.set_archive_limits(before)
 
 
 def _failed_row(spec: dict, status: str, message: str) -> dict:

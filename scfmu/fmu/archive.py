@@ -69,11 +69,13 @@ class ArchiveLimits:
 _LIMITS_OVERRIDE: ArchiveLimits | None = None
 
 
-def set_archive_limits(limits: ArchiveLimits | dict | None) -> None:
+def set_archive_limits(limits: ArchiveLimits | dict | None) -> ArchiveLimits | None:
     """Uses ``limits`` for every extraction of this process (a campaign's workers get the client's);
-    None restores the environment's/defaults."""
+    None restores the environment's/defaults. Returns the limits set before, to put back."""
     global _LIMITS_OVERRIDE
+    before = _LIMITS_OVERRIDE
     _LIMITS_OVERRIDE = ArchiveLimits(**limits) if isinstance(limits, dict) else limits
+    return before
 
 
 def archive_limits() -> ArchiveLimits:
