@@ -192,7 +192,8 @@ def _parser() -> argparse.ArgumentParser:
     add_scenario_arguments(ap)
     ap.add_argument("--engine", default=None, choices=ENGINES,
                     help="engine (all give bit-identical results on Co-Simulation units); default native, or, "
-                         "when a unit runs as Model Exchange, compiled (else lean)")
+                         "when a unit runs as Model Exchange, compiled (else native; lean, SciPy, only "
+                         "without either Rust library)")
     ap.add_argument("--out", default=None, help="output folder (default out/<scenario>[+<unit>...]: its own folder "
                                                 "per run; another run's folder gets a -2, -3, ... suffix)")
     ap.add_argument("--no-plot", action="store_true")
@@ -268,10 +269,16 @@ def main(argv=None) -> int:
                                      resolved=True)
     if args.engine is None:
         args.engine = "native"
-        if plan.model_exchange:  # native nests a Model Exchange unit as its Co-Simulation face (scfmu.engines.
-            # cs_face: the wrapper library of this platform); the compiled loop integrates it directly
+        if plan.model_exchange:  # both Rust engines step a Model Exchange unit with the one stepper
+            # (scfmu/engines/fmi_stepper): the compiled loop directly, native through the unit's Co-Simulation
+            # face (scfmu.engines.cs_face, the wrapper library of this platform). SciPy (lean) only when
+            # neither library is here, and then said.
             from .engines.compiled import available
-            args.engine = "compiled" if available() else "lean"
+            from .engines.cs_face import wrapper_library
+            args.engine = "compiled" if available() else "native" if wrapper_library() else "lean"
+            if args.engine == "lean":
+                print("scfmu run: no compiled loop or Model Exchange wrapper library for this platform: the "
+                      "Model Exchange units are integrated by SciPy (--engine lean)", file=sys.stderr)
     if args.log_every != 1 and args.engine != "native":
         raise UsageError(f"--log-every {args.log_every}: allowed only with --engine native (the {args.engine} "
                          f"engine logs every step)")
