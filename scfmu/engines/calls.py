@@ -109,6 +109,10 @@ class RawCalls:
             return lambda t, h: f(comp, t, h, 1)
         flags = (c_bool * 3)()
         last = c_double()
+        # the unit writes into both at every step: they live as long as this instance's calls (a buffer
+        # known only by its address would be freed when this function returns, and the unit would write
+        # lastSuccessfulTime into freed memory)
+        self._step_outputs = (flags, last)
         a_ev, a_term, a_early = (ctypes.addressof(flags) + i for i in range(3))
         a_last = ctypes.addressof(last)
         fmu = self.fmu
