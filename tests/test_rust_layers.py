@@ -18,7 +18,8 @@ from pathlib import Path
 SRC = Path(__file__).resolve().parents[1] / "src"
 ENGINES = SRC.parent / "scfmu" / "engines"  # scfmu's own Rust crates: the compiled loop, the ME wrapper, the stepper
 # (crate root, folders below it that are other crates)
-CRATES = [(SRC, ("cdylib", "package")), (SRC / "cdylib", ()), (SRC / "package" / "src", ())] + [
+CRATES = [(SRC, ("cdylib", "package", "dopri")), (SRC / "cdylib", ()), (SRC / "package" / "src", ()),
+          (SRC / "dopri" / "src", ())] + [
     (c.parent / "src", ()) for c in sorted(ENGINES.glob("*/Cargo.toml"))]
 BRACES = re.compile(r"(?<!\$)\b((?:crate|super|self)(?:::\w+)*)::\{([^{}]*)\}")  # `use super::{a, b::c}`
 PATH = re.compile(r"(?<!\$)\b(crate(?:::\w+)+|super(?:::\w+)+|self::\{[^}]*\}|self(?:::\w+)+)")
@@ -133,7 +134,7 @@ def violations(root: Path, other_crates=()) -> list[str]:
 def test_no_file_circle_in_any_crate_and_no_import_across_fmi_versions():
     found = {str(root.relative_to(SRC.parent)): violations(root, other) for root, other in CRATES}
     assert all(v == [] for v in found.values()), found
-    assert len(CRATES) == 6, [str(r) for r, _ in CRATES]  # src, cdylib, package + native_loop, me_cs, fmi_stepper
+    assert len(CRATES) == 7, [str(r) for r, _ in CRATES]  # src, cdylib, package, dopri + native_loop, me_cs, fmi_stepper
 
 
 def test_the_whole_crate_is_read():
@@ -145,7 +146,7 @@ def test_the_whole_crate_is_read():
     every = {p for p in SRC.rglob("*.rs") if p.parent != SRC / "package" / "tests"} - {SRC / "package" / "src" / "main.rs"}
     every |= set(ENGINES.glob("*/src/**/*.rs"))
     assert every == read
-    graph = edges(SRC, ("cdylib", "package"))
+    graph = edges(SRC, ("cdylib", "package", "dopri"))
     assert ("models", "attitude", "plant", "environment") in graph[("models", "attitude", "plant")]
     assert ("fmi", "boundary") in graph[("fmi", "fmi3", "common")]
 
