@@ -76,14 +76,9 @@ impl Stepper {
         self.accepted += 1;
         // ----- state events: a sign change of an indicator over [t, t + h]
         let mut t_new = if (t + h - t_stop).abs() <= eps { t_stop } else { t + h };
-        let mut crossed = false;
-        if self.nz > 0 {
-            // the unit is at (t + h, x_new) after the last stage
-            let mut zn = std::mem::take(&mut self.z_new);
-            w = w.max(self.indicators(u, &mut zn)?);
-            self.z_new = zn;
-            crossed = self.z.iter().zip(&self.z_new).any(|(a, b)| (*a > 0.0) != (*b > 0.0));
-        }
+        // the unit is at (t + h, x_new) after the last stage
+        let (crossed, wz) = self.crossed(u)?;
+        w = w.max(wz);
         if crossed {
             let (hi, st) = self.locate(u, t, h, eps, Self::dp_state_at)?;
             w = w.max(st);

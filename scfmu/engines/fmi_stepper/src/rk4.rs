@@ -56,14 +56,7 @@ impl Stepper {
             h = t_stop - t;
         }
         if !first {
-            let mut k0 = std::mem::take(&mut self.k[0]);
-            let r = if self.at == Some(t) {
-                self.derivatives_here(u, &mut k0)
-            } else {
-                self.rhs(u, t, &self.x, &mut k0)
-            };
-            self.k[0] = k0;
-            w = w.max(r?);
+            w = w.max(self.k1(u, t)?);
         }
         self.at = None;
         w = w.max(self.rk4_step(u, t, h)?);
@@ -75,13 +68,8 @@ impl Stepper {
         } else {
             w = w.max(self.set(u, t_new, &self.x_new)?);
         }
-        let mut crossed = false;
-        if self.nz > 0 {
-            let mut zn = std::mem::take(&mut self.z_new);
-            w = w.max(self.indicators(u, &mut zn)?);
-            self.z_new = zn;
-            crossed = self.z.iter().zip(&self.z_new).any(|(a, b)| (*a > 0.0) != (*b > 0.0));
-        }
+        let (crossed, wz) = self.crossed(u)?;
+        w = w.max(wz);
         if crossed {
             let (hi, st) = self.locate(u, t, h, eps, Self::rk4_state_at)?;
             w = w.max(st);

@@ -1,7 +1,7 @@
 //! The stepper's state and one communication step (see the crate documentation): the pieces between
 //! events, the event iteration, and the one event-location method.
 
-use crate::unit::{Method, Settings, Stop, Unit, WARNING};
+use crate::unit::{Method, Settings, Stop, Unit, OK, WARNING};
 
 const MAX_STEPS_PER_INTERVAL: usize = 1_000_000;
 const MAX_EVENT_ITERATIONS: usize = 1000;
@@ -157,9 +157,8 @@ impl Stepper {
         Err(Stop::Solver) // an event iteration that never settles
     }
 
-    /// Start of an event-free piece at t: k1 = f(t, x) into `k[0]` (only the derivatives where the unit already
-    /// is at (t, x)); the adaptive method's first step size when it has none.
-    fn piece_start(&mut self, u: &mut impl Unit, t: f64, t_stop: f64) -> Result<i32, Stop> {
+    /// k1 = f(t, x) into `k[0]`: only the derivatives when the unit already is at (t, x).
+    pub(crate) fn k1(&mut self, u: &mut impl Unit, t: f64) -> Result<i32, Stop> {
         let mut k0 = std::mem::take(&mut self.k[0]);
         let r = if self.at == Some(t) {
             self.derivatives_here(u, &mut k0)
@@ -167,7 +166,25 @@ impl Stepper {
             self.rhs(u, t, &self.x, &mut k0)
         };
         self.k[0] = k0;
-        let w = r?;
+        r
+    }
+
+    /// The event indicators where the unit is now, into `z_new`, and whether one changed sign since `z`
+    /// (with the worst status of the call).
+    pub(crate) fn crossed(&mut self, u: &mut impl Unit) -> Result<(bool, i32), Stop> {
+        if self.nz == 0 {
+            return Ok((false, OK));
+        }
+        let mut zn = std::mem::take(&mut self.z_new);
+        let w = self.indicators(u, &mut zn)?;
+        self.z_new = zn;
+        Ok((self.z.iter().zip(&self.z_new).any(|(a, b)| (*a > 0.0) != (*b > 0.0)), w))
+    }
+
+    /// Start of an event-free piece at t: k1 = f(t, x) into `k[0]` (only the derivatives where the unit already
+    /// is at (t, x)); the adaptive method's first step size when it has none.
+    fn piece_start(&mut self, u: &mut impl Unit, t: f64, t_stop: f64) -> Result<i32, Stop> {
+        let w = self.k1(u, t)?;
         self.at = Some(t);
         if self.h <= 0.0 && self.nx > 0 && self.settings.method == Method::DormandPrince {
             self.h = self.initial_step(u, t, t_stop - t)?;
