@@ -68,15 +68,15 @@
 //! packaging tool expands each cited key in the model's documentation and refuses an undeclared one.
 
 pub use crate::catalogue::{
-    read_catalogue, BoundDescription, Catalogue, FamilyDescription, FeedthroughDescription, LayerInfo,
-    ModelDescription, PackageInfo, Reference, ReferenceDescription, StateDescription, VariableDescription,
+    read_catalogue, BoundDescription, Catalogue, ClockDescription, FamilyDescription, FeedthroughDescription,
+    LayerInfo, ModelDescription, PackageInfo, Reference, ReferenceDescription, StateDescription, VariableDescription,
     CATALOGUE_FORMAT, RUNTIME_VERSION,
 };
 pub use crate::math;
 pub use crate::model::{
-    check, check_derived, check_finite_state, Bound, Causality, Experiment, Extras, Family, Feedthrough, Fmu, Model,
-    ModelEntry, ModelInfo, ModelResult, ParamEnum, Start, StateDecl, VarDecl, VarKind, Variability, Variables,
-    DERIVATIVE_VR_BASE, RESERVED_VR_START, STATE_VR_BASE, SWITCH,
+    check, check_derived, check_finite_state, Bound, Causality, ClockDecl, Experiment, Extras, Family, Feedthrough,
+    Fmu, Model, ModelEntry, ModelInfo, ModelResult, ParamEnum, Start, StateDecl, VarDecl, VarKind, Variability,
+    Variables, CLOCK_VR_BASE, DERIVATIVE_VR_BASE, RESERVED_VR_START, STATE_VR_BASE, SWITCH,
 };
 pub use crate::models::ports::{check_unit_quaternions, AttitudeControllerPorts};
 pub use crate::{declare_variables, export_fmus, param_enum};
@@ -119,6 +119,18 @@ pub fn describe(e: &ModelEntry) -> ModelDescription {
                 })
                 .collect()
         }),
+        clocks: e
+            .clocks
+            .iter()
+            .map(|c| ClockDescription {
+                name: c.name.into(),
+                description: c.description.into(),
+                interval: c.interval.into(),
+                shift: c.shift.into(),
+                steps: c.steps,
+                outputs: crate::model::clocked_outputs(e, c),
+            })
+            .collect(),
     }
 }
 
@@ -154,6 +166,7 @@ pub fn layer_info() -> LayerInfo {
         state_vr_base: STATE_VR_BASE,
         derivative_vr_base: DERIVATIVE_VR_BASE,
         reserved_vr_start: RESERVED_VR_START,
+        clock_vr_base: CLOCK_VR_BASE,
     }
 }
 

@@ -323,8 +323,41 @@ impl StateDecl {
 pub const STATE_VR_BASE: u32 = 1_000_000_000;
 /// Value reference of the derivative of continuous state i: `DERIVATIVE_VR_BASE + i`.
 pub const DERIVATIVE_VR_BASE: u32 = 1_000_100_000;
+/// Value reference of clock i of a clocked model ([`ClockDecl`], FMI 3.0 only): `CLOCK_VR_BASE + i`.
+pub const CLOCK_VR_BASE: u32 = 1_000_200_000;
 /// First value reference reserved for the layer (continuous states, their derivatives; FMI 3.0 `time`).
 pub const RESERVED_VR_START: u32 = STATE_VR_BASE;
+
+/// A time-based periodic input clock of a sampled model (FMI 3.0 only; FMI 2.0 is unchanged): it ticks
+/// at t_start + shift + k·interval (k = 0, 1, …), both taken from the model's parameters, so the
+/// model description declares it `intervalVariability="fixed"` without `intervalDecimal` and the importer
+/// reads them with `fmi3GetIntervalDecimal` / `fmi3GetShiftDecimal` in Initialization Mode. Clock i of a
+/// model has value reference [`CLOCK_VR_BASE`] + i; in Scheduled Execution its priority is i (a lower
+/// index runs first when two clocks tick at the same instant).
+///
+/// The clock's model partition, at a tick t_k, with the inputs the unit holds at t_k (inputs are not
+/// clocked): first the listed `outputs` are computed (`Model::outputs` at t_k, from the state before
+/// the tick) and held until the clock's next tick; then, if `steps`, the state advances over one interval
+/// (`Model::step(t_k, interval)`). That is the model's own arithmetic in the order a sampled run reads
+/// and steps it, so a clocked run gives the sampled run's outputs bit for bit. An output that no clock
+/// lists (a diagnostic that follows the inputs between samples) is computed whenever it is read, as
+/// without clocks.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClockDecl {
+    /// Variable name of the clock (`sample_clock`, `delivery_clock`).
+    pub name: &'static str,
+    pub description: &'static str,
+    /// Name of the Real parameter (fixed) whose value is the interval T in seconds.
+    pub interval: &'static str,
+    /// Name of the Real parameter (fixed) whose value is the shift of the first tick from the start
+    /// time in seconds; "" = no shift.
+    pub shift: &'static str,
+    /// Whether the partition advances the model's state over one interval at each tick.
+    pub steps: bool,
+    /// The outputs the partition computes at each tick (FMI scalar names or vector stems such as
+    /// `q_meas`): the clocked variables of this clock.
+    pub outputs: &'static [&'static str],
+}
 
 /// A publication a library cites. Texts (model descriptions, sources, equations, variable
 /// descriptions, family overviews) cite it by its bracketed key (`[Navabi-2019] Eq. 37`); the

@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 use super::decl::{initial_of, Bound, Causality, Initial, Reference, Start, VarKind, Variability};
 
 /// Version of the catalogue's byte layout; the packaging tool refuses any other.
-pub const CATALOGUE_FORMAT: u32 = 4;
+pub const CATALOGUE_FORMAT: u32 = 5;
 
 /// Version of this crate, recorded in every catalogue (and part of every GUID).
 pub const RUNTIME_VERSION: &str = env!("CARGO_PKG_VERSION");
@@ -59,6 +59,8 @@ pub struct LayerInfo {
     pub derivative_vr_base: u32,
     /// Value references from here on (other than `time_vr`) belong to the layer.
     pub reserved_vr_start: u32,
+    /// Clock i of a clocked model has value reference `clock_vr_base + i` (FMI 3.0 only).
+    pub clock_vr_base: u32,
 }
 
 /// A family of models: one page `docs/models/<slug>.md` with a title and a Markdown overview.
@@ -110,6 +112,8 @@ pub struct ModelDescription {
     pub variables: Vec<VariableDescription>,
     /// Model Exchange: the continuous states; `None` = Co-Simulation only.
     pub states: Option<Vec<StateDescription>>,
+    /// FMI 3.0 clocks of a sampled model (empty: not clocked).
+    pub clocks: Vec<ClockDescription>,
 }
 
 impl ModelDescription {
@@ -145,6 +149,17 @@ pub struct StateDescription {
     pub description: String,
     pub depends: Option<Vec<String>>,
     pub starts_from: Vec<String>,
+}
+
+/// A `ClockDecl` as owned data (`outputs`: FMI scalar names, stems expanded in declaration order).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ClockDescription {
+    pub name: String,
+    pub description: String,
+    pub interval: String,
+    pub shift: String,
+    pub steps: bool,
+    pub outputs: Vec<String>,
 }
 
 /// A `Feedthrough` as owned data.

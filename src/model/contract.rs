@@ -5,7 +5,7 @@ use serde::{de::DeserializeOwned, Serialize};
 
 #[cfg(doc)]
 use crate::catalogue::decl::{Bound, DERIVATIVE_VR_BASE, STATE_VR_BASE};
-use crate::catalogue::decl::{Causality, ModelInfo, StateDecl, VarDecl};
+use crate::catalogue::decl::{Causality, ClockDecl, ModelInfo, StateDecl, VarDecl};
 
 /// A value read from or written to a variable.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -172,6 +172,11 @@ pub trait Model: Clone + Serialize + DeserializeOwned + Send + 'static {
     fn take_log(&mut self) -> Vec<String> {
         Vec::new()
     }
+
+    /// FMI 3.0 clocks of a sampled model: one time-based periodic input clock per partition
+    /// ([`ClockDecl`]; the FMI layer runs the partitions in clocked Co-Simulation and in Scheduled
+    /// Execution with the model's own `outputs` and `step`). Default: none (not clocked).
+    const CLOCKS: &'static [ClockDecl] = &[];
 
     // ----- Model Exchange (optional) ------------------------------------------------------------
 

@@ -5,7 +5,7 @@
 use super::contract::{Model, Variables};
 use super::feedthrough::{names, Checked};
 use super::instance::{DynModel, Fmu};
-use crate::catalogue::decl::{Causality, Feedthrough, ModelInfo, Reference, StateDecl, VarDecl};
+use crate::catalogue::decl::{Causality, ClockDecl, Feedthrough, ModelInfo, Reference, StateDecl, VarDecl};
 
 /// Registry entry of one FMU.
 #[derive(Clone, Copy)]
@@ -14,6 +14,8 @@ pub struct ModelEntry {
     pub decls: &'static [VarDecl],
     /// Model Exchange: the continuous states ([`Model::STATES`]); `None` = Co-Simulation only.
     pub states: Option<&'static [StateDecl]>,
+    /// FMI 3.0 clocks of a sampled model ([`Model::CLOCKS`]); empty = not clocked.
+    pub clocks: &'static [ClockDecl],
     pub create: fn() -> Box<dyn DynModel>,
 }
 
@@ -24,6 +26,7 @@ impl ModelEntry {
             info: &M::INFO,
             decls: M::Vars::DECLS,
             states: M::STATES,
+            clocks: M::CLOCKS,
             create: || Box::new(Fmu::<M>::default()),
         }
     }
@@ -111,4 +114,15 @@ impl Extras {
         families: &[],
         references: &[],
     };
+}
+
+/// The FMI scalar names of the outputs clock `c` of `entry` computes at its ticks ([`ClockDecl::outputs`],
+/// vector stems replaced by their components), in declaration order.
+pub fn clocked_outputs(entry: &ModelEntry, c: &ClockDecl) -> Vec<String> {
+    entry
+        .decls
+        .iter()
+        .filter(|d| d.causality == Causality::Output && c.outputs.iter().any(|n| names(entry.decls, n, d)))
+        .map(|d| d.name.to_string())
+        .collect()
 }

@@ -21,8 +21,8 @@ mod param;
 mod restore_tests;
 
 pub use crate::catalogue::decl::{
-    initial_of, Bound, Causality, Feedthrough, Initial, ModelInfo, Reference, Start, StateDecl, VarDecl, VarKind,
-    Variability, DERIVATIVE_VR_BASE, RESERVED_VR_START, STATE_VR_BASE, SWITCH,
+    initial_of, Bound, Causality, ClockDecl, Feedthrough, Initial, ModelInfo, Reference, Start, StateDecl, VarDecl,
+    VarKind, Variability, CLOCK_VR_BASE, DERIVATIVE_VR_BASE, RESERVED_VR_START, STATE_VR_BASE, SWITCH,
 };
 pub use crate::text::same_str;
 pub use contract::{
@@ -30,7 +30,7 @@ pub use contract::{
     TOLERANCE_MAX, TOLERANCE_MIN,
 };
 pub use declare::{concat, field_problem, no_duplicate_names, no_duplicate_vrs, total_len};
-pub use entry::{scalar_list, Extras, Family, ModelEntry};
+pub use entry::{clocked_outputs, scalar_list, Extras, Family, ModelEntry};
 pub use instance::{DynModel, Fmu};
 pub use param::ParamEnum;
 
