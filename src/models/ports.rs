@@ -56,9 +56,21 @@ pub fn check_unit_quaternions(p: &AttitudeControllerPorts) -> Result<(), String>
 /// member names are the ones another terminal of the same kind must have (`plug` matching), whatever
 /// the ports are called: the plant's `q`, `w` and the Mekf's `q_est`, `w_est` are both `q_*`, `w_*`.
 pub const TERMINAL_GROUPS: &[(&str, &str, &[(&str, &str)])] = &[
-    ("attitude", "Attitude quaternion and body rate", &[("q", "q"), ("w", "w")]),
-    ("attitude_ref", "Commanded attitude quaternion and body rate", &[("q", "q_ref"), ("w", "w_ref")]),
-    ("attitude_est", "Estimated attitude quaternion and body rate", &[("q", "q_est"), ("w", "w_est")]),
+    (
+        "attitude",
+        "Attitude quaternion and body rate",
+        &[("q", "q"), ("w", "w")],
+    ),
+    (
+        "attitude_ref",
+        "Commanded attitude quaternion and body rate",
+        &[("q", "q_ref"), ("w", "w_ref")],
+    ),
+    (
+        "attitude_est",
+        "Estimated attitude quaternion and body rate",
+        &[("q", "q_est"), ("w", "w_est")],
+    ),
 ];
 
 /// `terminalKind` of [`TERMINAL_GROUPS`] (vendor-specific kinds start with `_scfmu_`, as FMI 3.0 asks).
@@ -116,7 +128,11 @@ fn vector_ports(decls: &[VarDecl]) -> Vec<VectorPort<'_>> {
             "x" => ["x", "y", "z"].map(String::from).to_vec(),
             "1" => (1..)
                 .map(|k: usize| k.to_string())
-                .take_while(|k| decls.get(i + k.parse::<usize>().unwrap() - 1).is_some_and(|d| same(d, k)))
+                .take_while(|k| {
+                    decls
+                        .get(i + k.parse::<usize>().unwrap() - 1)
+                        .is_some_and(|d| same(d, k))
+                })
                 .collect(),
             _ => vec![],
         };
@@ -146,7 +162,11 @@ pub fn terminals(decls: &[VarDecl]) -> Vec<TerminalDescription> {
     let mut out = vec![];
     for (name, description, members) in TERMINAL_GROUPS {
         let found: Vec<&VectorPort> = members.iter().filter_map(|(_, s)| port(s)).collect();
-        if found.len() != members.len() || found.iter().any(|p| p.decls[0].causality != found[0].decls[0].causality) {
+        if found.len() != members.len()
+            || found
+                .iter()
+                .any(|p| p.decls[0].causality != found[0].decls[0].causality)
+        {
             continue;
         }
         out.push(TerminalDescription {
@@ -157,7 +177,12 @@ pub fn terminals(decls: &[VarDecl]) -> Vec<TerminalDescription> {
             members: members
                 .iter()
                 .zip(&found)
-                .flat_map(|((m, _), p)| p.decls.iter().zip(&p.suffixes).map(move |(d, x)| member(&format!("{m}_{x}"), d.name)))
+                .flat_map(|((m, _), p)| {
+                    p.decls
+                        .iter()
+                        .zip(&p.suffixes)
+                        .map(move |(d, x)| member(&format!("{m}_{x}"), d.name))
+                })
                 .collect(),
         });
     }
@@ -167,7 +192,10 @@ pub fn terminals(decls: &[VarDecl]) -> Vec<TerminalDescription> {
             ("w", _) => QUATERNION_KIND,
             ("1", _) => CHANNELS_KIND,
             (_, "") if p.stem.contains("sun") => SUN_DIRECTION_KIND,
-            (_, unit) => VECTOR_MEANINGS.iter().find(|(u, _)| *u == unit).map_or(VECTOR_KIND, |(_, k)| *k),
+            (_, unit) => VECTOR_MEANINGS
+                .iter()
+                .find(|(u, _)| *u == unit)
+                .map_or(VECTOR_KIND, |(_, k)| *k),
         };
         // the port's description, without the component ("…, x", "…, scalar part")
         let description = d.description.rsplit_once(", ").map_or(d.description, |(head, _)| head);
@@ -176,7 +204,12 @@ pub fn terminals(decls: &[VarDecl]) -> Vec<TerminalDescription> {
             kind: kind.into(),
             matching_rule: if kind == CHANNELS_KIND { "sequence" } else { "plug" }.into(),
             description: description.to_string(),
-            members: p.decls.iter().zip(&p.suffixes).map(|(d, x)| member(x, d.name)).collect(),
+            members: p
+                .decls
+                .iter()
+                .zip(&p.suffixes)
+                .map(|(d, x)| member(x, d.name))
+                .collect(),
         });
     }
     out
@@ -194,7 +227,11 @@ mod tests {
             names.sort_unstable();
             names.dedup();
             assert_eq!(names.len(), t.len(), "{}: terminal names are unique", e.info.name);
-            for d in e.decls.iter().filter(|d| matches!(d.causality, Causality::Input | Causality::Output)) {
+            for d in e
+                .decls
+                .iter()
+                .filter(|d| matches!(d.causality, Causality::Input | Causality::Output))
+            {
                 let comp = d.name.rsplit_once('_').map(|(_, x)| x);
                 if matches!(comp, Some("x" | "y" | "z" | "w")) {
                     assert!(
@@ -208,13 +245,24 @@ mod tests {
         }
         let plant = terminals(crate::registry::find("AttitudePlant").unwrap().decls);
         let att = &plant[0];
-        assert_eq!((att.name.as_str(), att.kind.as_str()), ("attitude", ATTITUDE_STATE_KIND));
+        assert_eq!(
+            (att.name.as_str(), att.kind.as_str()),
+            ("attitude", ATTITUDE_STATE_KIND)
+        );
         let m: Vec<&str> = att.members.iter().map(|(m, _)| m.as_str()).collect();
         assert_eq!(m, ["q_w", "q_x", "q_y", "q_z", "w_x", "w_y", "w_z"]);
         let tc = plant.iter().find(|x| x.name == "torque_cmd").unwrap();
-        assert_eq!((tc.kind.as_str(), tc.members[2].1.as_str()), ("_scfmu_Torque", "torque_cmd_z"));
+        assert_eq!(
+            (tc.kind.as_str(), tc.members[2].1.as_str()),
+            ("_scfmu_Torque", "torque_cmd_z")
+        );
         let hold = terminals(crate::registry::find("SampleHold").unwrap().decls);
-        assert_eq!(hold.iter().map(|x| (x.name.as_str(), x.members.len())).collect::<Vec<_>>(), [("u", 8), ("y", 8)]);
+        assert_eq!(
+            hold.iter()
+                .map(|x| (x.name.as_str(), x.members.len()))
+                .collect::<Vec<_>>(),
+            [("u", 8), ("y", 8)]
+        );
         assert!(hold.iter().all(|x| x.matching_rule == "sequence"));
     }
 }

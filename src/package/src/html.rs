@@ -150,7 +150,17 @@ pub fn documentation_html(cat: &Catalogue, m: &ModelDescription) -> String {
     if !m.terminals.is_empty() {
         h.push_str("<h2>Terminals (FMI 3.0)</h2>\n<p>In <code>terminalsAndIcons/terminalsAndIcons.xml</code> of the FMI 3.0 archive; every member is a signal.</p>\n<table>\n<tr><th>terminal</th><th>kind</th><th>matching</th><th>members (member = variable)</th><th>meaning</th></tr>\n");
         for t in &m.terminals {
-            let members: Vec<String> = t.members.iter().map(|(a, b)| if a == b { format!("<code>{a}</code>") } else { format!("<code>{a}</code> = <code>{b}</code>") }).collect();
+            let members: Vec<String> = t
+                .members
+                .iter()
+                .map(|(a, b)| {
+                    if a == b {
+                        format!("<code>{a}</code>")
+                    } else {
+                        format!("<code>{a}</code> = <code>{b}</code>")
+                    }
+                })
+                .collect();
             let _ = writeln!(
                 h,
                 "<tr><td><code>{}</code></td><td><code>{}</code></td><td>{}</td><td>{}</td><td>{}</td></tr>",

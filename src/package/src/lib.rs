@@ -236,7 +236,12 @@ fn write_archive(
     };
     add(&mut zip, "modelDescription.xml", description.as_bytes(), 0o644)?;
     for (name, bytes) in binaries {
-        add(&mut zip, name, bytes, if name.starts_with("binaries/") { 0o755 } else { 0o644 })?;
+        add(
+            &mut zip,
+            name,
+            bytes,
+            if name.starts_with("binaries/") { 0o755 } else { 0o644 },
+        )?;
     }
     add(
         &mut zip,

@@ -210,7 +210,10 @@ fn check(cat: &Catalogue, xml: Option<&Path>, docs: Option<&Path>) -> Result<(),
     if let Some(x) = xml {
         stale.extend(stale_model_descriptions(cat, x));
         stale.extend(stale_model_descriptions3(cat, &x.join("fmi3")));
-        stale.extend(spacecraft_fmus_package::terminals::stale_terminals(cat, &x.join("fmi3/terminalsAndIcons")));
+        stale.extend(spacecraft_fmus_package::terminals::stale_terminals(
+            cat,
+            &x.join("fmi3/terminalsAndIcons"),
+        ));
     }
     if let Some(d) = docs {
         stale.extend(spacecraft_fmus_package::docs::stale_pages(d, cat));
