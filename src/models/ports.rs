@@ -55,7 +55,10 @@ pub fn check_unit_quaternions(p: &AttitudeControllerPorts) -> Result<(), String>
 /// port with one causality: (terminal name, description, members as (member name, port stem)). The
 /// member names are the ones another terminal of the same kind must have (`plug` matching), whatever
 /// the ports are called: the plant's `q`, `w` and the Mekf's `q_est`, `w_est` are both `q_*`, `w_*`.
-pub const TERMINAL_GROUPS: &[(&str, &str, &[(&str, &str)])] = &[
+/// One group: (terminal name, description, members as (member name, port stem)).
+pub type TerminalGroup = (&'static str, &'static str, &'static [(&'static str, &'static str)]);
+
+pub const TERMINAL_GROUPS: &[TerminalGroup] = &[
     (
         "attitude",
         "Attitude quaternion and body rate",
@@ -110,7 +113,7 @@ struct VectorPort<'a> {
 /// and numbered channels `<stem>_1 … <stem>_n` (n ≥ 2), each a run of consecutive declarations of one
 /// causality and unit.
 fn vector_ports(decls: &[VarDecl]) -> Vec<VectorPort<'_>> {
-    let split = |d: &VarDecl| d.name.rsplit_once('_').map(|(s, x)| (s, x));
+    let split = |d: &VarDecl| d.name.rsplit_once('_');
     let is_port = |d: &VarDecl| matches!(d.causality, Causality::Input | Causality::Output);
     let mut out = vec![];
     let mut i = 0;
