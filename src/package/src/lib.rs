@@ -14,13 +14,15 @@
 //!
 //! Files: [`checks`] (what the type system cannot check), [`structure`] (dependency lists), [`xml`]
 //! (XML helpers and the elements both versions share), [`fmi2`] and [`fmi3`] (the two model
-//! descriptions), [`html`] (documentation/index.html), [`docs`] (the Markdown model pages),
-//! [`platforms`] and [`build`] (binaries), `load` (reading a library's catalogue).
+//! descriptions), [`clocks`] (the FMI 3.0 clocks of sampled models), [`html`]
+//! (documentation/index.html), [`docs`] (the Markdown model pages), [`platforms`] and [`build`]
+//! (binaries), `load` (reading a library's catalogue).
 //!
 //! This crate, not the runtime, links the XML writer and `zip`.
 
 pub mod build;
 pub mod checks;
+pub mod clocks;
 pub mod docs;
 pub mod fmi2;
 pub mod fmi3;
