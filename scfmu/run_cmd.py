@@ -194,6 +194,11 @@ def _parser() -> argparse.ArgumentParser:
                     help="engine (all give bit-identical results on Co-Simulation units); default native, or, "
                          "when a unit runs as Model Exchange, compiled (else native; lean, SciPy, only "
                          "without either Rust library)")
+    ap.add_argument("--clocks", default="sampled", choices=("sampled", "clocked", "scheduled"),
+                    help="how FMI 3.0 units with clocks run: sampled (default: they sample inside doStep, as "
+                         "FMI 2.0 units always do), clocked (clocked Co-Simulation: each clock's partition "
+                         "activated at its ticks) or scheduled (Scheduled Execution, by a small scheduler); "
+                         "bit-identical results; clocked and scheduled run on the lean engine")
     ap.add_argument("--out", default=None, help="output folder (default out/<scenario>[+<unit>...]: its own folder "
                                                 "per run; another run's folder gets a -2, -3, ... suffix)")
     ap.add_argument("--no-plot", action="store_true")
@@ -222,7 +227,8 @@ def _write(sc, r, args, out: Path, ident: dict, unbound: list, plan=None) -> Non
     m, mu = r.metrics, r.metric_units
     print(f"{sc.name}: {sc.description or ''}".rstrip(": "))
     models = _unit_labels(sc, plan)
-    print(f"  {len(r['time']) - 1} steps of {sc.step:g} s to t = {sc.stop_time:g} s on the {args.engine} engine; "
+    clocks = "" if getattr(args, "clocks", "sampled") == "sampled" else f" (units on their clocks: {args.clocks})"
+    print(f"  {len(r['time']) - 1} steps of {sc.step:g} s to t = {sc.stop_time:g} s on the {args.engine} engine{clocks}; "
           f"units {models}; metric set {sc.metrics or '(none)'}")
     for k, v in m.items():
         if isinstance(v, float) and math.isfinite(v):
@@ -231,7 +237,7 @@ def _write(sc, r, args, out: Path, ident: dict, unbound: list, plan=None) -> Non
     write_csv(csv, r)
     (out / "run.json").write_text(json.dumps(ident, indent=1, sort_keys=True))
     manifest = out / f"{stem}.manifest.json"  # what ran: the scenario as plain data, units, metrics, warnings
-    manifest.write_text(json.dumps({"scenario": sc.to_dict(), "engine": args.engine, "metrics": m,
+    manifest.write_text(json.dumps({"scenario": sc.to_dict(), "engine": args.engine, "clocks": args.clocks, "metrics": m,
                                     "unbound_slot_values": unbound}, indent=1, default=str))
     written = [csv, manifest]
     if not args.no_plot:
@@ -267,6 +273,18 @@ def main(argv=None) -> int:
         return 2
     unbound = options.binding_report(plan.scenario, "scfmu run", args.strict, lambda t: print(t, file=sys.stderr),
                                      resolved=True)
+    if args.clocks != "sampled":
+        from .engines.clocked import clock_notice, clock_problem
+        why = clock_problem(plan, args.clocks)
+        if why is None and args.engine not in (None, "lean"):
+            why = f"--clocks {args.clocks} runs on the lean engine (its clocked master), not --engine {args.engine}"
+        if why:
+            print(f"scfmu run: {why}", file=sys.stderr)
+            return 2
+        notice = clock_notice(plan, args.clocks)
+        if notice:
+            print(notice, file=sys.stderr)
+        args.engine = "lean"
     if args.engine is None:
         args.engine = "native"
         if plan.model_exchange:  # both Rust engines step a Model Exchange unit with the one stepper
@@ -288,7 +306,8 @@ def main(argv=None) -> int:
     if notice:
         print(notice, file=sys.stderr)
     try:
-        r = simulate(plan, args.engine, **({"log_every": args.log_every} if args.log_every != 1 else {}))
+        r = simulate(plan, args.engine, clocks=args.clocks,
+                     **({"log_every": args.log_every} if args.log_every != 1 else {}))
     except PlanError as e:
         print(f"scfmu run: {e}", file=sys.stderr)
         return 2
