@@ -301,6 +301,8 @@ def main(argv=None) -> int:
         raise UsageError(f"--log-every {args.log_every}: allowed only with --engine native (the {args.engine} "
                          f"engine logs every step)")
     ident = run_identity(sc, args.engine)
+    if args.clocks != "sampled":  # (a sampled run's identity stays what it was)
+        ident["clocks"] = args.clocks
     out, notice = choose_folder(Path(args.out) if args.out else Path("out") / run_folder_name(sc), ident,
                                 chosen=args.out is not None)
     if notice:

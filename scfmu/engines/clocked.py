@@ -80,8 +80,8 @@ def clock_notice(plan: Plan, mode: str) -> str | None:
     plain = [f"{u.name}{' (FMI 2.0)' if u.fmi == 2 else ''}" for u in plan.units if not u.clocks]
     if not plain:
         return None
-    return (f"--clocks {mode}: {', '.join(plain)} declare no clocks: they step with doStep on the scenario's grid "
-            f"as in a sampled run")
+    return (f"--clocks {mode}: no clocks in {', '.join(plain)}: they step with doStep on the scenario's grid as "
+            f"in a sampled run")
 
 
 class ClockedMaster(LeanMaster):
