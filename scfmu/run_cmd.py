@@ -274,16 +274,16 @@ def main(argv=None) -> int:
     unbound = options.binding_report(plan.scenario, "scfmu run", args.strict, lambda t: print(t, file=sys.stderr),
                                      resolved=True)
     if args.clocks != "sampled":
-        from .engines.clocked import clock_notice, clock_problem
+        from .engines.clocked import clock_notice, clock_problem, order_notice
         why = clock_problem(plan, args.clocks)
         if why is None and args.engine not in (None, "lean"):
             why = f"--clocks {args.clocks} runs on the lean engine (its clocked master), not --engine {args.engine}"
         if why:
             print(f"scfmu run: {why}", file=sys.stderr)
             return 2
-        notice = clock_notice(plan, args.clocks)
-        if notice:
-            print(notice, file=sys.stderr)
+        for notice in (clock_notice(plan, args.clocks), order_notice(plan, args.clocks)):
+            if notice:
+                print(notice, file=sys.stderr)
         args.engine = "lean"
     if args.engine is None:
         args.engine = "native"

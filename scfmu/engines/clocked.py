@@ -84,6 +84,28 @@ def clock_notice(plan: Plan, mode: str) -> str | None:
             f"in a sampled run")
 
 
+def order_notice(plan: Plan, mode: str) -> str | None:
+    """The one line a clocked run prints when the Gauss–Seidel order reads a clocked output before its unit's
+    inputs are set at the same instant (a loop through a sampled unit, e.g. a Mekf reading the ModeManager
+    that reads the Mekf): there the reader gets the value of the unit's previous tick, where a sampled run
+    computes it from the unit's previous inputs, so the runs may differ. None when the order has no such read."""
+    from .lean import flat_ops
+    if mode == "sampled":
+        return None
+    clocked = {u.name: {n for c in u.clocks for n in c.clocked} for u in plan.units if u.clocks}
+    ops, _b = flat_ops(plan)
+    last_set = {inst: i for i, (kind, _t, inst, *_r) in enumerate(ops) if kind == "set"}
+    early = []
+    for g in plan.groups:
+        if g.src in clocked and g.src in last_set and plan.names.index(g.dst) < plan.names.index(g.src):
+            early += [f"{g.src}.{n} (read by {g.dst})" for n in g.src_names if n in clocked[g.src]]
+    if not early:
+        return None
+    return (f"--clocks {mode}: {', '.join(early)} read before their unit's inputs are set at its ticks: the reader "
+            f"gets the previous tick's value, where a sampled run computes it from the previous inputs (a loop "
+            f"through a sampled unit in the Gauss–Seidel order); the runs may differ there")
+
+
 class ClockedMaster(LeanMaster):
     """The lean master with the plan's clocked units run on their clocks (module docstring). ``run()``
     returns what :meth:`LeanMaster.run` returns; ``activations`` counts the partitions run per (unit,
