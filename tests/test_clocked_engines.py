@@ -1,11 +1,12 @@
 """Issue 48 item 2: our engines run FMI 3.0 clocked units on their clocks (clocked Co-Simulation and a
 Scheduled Execution scheduler) and give the sampled run's outputs.
 
-Oracle: the same scenario with the FMI 2.0 units on the reference master (fmpy's high-level calls, the
-units sampling inside doStep), written to CSV; the sampled FMI 3.0 run, the clocked run and the scheduled
-run must write the same CSV byte for byte. The schedule is checked against the closed form (tick k of a
-clock at t_start + shift + k·interval: the counts of activations). Errors: the one-line refusals of the
-command line and the API."""
+Oracles: the same scenario on the reference master (fmpy's high-level calls, every unit sampling inside
+doStep: our FMI 2.0 units, or a foreign clocked C unit run with eventModeUsed = false), written to CSV; the
+sampled, clocked and scheduled runs must write the same CSV byte for byte. The foreign unit's law in NumPy
+(tests/foreign_clocked.py), and the schedule's closed form (tick k of a clock at t_start + shift +
+k·interval: the counts of activations). Errors: the one-line refusals of the command line and the API, and
+a partition activated off its tick."""
 
 from __future__ import annotations
 
@@ -15,8 +16,9 @@ import math
 import numpy as np
 import pytest
 
+import foreign_clocked
 from scfmu import run_cmd
-from scfmu.engines import simulate
+from scfmu.engines import SimulationError, simulate
 from scfmu.engines.clocked import ClockedMaster, clock_notice, clock_problem
 from scfmu.engines.scheduler import Scheduler
 from scfmu.fmu import described, fmu_dir
@@ -24,6 +26,7 @@ from scfmu.scenario import get
 from scfmu.scenario.plan import PlanError, build_plan
 
 FMI3 = fmu_dir() / "fmi3"
+KP, KD = 14.965939284399212, 20.0  # paper 002's PID gains (ki = 0)
 
 
 def has_clocks(model: str) -> bool:
@@ -52,6 +55,78 @@ def csv_bytes(res, path) -> bytes:
 def bits_equal(a: dict, b: dict) -> bool:
     return list(a) == list(b) and all(np.array_equal(np.asarray(a[k]).view(np.uint64), np.asarray(b[k]).view(np.uint64))
                                       for k in a)
+
+
+@pytest.fixture(scope="module")
+def c3(tmp_path_factory):
+    d = tmp_path_factory.mktemp("c3clocked")
+    return foreign_clocked.build(d), foreign_clocked.build(d, scheduled=False)
+
+
+def foreign_loop(fmu, step=0.001, delay=0.004, stop=1.0):
+    """paper 002's single-axis loop with the foreign clocked PD (100 Hz, command delivered ``delay`` later) in
+    the controller's place and the FMI 3.0 plant when there is one."""
+    sc = get("paper002/PID", stop_time=stop, step=step).with_models({"controller": str(fmu)})
+    sc = sc.with_overrides({"controller.period": 0.01, "controller.delay": delay, "controller.kp": KP,
+                            "controller.kd": KD})
+    return in_fmi3(sc, {"plant"})
+
+
+@pytest.mark.parametrize("step,delay", [(0.001, 0.004), (0.02, 0.004), (0.005, 0.0)])
+def test_a_foreign_clocked_unit_gives_its_sampled_run_three_ways(c3, step, delay, tmp_path):
+    """A 100 Hz PD on a 1 kHz, a 50 Hz (samples between grid points) and a 200 Hz grid, with and without a
+    delivery delay: sampled (the unit's own sampling, on fmpy's calls and on the lean master), clocked and
+    scheduled write the same CSV; on the 1 kHz grid u is the law in NumPy from the logged theta, exactly."""
+    sc = foreign_loop(c3[0], step, delay)
+    ref_res = simulate(sc, "reference")
+    ref = csv_bytes(ref_res, tmp_path / "ref.csv")
+    plan = build_plan(sc)
+    assert [(c.name, c.vr, c.priority, c.clocked) for c in plan.unit("controller").clocks] == [
+        ("sample_clock", 100, 0, ["error"]), ("delivery_clock", 101, 1, ["u"])]
+    for clocks in ("sampled", "clocked", "scheduled"):
+        assert csv_bytes(simulate(plan, "lean", clocks=clocks), tmp_path / f"{clocks}.csv") == ref, clocks
+    assert abs(ref_res["theta"][-1]) > 0.05  # the loop moved
+    if step == 0.001:
+        u = foreign_clocked.pd_oracle(ref_res["time"], ref_res["theta"], sc.inputs["controller.theta_ref"], 0.01,
+                                      delay, KP, KD)
+        assert np.array_equal(u, ref_res["u"])
+
+
+def test_the_scheduler_activates_every_tick_once_in_time_and_priority_order(c3):
+    plan = build_plan(foreign_loop(c3[0], 0.02, 0.0))
+    with Scheduler(plan, log_activations=True) as se:
+        se.run()
+        log, acts, pre, timing = list(se.activation_log), dict(se.activations), dict(se.preemption), se.timing
+    assert [(c.name, i, s) for c, i, s in timing["controller"]] == [("sample_clock", 0.01, 0.0),
+                                                                    ("delivery_clock", 0.01, 0.0)]
+    assert acts == {("controller", "sample_clock"): 101, ("controller", "delivery_clock"): 101}
+    assert log[:4] == [(0.0, "controller", "sample_clock"), (0.0, "controller", "delivery_clock"),
+                       (0.01, "controller", "sample_clock"), (0.01, "controller", "delivery_clock")]
+    assert [t for t, _u, _c in log] == sorted(t for t, _u, _c in log)
+    # the unit brackets each partition with lockPreemption / unlockPreemption: one pair per activation
+    assert pre == {"locks": 202, "unlocks": 202, "depth": 0, "max_depth": 1, "errors": []}
+
+
+def test_a_partition_activated_off_its_tick_fails_the_run_with_the_units_message(c3):
+    plan = build_plan(foreign_loop(c3[0], 0.02, 0.004, stop=0.1))
+    why = {ClockedMaster: "nextEventTime 0.004, but the clocks' next tick is 0.005",  # (the master's check)
+           Scheduler: "fmi3ActivateModelPartition: clock 101 does not tick at t = 0.0050"}  # (the unit's)
+    for master in (ClockedMaster, Scheduler):
+        with master(plan) as m:
+            c, interval, shift = m.timing["controller"][1]
+            m.timing["controller"][1] = (c, interval, shift + 0.001)  # the master's schedule 1 ms late
+            with pytest.raises(SimulationError, match=why[master]):
+                m.run()
+
+
+def test_scheduled_needs_the_interface_clocked_does_not(c3):
+    plan = build_plan(foreign_loop(c3[1], 0.02, 0.004, stop=0.1))
+    assert clock_problem(plan, "clocked") is None
+    assert clock_problem(plan, "scheduled") == ("--clocks scheduled: controller (C3SampledPd_cs.fmu) has clocks but no "
+                                                "<ScheduledExecution> interface")
+    with pytest.raises(PlanError, match="no <ScheduledExecution>"):
+        simulate(plan, clocks="scheduled")
+    assert bits_equal(simulate(plan, clocks="clocked"), simulate(plan, "reference"))
 
 
 def pid_loop():

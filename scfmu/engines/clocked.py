@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import ctypes
 import math
+from pathlib import Path
 from ctypes import c_bool, c_double, c_int, c_uint32
 
 from .. import binding
@@ -49,6 +50,10 @@ def runnable_clocks(u) -> list:
     return [c for c in u.clocks if c.causality == "input" and c.interval_variability in ("constant", "fixed")]
 
 
+def _label(u) -> str:
+    return Path(u.model).name  # a model name, or an FMU file's name
+
+
 def clock_problem(plan: Plan, mode: str) -> str | None:
     """Why ``plan`` cannot run with ``clocks=mode`` (None when it can), in one line."""
     if mode not in CLOCK_MODES:
@@ -63,13 +68,13 @@ def clock_problem(plan: Plan, mode: str) -> str | None:
                 f"or run sampled")
     for u in clocked:
         if u.interface != "cs":
-            return f"--clocks {mode}: {u.name} ({u.model}) runs as Model Exchange: its clocks run in Co-Simulation only"
+            return f"--clocks {mode}: {u.name} ({_label(u)}) runs as Model Exchange: its clocks run in Co-Simulation only"
         odd = [c.name for c in u.clocks if c not in runnable_clocks(u)]
         if odd:
-            return (f"--clocks {mode}: {u.name} ({u.model}): clock(s) {', '.join(odd)} are not periodic input "
+            return (f"--clocks {mode}: {u.name} ({_label(u)}): clock(s) {', '.join(odd)} are not periodic input "
                     f"clocks of interval variability constant or fixed, the only ones this master schedules")
         if mode == "scheduled" and u.md.scheduledExecution is None:
-            return f"--clocks scheduled: {u.name} ({u.model}) has clocks but no <ScheduledExecution> interface"
+            return f"--clocks scheduled: {u.name} ({_label(u)}) has clocks but no <ScheduledExecution> interface"
     return None
 
 
@@ -161,7 +166,7 @@ class ClockedMaster(LeanMaster):
                 st = binding.bind(sl.dll, fname, raw=True)(comp, ctypes.addressof(vrs), n,
                                                            *[ctypes.addressof(a) for a in args])
                 if st > 1:
-                    raise SimulationError("fmu_error", f"{name} ({u.model}): {fname} failed: "
+                    raise SimulationError("fmu_error", f"{name} ({_label(u)}): {fname} failed: "
                                           + " | ".join(fmu.last_errors()))
             got = {c.vr: (iv[i], sh[i]) for i, c in enumerate(fixed)}
         timing = []
@@ -169,7 +174,7 @@ class ClockedMaster(LeanMaster):
             interval, shift = got.get(c.vr, (c.interval, c.shift or 0.0))
             if not (interval is not None and math.isfinite(interval) and interval > 0 and math.isfinite(shift)
                     and shift >= 0):
-                raise SimulationError("fmu_error", f"{name} ({u.model}): clock {c.name} has interval {interval} and "
+                raise SimulationError("fmu_error", f"{name} ({_label(u)}): clock {c.name} has interval {interval} and "
                                       f"shift {shift}: a periodic clock needs a finite interval > 0 and shift >= 0")
             timing.append((c, float(interval), float(shift)))
         timing.sort(key=lambda x: (x[0].priority if x[0].priority is not None else 1 << 31, x[0].vr))

@@ -325,10 +325,10 @@ class Fmu(ModelExchange):
             raise KeyError(f"{self.model} has no variable {name!r}") from None
 
     def inputs(self) -> list[str]:
-        return [v.name for v in self.md.modelVariables if v.causality == "input"]
+        return [v.name for v in self.md.modelVariables if v.causality == "input" and v.type != "Clock"]
 
-    def outputs(self) -> list[str]:
-        return [v.name for v in self.md.modelVariables if v.causality == "output"]
+    def outputs(self) -> list[str]:  # (FMI 3.0 clocks are no ports)
+        return [v.name for v in self.md.modelVariables if v.causality == "output" and v.type != "Clock"]
 
     def set(self, name: str, value) -> None:
         v = self.var(name)

@@ -112,11 +112,12 @@ class Unit:
 
     @property
     def inputs(self) -> list[str]:
-        return [n for n, v in self.vars.items() if v.causality == "input"]
+        """The input ports (an FMI 3.0 input clock is no port: the engines that run clocks activate it)."""
+        return [n for n, v in self.vars.items() if v.causality == "input" and v.type != "Clock"]
 
     @property
     def outputs(self) -> list[str]:
-        return [n for n, v in self.vars.items() if v.causality == "output"]
+        return [n for n, v in self.vars.items() if v.causality == "output" and v.type != "Clock"]
 
 
 @dataclass
