@@ -11,6 +11,7 @@ a partition activated off its tick."""
 from __future__ import annotations
 
 import copy
+import json
 import math
 
 import numpy as np
@@ -218,18 +219,19 @@ def test_clocks_on_fmi2_units_are_refused_in_one_line(capsys):
     assert err == ["scfmu run: " + why]
 
 
-@needs_clocks
-def test_cli_runs_on_the_clocks_and_refuses_another_engine(tmp_path, capsys):
-    pid = str(FMI3 / "PidController.fmu")
-    args = ["paper002/PID", "--t-end", "0.05", "--fmu", f"controller={pid}", "--set", "controller.kp=15",
-            "--set", "controller.step=0.001", "--no-plot"]
+def test_cli_runs_on_the_clocks_and_refuses_another_engine(c3, tmp_path, capsys):
+    args = ["paper002/PID", "--t-end", "0.05", "--fmu", f"controller={c3[0]}", "--set", f"controller.kp={KP}",
+            "--set", f"controller.kd={KD}", "--set", "controller.delay=0.004", "--no-plot"]
     assert run_cmd.main(args + ["--clocks", "clocked", "--engine", "native"]) == 2
     assert capsys.readouterr().err.strip().splitlines()[-1] == (
         "scfmu run: --clocks clocked runs on the lean engine (its clocked master), not --engine native")
     for clocks in ("sampled", "scheduled"):
-        assert run_cmd.main(args + ["--clocks", clocks, "--engine", "lean", "--out", str(tmp_path / clocks)]) == 0
+        assert run_cmd.main(args + ["--clocks", clocks, "--out", str(tmp_path / clocks)]) == 0
     out = capsys.readouterr()
-    assert "units on their clocks: scheduled" in out.out
-    assert "--clocks scheduled: no clocks in plant (FMI 2.0)" in out.err
+    assert "on the lean engine (units on their clocks: scheduled)" in out.out
+    assert ("--clocks scheduled: no clocks in plant (FMI 2.0): they step with doStep on the scenario's grid as in a "
+            "sampled run") in out.err.splitlines()
     a = (tmp_path / "sampled" / "paper002_PID.csv").read_bytes()
     assert a == (tmp_path / "scheduled" / "paper002_PID.csv").read_bytes()
+    manifest = json.loads((tmp_path / "scheduled" / "paper002_PID.manifest.json").read_text())
+    assert (manifest["engine"], manifest["clocks"]) == ("lean", "scheduled")
