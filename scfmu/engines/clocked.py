@@ -127,6 +127,7 @@ class ClockedMaster(LeanMaster):
         self.scenario = self.plan.scenario
         self.clocked = [u for u in self.plan.units if u.clocks]
         self.timing: dict = {}  # unit -> [(clock, interval, shift)] in priority order
+        self.shortest: dict = {}  # unit -> its shortest clock interval
         self.activations: dict = {}
         self.activation_log = [] if log_activations else None
         self.fmus = {}
@@ -179,6 +180,7 @@ class ClockedMaster(LeanMaster):
             timing.append((c, float(interval), float(shift)))
         timing.sort(key=lambda x: (x[0].priority if x[0].priority is not None else 1 << 31, x[0].vr))
         self.timing[name] = timing
+        self.shortest[name] = min(i for _c, i, _s in timing)  # (the tolerance of the unit's ticks)
 
     def _prepare_clocks(self) -> None:
         """The place of each clocked unit's partitions in the exchange, and its FMI clock functions."""
@@ -262,7 +264,7 @@ class ClockedMaster(LeanMaster):
         s2, nxt = c["update"]()
         st |= s2
         want = self.next_tick(n)
-        if st <= 1 and nxt is not None and abs(nxt - want) > tolerance(want, self.timing[n][0][1]):
+        if st <= 1 and nxt is not None and abs(nxt - want) > tolerance(want, self.shortest[n]):
             self.fmus[n].messages.append((3, "", f"fmi3UpdateDiscreteStates at t = {t}: nextEventTime {nxt}, but "
                                           f"the clocks' next tick is {want}"))
             st = 3
@@ -275,7 +277,7 @@ class ClockedMaster(LeanMaster):
         st = 0
         while True:
             tk = self.next_tick(n)
-            if tk >= t_end - tolerance(t_end, self.timing[n][0][1]):
+            if tk >= t_end - tolerance(t_end, self.shortest[n]):
                 break
             st |= c["step"](t, tk - t)
             st |= self._tick(n, self.due(n, tk), tk, False)
