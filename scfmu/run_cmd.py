@@ -207,15 +207,18 @@ def _parser() -> argparse.ArgumentParser:
     return ap
 
 
-def _unit_labels(sc, plan) -> str:
+def _unit_labels(sc, plan, clocks: str = "sampled") -> str:
     """``plant=AttitudePlant.fmu, controller=X.fmu (FMI 3.0 Model Exchange)``: each unit's file, with how it
-    runs when that is not FMI 2.0 Co-Simulation."""
+    runs when that is not FMI 2.0 Co-Simulation (a unit with clocks: clocked Co-Simulation or Scheduled
+    Execution under ``--clocks``)."""
     how = {u.name: (u.fmi, u.interface) for u in plan.units} if plan is not None else {}
+    clocked = {u.name for u in plan.units if u.clocks} if plan is not None and clocks != "sampled" else set()
+    cs = {"clocked": "clocked Co-Simulation", "scheduled": "Scheduled Execution"}.get(clocks, "Co-Simulation")
     out = []
     for c in sc.components:
         fmi, itf = how.get(c.name, (2, "cs"))
         note = "" if (fmi, itf) == (2, "cs") else \
-            f" (FMI {fmi}.0 {'Model Exchange' if itf == 'me' else 'Co-Simulation'})"
+            f" (FMI {fmi}.0 {'Model Exchange' if itf == 'me' else cs if c.name in clocked else 'Co-Simulation'})"
         out.append(f"{c.name}={Path(c.model).name}{note}")
     return ", ".join(out)
 
@@ -226,7 +229,7 @@ def _write(sc, r, args, out: Path, ident: dict, unbound: list, plan=None) -> Non
     out.mkdir(parents=True, exist_ok=True)
     m, mu = r.metrics, r.metric_units
     print(f"{sc.name}: {sc.description or ''}".rstrip(": "))
-    models = _unit_labels(sc, plan)
+    models = _unit_labels(sc, plan, getattr(args, "clocks", "sampled"))
     clocks = "" if getattr(args, "clocks", "sampled") == "sampled" else f" (units on their clocks: {args.clocks})"
     print(f"  {len(r['time']) - 1} steps of {sc.step:g} s to t = {sc.stop_time:g} s on the {args.engine} engine{clocks}; "
           f"units {models}; metric set {sc.metrics or '(none)'}")

@@ -229,6 +229,7 @@ def test_cli_runs_on_the_clocks_and_refuses_another_engine(c3, tmp_path, capsys)
         assert run_cmd.main(args + ["--clocks", clocks, "--out", str(tmp_path / clocks)]) == 0
     out = capsys.readouterr()
     assert "on the lean engine (units on their clocks: scheduled)" in out.out
+    assert "controller=C3SampledPd.fmu (FMI 3.0 Scheduled Execution)" in out.out
     assert ("--clocks scheduled: no clocks in plant (FMI 2.0): they step with doStep on the scenario's grid as in a "
             "sampled run") in out.err.splitlines()
     a = (tmp_path / "sampled" / "paper002_PID.csv").read_bytes()
