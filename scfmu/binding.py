@@ -50,6 +50,9 @@ class Callbacks2(Structure):
 
 # ----------------------------------------------------------------------------------------- FMI 3.0 types
 LOG3 = CFUNCTYPE(None, c_void_p, c_int, c_char_p, c_char_p)
+CLOCK_UPDATE3 = CFUNCTYPE(None, c_void_p)  # Scheduled Execution: an output or countdown clock ticked
+LOCK_PREEMPTION3 = CFUNCTYPE(None)  # Scheduled Execution: the FMU enters / leaves a critical section
+UNLOCK_PREEMPTION3 = CFUNCTYPE(None)
 
 # ----------------------------------------------------------------------------------------- signatures
 P = c_void_p
@@ -90,6 +93,8 @@ SIGNATURES = {  # name: (return type, argument types)
     "fmi3InstantiateCoSimulation": (P, [c_char_p, c_char_p, c_char_p, B, B, B, B, VRS, c_size_t, c_void_p, LOG3,
                                         c_void_p]),
     "fmi3InstantiateModelExchange": (P, [c_char_p, c_char_p, c_char_p, B, B, c_void_p, LOG3]),
+    "fmi3InstantiateScheduledExecution": (P, [c_char_p, c_char_p, c_char_p, B, B, c_void_p, LOG3, CLOCK_UPDATE3,
+                                              LOCK_PREEMPTION3, UNLOCK_PREEMPTION3]),
     "fmi3FreeInstance": (None, [P]),
     "fmi3EnterInitializationMode": (c_int, [P, B, c_double, c_double, B, c_double]),
     "fmi3ExitInitializationMode": (c_int, [P]),
@@ -113,6 +118,11 @@ SIGNATURES = {  # name: (return type, argument types)
     "fmi3SerializeFMUState": (c_int, [P, c_void_p, POINTER(c_uint8), c_size_t]),
     "fmi3DeserializeFMUState": (c_int, [P, POINTER(c_uint8), c_size_t, POINTER(c_void_p)]),
     "fmi3EnterEventMode": (c_int, [P]),
+    "fmi3EnterStepMode": (c_int, [P]),
+    "fmi3SetClock": (c_int, [P, VRS, c_size_t, PB]),
+    "fmi3GetIntervalDecimal": (c_int, [P, VRS, c_size_t, PD, POINTER(c_int)]),
+    "fmi3GetShiftDecimal": (c_int, [P, VRS, c_size_t, PD]),
+    "fmi3ActivateModelPartition": (c_int, [P, c_uint32, c_double]),
     "fmi3UpdateDiscreteStates": (c_int, [P, PB, PB, PB, PB, PB, PD]),
     "fmi3EnterContinuousTimeMode": (c_int, [P]),
     "fmi3CompletedIntegratorStep": (c_int, [P, B, PB, PB]),

@@ -194,6 +194,11 @@ def _parser() -> argparse.ArgumentParser:
                     help="engine (all give bit-identical results on Co-Simulation units); default native, or, "
                          "when a unit runs as Model Exchange, compiled (else native; lean, SciPy, only "
                          "without either Rust library)")
+    ap.add_argument("--clocks", default="sampled", choices=("sampled", "clocked", "scheduled"),
+                    help="how FMI 3.0 units with clocks run: sampled (default: they sample inside doStep, as "
+                         "FMI 2.0 units always do), clocked (clocked Co-Simulation: each clock's partition "
+                         "activated at its ticks) or scheduled (Scheduled Execution, by a small scheduler); "
+                         "bit-identical results; clocked and scheduled run on the lean engine")
     ap.add_argument("--out", default=None, help="output folder (default out/<scenario>[+<unit>...]: its own folder "
                                                 "per run; another run's folder gets a -2, -3, ... suffix)")
     ap.add_argument("--no-plot", action="store_true")
@@ -202,15 +207,18 @@ def _parser() -> argparse.ArgumentParser:
     return ap
 
 
-def _unit_labels(sc, plan) -> str:
+def _unit_labels(sc, plan, clocks: str = "sampled") -> str:
     """``plant=AttitudePlant.fmu, controller=X.fmu (FMI 3.0 Model Exchange)``: each unit's file, with how it
-    runs when that is not FMI 2.0 Co-Simulation."""
+    runs when that is not FMI 2.0 Co-Simulation (a unit with clocks: clocked Co-Simulation or Scheduled
+    Execution under ``--clocks``)."""
     how = {u.name: (u.fmi, u.interface) for u in plan.units} if plan is not None else {}
+    clocked = {u.name for u in plan.units if u.clocks} if plan is not None and clocks != "sampled" else set()
+    cs = {"clocked": "clocked Co-Simulation", "scheduled": "Scheduled Execution"}.get(clocks, "Co-Simulation")
     out = []
     for c in sc.components:
         fmi, itf = how.get(c.name, (2, "cs"))
         note = "" if (fmi, itf) == (2, "cs") else \
-            f" (FMI {fmi}.0 {'Model Exchange' if itf == 'me' else 'Co-Simulation'})"
+            f" (FMI {fmi}.0 {'Model Exchange' if itf == 'me' else cs if c.name in clocked else 'Co-Simulation'})"
         out.append(f"{c.name}={Path(c.model).name}{note}")
     return ", ".join(out)
 
@@ -221,8 +229,9 @@ def _write(sc, r, args, out: Path, ident: dict, unbound: list, plan=None) -> Non
     out.mkdir(parents=True, exist_ok=True)
     m, mu = r.metrics, r.metric_units
     print(f"{sc.name}: {sc.description or ''}".rstrip(": "))
-    models = _unit_labels(sc, plan)
-    print(f"  {len(r['time']) - 1} steps of {sc.step:g} s to t = {sc.stop_time:g} s on the {args.engine} engine; "
+    models = _unit_labels(sc, plan, getattr(args, "clocks", "sampled"))
+    clocks = "" if getattr(args, "clocks", "sampled") == "sampled" else f" (units on their clocks: {args.clocks})"
+    print(f"  {len(r['time']) - 1} steps of {sc.step:g} s to t = {sc.stop_time:g} s on the {args.engine} engine{clocks}; "
           f"units {models}; metric set {sc.metrics or '(none)'}")
     for k, v in m.items():
         if isinstance(v, float) and math.isfinite(v):
@@ -231,7 +240,7 @@ def _write(sc, r, args, out: Path, ident: dict, unbound: list, plan=None) -> Non
     write_csv(csv, r)
     (out / "run.json").write_text(json.dumps(ident, indent=1, sort_keys=True))
     manifest = out / f"{stem}.manifest.json"  # what ran: the scenario as plain data, units, metrics, warnings
-    manifest.write_text(json.dumps({"scenario": sc.to_dict(), "engine": args.engine, "metrics": m,
+    manifest.write_text(json.dumps({"scenario": sc.to_dict(), "engine": args.engine, "clocks": args.clocks, "metrics": m,
                                     "unbound_slot_values": unbound}, indent=1, default=str))
     written = [csv, manifest]
     if not args.no_plot:
@@ -267,6 +276,18 @@ def main(argv=None) -> int:
         return 2
     unbound = options.binding_report(plan.scenario, "scfmu run", args.strict, lambda t: print(t, file=sys.stderr),
                                      resolved=True)
+    if args.clocks != "sampled":
+        from .engines.clocked import clock_notice, clock_problem, order_notice
+        why = clock_problem(plan, args.clocks)
+        if why is None and args.engine not in (None, "lean"):
+            why = f"--clocks {args.clocks} runs on the lean engine (its clocked master), not --engine {args.engine}"
+        if why:
+            print(f"scfmu run: {why}", file=sys.stderr)
+            return 2
+        for notice in (clock_notice(plan, args.clocks), order_notice(plan, args.clocks)):
+            if notice:
+                print(notice, file=sys.stderr)
+        args.engine = "lean"
     if args.engine is None:
         args.engine = "native"
         if plan.model_exchange:  # both Rust engines step a Model Exchange unit with the one stepper
@@ -283,12 +304,15 @@ def main(argv=None) -> int:
         raise UsageError(f"--log-every {args.log_every}: allowed only with --engine native (the {args.engine} "
                          f"engine logs every step)")
     ident = run_identity(sc, args.engine)
+    if args.clocks != "sampled":  # (a sampled run's identity stays what it was)
+        ident["clocks"] = args.clocks
     out, notice = choose_folder(Path(args.out) if args.out else Path("out") / run_folder_name(sc), ident,
                                 chosen=args.out is not None)
     if notice:
         print(notice, file=sys.stderr)
     try:
-        r = simulate(plan, args.engine, **({"log_every": args.log_every} if args.log_every != 1 else {}))
+        r = simulate(plan, args.engine, clocks=args.clocks,
+                     **({"log_every": args.log_every} if args.log_every != 1 else {}))
     except PlanError as e:
         print(f"scfmu run: {e}", file=sys.stderr)
         return 2

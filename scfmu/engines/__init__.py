@@ -126,8 +126,8 @@ def log_units(plan: Plan) -> dict:
     return out
 
 
-def simulate(scenario, engine: str = "native", *, fmus: dict | None = None, overrides: dict | None = None,
-             seed: int | None = None, model_exchange=frozenset(), **kw) -> Result:
+def simulate(scenario, engine: str | None = None, *, fmus: dict | None = None, overrides: dict | None = None,
+             seed: int | None = None, model_exchange=frozenset(), clocks: str = "sampled", **kw) -> Result:
     """Runs a scenario (a :class:`~scfmu.scenario.Scenario` or a registered name such as ``"default"``) on
     one of the engines (``"native"``, default; ``"compiled"``; ``"auto"``; ``"lean"``; ``"reference"``) and
     returns the logged signals.
@@ -138,7 +138,12 @@ def simulate(scenario, engine: str = "native", *, fmus: dict | None = None, over
     ``Component.interface = "me"``; a unit that offers Model Exchange only always is). Engine options
     (``log_every``, ``reuse`` for native) pass through. The scenario is resolved once, into one
     :class:`~scfmu.scenario.plan.Plan` that the engine executes. A failing run raises
-    :class:`SimulationError` with a status (``fmu_error``, ``nonfinite``, ...) and the FMUs' messages."""
+    :class:`SimulationError` with a status (``fmu_error``, ``nonfinite``, ...) and the FMUs' messages.
+
+    ``clocks``: ``"sampled"`` (default: every unit samples inside ``doStep``), ``"clocked"`` (FMI 3.0 units
+    with clocks run on them in clocked Co-Simulation) or ``"scheduled"`` (in Scheduled Execution, by a small
+    scheduler): both on the lean master (the default engine then; another engine is a ``ValueError``), with
+    bit-identical results (:mod:`scfmu.engines.clocked`). A plan without clocked units is a ``PlanError``."""
     if isinstance(scenario, str):
         from ..scenario import get
         scenario = get(scenario)
@@ -151,7 +156,11 @@ def simulate(scenario, engine: str = "native", *, fmus: dict | None = None, over
         scenario = scenario.with_overrides(overrides)
     if seed is not None:
         scenario = scenario.with_seed(seed)
-    engine = resolve_engine(engine)
+    if clocks not in ("sampled", "clocked", "scheduled"):
+        raise ValueError(f"clocks {clocks!r}: expected 'sampled', 'clocked' or 'scheduled'")
+    if clocks != "sampled" and engine not in (None, "lean"):
+        raise ValueError(f"clocks {clocks!r} runs on the lean engine (its clocked master), not {engine!r}")
+    engine = resolve_engine(engine or ("native" if clocks == "sampled" else "lean"))
     if engine not in ENGINES:
         raise ValueError(f"engine {engine!r}: expected one of {ENGINES} or 'auto'")
     log_every = kw.get("log_every", 1) if engine == "native" else 1
@@ -165,6 +174,11 @@ def simulate(scenario, engine: str = "native", *, fmus: dict | None = None, over
         plan = build_plan(scenario, model_exchange=model_exchange, log_every=log_every)
     if engine == "reference":
         out = run_reference(plan)
+    elif clocks != "sampled":
+        from .clocked import ClockedMaster
+        from .scheduler import Scheduler
+        with (ClockedMaster if clocks == "clocked" else Scheduler)(plan) as m:
+            out = m.run()
     elif engine == "lean":
         with LeanMaster(plan) as m:
             out = m.run()

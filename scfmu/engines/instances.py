@@ -20,11 +20,15 @@ def as_plan(scenario, path_of=None, model_exchange=frozenset()) -> Plan:
     return build_plan(scenario, path_of=path_of, model_exchange=model_exchange)
 
 
-def build_fmus(plan, path_of=None, reuse: bool = False, model_exchange=frozenset()) -> dict[str, Fmu]:
+def build_fmus(plan, path_of=None, reuse: bool = False, model_exchange=frozenset(), clocking: dict | None = None,
+               preemption=None, in_init=None) -> dict[str, Fmu]:
     """Instantiates and initializes every instance of the plan (or of a scenario: its plan is built),
     parameters in initialization mode, then writes the fixed ``inputs``. Returns {instance name: Fmu}
     in Gauss–Seidel order. With ``reuse`` the FMUs are unpacked once per process. Model Exchange
-    instances run under SciPy's solve_ivp (:class:`scfmu.fmu.Fmu`) with their plan's solver settings."""
+    instances run under SciPy's solve_ivp (:class:`scfmu.fmu.Fmu`) with their plan's solver settings.
+    ``clocking``: ``{instance: "event" | "scheduled"}``, the FMI 3.0 units instantiated to run on their clocks
+    (``eventModeUsed = true``, or Scheduled Execution with the ``preemption`` callbacks); ``in_init(name,
+    fmu)`` is called in Initialization Mode after the parameters (where clock intervals are read)."""
     plan = as_plan(plan, path_of, model_exchange)
     fmus: dict[str, Fmu] = {}
     try:
@@ -35,8 +39,9 @@ def build_fmus(plan, path_of=None, reuse: bool = False, model_exchange=frozenset
                       "me_max_step": u.solver["max_step"]}
             fmus[u.name] = Fmu(u.model, name=u.name, start_time=plan.scenario.start_time, path=u.path,
                                initialize=False, unpacked=unpacked(u.path) if reuse else None,
-                               interface=u.interface, **kw)
-        initialize_fmus(fmus, plan)
+                               interface=u.interface, clocking=(clocking or {}).get(u.name, ""),
+                               preemption=preemption, **kw)
+        initialize_fmus(fmus, plan, in_init)
     except Exception:
         for f in fmus.values():
             f.close()
@@ -49,7 +54,7 @@ def fmu_setter(f: Fmu):
     return f.set_refs
 
 
-def initialize_fmus(fmus: dict[str, Fmu], plan) -> None:
+def initialize_fmus(fmus: dict[str, Fmu], plan, in_init=None) -> None:
     """Initializes instantiated (or reset) FMUs: set-up, parameters in initialization mode, then the
     fixed ``inputs`` (both through :func:`apply_params`). Raises SimulationError when an FMU refuses to
     initialize."""
@@ -59,6 +64,8 @@ def initialize_fmus(fmus: dict[str, Fmu], plan) -> None:
         f = fmus[c.name]
         f.enter_initialization_mode(scenario.start_time)
         apply_params(plan.params[c.name], fmu_setter(f))
+        if in_init is not None:
+            in_init(c.name, f)
         try:
             f.exit_initialization_mode()
         except Exception as e:

@@ -29,7 +29,7 @@ from pathlib import Path
 from fmpy import read_model_description
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Model, FMU2Slave, defaultCallbacks, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
-from fmpy.fmi3 import FMU3Model, FMU3Slave
+from fmpy.fmi3 import FMU3Model, FMU3ScheduledExecution, FMU3Slave
 
 from .locate import UnknownModel, fmu_dir, fmu_path, is_path, models, set_fmu_dir
 from .archive import ArchiveError, ArchiveLimits, archive_limits, inspect_archive, safe_extract, set_archive_limits
@@ -169,8 +169,11 @@ class Fmu(ModelExchange):
                  start_time: float = 0.0, stop_time: float | None = None, tolerance: float | None = None,
                  path: Path | None = None, initialize: bool = True, logging_on: bool = False,
                  unpacked: tuple | None = None, interface: str = "cs", me_method: str = "DOP853",
-                 me_rtol: float = 1e-10, me_atol: float = 1e-12, me_max_step: float = 0.0):
+                 me_rtol: float = 1e-10, me_atol: float = 1e-12, me_max_step: float = 0.0, clocking: str = "",
+                 preemption=None):
         self.model = model
+        self.clocking = clocking  # FMI 3.0 clocks: "" none; "event": eventModeUsed; "scheduled": Scheduled Execution
+        self.preemption = preemption  # Scheduled Execution: (lockPreemption, unlockPreemption) Python callables
         self.path = Path(path) if path else fmu_path(model)
         self._owns_dir = False
         if unpacked is None:  # the unit cache's entry (shared, kept), else a folder of this instance's own
@@ -194,6 +197,7 @@ class Fmu(ModelExchange):
 
     def _open(self, model, unpacked, params, name, start_time, stop_time, tolerance, initialize, logging_on,
               interface, me_method, me_rtol, me_atol, me_max_step) -> None:
+        clocking = self.clocking
         if unpacked is None:
             self.md = read_model_description(self.unzipdir)
         self.fmi = int(str(self.md.fmiVersion).split(".")[0])
@@ -220,9 +224,14 @@ class Fmu(ModelExchange):
             if self.md.coSimulation is None:
                 raise ValueError(f"{model} offers no Co-Simulation interface (Model Exchange only): run it as "
                                  f"Model Exchange")
-            cls = FMU2Slave if self.fmi == 2 else FMU3Slave
+            if clocking and (self.fmi != 3 or clocking not in ("event", "scheduled")):
+                raise ValueError(f"{model}: clocking {clocking!r}: 'event' or 'scheduled', FMI 3.0 only")
+            if clocking == "scheduled" and self.md.scheduledExecution is None:
+                raise ValueError(f"{model} offers no Scheduled Execution interface")
+            cls = FMU2Slave if self.fmi == 2 else FMU3ScheduledExecution if clocking == "scheduled" else FMU3Slave
             slave = cls(guid=self.md.guid, unzipDirectory=self.unzipdir,
-                        modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=iname)
+                        modelIdentifier=(self.md.scheduledExecution if clocking == "scheduled"
+                                         else self.md.coSimulation).modelIdentifier, instanceName=iname)
         self._instance_name = iname
         with self._fmu_errors():
             if self.fmi == 2:
@@ -235,7 +244,12 @@ class Fmu(ModelExchange):
                     msgs.append((int(status), (category or b"").decode(), (message or b"").decode()))
 
                 self.callbacks = log3
-                slave.instantiate(loggingOn=logging_on, logMessage=log3)
+                if clocking == "scheduled":
+                    self._instantiate_se(slave, log3, logging_on)
+                elif clocking == "event":
+                    slave.instantiate(loggingOn=logging_on, logMessage=log3, eventModeUsed=True)
+                else:
+                    slave.instantiate(loggingOn=logging_on, logMessage=log3)
         self.slave = slave
         self.time = start_time
         if initialize:
@@ -243,6 +257,22 @@ class Fmu(ModelExchange):
             for k, v in (params or {}).items():
                 self.set(k, v)
             self.exit_initialization_mode()
+
+    def _instantiate_se(self, slave, log3, logging_on: bool) -> None:
+        """``fmi3InstantiateScheduledExecution`` with the importer's own preemption callbacks (fmpy's class
+        installs no-ops), through :mod:`scfmu.binding`; the callbacks live as long as this object."""
+        from .. import binding
+        lock, unlock = self.preemption or (lambda: None, lambda: None)
+        cbs = (binding.LOG3(log3), binding.CLOCK_UPDATE3(lambda _env: None), binding.LOCK_PREEMPTION3(lock),
+               binding.UNLOCK_PREEMPTION3(unlock))
+        slave._se_callbacks = cbs
+        f = binding.bind(slave.dll, "fmi3InstantiateScheduledExecution")
+        res = os.path.join(self.unzipdir, "resources") + os.path.sep
+        slave.component = f(slave.instanceName.encode(), slave.guid.encode(), res.encode(), False, logging_on,
+                            None, *cbs)
+        if not slave.component:
+            raise ValueError(f"{self.model}: fmi3InstantiateScheduledExecution returned NULL: "
+                             + " | ".join(m[2] for m in self.messages[-3:]))
 
     def enter_initialization_mode(self, start_time: float = 0.0, tolerance: float | None = None,
                                   stop_time: float | None = None) -> None:
@@ -295,10 +325,10 @@ class Fmu(ModelExchange):
             raise KeyError(f"{self.model} has no variable {name!r}") from None
 
     def inputs(self) -> list[str]:
-        return [v.name for v in self.md.modelVariables if v.causality == "input"]
+        return [v.name for v in self.md.modelVariables if v.causality == "input" and v.type != "Clock"]
 
-    def outputs(self) -> list[str]:
-        return [v.name for v in self.md.modelVariables if v.causality == "output"]
+    def outputs(self) -> list[str]:  # (FMI 3.0 clocks are no ports)
+        return [v.name for v in self.md.modelVariables if v.causality == "output" and v.type != "Clock"]
 
     def set(self, name: str, value) -> None:
         v = self.var(name)
@@ -398,3 +428,4 @@ class Fmu(ModelExchange):
         finally:
             if self._owns_dir:
                 shutil.rmtree(self.unzipdir, ignore_errors=True)
+

@@ -222,7 +222,7 @@ def suggest_maps(sc: Scenario, vars_of: dict, mds: dict) -> list[str]:
     vector whose elements all map the same way is one flag (``--map controller.omega=w``)."""
     import difflib
     names = [c.name for c in sc.components]
-    ours = {n: {sc.alias(n, p): v for p, v in vars_of[n].items()} for n in names}
+    ours = {n: {sc.alias(n, p): v for p, v in vars_of[n].items() if v.type != "Clock"} for n in names}  # (no ports)
     outs = {n: [p for p, v in ours[n].items() if v.causality == "output"] for n in names}
     picks: dict = {}
     for d in names:

@@ -54,6 +54,42 @@ class PlanError(ValueError):
 
 
 @dataclass
+class Clock:
+    """An FMI 3.0 ``<Clock>`` of a unit: value reference, name, causality, interval variability, priority
+    (None when undeclared), ``intervalDecimal``/``shiftDecimal`` when the description gives them, and the
+    variables it clocks (those whose ``clocks`` attribute names it). A time-based periodic input clock of
+    ``intervalVariability="fixed"`` without ``intervalDecimal`` gets its interval and shift from the unit in
+    Initialization Mode (``fmi3GetIntervalDecimal``/``fmi3GetShiftDecimal``, FMI 3.0 section 2.2.9): the
+    engines that run clocks read them there (:mod:`scfmu.engines.clocked`)."""
+
+    name: str
+    vr: int
+    causality: str
+    interval_variability: str
+    priority: int | None
+    interval: float | None
+    shift: float | None
+    clocked: list[str]
+
+
+def unit_clocks(path, md) -> list[Clock]:
+    """The clocks of a unit's model description, in value-reference order (none for FMI 2.0)."""
+    from ..fmu.clocks import clock_attributes
+    clocks = [v for v in md.modelVariables if v.type == "Clock"]
+    if not clocks:
+        return []
+    attrs = clock_attributes(path)
+    out = []
+    for c in sorted(clocks, key=lambda v: v.valueReference):
+        ticked = [v.name for v in md.modelVariables if v.clocks and any(k.valueReference == c.valueReference
+                                                                          for k in v.clocks)]
+        a = attrs.get(c.valueReference, {})
+        out.append(Clock(c.name, c.valueReference, c.causality, c.intervalVariability or "", a.get("priority"),
+                         a.get("intervalDecimal"), a.get("shiftDecimal"), ticked))
+    return out
+
+
+@dataclass
 class Unit:
     """One instance of the plan."""
 
@@ -65,6 +101,7 @@ class Unit:
     interface: str  # "cs" or "me"
     solver: dict = field(default_factory=dict)  # ME: {"method", "rtol", "atol"}
     vars: dict = field(default_factory=dict)  # name -> fmpy ModelVariable
+    clocks: list = field(default_factory=list)  # FMI 3.0: [Clock] (the partitions a clocked run activates)
 
     def vr(self, name: str) -> int:
         return self.vars[name].valueReference
@@ -75,11 +112,12 @@ class Unit:
 
     @property
     def inputs(self) -> list[str]:
-        return [n for n, v in self.vars.items() if v.causality == "input"]
+        """The input ports (an FMI 3.0 input clock is no port: the engines that run clocks activate it)."""
+        return [n for n, v in self.vars.items() if v.causality == "input" and v.type != "Clock"]
 
     @property
     def outputs(self) -> list[str]:
-        return [n for n, v in self.vars.items() if v.causality == "output"]
+        return [n for n, v in self.vars.items() if v.causality == "output" and v.type != "Clock"]
 
 
 @dataclass
@@ -272,7 +310,7 @@ def plan_units(sc: Scenario, paths, model_exchange=frozenset()) -> list[Unit]:
             raise PlanError(f"{c.name} ({c.model}): FMI {md.fmiVersion} is not supported (FMI 2.0 or 3.0)")
         itf = _interface(c, md, model_exchange)
         units.append(Unit(c.name, c.model, p, md, fmi, itf, solver_of(c) if itf == "me" else {},
-                          {v.name: v for v in md.modelVariables}))
+                          {v.name: v for v in md.modelVariables}, unit_clocks(p, md) if fmi == 3 else []))
     return units
 
 
