@@ -169,6 +169,53 @@ const CONVENTIONS: &str = concat!(
     "<li>\"No limit\" is encoded as 1e30.</li></ul>\n",
 );
 
+/// The FMI 3.0 terminals of a model, as a table (nothing for a model without terminals).
+fn terminals_table(h: &mut String, m: &ModelDescription) {
+    if !m.terminals.is_empty() {
+        h.push_str("<h2>Terminals (FMI 3.0)</h2>\n<p>In <code>terminalsAndIcons/terminalsAndIcons.xml</code> of the FMI 3.0 archive; every member is a signal.</p>\n<table>\n<tr><th>terminal</th><th>kind</th><th>matching</th><th>members (member = variable)</th><th>meaning</th></tr>\n");
+        for t in &m.terminals {
+            let members: Vec<String> = t
+                .members
+                .iter()
+                .map(|(a, b)| {
+                    if a == b {
+                        format!("<code>{a}</code>")
+                    } else {
+                        format!("<code>{a}</code> = <code>{b}</code>")
+                    }
+                })
+                .collect();
+            let _ = writeln!(
+                *h,
+                "<tr><td><code>{}</code></td><td><code>{}</code></td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                t.name,
+                t.kind,
+                t.matching_rule,
+                members.join(", "),
+                html_escape(&t.description)
+            );
+        }
+        h.push_str("</table>\n");
+    }
+}
+
+/// The FMI 3.0 clocks of a sampled model, as a table (nothing for a model without clocks).
+fn clocks_table(h: &mut String, cat: &Catalogue, m: &ModelDescription) {
+    if !m.clocks.is_empty() {
+        let _ = writeln!(*h, "<h2>Clocks</h2>\n<p>{}</p>\n<table>", html_escape(CLOCKS_TEXT));
+        let _ = writeln!(*h, "<tr><th>{}</th></tr>", CLOCK_HEADER.join("</th><th>"));
+        for i in 0..m.clocks.len() {
+            let [name, rest @ ..] = clock_cells(m, &cat.layer, i, html_escape);
+            let _ = writeln!(
+                *h,
+                "<tr><td><code>{name}</code></td><td>{}</td></tr>",
+                rest.join("</td><td>")
+            );
+        }
+        h.push_str("</table>\n");
+    }
+}
+
 /// documentation/index.html: purpose, source, equations, conventions, variable tables, references.
 pub fn documentation_html(cat: &Catalogue, m: &ModelDescription) -> String {
     let mut h = String::new();
@@ -203,45 +250,8 @@ pub fn documentation_html(cat: &Catalogue, m: &ModelDescription) -> String {
         }
         h.push_str("</table>\n");
     }
-    if !m.terminals.is_empty() {
-        h.push_str("<h2>Terminals (FMI 3.0)</h2>\n<p>In <code>terminalsAndIcons/terminalsAndIcons.xml</code> of the FMI 3.0 archive; every member is a signal.</p>\n<table>\n<tr><th>terminal</th><th>kind</th><th>matching</th><th>members (member = variable)</th><th>meaning</th></tr>\n");
-        for t in &m.terminals {
-            let members: Vec<String> = t
-                .members
-                .iter()
-                .map(|(a, b)| {
-                    if a == b {
-                        format!("<code>{a}</code>")
-                    } else {
-                        format!("<code>{a}</code> = <code>{b}</code>")
-                    }
-                })
-                .collect();
-            let _ = writeln!(
-                h,
-                "<tr><td><code>{}</code></td><td><code>{}</code></td><td>{}</td><td>{}</td><td>{}</td></tr>",
-                t.name,
-                t.kind,
-                t.matching_rule,
-                members.join(", "),
-                html_escape(&t.description)
-            );
-        }
-        h.push_str("</table>\n");
-    }
-    if !m.clocks.is_empty() {
-        let _ = writeln!(h, "<h2>Clocks</h2>\n<p>{}</p>\n<table>", html_escape(CLOCKS_TEXT));
-        let _ = writeln!(h, "<tr><th>{}</th></tr>", CLOCK_HEADER.join("</th><th>"));
-        for i in 0..m.clocks.len() {
-            let [name, rest @ ..] = clock_cells(m, &cat.layer, i, html_escape);
-            let _ = writeln!(
-                h,
-                "<tr><td><code>{name}</code></td><td>{}</td></tr>",
-                rest.join("</td><td>")
-            );
-        }
-        h.push_str("</table>\n");
-    }
+    terminals_table(&mut h, m);
+    clocks_table(&mut h, cat, m);
     let cited = cited_in(cat, &m.texts());
     if !cited.is_empty() {
         h.push_str("<h2>References</h2>\n<ul>\n");
