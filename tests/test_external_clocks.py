@@ -347,3 +347,65 @@ def test_scheduled_execution_of_an_unclocked_unit_is_refused(tmp_path):
     with pytest.raises(Exception, match="Failed to instantiate"):
         s.instantiate(logMessage=log)
     assert any("InstantiateScheduledExecution" in m for m in log), log
+
+
+# ----- terminals: what an external tool reads of terminalsAndIcons.xml ------------------------------------------
+
+def _terminal_files() -> dict:
+    out = {}
+    for p in sorted((fmu_dir() / "fmi3").glob("*.fmu")):
+        with zipfile.ZipFile(p) as z:
+            if "terminalsAndIcons/terminalsAndIcons.xml" in z.namelist():
+                out[p.stem] = (z.read("terminalsAndIcons/terminalsAndIcons.xml"), z.read("modelDescription.xml"))
+    return out
+
+
+def test_fmpy_has_no_terminals_reader_only_the_schema():
+    """fmpy 0.3.32 reads no terminalsAndIcons.xml (read_model_description and validate_fmu ignore it); it ships
+    the standard's schema for it, which is what an fmpy user can check a file against."""
+    import fmpy
+    root = Path(fmpy.__file__).parent
+    assert (root / "schema" / "fmi3" / "fmi3TerminalsAndIcons.xsd").is_file()
+    assert not [p.name for p in root.glob("*.py") if "terminalsAndIcons" in p.read_text(errors="replace")]
+
+
+@pytest.mark.skipif(not _terminal_files(), reason="no FMU carries terminalsAndIcons/terminalsAndIcons.xml yet")
+def test_terminals_pass_the_schema_fmpy_ships():
+    """Every terminalsAndIcons.xml in our FMI 3.0 FMUs is valid against fmpy's copy of the standard's schema,
+    and every terminal member names a variable of the unit's description."""
+    import fmpy
+    from lxml import etree
+    xsd = etree.XMLSchema(file=str(Path(fmpy.__file__).parent / "schema" / "fmi3" / "fmi3TerminalsAndIcons.xsd"))
+    for model, (text, md) in _terminal_files().items():
+        doc = etree.fromstring(text)
+        assert xsd.validate(doc), (model, [e.message for e in xsd.error_log][:3])
+        names = {e.get("name") for e in ET.fromstring(md).find("ModelVariables")}
+        members = [m.get("variableName") for m in doc.iter("TerminalMemberVariable")]
+        assert members and set(members) <= names, (model, set(members) - names)
+
+
+# ----- the schedule figure's script (docs/fmi3.md) ---------------------------------------------------------------
+
+def test_schedule_script_logs_the_ticks_of_a_real_scheduled_execution_run(tmp_path):
+    """scripts/schedule_figure.py over 0.25 s: the PID activated every 1 ms (251 times from 0 to 0.25 s), the
+    gyro every 10 ms (26), the star tracker's sample at 0 and 0.2 s and its delivery at 0.1 s, in time order;
+    the figure is written."""
+    import csv
+    import subprocess
+    import sys
+    root = Path(__file__).resolve().parents[1]
+    r = subprocess.run([sys.executable, str(root / "scripts" / "schedule_figure.py"), "--t-end", "0.25", "--out",
+                        str(tmp_path / "s.png"), "--log", str(tmp_path / "s.csv")], capture_output=True, text=True,
+                       timeout=300)
+    assert r.returncode == 0, r.stderr[-2000:]
+    rows = list(csv.DictReader(open(tmp_path / "s.csv")))
+    by = {}
+    for row in rows:
+        by.setdefault((row["unit"], row["clock"]), []).append(float(row["time_s"]))
+    assert len(by[("pid", "sample_clock")]) == 251 and len(by[("gyro", "sample_clock")]) == 26
+    np.testing.assert_allclose(by[("pid", "sample_clock")], np.arange(251) * 0.001, rtol=0, atol=1e-12)
+    assert by[("star_tracker", "sample_clock")] == pytest.approx([0.0, 0.2])
+    assert by[("star_tracker", "delivery_clock")] == pytest.approx([0.1])
+    times = [float(row["time_s"]) for row in rows]
+    assert times == sorted(times)
+    assert (tmp_path / "s.png").stat().st_size > 10_000
