@@ -21,7 +21,7 @@ use std::sync::{Arc, Mutex};
 use fmi_rs::fmi3::log::Logger;
 use fmi_rs::fmi3::native::NativeLibrary;
 use fmi_rs::fmi3::types::{fmi3IntervalQualifier, fmi3Status};
-use fmi_rs::fmi3::{Implementation, Instance};
+use fmi_rs::fmi3::Implementation;
 use fmi_rs::model_description::fmi3::{Causality, ModelDescription, VariableType};
 
 /// `<FMU folder>/<rel>.fmu`: `SCFMU_FMU_DIR` when set (as for the Python tests), else the checkout's `fmus/`.
@@ -71,7 +71,11 @@ fn inputs(model: &str, t: f64) -> Vec<(&'static str, f64)> {
 }
 
 fn ok(s: fmi3Status, what: &str, log: &Keep) {
-    assert!(matches!(s, fmi3Status::Ok), "{what}: {s:?}; log: {:?}", log.0.lock().unwrap());
+    assert!(
+        matches!(s, fmi3Status::Ok),
+        "{what}: {s:?}; log: {:?}",
+        log.0.lock().unwrap()
+    );
 }
 
 /// The unit's Float64 outputs (name, value reference), in description order.
@@ -99,10 +103,26 @@ fn sampled(model: &str, h: f64, n: usize, outs: &[(String, u32)]) -> Vec<Vec<f64
     use fmi_rs::fmi2::{CS, FMU2};
     let dir = unzip(model, &format!("{model}2"));
     let md = fmi_rs::model_description::fmi2::ModelDescription::from_path(&dir.join("modelDescription.xml")).unwrap();
-    let f = FMU2::<CS>::new(&dir, model, model, &md.guid, false, false, false, Arc::new(DefaultLogger::default()), false)
-        .unwrap();
+    let f = FMU2::<CS>::new(
+        &dir,
+        model,
+        model,
+        &md.guid,
+        false,
+        false,
+        false,
+        Arc::new(DefaultLogger::default()),
+        false,
+    )
+    .unwrap();
     let ok2 = |s: fmi2Status, w: &str| assert!(matches!(s, fmi2Status::Ok), "{w}: {s:?}");
-    let vr2 = |name: &str| md.modelVariables.iter().find(|v| v.name == name).unwrap().valueReference;
+    let vr2 = |name: &str| {
+        md.modelVariables
+            .iter()
+            .find(|v| v.name == name)
+            .unwrap()
+            .valueReference
+    };
     ok2(f.setupExperiment(None, 0.0, None), "setupExperiment");
     ok2(f.enterInitializationMode(), "enterInitializationMode");
     ok2(f.exitInitializationMode(), "exitInitializationMode");
@@ -146,16 +166,42 @@ fn clocked_equals_sampled(model: &str, h: f64, n: usize, timing: &[(f64, f64)]) 
     let lib = NativeLibrary::load(dir.join(format!("binaries/x86_64-linux/{model}.so"))).expect("load");
     let log = Arc::new(Keep::default());
     let f = lib
-        .instantiateCoSimulation(model, &md.instantiationToken, None, false, true, true, false, &[], log.clone())
-        .unwrap_or_else(|e| panic!("{model}: fmi3InstantiateCoSimulation: {e:?}; {:?}", log.0.lock().unwrap()));
-    ok(f.enterInitializationMode(None, 0.0, None), "fmi3EnterInitializationMode", &log);
+        .instantiateCoSimulation(
+            model,
+            &md.instantiationToken,
+            None,
+            false,
+            true,
+            true,
+            false,
+            &[],
+            log.clone(),
+        )
+        .unwrap_or_else(|e| {
+            panic!(
+                "{model}: fmi3InstantiateCoSimulation: {e:?}; {:?}",
+                log.0.lock().unwrap()
+            )
+        });
+    ok(
+        f.enterInitializationMode(None, 0.0, None),
+        "fmi3EnterInitializationMode",
+        &log,
+    );
     let (mut iv, mut sh) = (vec![0.0; clocks.len()], vec![0.0; clocks.len()]);
     let mut q = vec![fmi3IntervalQualifier::IntervalNotYetKnown; clocks.len()];
-    ok(f.getIntervalDecimal(&clocks, &mut iv, &mut q), "fmi3GetIntervalDecimal", &log);
+    ok(
+        f.getIntervalDecimal(&clocks, &mut iv, &mut q),
+        "fmi3GetIntervalDecimal",
+        &log,
+    );
     ok(f.getShiftDecimal(&clocks, &mut sh), "fmi3GetShiftDecimal", &log);
     let got: Vec<(f64, f64)> = iv.iter().copied().zip(sh.iter().copied()).collect();
     assert_eq!(got, timing, "{model}: interval and shift of each clock");
-    assert!(q.iter().all(|q| *q == fmi3IntervalQualifier::IntervalChanged), "{model}: {q:?}");
+    assert!(
+        q.iter().all(|q| *q == fmi3IntervalQualifier::IntervalChanged),
+        "{model}: {q:?}"
+    );
     ok(f.exitInitializationMode(), "fmi3ExitInitializationMode", &log);
     let mut rows = vec![];
     for k in 0..n {
@@ -163,21 +209,36 @@ fn clocked_equals_sampled(model: &str, h: f64, n: usize, timing: &[(f64, f64)]) 
         for (name, x) in inputs(model, t) {
             ok(f.setFloat64(&[vr(&md, name)], &[x]), "fmi3SetFloat64", &log);
         }
-        let active: Vec<u32> =
-            clocks.iter().zip(timing).filter(|(_, &(i, s))| due(t, i, s)).map(|(c, _)| *c).collect();
+        let active: Vec<u32> = clocks
+            .iter()
+            .zip(timing)
+            .filter(|(_, &(i, s))| due(t, i, s))
+            .map(|(c, _)| *c)
+            .collect();
         if !active.is_empty() {
             ok(f.setClock(&active, &vec![true; active.len()]), "fmi3SetClock", &log);
         }
         let (mut need, mut term, mut nom, mut val, mut next) = (true, true, true, true, None);
-        ok(f.updateDiscreteStates(&mut need, &mut term, &mut nom, &mut val, &mut next), "fmi3UpdateDiscreteStates", &log);
-        assert!(!need && !term && next.is_some_and(|x| x > t), "{model} at {t}: {need} {term} {next:?}");
+        ok(
+            f.updateDiscreteStates(&mut need, &mut term, &mut nom, &mut val, &mut next),
+            "fmi3UpdateDiscreteStates",
+            &log,
+        );
+        assert!(
+            !need && !term && next.is_some_and(|x| x > t),
+            "{model} at {t}: {need} {term} {next:?}"
+        );
         let mut row = vec![0.0; outs.len()];
         let refs: Vec<u32> = outs.iter().map(|o| o.1).collect();
         ok(f.getFloat64(&refs, &mut row), "fmi3GetFloat64", &log);
         rows.push(row);
         ok(f.enterStepMode(), "fmi3EnterStepMode", &log);
         let (mut ev, mut te, mut er, mut last) = (false, false, false, 0.0);
-        ok(f.doStep(t, h, true, &mut ev, &mut te, &mut er, &mut last), "fmi3DoStep", &log);
+        ok(
+            f.doStep(t, h, true, &mut ev, &mut te, &mut er, &mut last),
+            "fmi3DoStep",
+            &log,
+        );
         ok(f.enterEventMode(), "fmi3EnterEventMode", &log);
     }
     ok(f.terminate(), "fmi3Terminate", &log);
@@ -186,10 +247,15 @@ fn clocked_equals_sampled(model: &str, h: f64, n: usize, timing: &[(f64, f64)]) 
     for (j, (name, _)) in outs.iter().enumerate() {
         let a: Vec<u64> = rows.iter().map(|r| r[j].to_bits()).collect();
         let b: Vec<u64> = reference.iter().map(|r| r[j].to_bits()).collect();
-        assert_eq!(a, b, "{model}.{name}: fmi-rs's clocked run differs from the sampled FMI 2.0 run");
+        assert_eq!(
+            a, b,
+            "{model}.{name}: fmi-rs's clocked run differs from the sampled FMI 2.0 run"
+        );
     }
     assert!(
-        outs.iter().enumerate().any(|(j, _)| rows.iter().any(|r| r[j] != rows[0][j])),
+        outs.iter()
+            .enumerate()
+            .any(|(j, _)| rows.iter().any(|r| r[j] != rows[0][j])),
         "{model}: every output constant"
     );
     let _ = std::fs::remove_dir_all(&dir);
