@@ -115,7 +115,7 @@ def draw(log, out: Path, t_end: float) -> None:
     for ax, (t0, t1) in zip(axes, ((0.0, t_end), (0.0, 0.05))):
         for y, key in enumerate(rows):
             ts = [t for t, u, c in log if (u, c) == key and t0 - 1e-12 <= t <= t1 + 1e-12]
-            ax.vlines(ts, y - 0.35, y + 0.35, colors=colours[y % len(colours)], linewidth=0.6 if t1 > 0.1 else 1.2)
+            ax.vlines(ts, y - 0.35, y + 0.35, colors=colours[y % len(colours)], linewidth=0.4 if t1 > 0.1 else 1.2)
         ax.set_yticks(range(len(rows)), [label.get(k, f"{k[0]}\n{k[1]}") for k in rows], fontsize=8)
         ax.set_ylim(len(rows) - 0.4, -0.6)
         ax.set_xlim(t0 - 0.005 * (t1 - t0), t1 + 0.005 * (t1 - t0))
@@ -126,8 +126,9 @@ def draw(log, out: Path, t_end: float) -> None:
     for ts, td in zip(samples, deliveries):
         axes[0].annotate("", xy=(td, yd - 0.35), xytext=(ts, ys + 0.35),
                          arrowprops={"arrowstyle": "->", "color": "0.4", "lw": 0.8})
-    if samples and deliveries:
-        axes[0].text((samples[0] + deliveries[0]) / 2, (ys + yd) / 2, f"latency {deliveries[0] - samples[0]:.1f} s",
+    if len(samples) > 1 and len(deliveries) > 1:
+        axes[0].text((samples[1] + deliveries[1]) / 2, (ys + yd) / 2 - 0.18,
+                     f"latency {deliveries[1] - samples[1]:.1f} s",
                      fontsize=7, ha="center", va="center", color="0.3",
                      bbox={"facecolor": "white", "edgecolor": "none", "pad": 1})
     counts = {k: sum(1 for _, u, c in log if (u, c) == k) for k in rows}
@@ -136,7 +137,8 @@ def draw(log, out: Path, t_end: float) -> None:
     axes[1].set_title("first 50 ms (" + ", ".join(f"{label.get(k, k[0]).split(chr(10))[0]} {k[1]}: "
                                                    f"{counts[k]} calls in {t_end:g} s" for k in rows) + ")",
                       fontsize=7)
-    axes[1].set_xlabel("time t (s)")
+    for ax in axes:
+        ax.set_xlabel("time t (s)", fontsize=8)
     fig.tight_layout()
     out.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(out, dpi=120)

@@ -396,6 +396,8 @@ def test_terminals_pass_the_schema_fmpy_ships():
         names = {e.get("name") for e in ET.fromstring(md).find("ModelVariables")}
         members = [m.get("variableName") for m in doc.iter("TerminalMemberVariable")]
         assert members and set(members) <= names, (model, set(members) - names)
+    text = next(iter(_terminal_files().values()))[0]  # the check fails on a broken file (a required attribute gone)
+    assert not xsd.validate(etree.fromstring(text.replace(b' matchingRule="', b' matching="', 1)))
 
 
 # ----- the schedule figure's script (docs/fmi3.md) ---------------------------------------------------------------
