@@ -69,8 +69,8 @@
 
 pub use crate::catalogue::{
     read_catalogue, BoundDescription, Catalogue, ClockDescription, FamilyDescription, FeedthroughDescription,
-    LayerInfo, ModelDescription, PackageInfo, Reference, ReferenceDescription, StateDescription, VariableDescription,
-    CATALOGUE_FORMAT, RUNTIME_VERSION,
+    LayerInfo, ModelDescription, PackageInfo, Reference, ReferenceDescription, StateDescription, TerminalDescription,
+    VariableDescription, CATALOGUE_FORMAT, RUNTIME_VERSION,
 };
 pub use crate::math;
 pub use crate::model::{
@@ -131,6 +131,7 @@ pub fn describe(e: &ModelEntry) -> ModelDescription {
                 outputs: crate::model::clocked_outputs(e, c),
             })
             .collect(),
+        terminals: crate::models::ports::terminals(e.decls),
     }
 }
 

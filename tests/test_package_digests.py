@@ -1,6 +1,6 @@
 """The packaging tool's output is pinned byte for byte: the sha256 of every generated file — each FMU's
-`modelDescription.xml` and `documentation/index.html` (fmus/*.fmu and fmus/fmi3/*.fmu), the committed
-modelDescription/ files and the generated pages docs/models/*.md and docs/references.md — equals the
+`modelDescription.xml`, `documentation/index.html` and (FMI 3.0) `terminalsAndIcons/terminalsAndIcons.xml`
+(fmus/*.fmu and fmus/fmi3/*.fmu), the committed modelDescription/ files (fmi3/terminalsAndIcons/ too) and the generated pages docs/models/*.md and docs/references.md — equals the
 list in tests/data/package_digests.json. A refactoring of the catalogue or the packager must leave them
 all unchanged.
 
@@ -21,7 +21,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 DIGESTS = ROOT / "tests" / "data" / "package_digests.json"
-MEMBERS = ("modelDescription.xml", "documentation/index.html")
+MEMBERS = ("modelDescription.xml", "documentation/index.html", "terminalsAndIcons/terminalsAndIcons.xml")
 
 
 def generated_files(root: Path = ROOT) -> dict[str, bytes]:
@@ -29,9 +29,10 @@ def generated_files(root: Path = ROOT) -> dict[str, bytes]:
     files: dict[str, bytes] = {}
     for fmu in sorted([*root.glob("fmus/*.fmu"), *root.glob("fmus/fmi3/*.fmu")]):
         with zipfile.ZipFile(fmu) as z:
-            for member in MEMBERS:
+            for member in (m for m in MEMBERS if m in z.namelist()):
                 files[f"{fmu.relative_to(root).as_posix()}:{member}"] = z.read(member)
     pages = [*root.glob("modelDescription/*.xml"), *root.glob("modelDescription/fmi3/*.xml"),
+             *root.glob("modelDescription/fmi3/terminalsAndIcons/*.xml"),
              *root.glob("docs/models/*.md"), root / "docs" / "references.md"]
     for path in sorted(pages):
         files[path.relative_to(root).as_posix()] = path.read_bytes()

@@ -21,7 +21,7 @@ from fmpy import read_model_description
 
 from ..fmu import ArchiveError, described, fmu_path, inspect_archive
 from .model import Scenario
-from .plan import Plan, PlanError, apply_params, link_problem, plan_units, remember, timing_problem, values, wire
+from .plan import Plan, PlanError, apply_params, link_problem, plan_units, remember, timing_problem, unit_terminals, values, wire
 from .resolve import resolve
 from .values import did_you_mean, value_problem
 
@@ -161,10 +161,11 @@ def check(scenario: Scenario, instantiate: bool = True, log_every: int | None = 
         return rep
     vars_of = {u.name: u.vars for u in units}
     ports = plan.ports()
+    terms = unit_terminals(sc, units)
     try:  # the wiring, worked out once; when it fails, every reason and the closest names
-        links = sc.wiring(ports)
+        links = sc.wiring(ports, terms)
     except (KeyError, ValueError):
-        problems = sc.wiring_problems(ports)
+        problems = sc.wiring_problems(ports, terms)
         if not problems:
             raise
         rep.errors += [f"wiring: {x}" for x in problems]

@@ -36,7 +36,7 @@ from .values import timing_problems
 _FIELDS = {f.name for f in fields(Scenario)}
 _COMPONENT = {"name", "model", "params", "slot", "ports", "bind", "unused", "interface", "solver"}
 _TYPES = {"name": str, "stop_time": (int, float), "step": (int, float), "start_time": (int, float), "log": dict,
-          "connections": dict, "unconnected": list, "inputs": dict, "auto_connect": bool, "seed_params": list,
+          "connections": dict, "terminals": dict, "unconnected": list, "inputs": dict, "auto_connect": bool, "seed_params": list,
           "metrics": str, "description": str, "components": list}
 
 

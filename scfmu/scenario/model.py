@@ -11,6 +11,9 @@ name of exactly one *other* instance. Exceptions are explicit:
 
 * ``connections``: ``{"dst_instance.input": "src_instance.output"}``, which takes precedence over the
   name match (use it when names differ or when several instances have the output);
+* ``terminals``: ``{"dst_instance.terminal": "src_instance.terminal"}``, FMI 3.0 terminals connected as
+  one, expanded into their scalar links by the terminals' matching rule (:mod:`scfmu.scenario.terminals`;
+  e.g. ``{"controller.attitude": "plant.attitude", "plant.torque_cmd": "controller.torque_cmd"}``);
 * ``unconnected``: glob patterns (``fnmatch``) of inputs, bare (``"torque_dist_*"``) or qualified
   (``"plant.torque_dist_*"``), left at their start value (or at the value given in ``inputs``).
   ``DEFAULT_UNCONNECTED`` lists the optional inputs of the current FMUs (disturbance inputs, wheel
@@ -116,6 +119,7 @@ class Scenario:
     step: float
     log: dict = field(default_factory=dict)  # key -> "instance.variable"
     connections: dict = field(default_factory=dict)  # "dst.input" -> "src.output" (exceptions to name matching)
+    terminals: dict = field(default_factory=dict)  # "dst.terminal" -> "src.terminal" (FMI 3.0 terminals)
     unconnected: list = field(default_factory=lambda: list(DEFAULT_UNCONNECTED))
     inputs: dict = field(default_factory=dict)  # "instance.input" -> value, written after initialization
     auto_connect: bool = True
@@ -152,6 +156,8 @@ class Scenario:
 
     def to_dict(self) -> dict:
         d = asdict(self)
+        if not d["terminals"]:  # likewise a scenario without terminal connections
+            del d["terminals"]
         for c in d["components"]:  # empty bindings left out: the plain data (and campaign ids) of scenarios
             for k in ("bind", "unused"):  # without them are what they were before they existed
                 if not c[k]:
@@ -240,8 +246,18 @@ class Scenario:
         return s
 
     # ----- wiring ---------------------------------------------------------------------------------------
-    def wiring(self, ports: dict[str, tuple[list[str], list[str]]]) -> list[tuple[str, str, str, str]]:
-        """Resolves the connections given each instance's (inputs, outputs) port names (``ports[name]``).
+    def _connections(self, terminals) -> dict:
+        """``connections`` with the scalar links of the ``terminals`` entries (:mod:`.terminals`)."""
+        from .terminals import expand
+        links, problems = expand(self, terminals)
+        if problems:
+            raise ValueError(problems[0])
+        return {**links, **self.connections}
+
+    def wiring(self, ports: dict[str, tuple[list[str], list[str]]],
+               terminals: dict | None = None) -> list[tuple[str, str, str, str]]:
+        """Resolves the connections given each instance's (inputs, outputs) port names (``ports[name]``)
+        and, for the ``terminals`` entries, each instance's FMI 3.0 terminals (``terminals[name]``).
         Returns ``(dst_instance, dst_input, src_instance, src_output)`` in Gauss–Seidel order: grouped by
         destination in component order, and within a destination by source (in the order sources first
         appear among the destination's inputs), each group keeping the destination's input order: the
@@ -249,11 +265,12 @@ class Scenario:
         names = [c.name for c in self.components]
         if len(set(names)) != len(names):
             raise ValueError(f"duplicate instance names in {names}")
+        connections = self._connections(terminals)
         # match on the scenario's names (a unit's own port names renamed by its ``ports`` map); links are
         # returned with the units' own names
         ports = {n: ([self.alias(n, p) for p in ports[n][0]], [self.alias(n, p) for p in ports[n][1]])
                  for n in names}
-        for dst, src in self.connections.items():
+        for dst, src in connections.items():
             for q in (dst, src):
                 inst, _, var = q.partition(".")
                 if inst not in ports:
@@ -269,8 +286,8 @@ class Scenario:
             per_src: dict[str, list[tuple[str, str]]] = {}
             for inp in ports[dst][0]:
                 q = f"{dst}.{inp}"
-                if q in self.connections:
-                    si, _, sv = self.connections[q].partition(".")
+                if q in connections:
+                    si, _, sv = connections[q].partition(".")
                     per_src.setdefault(si, []).append((inp, sv))
                     continue
                 if q in self.inputs or f"{dst}.{self.native_name(dst, inp)}" in self.inputs:
@@ -289,18 +306,20 @@ class Scenario:
                     links.append((dst, self.native_name(dst, inp), src, self.native_name(src, out)))
         return links
 
-    def wiring_problems(self, ports: dict[str, tuple[list[str], list[str]]]) -> list[str]:
-        """Every reason :meth:`wiring` would refuse, not only the first (inputs without a source or with
-        several, explicit connections naming unknown ports)."""
+    def wiring_problems(self, ports: dict[str, tuple[list[str], list[str]]], terminals: dict | None = None) -> list[str]:
+        """Every reason :meth:`wiring` would refuse, not only the first (terminal connections that do not
+        match, inputs without a source or with several, explicit connections naming unknown ports)."""
+        from .terminals import expand
         try:
-            self.wiring(ports)
+            self.wiring(ports, terminals)
             return []
         except (KeyError, ValueError):
             pass
-        out = []
+        by_terminal, out = expand(self, terminals)
+        connections = {**by_terminal, **self.connections}
         names = [c.name for c in self.components]
         ours = {n: ([self.alias(n, p) for p in ports[n][0]], [self.alias(n, p) for p in ports[n][1]]) for n in names}
-        for dst, src in self.connections.items():
+        for dst, src in connections.items():
             di, _, dv = dst.partition(".")
             si, _, sv = src.partition(".")
             if di not in ours or dv not in ours[di][0]:
@@ -310,7 +329,7 @@ class Scenario:
         for dst in names:
             for inp in ours[dst][0]:
                 q = f"{dst}.{inp}"
-                if q in self.connections or q in self.inputs:
+                if q in connections or q in self.inputs:
                     continue
                 sources = [s for s in names if s != dst and inp in ours[s][1]] if self.auto_connect else []
                 if len(sources) > 1:

@@ -258,7 +258,7 @@ def _signature(sc: Scenario, paths, model_exchange) -> tuple:
         st = p.stat()
         comps.append((c.name, c.model, str(p), st.st_mtime_ns, st.st_size, c.interface,
                       tuple(sorted((k, repr(v)) for k, v in c.solver.items())), tuple(sorted(c.ports.items()))))
-    return (tuple(comps), tuple(sorted(sc.connections.items())), tuple(sc.unconnected), tuple(sorted(sc.inputs)),
+    return (tuple(comps), tuple(sorted(sc.connections.items())), tuple(sorted(sc.terminals.items())), tuple(sc.unconnected), tuple(sorted(sc.inputs)),
             sc.auto_connect, tuple(sc.log.items()), frozenset(model_exchange))
 
 
@@ -287,12 +287,20 @@ def remember(plan: Plan, paths, model_exchange=frozenset()) -> None:
     _SKELETONS[_signature(plan.scenario, paths, model_exchange)] = (plan.units, plan.links, plan.groups, plan.log)
 
 
+def unit_terminals(sc: Scenario, units: list[Unit]) -> dict | None:
+    """Each unit's FMI 3.0 terminals when the scenario connects terminals (else None: nothing is read)."""
+    if not sc.terminals:
+        return None
+    from ..fmu.terminals import terminals_of
+    return {u.name: terminals_of(u.path) for u in units}
+
+
 def wire(sc: Scenario, units: list[Unit], links=None) -> Plan:
     """The plan of a resolved scenario's units: its wiring (``links``, when the caller computed it), link
     groups and logged signals; a :class:`PlanError` names a connection or logged signal no engine can make."""
     by_name = {u.name: u for u in units}
     if links is None:
-        links = sc.wiring({u.name: (u.inputs, u.outputs) for u in units})
+        links = sc.wiring({u.name: (u.inputs, u.outputs) for u in units}, unit_terminals(sc, units))
     problems = []
     for d, di, s, so in links:
         why = link_problem(by_name[d], di, by_name[s], so)

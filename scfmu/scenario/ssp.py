@@ -192,7 +192,11 @@ def _system(system, scenario: Scenario, mds: dict, version: str = "1.0", clocks:
     ports = {c.name: ([v.name for v in mds[c.model].modelVariables if v.causality == "input" and v.type != "Clock"],
                       [v.name for v in mds[c.model].modelVariables if v.causality == "output" and v.type != "Clock"])
              for c in scenario.components}  # clocks are connectors of a 2.0 file, never wired by name
-    links = scenario.wiring(ports)
+    terms = None
+    if scenario.terminals:  # terminal connections are written as the scalar links they expand into
+        from ..fmu.terminals import terminals_of
+        terms = {c.name: terminals_of(fmu_path(c.model)) for c in scenario.components}
+    links = scenario.wiring(ports, terms)
     fixed = {}
     for q, value in scenario.inputs.items():
         inst, _, var = q.partition(".")

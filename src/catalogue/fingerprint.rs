@@ -1,6 +1,6 @@
 //! The GUID of a model: a name-based UUID (v5) of its declarations — name, flags, default
-//! experiment, feed-through, every variable with its unit definition and bounds — and the package
-//! version. It changes exactly when the interface (or the release) changes. The runtime computes it
+//! experiment, feed-through, every variable with its unit definition and bounds, the continuous states
+//! and the FMI 3.0 clocks — and the package version. It changes exactly when the interface (or the release) changes. The runtime computes it
 //! from the static declarations (`crate::model::guid`, at `fmi2Instantiate` and for FMU states) and
 //! the packaging tool from a catalogue's owned copy ([`guid_of`]); both go through [`fingerprint`],
 //! over borrowed rows, so the two cannot disagree.
@@ -48,11 +48,22 @@ pub struct StateRow<'a> {
     pub starts_from: Vec<&'a str>,
 }
 
+/// One FMI 3.0 clock as it enters the GUID (`outputs`: FMI scalar names, as the catalogue carries them).
+pub struct ClockRow<'a> {
+    pub name: &'a str,
+    pub description: &'a str,
+    pub interval: &'a str,
+    pub shift: &'a str,
+    pub steps: bool,
+    pub outputs: Vec<&'a str>,
+}
+
 /// The canonical text the GUID is computed from.
 pub fn fingerprint<'a>(
     h: Header<'_>,
     vars: impl Iterator<Item = VarRow<'a>>,
     states: Option<Vec<StateRow<'_>>>,
+    clocks: &[ClockRow<'_>],
 ) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "spacecraft_fmus {}", env!("CARGO_PKG_VERSION"));
@@ -86,6 +97,14 @@ pub fn fingerprint<'a>(
                 x.name, x.unit, x.description, x.depends, x.starts_from
             );
         }
+    }
+    // clocked models only, so that a model without clocks keeps its GUID
+    for c in clocks {
+        let _ = writeln!(
+            s,
+            "clock|{}|{}|{}|{}|{}|{:?}",
+            c.name, c.description, c.interval, c.shift, c.steps, c.outputs
+        );
     }
     s
 }
@@ -138,6 +157,18 @@ pub fn guid_of(m: &ModelDescription) -> String {
             })
             .collect()
     });
-    let bytes = guid_bytes(&fingerprint(header, vars, states));
+    let clocks: Vec<ClockRow> = m
+        .clocks
+        .iter()
+        .map(|c| ClockRow {
+            name: &c.name,
+            description: &c.description,
+            interval: &c.interval,
+            shift: &c.shift,
+            steps: c.steps,
+            outputs: c.outputs.iter().map(String::as_str).collect(),
+        })
+        .collect();
+    let bytes = guid_bytes(&fingerprint(header, vars, states, &clocks));
     String::from_utf8(bytes.to_vec()).expect("hyphenated UUID is ASCII")
 }

@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 use super::decl::{initial_of, Bound, Causality, Initial, Reference, Start, VarKind, Variability};
 
 /// Version of the catalogue's byte layout; the packaging tool refuses any other.
-pub const CATALOGUE_FORMAT: u32 = 5;
+pub const CATALOGUE_FORMAT: u32 = 6;
 
 /// Version of this crate, recorded in every catalogue (and part of every GUID).
 pub const RUNTIME_VERSION: &str = env!("CARGO_PKG_VERSION");
@@ -114,6 +114,9 @@ pub struct ModelDescription {
     pub states: Option<Vec<StateDescription>>,
     /// FMI 3.0 clocks of a sampled model (empty: not clocked).
     pub clocks: Vec<ClockDescription>,
+    /// FMI 3.0 terminals (`terminalsAndIcons/terminalsAndIcons.xml`): every vector port, and the groups
+    /// of ports that connect together (`crate::models::ports::terminals`); empty = no terminals file.
+    pub terminals: Vec<TerminalDescription>,
 }
 
 impl ModelDescription {
@@ -160,6 +163,20 @@ pub struct ClockDescription {
     pub shift: String,
     pub steps: bool,
     pub outputs: Vec<String>,
+}
+
+/// One FMI 3.0 terminal: a named group of ports with a meaning (`kind`, the standard's `terminalKind`),
+/// connected to another terminal by its `matching_rule` (`plug`: member by member, by member name, every
+/// member present on both sides; `sequence`: by position). Every member is a signal.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TerminalDescription {
+    pub name: String,
+    pub kind: String,
+    pub matching_rule: String,
+    pub description: String,
+    /// (memberName, variableName) pairs in order: the member name is what matching compares, the variable
+    /// the FMI scalar that is read or written.
+    pub members: Vec<(String, String)>,
 }
 
 /// A `Feedthrough` as owned data.

@@ -3,9 +3,10 @@
 //! computes the same from a catalogue's owned copy). Nothing here renders XML.
 
 use super::{Feedthrough, ModelEntry};
-use crate::catalogue::fingerprint::{fingerprint, guid_bytes, Header, StateRow, VarRow, GUID_LEN};
+use crate::catalogue::fingerprint::{fingerprint, guid_bytes, ClockRow, Header, StateRow, VarRow, GUID_LEN};
 
-/// The fingerprint rows of a registry entry (borrowed: no copy of a string).
+/// The fingerprint rows of a registry entry (borrowed: no copy of a string, except the scalar names of
+/// a clock's outputs, which the catalogue carries expanded).
 fn compute(entry: &ModelEntry) -> [u8; GUID_LEN] {
     let info = entry.info;
     let header = Header {
@@ -43,7 +44,21 @@ fn compute(entry: &ModelEntry) -> [u8; GUID_LEN] {
             })
             .collect()
     });
-    guid_bytes(&fingerprint(header, vars, states))
+    let outputs: Vec<Vec<String>> = entry.clocks.iter().map(|c| super::clocked_outputs(entry, c)).collect();
+    let clocks: Vec<ClockRow> = entry
+        .clocks
+        .iter()
+        .zip(&outputs)
+        .map(|(c, o)| ClockRow {
+            name: c.name,
+            description: c.description,
+            interval: c.interval,
+            shift: c.shift,
+            steps: c.steps,
+            outputs: o.iter().map(String::as_str).collect(),
+        })
+        .collect();
+    guid_bytes(&fingerprint(header, vars, states, &clocks))
 }
 
 /// The GUID computed afresh (uncached).

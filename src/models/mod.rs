@@ -72,3 +72,6 @@ pub mod ports;
 pub mod references;
 pub mod sensors;
 pub mod single_axis;
+
+#[cfg(test)]
+mod clock_tests;

@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use super::modes::{Inputs, ModeLogic, ModeParams};
 use crate::declare_variables;
-use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult, SWITCH};
+use crate::model::{ClockDecl, Experiment, Feedthrough, Model, ModelInfo, ModelResult, SWITCH};
 use crate::models::sensors::shared::{last_sample_before, sample_index, MAX_SAMPLES_PER_CALL};
 
 declare_variables! {
@@ -101,6 +101,16 @@ fn increments(v: &ModeManagerVars, seen: (f64, f64)) -> Result<(f64, i32), Strin
 
 impl Model for ModeManager {
     type Vars = ModeManagerVars;
+    const CLOCKS: &'static [ClockDecl] = &[
+        ClockDecl {
+            name: "sample_clock",
+            description: "Sample clock of the mode logic: at each tick the mode and its selections are computed and held",
+            interval: "sample_period",
+            shift: "",
+            steps: true,
+            outputs: &["mode", "time_in_mode", "mode_changes", "torque_select", "dipole_select", "estimator_init", "controller_enable", "rate", "sigma_att", "nis_avg", "sun_angle", "last_reason"],
+        },
+    ];
     fn time_grid(v: &ModeManagerVars) -> Option<f64> {
         Some(v.sample_period)
     }

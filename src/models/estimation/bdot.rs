@@ -5,7 +5,7 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 use crate::declare_variables;
-use crate::model::{check_derived, Experiment, Feedthrough, Model, ModelInfo, ModelResult};
+use crate::model::{ClockDecl, Experiment, Feedthrough, Model, ModelInfo, ModelResult, check_derived};
 use crate::models::sensors::shared::{last_sample_before, sample_index, MAX_SAMPLES_PER_CALL};
 
 declare_variables! {
@@ -83,6 +83,16 @@ impl BDot {
 
 impl Model for BDot {
     type Vars = BDotVars;
+    const CLOCKS: &'static [ClockDecl] = &[
+        ClockDecl {
+            name: "sample_clock",
+            description: "Sample clock: at each tick the dipole command and the field-direction rate are computed and held",
+            interval: "sample_period",
+            shift: "",
+            steps: true,
+            outputs: &["m_cmd", "b_dir_rate"],
+        },
+    ];
     fn time_grid(v: &BDotVars) -> Option<f64> {
         Some(v.sample_period)
     }

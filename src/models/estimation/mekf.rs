@@ -14,7 +14,7 @@ use crate::declare_variables;
 use crate::math::attitude::{attitude_matrix, skew};
 use crate::math::attitude_kalman::{error_transition, gyro_process_noise, joseph_update_with_gain, quat_exp, quat_log, Matrix6};
 use crate::math::sample_grid;
-use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult};
+use crate::model::{ClockDecl, Experiment, Feedthrough, Model, ModelInfo, ModelResult};
 
 #[path = "mekf_delay.rs"]
 mod delay;
@@ -321,6 +321,16 @@ impl Mekf {
 
 impl Model for Mekf {
     type Vars = MekfVars;
+    const CLOCKS: &'static [ClockDecl] = &[
+        ClockDecl {
+            name: "sample_clock",
+            description: "Sample clock of the filter: at each tick the estimate of the sample is output and held, then the filter propagates",
+            interval: "sample_period",
+            shift: "",
+            steps: true,
+            outputs: &["q_est", "w_est", "bias_est", "p_att", "p_bias", "innovation", "nis", "nis_dim", "nis_sum", "nis_dim_sum"],
+        },
+    ];
     fn time_grid(v: &MekfVars) -> Option<f64> {
         Some(v.sample_period)
     }

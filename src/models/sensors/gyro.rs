@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 use super::shared::{sample_index, last_sample_before, rotation, MAX_SAMPLES_PER_CALL};
 use crate::declare_variables;
 use crate::math::random::normal;
-use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult};
+use crate::model::{ClockDecl, Experiment, Feedthrough, Model, ModelInfo, ModelResult};
 
 /// √(2 ln 2 / π): the Allan deviation of flicker rate noise of coefficient B is this × B ([IEEE-952]).
 pub const FLICKER_FLOOR: f64 = 0.664_282_470_267_960_1;
@@ -102,6 +102,16 @@ impl Gyro {
 
 impl Model for Gyro {
     type Vars = GyroVars;
+    const CLOCKS: &'static [ClockDecl] = &[
+        ClockDecl {
+            name: "sample_clock",
+            description: "Sample clock: at each tick the measured rate and the bias are computed and held",
+            interval: "sample_period",
+            shift: "",
+            steps: true,
+            outputs: &["w_meas", "bias_total"],
+        },
+    ];
     fn time_grid(v: &GyroVars) -> Option<f64> {
         Some(v.sample_period)
     }

@@ -10,7 +10,7 @@ use crate::declare_variables;
 use crate::math::attitude::attitude_matrix;
 use crate::math::environment::CircularOrbit;
 use crate::math::random::normal;
-use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult, SWITCH};
+use crate::model::{ClockDecl, Experiment, Feedthrough, Model, ModelInfo, ModelResult, SWITCH};
 
 declare_variables! {
     pub struct MagnetometerVars {
@@ -68,6 +68,16 @@ impl Magnetometer {
 
 impl Model for Magnetometer {
     type Vars = MagnetometerVars;
+    const CLOCKS: &'static [ClockDecl] = &[
+        ClockDecl {
+            name: "sample_clock",
+            description: "Sample clock: at each tick the measured field is computed and held",
+            interval: "sample_period",
+            shift: "",
+            steps: true,
+            outputs: &["b_meas"],
+        },
+    ];
     fn time_grid(v: &MagnetometerVars) -> Option<f64> {
         Some(v.sample_period)
     }

@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use super::shared::{sample_index, max_queue, DelayLine};
 use crate::declare_variables;
-use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult};
+use crate::model::{ClockDecl, Experiment, Feedthrough, Model, ModelInfo, ModelResult};
 
 /// Number of channels.
 pub const CHANNELS: usize = 8;
@@ -50,6 +50,24 @@ fn inputs(v: &SampleHoldVars) -> [f64; CHANNELS] {
 
 impl Model for SampleHold {
     type Vars = SampleHoldVars;
+    const CLOCKS: &'static [ClockDecl] = &[
+        ClockDecl {
+            name: "sample_clock",
+            description: "Sample clock: the inputs are latched at each tick",
+            interval: "sample_period",
+            shift: "",
+            steps: true,
+            outputs: &[],
+        },
+        ClockDecl {
+            name: "delivery_clock",
+            description: "Delivery clock: at each tick (sample instant + delay) the delivered sample is output and held",
+            interval: "sample_period",
+            shift: "delay",
+            steps: false,
+            outputs: &["y_1", "y_2", "y_3", "y_4", "y_5", "y_6", "y_7", "y_8"],
+        },
+    ];
     fn time_grid(v: &SampleHoldVars) -> Option<f64> {
         Some(v.sample_period)
     }

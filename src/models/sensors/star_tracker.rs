@@ -9,7 +9,7 @@ use crate::declare_variables;
 use crate::math::attitude::attitude_matrix;
 use crate::math::environment::sun_ref;
 use crate::math::random::normal;
-use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult};
+use crate::model::{ClockDecl, Experiment, Feedthrough, Model, ModelInfo, ModelResult};
 
 declare_variables! {
     pub struct StarTrackerVars {
@@ -73,6 +73,24 @@ impl StarTracker {
 
 impl Model for StarTracker {
     type Vars = StarTrackerVars;
+    const CLOCKS: &'static [ClockDecl] = &[
+        ClockDecl {
+            name: "sample_clock",
+            description: "Sample clock: the true attitude is measured at each tick",
+            interval: "sample_period",
+            shift: "",
+            steps: true,
+            outputs: &[],
+        },
+        ClockDecl {
+            name: "delivery_clock",
+            description: "Delivery clock: at each tick (sample instant + latency) the delivered quaternion and its flags are output and held",
+            interval: "sample_period",
+            shift: "latency",
+            steps: false,
+            outputs: &["q_meas", "valid", "st_valid"],
+        },
+    ];
     fn time_grid(v: &StarTrackerVars) -> Option<f64> {
         Some(v.sample_period)
     }

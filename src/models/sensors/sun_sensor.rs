@@ -15,7 +15,7 @@ use crate::declare_variables;
 use crate::math::attitude::attitude_matrix;
 use crate::math::environment::{in_eclipse, sun_ref, CircularOrbit};
 use crate::math::random::normal;
-use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult, SWITCH};
+use crate::model::{ClockDecl, Experiment, Feedthrough, Model, ModelInfo, ModelResult, SWITCH};
 
 declare_variables! {
     pub struct SunSensorVars {
@@ -110,6 +110,16 @@ impl SunSensor {
 
 impl Model for SunSensor {
     type Vars = SunSensorVars;
+    const CLOCKS: &'static [ClockDecl] = &[
+        ClockDecl {
+            name: "sample_clock",
+            description: "Sample clock: at each tick the sun direction and its flags are computed and held",
+            interval: "sample_period",
+            shift: "",
+            steps: true,
+            outputs: &["sun_meas", "valid", "sun_valid"],
+        },
+    ];
     fn time_grid(v: &SunSensorVars) -> Option<f64> {
         Some(v.sample_period)
     }

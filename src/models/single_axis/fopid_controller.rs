@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use super::shared::{law_params, sampled_output, sampled_step, SampleCounter};
 use crate::declare_variables;
 use super::shared::laws::FopidLaw;
-use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult, SWITCH};
+use crate::model::{ClockDecl, Experiment, Feedthrough, Model, ModelInfo, ModelResult, SWITCH};
 
 declare_variables! {
     pub struct FopidControllerVars {
@@ -36,6 +36,16 @@ pub struct FopidController {
 
 impl Model for FopidController {
     type Vars = FopidControllerVars;
+    const CLOCKS: &'static [ClockDecl] = &[
+        ClockDecl {
+            name: "sample_clock",
+            description: "Sample clock of the law: at each tick u is computed from the inputs and held; the error is appended to the history",
+            interval: "step",
+            shift: "",
+            steps: true,
+            outputs: &["u"],
+        },
+    ];
     fn time_grid(v: &FopidControllerVars) -> Option<f64> {
         Some(v.step)
     }

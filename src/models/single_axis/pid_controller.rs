@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use super::shared::{law_params, sampled_output, sampled_step, SampleCounter};
 use crate::declare_variables;
 use super::shared::laws::PidLaw;
-use crate::model::{Experiment, Feedthrough, Model, ModelInfo, ModelResult, SWITCH};
+use crate::model::{ClockDecl, Experiment, Feedthrough, Model, ModelInfo, ModelResult, SWITCH};
 
 declare_variables! {
     pub struct PidControllerVars {
@@ -34,6 +34,16 @@ pub struct PidController {
 
 impl Model for PidController {
     type Vars = PidControllerVars;
+    const CLOCKS: &'static [ClockDecl] = &[
+        ClockDecl {
+            name: "sample_clock",
+            description: "Sample clock of the law: at each tick u is computed from the inputs and held; the error is appended to the history",
+            interval: "step",
+            shift: "",
+            steps: true,
+            outputs: &["u"],
+        },
+    ];
     fn time_grid(v: &PidControllerVars) -> Option<f64> {
         Some(v.step)
     }

@@ -1,8 +1,8 @@
 //! Checks of a catalogue that the type system cannot make, run before anything is written: unique
 //! names and value references (clear of the ones the FMI layer reserves, as the catalogue's
 //! [`LayerInfo`] states them), known units, descriptions, start values inside their bounds, continuous
-//! states that clash with nothing, feed-through names that are outputs and inputs, and citations of
-//! publications the library declares.
+//! states and clocks that clash with nothing, feed-through names that are outputs and inputs, and
+//! citations of publications the library declares.
 
 use spacecraft_fmus::catalogue::{
     cited_keys, BoundDescription, Catalogue, Causality, FeedthroughDescription, LayerInfo, ModelDescription, Start,
@@ -51,6 +51,7 @@ pub fn check_model(m: &ModelDescription, layer: &LayerInfo) -> Result<(), String
         check_variable(name, a, layer)?;
     }
     check_states(m, layer)?;
+    crate::clocks::check_clocks(m, layer)?;
     check_feedthrough(m)
 }
 

@@ -6,9 +6,11 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use spacecraft_fmus::catalogue::{Catalogue, FamilyDescription, ModelDescription, VariableDescription};
+use spacecraft_fmus::catalogue::{Catalogue, FamilyDescription, LayerInfo, ModelDescription, VariableDescription};
 
-use crate::html::{citation, cited_in, interfaces_text, variable_cells, VARIABLE_SECTIONS};
+use crate::html::{
+    citation, cited_in, clock_cells, interfaces_text, variable_cells, CLOCKS_TEXT, CLOCK_HEADER, VARIABLE_SECTIONS,
+};
 
 fn cell(s: &str) -> String {
     s.replace('|', "\\|").replace('\n', " ")
@@ -40,7 +42,7 @@ fn members<'c>(cat: &'c Catalogue, f: &FamilyDescription) -> Vec<&'c ModelDescri
 }
 
 /// One FMU's section of its family page.
-fn model_section(out: &mut String, m: &ModelDescription) {
+fn model_section(out: &mut String, m: &ModelDescription, layer: &LayerInfo) {
     let _ = writeln!(out, "## {}\n\n{}\n\n**Source:** {}\n", m.name, m.description, m.source);
     let _ = writeln!(
         out,
@@ -60,6 +62,20 @@ fn model_section(out: &mut String, m: &ModelDescription) {
     for (title, caus) in VARIABLE_SECTIONS {
         let rows: Vec<&VariableDescription> = m.variables.iter().filter(|d| d.causality == caus).collect();
         variable_table(out, title, &rows);
+    }
+    if !m.clocks.is_empty() {
+        let _ = writeln!(out, "**Clocks**\n\n{CLOCKS_TEXT}\n");
+        let _ = writeln!(
+            out,
+            "| {} |\n|{}",
+            CLOCK_HEADER.join(" | "),
+            "---|".repeat(CLOCK_HEADER.len())
+        );
+        for i in 0..m.clocks.len() {
+            let [name, rest @ ..] = clock_cells(m, layer, i, cell);
+            let _ = writeln!(out, "| `{name}` | {} |", rest.join(" | "));
+        }
+        out.push('\n');
     }
 }
 
@@ -81,7 +97,7 @@ pub fn family_markdown(cat: &Catalogue, f: &FamilyDescription) -> String {
     }
     out.push('\n');
     for m in &models {
-        model_section(&mut out, m);
+        model_section(&mut out, m, &cat.layer);
     }
     let texts: Vec<&str> = models
         .iter()

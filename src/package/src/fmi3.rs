@@ -11,10 +11,13 @@
 //!   the two descriptions cannot disagree;
 //! - Model Exchange (`<ModelExchange>`, for the models that have it): the continuous states and their
 //!   derivatives are `<Float64>` variables at the same value references as in FMI 2.0
-//!   (`state_vr_base + k`, `derivative_vr_base + k`), `derivative` names the state's value reference.
+//!   (`state_vr_base + k`, `derivative_vr_base + k`), `derivative` names the state's value reference;
+//! - clocks (sampled models that declare them, [`crate::clocks`]): `hasEventMode="true"`, a
+//!   `<ScheduledExecution>` element, one `<Clock>` per clock and the clocked outputs marked as such.
 
 use spacecraft_fmus::catalogue::{Catalogue, Causality, LayerInfo, ModelDescription, VarKind};
 
+use crate::clocks::{clock_of, clock_vr, write_clocks};
 use crate::structure::{derivative_dependencies, initial_unknowns, output_dependencies, state_indices};
 use crate::xml::{
     empty, end, join, local_attrs, model_description_document, start, value_attrs, variable_attrs, Version, W,
@@ -55,7 +58,8 @@ pub fn model_description3(cat: &Catalogue, m: &ModelDescription) -> String {
     model_description_document(cat, m, &v)
 }
 
-/// `<ModelExchange>` (models with continuous states) and `<CoSimulation>`.
+/// `<ModelExchange>` (models with continuous states), `<CoSimulation>`, and `<ScheduledExecution>` for a
+/// model with clocks.
 fn write_interfaces(w: &mut W, m: &ModelDescription) {
     // the attributes both interface elements have, in the order of the standard's schema
     let shared = || -> Vec<(&str, String)> {
@@ -86,13 +90,19 @@ fn write_interfaces(w: &mut W, m: &ModelDescription) {
         ("providesIntermediateUpdate", "false".into()),
         ("mightReturnEarlyFromDoStep", "false".into()),
         ("canReturnEarlyAfterIntermediateUpdate", "false".into()),
-        ("hasEventMode", "false".into()),
+        // a model with clocks must have Event Mode (FMI 3.0 section 4.4)
+        ("hasEventMode", (!m.clocks.is_empty()).to_string()),
         ("providesEvaluateDiscreteStates", "false".into()),
     ]);
     empty(w, "CoSimulation", &cs);
+    if !m.clocks.is_empty() {
+        // the common capability flags are the only attributes of <ScheduledExecution>
+        empty(w, "ScheduledExecution", &shared());
+    }
 }
 
-/// `time`, the declared variables, then (Model Exchange) the continuous states and their derivatives.
+/// `time`, the declared variables, (Model Exchange) the continuous states and their derivatives, then the
+/// clocks.
 fn write_variables(w: &mut W, m: &ModelDescription, layer: &LayerInfo) {
     empty(
         w,
@@ -107,6 +117,15 @@ fn write_variables(w: &mut W, m: &ModelDescription, layer: &LayerInfo) {
     );
     for d in &m.variables {
         let mut attrs = variable_attrs(d);
+        if let Some(i) = clock_of(m, &d.name) {
+            // a clocked variable is discrete, and names its clock (after variability, as in the schema)
+            let v = attrs
+                .iter()
+                .position(|(k, _)| *k == "variability")
+                .expect("every variable has one");
+            attrs[v].1 = "discrete".into();
+            attrs.insert(v + 1, ("clocks", clock_vr(layer, i).to_string()));
+        }
         attrs.extend(value_attrs(d));
         let tag = match d.kind {
             VarKind::Real => "Float64",
@@ -133,6 +152,7 @@ fn write_variables(w: &mut W, m: &ModelDescription, layer: &LayerInfo) {
         attrs.push(("derivative", (layer.state_vr_base + k as u32).to_string()));
         empty(w, "Float64", &attrs);
     }
+    write_clocks(w, m, layer);
 }
 
 /// `<ModelStructure>`: outputs, state derivatives and initial unknowns, by value reference.
@@ -149,10 +169,12 @@ fn write_structure(w: &mut W, m: &ModelDescription, layer: &LayerInfo) {
         let mut deps = output_dependencies(m, d);
         deps.extend(state_indices(m));
         debug_assert_eq!(vr_of_index(m, layer, i + 1), d.vr);
-        let attrs = [
-            ("valueReference", d.vr.to_string()),
-            ("dependencies", vrs_of(m, layer, &deps)),
-        ];
+        let mut vrs = vrs_of(m, layer, &deps);
+        if let Some(k) = clock_of(m, &d.name) {
+            // a clocked output depends on its clock too (the standard asks for it to be listed)
+            vrs = format!("{vrs} {}", clock_vr(layer, k)).trim_start().to_string();
+        }
+        let attrs = [("valueReference", d.vr.to_string()), ("dependencies", vrs)];
         empty(w, "Output", &attrs);
     }
     // every state's derivative, in state order (the order of fmi3GetContinuousStates and friends)

@@ -5,8 +5,10 @@
 use std::fmt::Write as _;
 
 use spacecraft_fmus::catalogue::{
-    BoundDescription, Catalogue, Causality, ModelDescription, ReferenceDescription, VariableDescription,
+    BoundDescription, Catalogue, Causality, LayerInfo, ModelDescription, ReferenceDescription, VariableDescription,
 };
+
+use crate::clocks::clock_vr;
 
 use crate::xml::{start_str, variability_str, GENERATION_TOOL};
 
@@ -88,8 +90,62 @@ pub fn citation(r: &ReferenceDescription) -> String {
     }
 }
 
-/// Which FMI interfaces a model offers, in one sentence (model pages and documentation/index.html).
+/// Which FMI interfaces a model offers, in one sentence (model pages and documentation/index.html), and
+/// for a model with clocks a second one on its clocked FMI 3.0 interfaces.
 pub fn interfaces_text(m: &ModelDescription) -> String {
+    let text = interfaces_sentence(m);
+    if m.clocks.is_empty() {
+        return text;
+    }
+    format!(
+        "{text} In FMI 3.0 it is also clocked: Co-Simulation with Event Mode and Scheduled Execution, {} (see Clocks).",
+        match m.clocks.len() {
+            1 => "one input clock".to_string(),
+            n => format!("{n} input clocks"),
+        }
+    )
+}
+
+/// The clocks section of the documentation: what the clocks are, before their table.
+pub(crate) const CLOCKS_TEXT: &str = "FMI 3.0 only (FMI 2.0 runs the unit sampled inside its step). Each clock is a time-based periodic input clock (intervalVariability fixed): it ticks at the start time plus the shift, then once per interval, both read from the named parameters (fmi3GetIntervalDecimal and fmi3GetShiftDecimal in Initialization Mode; no shift: 0). At a tick, with the inputs the unit holds then, the clock's partition computes its outputs from the state before the tick and holds them until the clock's next tick; then, where the table says so, the state advances over one interval. A lower clock index runs first when two clocks tick together (its priority in Scheduled Execution).";
+
+/// The header of the clock table, and [`clock_cells`] of each row.
+pub(crate) const CLOCK_HEADER: [&str; 6] = ["name", "vr", "interval", "shift", "partition", "meaning"];
+
+/// The cells of clock `i`'s row: name, value reference, interval and shift parameters, what its partition
+/// does, and meaning (the last two passed through the table's `escape`).
+pub(crate) fn clock_cells(
+    m: &ModelDescription,
+    layer: &LayerInfo,
+    i: usize,
+    escape: fn(&str) -> String,
+) -> [String; 6] {
+    let c = &m.clocks[i];
+    let outputs = match c.outputs.len() {
+        0 => None,
+        _ => Some(format!("computes {}", c.outputs.join(", "))),
+    };
+    let step = c.steps.then(|| "advances the state one interval".to_string());
+    let partition = [outputs, step]
+        .into_iter()
+        .flatten()
+        .collect::<Vec<_>>()
+        .join("; then ");
+    [
+        c.name.clone(),
+        clock_vr(layer, i).to_string(),
+        c.interval.clone(),
+        if c.shift.is_empty() {
+            "none".into()
+        } else {
+            c.shift.clone()
+        },
+        escape(&partition),
+        escape(&c.description),
+    ]
+}
+
+fn interfaces_sentence(m: &ModelDescription) -> String {
     match &m.states {
         Some(states) if states.is_empty() => {
             "FMI 2.0 and FMI 3.0 Model Exchange (a static law: no continuous state) and Co-Simulation.".into()
@@ -139,6 +195,45 @@ pub fn documentation_html(cat: &Catalogue, m: &ModelDescription) -> String {
         let _ = writeln!(h, "<h2>{title}</h2>\n<table>\n<tr><th>name</th><th>vr</th><th>type</th><th>variability</th><th>start</th><th>unit</th><th>admissible</th><th>meaning</th></tr>");
         for d in rows {
             let [name, rest @ ..] = variable_cells(d, html_escape);
+            let _ = writeln!(
+                h,
+                "<tr><td><code>{name}</code></td><td>{}</td></tr>",
+                rest.join("</td><td>")
+            );
+        }
+        h.push_str("</table>\n");
+    }
+    if !m.terminals.is_empty() {
+        h.push_str("<h2>Terminals (FMI 3.0)</h2>\n<p>In <code>terminalsAndIcons/terminalsAndIcons.xml</code> of the FMI 3.0 archive; every member is a signal.</p>\n<table>\n<tr><th>terminal</th><th>kind</th><th>matching</th><th>members (member = variable)</th><th>meaning</th></tr>\n");
+        for t in &m.terminals {
+            let members: Vec<String> = t
+                .members
+                .iter()
+                .map(|(a, b)| {
+                    if a == b {
+                        format!("<code>{a}</code>")
+                    } else {
+                        format!("<code>{a}</code> = <code>{b}</code>")
+                    }
+                })
+                .collect();
+            let _ = writeln!(
+                h,
+                "<tr><td><code>{}</code></td><td><code>{}</code></td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                t.name,
+                t.kind,
+                t.matching_rule,
+                members.join(", "),
+                html_escape(&t.description)
+            );
+        }
+        h.push_str("</table>\n");
+    }
+    if !m.clocks.is_empty() {
+        let _ = writeln!(h, "<h2>Clocks</h2>\n<p>{}</p>\n<table>", html_escape(CLOCKS_TEXT));
+        let _ = writeln!(h, "<tr><th>{}</th></tr>", CLOCK_HEADER.join("</th><th>"));
+        for i in 0..m.clocks.len() {
+            let [name, rest @ ..] = clock_cells(m, &cat.layer, i, html_escape);
             let _ = writeln!(
                 h,
                 "<tr><td><code>{name}</code></td><td>{}</td></tr>",

@@ -14,13 +14,15 @@
 //!
 //! Files: [`checks`] (what the type system cannot check), [`structure`] (dependency lists), [`xml`]
 //! (XML helpers and the elements both versions share), [`fmi2`] and [`fmi3`] (the two model
-//! descriptions), [`html`] (documentation/index.html), [`docs`] (the Markdown model pages),
-//! [`platforms`] and [`build`] (binaries), `load` (reading a library's catalogue).
+//! descriptions), [`clocks`] (the FMI 3.0 clocks of sampled models), [`html`]
+//! (documentation/index.html), [`docs`] (the Markdown model pages), [`platforms`] and [`build`]
+//! (binaries), `load` (reading a library's catalogue).
 //!
 //! This crate, not the runtime, links the XML writer and `zip`.
 
 pub mod build;
 pub mod checks;
+pub mod clocks;
 pub mod docs;
 pub mod fmi2;
 pub mod fmi3;
@@ -29,6 +31,7 @@ mod load;
 pub mod names;
 pub mod platforms;
 pub mod structure;
+pub mod terminals;
 pub mod xml;
 
 use std::fs;
@@ -202,11 +205,16 @@ pub fn write_fmu3(
             Ok((format!("binaries/{tuple}/{name}.{}", b.ext), b.bytes))
         })
         .collect::<std::io::Result<Vec<_>>>()?;
+    let terminals = terminals::terminals_and_icons(cat, m);
+    let mut files = files;
+    if let Some(t) = &terminals {
+        files.push((terminals::ARCHIVE_PATH.to_string(), t.as_bytes()));
+    }
     write_archive(cat, m, &model_description3(cat, m), &files, out_dir)
 }
 
-/// The archive both FMI versions share: `modelDescription.xml`, the binaries at their paths, then
-/// `documentation/index.html`, with fixed timestamps and order.
+/// The archive both FMI versions share: `modelDescription.xml`, the binaries at their paths (and, FMI
+/// 3.0, the terminals file), then `documentation/index.html`, with fixed timestamps and order.
 fn write_archive(
     cat: &Catalogue,
     m: &ModelDescription,
@@ -230,7 +238,12 @@ fn write_archive(
     };
     add(&mut zip, "modelDescription.xml", description.as_bytes(), 0o644)?;
     for (name, bytes) in binaries {
-        add(&mut zip, name, bytes, 0o755)?;
+        add(
+            &mut zip,
+            name,
+            bytes,
+            if name.starts_with("binaries/") { 0o755 } else { 0o644 },
+        )?;
     }
     add(
         &mut zip,

@@ -194,6 +194,8 @@ fn write_generated(cat: &Catalogue, xml: Option<&Path>, docs: Option<&Path>) -> 
             .map_err(|e| format!("cannot write model descriptions to {}: {e}", x.display()))?;
         write_model_descriptions3(cat, &x.join("fmi3"))
             .map_err(|e| format!("cannot write FMI 3.0 model descriptions to {}/fmi3: {e}", x.display()))?;
+        spacecraft_fmus_package::terminals::write_terminals(cat, &x.join("fmi3/terminalsAndIcons"))
+            .map_err(|e| format!("cannot write terminals to {}/fmi3/terminalsAndIcons: {e}", x.display()))?;
     }
     if let Some(d) = docs {
         spacecraft_fmus_package::docs::write_pages(d, cat)
@@ -208,6 +210,10 @@ fn check(cat: &Catalogue, xml: Option<&Path>, docs: Option<&Path>) -> Result<(),
     if let Some(x) = xml {
         stale.extend(stale_model_descriptions(cat, x));
         stale.extend(stale_model_descriptions3(cat, &x.join("fmi3")));
+        stale.extend(spacecraft_fmus_package::terminals::stale_terminals(
+            cat,
+            &x.join("fmi3/terminalsAndIcons"),
+        ));
     }
     if let Some(d) = docs {
         stale.extend(spacecraft_fmus_package::docs::stale_pages(d, cat));
