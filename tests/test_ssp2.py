@@ -321,3 +321,84 @@ def test_libcosim_reads_ssp_2_0_with_fmi2_units_and_refuses_fmi3_units(exported,
     with pytest.raises(AssertionError):
         CosimExecution.from_ssp_file(str(exported), step_size=10_000_000)
     assert "connector type" in get_last_error_message()
+
+
+def test_clock_attributes_come_from_the_fmus_own_description(tmp_path):
+    """A clock as our units declare them (value reference 1000200000, fixed interval, a priority): fmpy 0.3.32
+    keeps `clocks` as the attribute's text and reads no priority, so the writer reads the FMU's XML: the Clock
+    connector carries intervalVariability and priority, the clocked connectors name the clock (not one clock
+    per digit of its value reference)."""
+    md = CLOCKED_MD.replace('valueReference="1" causality="input" variability="discrete" intervalVariability='
+                            '"triggered"', 'valueReference="1000200000" causality="input" variability="discrete" '
+                            'intervalVariability="fixed" priority="0"').replace('clocks="1"', 'clocks="1000200000"')
+    assert md.count("1000200000") == 3
+    fmu = tmp_path / "Clocked.fmu"
+    with zipfile.ZipFile(fmu, "w") as z:
+        z.writestr("modelDescription.xml", md)
+    sc = Scenario(name="clocked", components=[Component("a", str(fmu))], stop_time=1.0, step=0.1, unconnected=["*"],
+                  auto_connect=False)
+    path = ssp.write_ssp(sc, tmp_path / "clocked.ssp", path_of=Path, version="2.0")
+    root, _ = ssd_of(path)
+    conns = {k.get("name"): k for k in root.iter(f"{SSD}Connector")}
+    assert [(t.tag, dict(t.attrib)) for t in conns["tick"]] == \
+        [(f"{SSC}Clock", {"intervalVariability": "fixed", "priority": "0"})]
+    for name in ("u", "y"):
+        assert [(t.tag, t.get("name")) for t in conns[name]] == [(f"{SSC}Float64", None), (f"{SSD}Clock", "tick")]
+    assert ssp2.structure_problems(path) == []
+    if ssp2.schema_dir() is not None:
+        assert ssp2.xsd_problems(path, ssp2.schema_dir()) == []
+
+
+CLOCKED_SCENARIO = "leo/nadir-textbook"  # gyro, star tracker, MEKF, sample-and-hold: clocked units, two with two clocks
+
+
+def _clocks_in(fmu_bytes: bytes) -> tuple[dict, dict]:
+    """From a unit's own modelDescription.xml (ElementTree): its clocks {name: attributes} and its clocked
+    outputs {name: [clock names]}."""
+    import io
+    with zipfile.ZipFile(io.BytesIO(fmu_bytes)) as z:
+        root = ET.fromstring(z.read("modelDescription.xml"))
+    mv = root.find("ModelVariables")
+    clocks = {e.get("valueReference"): e for e in mv if e.tag == "Clock"}
+    return ({e.get("name"): dict(e.attrib) for e in clocks.values()},
+            {e.get("name"): [clocks[r].get("name") for r in e.get("clocks").split()] for e in mv
+             if e.get("clocks") and e.get("causality") == "output"})
+
+
+def test_clocked_units_in_an_ssp_2_0_file(tmp_path):
+    """A scenario of clocked units exported as SSP 2.0: every clock of every unit is a connector (kind input,
+    type ssc:Clock with the clock's intervalVariability and priority), every clocked output names its clocks
+    by ssd:Clock, the file passes the structure check (and the official schemas when given), and `scfmu run`
+    runs it with the same results as the scenario run directly with the FMI 3.0 units."""
+    r = scfmu("export", "ssp", CLOCKED_SCENARIO, "--ssp-version", "2.0", "--out", tmp_path)
+    assert r.returncode == 0, r.stderr
+    path = tmp_path / (CLOCKED_SCENARIO.replace("/", "_") + ".ssp")
+    root, members = ssd_of(path)
+    n_clocked = 0
+    for c in root.iter(f"{SSD}Component"):
+        clocks, clocked = _clocks_in(members[c.get("source")])
+        conns = {k.get("name"): k for k in c.iter(f"{SSD}Connector")}
+        n_clocked += bool(clocks)
+        for name, attrs in clocks.items():
+            (t,) = list(conns[name])
+            assert conns[name].get("kind") == "input" and t.tag == f"{SSC}Clock", (c.get("name"), name)
+            assert dict(t.attrib) == {a: attrs[a] for a in ssp2.CLOCK_ATTRS if a in attrs}
+            assert t.get("intervalVariability") == "fixed" and t.get("priority") is not None
+        for name, k in conns.items():
+            assert [x.get("name") for x in k.findall(f"{SSD}Clock")] == clocked.get(name, []), (c.get("name"), name)
+    assert n_clocked >= 4, "the gyro, star tracker, MEKF and sample-and-hold declare clocks"
+    assert ssp2.structure_problems(path) == []
+    if ssp2.schema_dir() is not None:
+        assert ssp2.xsd_problems(path, ssp2.schema_dir()) == []
+    r = scfmu("run", path, "--t-end", 5, "--out", tmp_path / "run")
+    assert r.returncode == 0, r.stderr
+    sc = scenarios.get(CLOCKED_SCENARIO, stop_time=5.0)
+    direct = sc.with_models({c.name: str(fmi3(c.model)) for c in sc.components})
+    for c, o in zip(direct.components, sc.components):
+        c.params = dict(o.params)
+    ref = run_reference(direct)
+    csv = np.genfromtxt(tmp_path / "run" / f"{CLOCKED_SCENARIO.replace('/', '_')}.csv", delimiter=",", names=True)
+    keys = [k for k in ref if k in csv.dtype.names and k != "time"]
+    assert len(keys) >= 3, (sorted(ref), csv.dtype.names)
+    for k in keys:
+        np.testing.assert_array_equal(csv[k], ref[k], err_msg=k)

@@ -45,8 +45,8 @@ from fmpy import read_model_description
 from ..fmu import fmu_path, is_path
 from .model import Component, Scenario
 from .resolve import resolve
-from .ssp2 import (Refused, check_version, connector_extras, connector_type, fmi3_path, size_variables,
-                   structure_problems, value_tag)
+from .ssp2 import (Refused, check_version, clock_attributes, connector_extras, connector_type, fmi3_path,
+                   size_variables, structure_problems, value_tag)
 
 SSD_NS = "http://ssp-standard.org/SSP1/SystemStructureDescription"
 SSC_NS = "http://ssp-standard.org/SSP1/SystemStructureCommon"
@@ -149,7 +149,8 @@ def write_ssp(scenario: Scenario, path: str | Path, path_of=None, version: str =
                       {"version": version, "name": identifier(file_stem(scenario.name)), "generationTool": "scfmu.ssp",
                        "description": scenario.description or scenario.name})
     system = ET.SubElement(root, _q("ssd", "System"), {"name": "loop"})
-    ssv_files = _system(system, scenario, mds, version)
+    clocks = {m: clock_attributes(path_of(m)) for m in mds if _fmi(mds[m]) >= 3} if version == "2.0" else {}
+    ssv_files = _system(system, scenario, mds, version, clocks)
     _experiment(root, scenario)
     ET.indent(root)
     ssd = ET.tostring(root, encoding="UTF-8", xml_declaration=True)
@@ -183,9 +184,10 @@ def _fmi(md) -> int:
     return int(md.fmiVersion.split(".")[0])
 
 
-def _system(system, scenario: Scenario, mds: dict, version: str = "1.0") -> dict:
+def _system(system, scenario: Scenario, mds: dict, version: str = "1.0", clocks: dict | None = None) -> dict:
     """Fills the ``ssd:System``: elements with connectors and parameter bindings, connections and the
-    OMSimulator master annotation. Returns the ``.ssv`` files (archive name -> bytes)."""
+    OMSimulator master annotation (``clocks``: model -> its clocks' attributes, 2.0 files). Returns the ``.ssv``
+    files (archive name -> bytes)."""
     vars_of = {c.name: {v.name: v for v in mds[c.model].modelVariables} for c in scenario.components}
     ports = {c.name: ([v.name for v in mds[c.model].modelVariables if v.causality == "input" and v.type != "Clock"],
                       [v.name for v in mds[c.model].modelVariables if v.causality == "output" and v.type != "Clock"])
@@ -217,7 +219,7 @@ def _system(system, scenario: Scenario, mds: dict, version: str = "1.0") -> dict
                 if version == "1.0":
                     _type_elem(conn, "ssc", v.type)
                 else:
-                    connector_type(conn, SSC_NS, v, _fmi(mds[c.model]))
+                    connector_type(conn, SSC_NS, v, _fmi(mds[c.model]), (clocks or {}).get(c.model))
                     connector_extras(conn, v, mds[c.model])
         if version == "2.0":
             for v in size_variables(mds[c.model]):  # the sizes named by sizeConnector are connectors too
@@ -235,7 +237,7 @@ def _system(system, scenario: Scenario, mds: dict, version: str = "1.0") -> dict
             binds = ET.SubElement(comp, _q("ssd", "ParameterBindings"))
             ET.SubElement(binds, _q("ssd", "ParameterBinding"),
                           {"source": src, "type": "application/x-ssp-parameter-set"})
-    connections = ET.SubElement(system, _q("ssd", "Connections"))
+    connections = ET.SubElement(system, _q("ssd", "Connections")) if links else None  # (the schema: one or more)
     for d, di, s, so in links:
         ET.SubElement(connections, _q("ssd", "Connection"),
                       {"startElement": s, "startConnector": so, "endElement": d, "endConnector": di})

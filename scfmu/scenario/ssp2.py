@@ -85,9 +85,41 @@ def fmi3_path(model: str) -> Path:
     return p
 
 
-def connector_type(parent, ns: str, v, fmi: int):
+# the attributes of an FMI 3.0 clock that SSP 2.0's ssc:Clock carries too (same names, same meaning)
+CLOCK_ATTRS = ("intervalVariability", "intervalDecimal", "shiftDecimal", "supportsFraction", "resolution",
+               "intervalCounter", "shiftCounter", "priority")
+
+
+def clock_attributes(fmu) -> dict[int, dict[str, str]]:
+    """The SSP attributes of each clock of the FMI 3.0 FMU ``fmu`` (an archive or an unpacked folder), by value
+    reference, as written in its ``modelDescription.xml``. fmpy (0.3.32) reads of a clock only its
+    ``intervalVariability`` (not its priority, interval or shift), so the writer takes them from the file."""
+    fmu = Path(fmu)
+    if fmu.is_dir():
+        text = (fmu / "modelDescription.xml").read_bytes()
+    else:
+        with zipfile.ZipFile(fmu) as z:
+            text = z.read("modelDescription.xml")
+    root = ET.fromstring(text)
+    variables = root.find("ModelVariables")
+    return {int(e.get("valueReference")): {a: e.get(a) for a in CLOCK_ATTRS if e.get(a) is not None}
+            for e in ([] if variables is None else variables) if e.tag == "Clock"}
+
+
+def clock_refs(v) -> list[int]:
+    """The value references of the clocks variable ``v`` ticks with: fmpy (0.3.32) keeps the ``clocks``
+    attribute as its text (value references separated by blanks), a description built by hand may hold a
+    list of value references or of clock variables."""
+    clocks = getattr(v, "clocks", None) or []
+    if isinstance(clocks, str):
+        return [int(x) for x in clocks.split()]
+    return [c.valueReference if hasattr(c, "valueReference") else int(c) for c in clocks]
+
+
+def connector_type(parent, ns: str, v, fmi: int, clocks: dict | None = None):
     """The type child of a 2.0 connector for FMU variable ``v`` (of an FMI ``fmi`` unit): the variable's own
-    type; None (type left to the FMU, as the standard allows) for an enumeration."""
+    type; None (type left to the FMU, as the standard allows) for an enumeration. A clock's attributes come
+    from ``clocks`` (:func:`clock_attributes`) when given, else from ``v``."""
     vtype = v.type
     if fmi < 3 and vtype == "Enumeration":
         vtype = "Integer"  # as in the 1.0 files
@@ -95,11 +127,14 @@ def connector_type(parent, ns: str, v, fmi: int):
         return None
     attrs = {}
     if vtype == "Clock":
-        for a in ("intervalVariability", "intervalDecimal", "shiftDecimal", "resolution", "intervalCounter",
-                  "priority"):
-            val = getattr(v, a, None)
-            if val is not None:
-                attrs[a] = str(val)
+        if clocks is not None and v.valueReference in clocks:
+            attrs = dict(clocks[v.valueReference])
+        else:
+            for a in CLOCK_ATTRS:
+                val = getattr(v, a, None)
+                if val is not None and not (a == "supportsFraction" and val is False) and \
+                        not (a == "shiftCounter" and val == 0):  # (fmpy's defaults: attributes not written)
+                    attrs[a] = str(val).lower() if isinstance(val, bool) else str(val)
     return ET.SubElement(parent, f"{{{ns}}}{vtype}", attrs)
 
 
@@ -111,9 +146,11 @@ def connector_extras(conn, v, md) -> None:
             ET.SubElement(conn, f"{{{SSC}}}Dimension", {"size": str(int(d.start))})
         elif d.valueReference in by_vr:
             ET.SubElement(conn, f"{{{SSC}}}Dimension", {"sizeConnector": by_vr[d.valueReference].name})
-    for clock in getattr(v, "clocks", None) or []:
-        name = clock.name if hasattr(clock, "name") else by_vr[int(clock)].name
-        ET.SubElement(conn, f"{{{SSD}}}Clock", {"name": name})
+    for vr in clock_refs(v):
+        if vr not in by_vr:
+            raise Refused(f"{md.modelName}: variable {v.name} names clock value reference {vr}, which the "
+                          f"model description does not declare")
+        ET.SubElement(conn, f"{{{SSD}}}Clock", {"name": by_vr[vr].name})
 
 
 def size_variables(md) -> list:
