@@ -193,7 +193,8 @@ fn a_model_without_clocks_has_no_clock_element() {
 #[test]
 fn inconsistent_clocks_are_refused() {
     let base = clocked_catalogue();
-    let cases: [(&str, fn(&mut ClockDescription)); 5] = [
+    type Break = fn(&mut ClockDescription);
+    let cases: [(&str, Break); 5] = [
         ("not a fixed Real parameter", |c| c.interval = "theta".into()),
         ("does not declare", |c| c.shift = "no_such_parameter".into()),
         ("which is not an output", |c| c.outputs.push("kp".into())),
