@@ -16,7 +16,7 @@ use std::sync::{Mutex, MutexGuard};
 
 use serde::{Deserialize, Serialize};
 
-use super::instance::{CallResult, Fail, Instance, Reason, Run};
+use super::instance::{CallResult, ClockMode, Clocks, Fail, Instance, Reason, Run};
 use super::live::{BuildAddrHasher, Serials, KIND_STATE};
 use super::types::{Dialect, FsmState};
 use crate::model::DynModel;
@@ -24,7 +24,7 @@ use crate::model::DynModel;
 const MAGIC: &[u8; 8] = b"SCFMUST\0";
 // 2: the run carries the time of the last event (Model Exchange); 3: the FMI version of the instance;
 // 4: the states of the version-neutral state machine, the interface recorded by its name
-const FORMAT_VERSION: u32 = 4;
+const FORMAT_VERSION: u32 = 5;
 const HEADER: usize = 16;
 const TRAILER: usize = 4;
 
@@ -35,6 +35,8 @@ pub struct Snapshot {
     pub dialect: &'static Dialect,
     pub run: Run,
     pub model: Box<dyn DynModel>,
+    /// The clocks' bookkeeping (active flags, next ticks, held outputs).
+    pub clocks: Clocks,
     /// Bytes computed by the serialized-size call, reused by the serialize call that follows.
     pub serialized: Option<Vec<u8>>,
 }
@@ -47,6 +49,7 @@ struct Payload {
     guid: String,
     run: Run,
     model: Vec<u8>,
+    clocks: Clocks,
 }
 
 /// Live snapshots: token → (snapshot, token of the instance that created it, freed with that instance).
@@ -86,6 +89,29 @@ fn check_version(taken_by: &str, inst: &Instance, what: &'static str) -> CallRes
 /// A state taken in a Model Exchange mode is refused by a Co-Simulation instance and the reverse (at
 /// restore and already at deserialize, so that an accepted serialized state can always be set).
 fn check_kind(run: &Run, inst: &Instance) -> CallResult {
+    // a clocked Co-Simulation instance has Event Mode too, a scheduled one the Activation state
+    let clocked = match run.fsm {
+        FsmState::EventMode => inst.clocks.mode == ClockMode::Stepped,
+        FsmState::Activation => inst.clocks.mode == ClockMode::Scheduled,
+        _ => false,
+    };
+    if clocked && !inst.model_exchange {
+        return Ok(());
+    }
+    let scheduled = inst.clocks.mode == ClockMode::Scheduled;
+    if scheduled != (run.fsm == FsmState::Activation)
+        && (!scheduled
+            || matches!(
+                run.fsm,
+                FsmState::StepMode | FsmState::EventMode | FsmState::ContinuousTimeMode
+            ))
+    {
+        return Err(Fail::error(format!(
+            "FMU state was taken in state {:?}; this instance {} Scheduled Execution",
+            run.fsm,
+            if scheduled { "runs" } else { "does not run" }
+        )));
+    }
     let me_state = matches!(run.fsm, FsmState::EventMode | FsmState::ContinuousTimeMode);
     if (me_state && !inst.model_exchange) || (inst.model_exchange && run.fsm == FsmState::StepMode) {
         let kind = |me: bool| if me { "Model Exchange" } else { "Co-Simulation" };
@@ -105,6 +131,7 @@ impl Snapshot {
             dialect: inst.dialect,
             run: inst.run,
             model: inst.model.clone_box(),
+            clocks: inst.clocks.clone(),
             serialized: None,
         }
     }
@@ -118,8 +145,10 @@ impl Snapshot {
         }
         check_version(self.dialect.version, inst, "FMU state")?;
         check_kind(&self.run, inst)?;
+        inst.check_clocks(&self.clocks)?;
         inst.model = self.model.clone_box();
         inst.run = self.run;
+        inst.clocks = self.clocks.clone();
         Ok(())
     }
 
@@ -190,6 +219,7 @@ impl Snapshot {
                 .model
                 .to_bytes()
                 .map_err(|e| Fail::error(format!("cannot encode model state: {e}")))?,
+            clocks: self.clocks.clone(),
         };
         let body = postcard::to_stdvec(&payload).map_err(|e| Fail::error(format!("cannot encode FMU state: {e}")))?;
         let mut out = Vec::with_capacity(HEADER + body.len() + TRAILER);
@@ -270,11 +300,13 @@ impl Snapshot {
         model
             .validate(&p.run.exp)
             .map_err(|e| Fail::error(format!("serialized state is invalid: {e}")))?;
+        inst.check_clocks(&p.clocks)?;
         Ok(Snapshot {
             model_name: inst.entry.info.name,
             dialect: inst.dialect,
             run: p.run,
             model,
+            clocks: p.clocks,
             serialized: None,
         })
     }

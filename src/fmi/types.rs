@@ -67,6 +67,9 @@ pub enum FsmState {
     EventMode,
     /// Model Exchange: the importer's solver integrates the continuous states.
     ContinuousTimeMode,
+    /// A clocked model whose partitions the importer activates one at a time (between activations
+    /// inputs may be set and outputs read).
+    Activation,
 }
 
 impl FsmState {

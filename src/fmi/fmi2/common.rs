@@ -49,6 +49,7 @@ pub fn state_name(s: FsmState) -> &'static str {
         FsmState::Fatal => "Fatal",
         FsmState::EventMode => "EventMode",
         FsmState::ContinuousTimeMode => "ContinuousTimeMode",
+        FsmState::Activation => "Activation (not an FMI 2.0 state)",
     }
 }
 

@@ -56,7 +56,8 @@ const VERSION: &CStr = c"3.0";
 pub mod mask3 {
     use crate::fmi::types::mask_of as m;
     use crate::fmi::types::FsmState::*;
-    // Event Mode and Continuous-Time Mode are reached by Model Exchange instances only (`fmi3_me`).
+    // Event Mode: Model Exchange and clocked Co-Simulation; Continuous-Time Mode: Model Exchange only;
+    // Activation (Clock Activation Mode): Scheduled Execution only.
     /// Every state but Fatal (the super state "FMU State Settable" plus Terminated).
     pub const ANY: u16 = m(&[
         Instantiated,
@@ -65,17 +66,26 @@ pub mod mask3 {
         Terminated,
         EventMode,
         ContinuousTimeMode,
+        Activation,
     ]);
     pub const ENTER_INITIALIZATION_MODE: u16 = m(&[Instantiated]);
     pub const EXIT_INITIALIZATION_MODE: u16 = m(&[InitializationMode]);
-    pub const TERMINATE: u16 = m(&[StepMode, EventMode, ContinuousTimeMode]);
-    pub const GET: u16 = m(&[InitializationMode, StepMode, Terminated, EventMode, ContinuousTimeMode]);
+    pub const TERMINATE: u16 = m(&[StepMode, EventMode, ContinuousTimeMode, Activation]);
+    pub const GET: u16 = m(&[
+        InitializationMode,
+        StepMode,
+        Terminated,
+        EventMode,
+        ContinuousTimeMode,
+        Activation,
+    ]);
     pub const SET: u16 = m(&[
         Instantiated,
         InitializationMode,
         StepMode,
         EventMode,
         ContinuousTimeMode,
+        Activation,
     ]);
     pub const DIRECTIONAL_DERIVATIVE: u16 =
         m(&[InitializationMode, StepMode, Terminated, EventMode, ContinuousTimeMode]);
@@ -166,6 +176,7 @@ pub fn state_name(s: FsmState) -> &'static str {
         FsmState::Fatal => "Fatal",
         FsmState::EventMode => "Event Mode",
         FsmState::ContinuousTimeMode => "Continuous-Time Mode",
+        FsmState::Activation => "Clock Activation Mode",
     }
 }
 

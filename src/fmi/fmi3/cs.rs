@@ -1,5 +1,5 @@
-//! FMI 3.0 Co-Simulation only: `fmi3InstantiateCoSimulation`, `fmi3DoStep`, and the Step Mode functions
-//! of features these FMUs do not declare.
+//! FMI 3.0 Co-Simulation only: `fmi3InstantiateCoSimulation` (Event Mode for clocked models), `fmi3DoStep`,
+//! and the Step Mode functions of features these FMUs do not declare (clocked Event Mode: `clocks.rs`).
 #![allow(
     non_snake_case,
     clippy::missing_safety_doc,
@@ -10,8 +10,9 @@
 use std::ffi::{c_char, c_int, c_void};
 
 use super::common::{call3, mask3, refuse, request3, require_co_simulation, Instance3, Log3Fn, FMI3};
-use crate::fmi::boundary::{self, out_ptr, slice, Request};
-use crate::fmi::instance::{Fail, Reason};
+use crate::fmi::boundary::{self, instance_of, out_ptr, slice, Request};
+use crate::fmi::instance::{ClockMode, Fail, Reason};
+use crate::fmi::types::Status;
 use crate::model::ModelEntry;
 
 /// `fmi3InstantiateCoSimulation` for a library holding `models`: the model is picked by the library's
@@ -41,11 +42,17 @@ pub fn fmi3InstantiateCoSimulation(
         env,
         log_message,
     );
-    boundary::instantiate(Request {
+    let c = boundary::instantiate(Request {
+        // a model without clocks has no Event Mode in Co-Simulation
+        refuse_model: &|entry| {
+            (event_mode_used != 0 && entry.clocks.is_empty()).then(|| {
+                format!(
+                    "eventModeUsed = true, but {} has no Event Mode (hasEventMode = false)",
+                    entry.info.name
+                )
+            })
+        },
         check_arguments: &|| {
-            if event_mode_used != 0 {
-                return Err("eventModeUsed = true, but this FMU has no Event Mode (hasEventMode = false)".into());
-            }
             if n_required_intermediate > 0 {
                 let vrs = unsafe {
                     slice(
@@ -60,7 +67,21 @@ pub fn fmi3InstantiateCoSimulation(
             Ok(())
         },
         ..request
-    })
+    });
+    if let Some(inst) = instance_of(c, &FMI3).filter(|i| !i.entry.clocks.is_empty()) {
+        if event_mode_used != 0 {
+            inst.clocks.mode = ClockMode::Stepped;
+        } else {
+            // the standard asks clocked FMUs for eventModeUsed = true; kept lenient so that existing
+            // importers go on working: the unit samples inside fmi3DoStep as without clocks
+            inst.log(
+                Status::Warning,
+                "logStatusWarning",
+                "fmi3InstantiateCoSimulation: eventModeUsed = false on a clocked FMU: its clocks are not used, the unit samples inside fmi3DoStep (communication points on its sample grid)",
+            );
+        }
+    }
+    c
 }
 
 pub extern "C" fn fmi3DoStep(
@@ -88,15 +109,6 @@ pub extern "C" fn fmi3DoStep(
         *last = inst.run.time;
         r
     })
-}
-
-pub extern "C" fn fmi3EnterStepMode(c: Instance3) -> c_int {
-    refuse(
-        c,
-        "fmi3EnterStepMode",
-        mask3::ANY,
-        "Event Mode is never entered: fmi3ExitInitializationMode leads to Step Mode directly",
-    )
 }
 
 pub extern "C" fn fmi3GetOutputDerivatives(

@@ -18,6 +18,7 @@ macro_rules! __export_fmi3 {
     ($models:ident) => {
         const _: () = {
             use ::std::ffi::{c_char, c_int, c_void};
+            use $crate::fmi::fmi3::clocks as ck3;
             use $crate::fmi::fmi3::common as co3;
             use $crate::fmi::fmi3::cs as cs3;
             use $crate::fmi::fmi3::me as me3;
@@ -73,8 +74,22 @@ macro_rules! __export_fmi3 {
             ) -> Inst3 {
                 me3::fmi3InstantiateModelExchange($models, name, token, resources, visible, logging_on, env, log)
             }
+            #[no_mangle]
+            pub extern "C" fn fmi3InstantiateScheduledExecution(
+                name: *const c_char,
+                token: *const c_char,
+                resources: *const c_char,
+                visible: u8,
+                logging_on: u8,
+                env: *mut c_void,
+                log: Log3,
+                clock_update: *const c_void,
+                lock: Option<$crate::fmi::fmi3::clocks::PreemptionFn>,
+                unlock: Option<$crate::fmi::fmi3::clocks::PreemptionFn>,
+            ) -> Inst3 {
+                ck3::fmi3InstantiateScheduledExecution($models, name, token, resources, visible, logging_on, env, log, clock_update, lock, unlock)
+            }
             $crate::__fmi_forward! {
-                un3::fmi3InstantiateScheduledExecution(name: *const c_char, token: *const c_char, resources: *const c_char, visible: u8, logging_on: u8, env: *mut c_void, log: Log3, clock_update: *const c_void, lock: *const c_void, unlock: *const c_void) -> Inst3;
                 co3::fmi3FreeInstance(c: Inst3);
                 co3::fmi3EnterInitializationMode(c: Inst3, tol_defined: u8, tol: f64, start: f64, stop_defined: u8, stop: f64) -> c_int;
                 co3::fmi3ExitInitializationMode(c: Inst3) -> c_int;
@@ -96,14 +111,14 @@ macro_rules! __export_fmi3 {
                 un3::fmi3GetAdjointDerivative(c: Inst3, u: *const u32, nu: usize, k: *const u32, nk: usize, seed: *const f64, ns: usize, out: *mut f64, no: usize) -> c_int;
                 un3::fmi3EnterConfigurationMode(c: Inst3) -> c_int;
                 un3::fmi3ExitConfigurationMode(c: Inst3) -> c_int;
-                un3::fmi3GetIntervalDecimal(c: Inst3, vr: *const u32, n: usize, i: *mut f64, q: *mut c_int) -> c_int;
-                un3::fmi3GetIntervalFraction(c: Inst3, vr: *const u32, n: usize, k: *mut u64, r: *mut u64, q: *mut c_int) -> c_int;
-                un3::fmi3GetShiftDecimal(c: Inst3, vr: *const u32, n: usize, s: *mut f64) -> c_int;
-                un3::fmi3GetShiftFraction(c: Inst3, vr: *const u32, n: usize, k: *mut u64, r: *mut u64) -> c_int;
-                un3::fmi3SetIntervalDecimal(c: Inst3, vr: *const u32, n: usize, i: *const f64) -> c_int;
-                un3::fmi3SetIntervalFraction(c: Inst3, vr: *const u32, n: usize, k: *const u64, r: *const u64) -> c_int;
-                un3::fmi3SetShiftDecimal(c: Inst3, vr: *const u32, n: usize, s: *const f64) -> c_int;
-                un3::fmi3SetShiftFraction(c: Inst3, vr: *const u32, n: usize, k: *const u64, r: *const u64) -> c_int;
+                ck3::fmi3GetIntervalDecimal(c: Inst3, vr: *const u32, n: usize, i: *mut f64, q: *mut c_int) -> c_int;
+                ck3::fmi3GetIntervalFraction(c: Inst3, vr: *const u32, n: usize, k: *mut u64, r: *mut u64, q: *mut c_int) -> c_int;
+                ck3::fmi3GetShiftDecimal(c: Inst3, vr: *const u32, n: usize, s: *mut f64) -> c_int;
+                ck3::fmi3GetShiftFraction(c: Inst3, vr: *const u32, n: usize, k: *mut u64, r: *mut u64) -> c_int;
+                ck3::fmi3SetIntervalDecimal(c: Inst3, vr: *const u32, n: usize, i: *const f64) -> c_int;
+                ck3::fmi3SetIntervalFraction(c: Inst3, vr: *const u32, n: usize, k: *const u64, r: *const u64) -> c_int;
+                ck3::fmi3SetShiftDecimal(c: Inst3, vr: *const u32, n: usize, s: *const f64) -> c_int;
+                ck3::fmi3SetShiftFraction(c: Inst3, vr: *const u32, n: usize, k: *const u64, r: *const u64) -> c_int;
                 me3::fmi3EvaluateDiscreteStates(c: Inst3) -> c_int;
                 me3::fmi3UpdateDiscreteStates(c: Inst3, a: *mut u8, b: *mut u8, d: *mut u8, e: *mut u8, f: *mut u8, t: *mut f64) -> c_int;
                 me3::fmi3EnterContinuousTimeMode(c: Inst3) -> c_int;
@@ -116,10 +131,10 @@ macro_rules! __export_fmi3 {
                 me3::fmi3GetNominalsOfContinuousStates(c: Inst3, x: *mut f64, n: usize) -> c_int;
                 me3::fmi3GetNumberOfEventIndicators(c: Inst3, n: *mut usize) -> c_int;
                 me3::fmi3GetNumberOfContinuousStates(c: Inst3, n: *mut usize) -> c_int;
-                cs3::fmi3EnterStepMode(c: Inst3) -> c_int;
+                ck3::fmi3EnterStepMode(c: Inst3) -> c_int;
                 cs3::fmi3GetOutputDerivatives(c: Inst3, vr: *const u32, n: usize, order: *const i32, v: *mut f64, nv: usize) -> c_int;
                 cs3::fmi3DoStep(c: Inst3, t: f64, h: f64, no_prior: u8, event: *mut u8, terminate: *mut u8, early: *mut u8, last: *mut f64) -> c_int;
-                un3::fmi3ActivateModelPartition(c: Inst3, clock: u32, t: f64) -> c_int;
+                ck3::fmi3ActivateModelPartition(c: Inst3, clock: u32, t: f64) -> c_int;
             }
         };
     };

@@ -10,6 +10,7 @@ macro_rules! __export_fmi3_values {
     () => {
         const _: () = {
             use ::std::ffi::{c_char, c_int, c_void};
+            use $crate::fmi::fmi3::clocks as ck3;
             use $crate::fmi::fmi3::unsupported as un3;
             use $crate::fmi::fmi3::values as va3;
             type Inst3 = *mut c_void;
@@ -40,8 +41,8 @@ macro_rules! __export_fmi3_values {
                 un3::fmi3SetString(c: Inst3, vr: *const u32, n: usize, v: *const *const c_char, nv: usize) -> c_int;
                 un3::fmi3GetBinary(c: Inst3, vr: *const u32, n: usize, sizes: *mut usize, v: *mut *const u8, nv: usize) -> c_int;
                 un3::fmi3SetBinary(c: Inst3, vr: *const u32, n: usize, sizes: *const usize, v: *const *const u8, nv: usize) -> c_int;
-                un3::fmi3GetClock(c: Inst3, vr: *const u32, n: usize, v: *mut u8) -> c_int;
-                un3::fmi3SetClock(c: Inst3, vr: *const u32, n: usize, v: *const u8) -> c_int;
+                ck3::fmi3GetClock(c: Inst3, vr: *const u32, n: usize, v: *mut u8) -> c_int;
+                ck3::fmi3SetClock(c: Inst3, vr: *const u32, n: usize, v: *const u8) -> c_int;
             }
         };
     };

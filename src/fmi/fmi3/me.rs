@@ -218,12 +218,7 @@ pub extern "C" fn fmi3EnterEventMode(c: Instance3) -> c_int {
     if is_model_exchange(c) {
         return enter_event_mode(c);
     }
-    refuse(
-        c,
-        "fmi3EnterEventMode",
-        mask3::ANY,
-        "hasEventMode = false (instantiate with eventModeUsed = false)",
-    )
+    super::clocks::enter_event_mode(c)
 }
 
 pub extern "C" fn fmi3EvaluateDiscreteStates(c: Instance3) -> c_int {
@@ -256,10 +251,5 @@ pub extern "C" fn fmi3UpdateDiscreteStates(
     if is_model_exchange(c) {
         return update_discrete_states(c, need, terminate, nominals_changed, values_changed, defined, t);
     }
-    refuse(
-        c,
-        "fmi3UpdateDiscreteStates",
-        mask3::ANY,
-        "this Co-Simulation FMU has no Event Mode",
-    )
+    super::clocks::update_discrete_states(c, need, terminate, nominals_changed, values_changed, defined, t)
 }

@@ -1,5 +1,5 @@
 //! Every FMI 3.0 function of a feature these FMUs do not declare (adjoint derivatives, Configuration
-//! Mode, variable types other than Float64/Int32/Boolean, clocks, Scheduled Execution). They exist
+//! Mode, variable types other than Float64/Int32/Boolean besides Clock). They exist
 //! because the standard's importers (fmpy, FMI Library) resolve every `fmi3*` symbol when they load a
 //! binary; each one refuses with `fmi3Error` and a logged reason, as the standard prescribes for a call
 //! the model description does not allow.
@@ -10,9 +10,9 @@
     clippy::too_many_arguments
 )]
 
-use std::ffi::{c_char, c_int, c_void};
+use std::ffi::{c_char, c_int};
 
-use super::common::{call3, log_without_instance3, mask3, refuse, Instance3, Log3Fn};
+use super::common::{call3, mask3, refuse, Instance3};
 use crate::fmi::boundary::slice;
 use crate::fmi::instance::Fail;
 
@@ -105,46 +105,4 @@ other_types! {
 no_such_type! {
     fmi3GetBinary(_sizes: *mut usize, _v: *mut *const u8, _nv: usize) => mask3::GET, "Binary";
     fmi3SetBinary(_sizes: *const usize, _v: *const *const u8, _nv: usize) => mask3::SET, "Binary";
-    fmi3GetClock(_v: *mut u8) => mask3::ANY, "Clock";
-    fmi3SetClock(_v: *const u8) => mask3::ANY, "Clock";
-    fmi3GetIntervalDecimal(_i: *mut f64, _q: *mut c_int) => mask3::ANY, "Clock";
-    fmi3GetIntervalFraction(_counters: *mut u64, _r: *mut u64, _q: *mut c_int) => mask3::ANY, "Clock";
-    fmi3GetShiftDecimal(_s: *mut f64) => mask3::ANY, "Clock";
-    fmi3GetShiftFraction(_counters: *mut u64, _r: *mut u64) => mask3::ANY, "Clock";
-    fmi3SetIntervalDecimal(_i: *const f64) => mask3::ANY, "Clock";
-    fmi3SetIntervalFraction(_counters: *const u64, _r: *const u64) => mask3::ANY, "Clock";
-    fmi3SetShiftDecimal(_s: *const f64) => mask3::ANY, "Clock";
-    fmi3SetShiftFraction(_counters: *const u64, _r: *const u64) => mask3::ANY, "Clock";
-}
-
-// ----- Scheduled Execution ---------------------------------------------------------------------------
-
-pub extern "C" fn fmi3InstantiateScheduledExecution(
-    _name: *const c_char,
-    _token: *const c_char,
-    _resources: *const c_char,
-    _visible: u8,
-    _logging_on: u8,
-    env: *mut c_void,
-    log_message: Option<Log3Fn>,
-    _clock_update: *const c_void,
-    _lock: *const c_void,
-    _unlock: *const c_void,
-) -> Instance3 {
-    log_without_instance3(
-        log_message,
-        env,
-        "fmi3InstantiateScheduledExecution",
-        "this FMU provides no Scheduled Execution (no <ScheduledExecution> element)",
-    );
-    std::ptr::null_mut()
-}
-
-pub extern "C" fn fmi3ActivateModelPartition(c: Instance3, _clock: u32, _t: f64) -> c_int {
-    refuse(
-        c,
-        "fmi3ActivateModelPartition",
-        mask3::ANY,
-        "Scheduled Execution function; this FMU provides Co-Simulation only",
-    )
 }

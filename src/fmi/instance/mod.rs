@@ -9,6 +9,7 @@ use std::ffi::{c_void, CString};
 
 use serde::{Deserialize, Serialize};
 
+mod clocks;
 mod jacobian;
 mod logging;
 pub mod me;
@@ -17,6 +18,7 @@ mod values;
 pub use crate::fmi::fail::{CallResult, Fail, Reason};
 use crate::fmi::types::{Dialect, FsmState, PrintfLogFn, Status, TextLogFn, LOG_CATEGORIES};
 use crate::math::sample_grid;
+pub use clocks::{ClockMode, Clocks};
 
 /// The master's logger, by the shape of its callback.
 #[derive(Clone, Copy)]
@@ -119,6 +121,7 @@ impl Run {
                 | FsmState::Error
                 | FsmState::EventMode
                 | FsmState::ContinuousTimeMode
+                | FsmState::Activation
         ) {
             return Err(format!(
                 "state machine state {:?} cannot be restored (no FMU state can be taken in it)",
@@ -156,6 +159,10 @@ pub struct Instance {
     pub run: Run,
     pub model: Box<dyn DynModel>,
     index: VrIndex,
+    /// The clocks' bookkeeping (a clocked model driven by clocks; else mode `Off` and empty).
+    pub clocks: Clocks,
+    /// Scheduled Execution: the importer's lock and unlock callbacks, called around each activation.
+    pub preemption: Option<(unsafe extern "C" fn(), unsafe extern "C" fn())>,
 }
 
 impl Instance {
@@ -179,6 +186,11 @@ impl Instance {
             run: Run::INSTANTIATED,
             model: (entry.create)(),
             index: VrIndex::new(entry.decls),
+            clocks: Clocks {
+                reported: vec![false; entry.clocks.len()],
+                ..Clocks::default()
+            },
+            preemption: None,
         }
     }
 
@@ -256,11 +268,14 @@ impl Instance {
                 None
             }
         };
-        self.run.fsm = if self.model_exchange {
-            FsmState::EventMode
-        } else {
-            FsmState::StepMode
+        self.run.fsm = match (self.model_exchange, self.clocks.mode) {
+            (true, _) | (false, ClockMode::Stepped) => FsmState::EventMode,
+            (false, ClockMode::Scheduled) => FsmState::Activation,
+            (false, ClockMode::Off) => FsmState::StepMode,
         };
+        if self.clocks.mode != ClockMode::Off {
+            self.start_clocks(self.clocks.mode);
+        }
         self.run.event_time = self.run.time;
         warning.map_or(Ok(()), Err)
     }
@@ -284,7 +299,10 @@ impl Instance {
         if let Some(period) = self.model.time_grid() {
             sample_grid::check_time("the step's end t + h =", t + h, period).map_err(Fail::error)?;
         }
-        if let Err(reason) = self.model.do_step(t, h) {
+        if self.clocks.mode == ClockMode::Stepped {
+            // the partitions ran at their ticks: the step only advances time
+            self.check_no_tick_passed(t, h)?;
+        } else if let Err(reason) = self.model.do_step(t, h) {
             self.run.fsm = FsmState::Error;
             return Err(Fail::error(format!("step from t = {t} failed: {reason}")));
         }
@@ -300,6 +318,11 @@ impl Instance {
     pub fn reset(&mut self) {
         self.model = (self.entry.create)();
         self.run = Run::INSTANTIATED;
+        self.clocks = Clocks {
+            mode: self.clocks.mode,
+            reported: vec![false; self.entry.clocks.len()],
+            ..Clocks::default()
+        };
     }
 }
 

@@ -132,8 +132,13 @@ impl Instance {
     /// parameters are (re)applied first so that initial outputs reflect them.
     pub fn ensure_outputs(&mut self) -> CallResult {
         self.ensure_initialized()?;
+        if self.run.fsm == FsmState::EventMode && self.clocks.active.contains(&true) {
+            // a clocked output read before the discrete states are updated: the partitions run now
+            self.run_active_partitions()?;
+        }
         if self.run.outputs_dirty && self.run.fsm != FsmState::Instantiated {
             self.model.update_outputs(self.run.time).map_err(Fail::error)?;
+            self.apply_held();
             self.run.outputs_dirty = false;
         }
         Ok(())
@@ -163,6 +168,7 @@ impl Instance {
             .collect();
         match self.model.update_outputs(self.run.time) {
             Ok(()) => {
+                self.apply_held();
                 self.run.outputs_dirty = false;
                 Ok(())
             }
