@@ -95,11 +95,14 @@ def test_archive_layout_and_description(model):
     assert md3.fmiVersion == "3.0" and md3.instantiationToken == md2.guid
     v3 = {v.name: v for v in md3.modelVariables}
     assert v3["time"].causality == "independent" and v3["time"].valueReference == TIME_VR
-    # every FMI 2.0 variable, the Model Exchange states and derivatives included (same value references)
-    assert len(md3.modelVariables) == len(md2.modelVariables) + 1
+    # every FMI 2.0 variable, the Model Exchange states and derivatives included (same value references),
+    # then the clocks of a sampled unit (FMI 3.0 only); a clocked output is discrete (2.4.7)
+    clocks = [v for v in md3.modelVariables if v.type == "Clock"]
+    assert len(md3.modelVariables) == len(md2.modelVariables) + 1 + len(clocks)
     for v in md2.modelVariables:
         w = v3[v.name]
-        assert (w.valueReference, w.causality, w.variability, w.start, w.unit) == (v.valueReference, v.causality, v.variability, v.start, v.unit)
+        variability = "discrete" if w.clocks else v.variability
+        assert (w.valueReference, w.causality, w.variability, w.start, w.unit) == (v.valueReference, v.causality, variability, v.start, v.unit)
         if v.derivative is not None:
             assert w.derivative.name == v.derivative.name
         assert w.type == {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean"}[v.type]

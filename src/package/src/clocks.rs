@@ -12,8 +12,10 @@
 //! The outputs a clock computes at its ticks are its clocked variables: `clocks="<vr>"`,
 //! `variability="discrete"` (a clocked variable is discrete or tunable), and in `<ModelStructure>` their
 //! `<Output>` dependencies include the clock (the standard asks for a clocked variable's dependency on its
-//! clock to be listed). They stay `<InitialUnknown>`s: the unit computes them in Initialization Mode as
-//! without clocks (the standard lets an FMU initialize clocked variables there).
+//! clock to be listed). They are not `<InitialUnknown>`s: the standard lists there the outputs that are
+//! not clocked and only those clocked variables an FMU chooses to initialize in Initialization Mode, and
+//! these take their values at their clock's ticks (as the Reference FMUs' clocked outputs; fmpy's
+//! validation also expects it).
 
 use spacecraft_fmus::catalogue::{Causality, LayerInfo, ModelDescription, VarKind, Variability};
 

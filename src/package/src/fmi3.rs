@@ -185,8 +185,12 @@ fn write_structure(w: &mut W, m: &ModelDescription, layer: &LayerInfo) {
         ];
         empty(w, "ContinuousStateDerivative", &attrs);
     }
-    // outputs and calculated parameters, then the states and derivatives (initial = "calculated")
+    // outputs and calculated parameters, then the states and derivatives (initial = "calculated"); a
+    // clocked output is not one (its value comes from its clock's ticks)
     for (ix, deps) in initial_unknowns(m) {
+        if ix <= m.variables.len() && clock_of(m, &m.variables[ix - 1].name).is_some() {
+            continue;
+        }
         let attrs = [
             ("valueReference", vr_of_index(m, layer, ix).to_string()),
             ("dependencies", vrs_of(m, layer, &deps)),

@@ -98,7 +98,7 @@ pub fn interfaces_text(m: &ModelDescription) -> String {
         return text;
     }
     format!(
-        "{text} In FMI 3.0 it is also clocked: Co-Simulation with Event Mode and Scheduled Execution, {} (see Clocks).",
+        "{text} In FMI 3.0 it also offers clocked Co-Simulation (Event Mode) and Scheduled Execution, with {} (see Clocks).",
         match m.clocks.len() {
             1 => "one input clock".to_string(),
             n => format!("{n} input clocks"),
@@ -107,7 +107,17 @@ pub fn interfaces_text(m: &ModelDescription) -> String {
 }
 
 /// The clocks section of the documentation: what the clocks are, before their table.
-pub(crate) const CLOCKS_TEXT: &str = "FMI 3.0 only (FMI 2.0 runs the unit sampled inside its step). Each clock is a time-based periodic input clock (intervalVariability fixed): it ticks at the start time plus the shift, then once per interval, both read from the named parameters (fmi3GetIntervalDecimal and fmi3GetShiftDecimal in Initialization Mode; no shift: 0). At a tick, with the inputs the unit holds then, the clock's partition computes its outputs from the state before the tick and holds them until the clock's next tick; then, where the table says so, the state advances over one interval. A lower clock index runs first when two clocks tick together (its priority in Scheduled Execution).";
+pub(crate) const CLOCKS_TEXT: &str = concat!(
+    "FMI 3.0 only (FMI 2.0 runs the unit sampled inside its step). Each clock is a time-based periodic ",
+    "input clock (intervalVariability fixed): it ticks at the start time plus the shift, then once per ",
+    "interval, both read from the named parameters (fmi3GetIntervalDecimal and fmi3GetShiftDecimal in ",
+    "Initialization Mode; no shift: 0). At a tick, with the inputs the unit holds then, the clock's ",
+    "partition computes its outputs from the state before the tick and holds them until the clock's next ",
+    "tick; then, where the table says so, the state advances over one interval. A lower clock index runs ",
+    "first when two clocks tick together (its priority in Scheduled Execution). In the FMI 3.0 ",
+    "description the outputs a clock computes are discrete clocked variables (the variable tables give ",
+    "their FMI 2.0 variability).",
+);
 
 /// The header of the clock table, and [`clock_cells`] of each row.
 pub(crate) const CLOCK_HEADER: [&str; 6] = ["name", "vr", "interval", "shift", "partition", "meaning"];
