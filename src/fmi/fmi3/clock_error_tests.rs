@@ -223,3 +223,61 @@ fn fmu_states_carry_the_clock_bookkeeping() {
     fmi3FreeFMUState(c, &mut back);
     fmi3FreeInstance(c);
 }
+
+static LOCKS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+static UNLOCKS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+unsafe extern "C" fn lock() {
+    LOCKS.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+}
+unsafe extern "C" fn unlock() {
+    UNLOCKS.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+}
+
+/// The importer's preemption callbacks are called once each around every activation, and the
+/// instance is in Clock Activation Mode: no step, no Event Mode, no fmi3SetClock.
+#[test]
+fn scheduled_execution_calls_the_preemption_callbacks_around_each_activation() {
+    let e = entry("Gyro");
+    let log = Log::default();
+    let token = std::ffi::CString::new(crate::model::guid::guid(e).as_str()).unwrap();
+    let env = &log as *const Log as *mut c_void;
+    let c = fmi3InstantiateScheduledExecution(
+        crate::registry::ALL,
+        c"se".as_ptr(),
+        token.as_ptr(),
+        std::ptr::null(),
+        0,
+        0,
+        env,
+        Some(super::clock_tests::record),
+        std::ptr::null(),
+        Some(lock),
+        Some(unlock),
+    );
+    assert!(!c.is_null());
+    assert_eq!(fmi3EnterInitializationMode(c, 0, 0.0, 0.0, 0, 0.0), 0);
+    set(c, e, "sample_period", 0.5);
+    assert_eq!(fmi3ExitInitializationMode(c), 0);
+    for k in 0..3 {
+        assert_eq!(
+            fmi3ActivateModelPartition(c, SAMPLE, 0.5 * k as f64),
+            0,
+            "{}",
+            last(&log)
+        );
+    }
+    use std::sync::atomic::Ordering::SeqCst;
+    assert_eq!((LOCKS.load(SeqCst), UNLOCKS.load(SeqCst)), (3, 3));
+    assert_eq!(fmi3ActivateModelPartition(c, SAMPLE, 1.0), 3); // the tick at 1.0 is done
+    assert!(last(&log).contains("next tick is at t = 1.5"), "{}", last(&log));
+    let calls: [(&str, &dyn Fn() -> c_int); 3] = [
+        ("fmi3DoStep", &|| step(c, 1.0, 0.5)),
+        ("fmi3EnterEventMode", &|| fmi3EnterEventMode(c)),
+        ("fmi3SetClock", &|| fmi3SetClock(c, &SAMPLE, 1, &1)),
+    ];
+    for (f, call) in calls {
+        assert_eq!(call(), 3, "{f}");
+        assert!(last(&log).contains(f), "{}", last(&log));
+    }
+    fmi3FreeInstance(c);
+}
