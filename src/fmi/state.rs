@@ -112,6 +112,11 @@ fn check_kind(run: &Run, inst: &Instance) -> CallResult {
             if scheduled { "runs" } else { "does not run" }
         )));
     }
+    if run.fsm == FsmState::EventMode && !inst.model_exchange && !inst.entry.clocks.is_empty() {
+        return Err(Fail::error(
+            "FMU state was taken in Event Mode of a clocked Co-Simulation instance; this instance runs Co-Simulation without clocks",
+        ));
+    }
     let me_state = matches!(run.fsm, FsmState::EventMode | FsmState::ContinuousTimeMode);
     if (me_state && !inst.model_exchange) || (inst.model_exchange && run.fsm == FsmState::StepMode) {
         let kind = |me: bool| if me { "Model Exchange" } else { "Co-Simulation" };

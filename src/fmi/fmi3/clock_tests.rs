@@ -351,6 +351,17 @@ fn star_tracker_with_latency() {
     );
 }
 
+/// Latency of one period: the delivery tick coincides with the next sample tick, where the delivered
+/// quaternion and its flag must come from the state before that sample is taken.
+#[test]
+fn star_tracker_with_a_latency_of_one_period() {
+    same_in_all_three(
+        "StarTracker",
+        &[("sample_period", 0.2), ("latency", 0.2), ("seed", 5.0)],
+        4.0,
+    );
+}
+
 #[test]
 fn sun_sensor() {
     same_in_all_three(

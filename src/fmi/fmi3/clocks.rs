@@ -32,7 +32,9 @@ fn require_stepped(inst: &Instance) -> CallResult {
     require_co_simulation(inst)?;
     match inst.clocks.mode {
         ClockMode::Stepped => Ok(()),
-        ClockMode::Scheduled => Err(Fail::error("not a Scheduled Execution function (this instance was created by fmi3InstantiateScheduledExecution)")),
+        ClockMode::Scheduled => Err(Fail::error(
+            "not used in Scheduled Execution (this instance was created by fmi3InstantiateScheduledExecution: its partitions run through fmi3ActivateModelPartition)",
+        )),
         ClockMode::Off if inst.entry.clocks.is_empty() => {
             Err(Fail::error("this Co-Simulation FMU has no Event Mode and no clocks (hasEventMode = false)"))
         }

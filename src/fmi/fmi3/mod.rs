@@ -7,6 +7,8 @@
 //! nothing here imports FMI 2.0.
 
 #[cfg(test)]
+mod clock_error_tests;
+#[cfg(test)]
 mod clock_tests;
 pub mod clocks;
 pub mod common;

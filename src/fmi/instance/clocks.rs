@@ -12,39 +12,10 @@
 //! the state over one interval. So two clocks ticking together (a sample and a delivery with a delay of
 //! whole periods) give what a sampled run gives: outputs read before the step.
 
-use serde::{Deserialize, Serialize};
-
+use super::clock_book::{ClockMode, Clocks};
 use super::{CallResult, Fail, Instance};
 use crate::math::sample_grid;
 use crate::model::{clocked_outputs, ClockDecl, SlotMut, Value, VarKind};
-
-/// How an instance runs its clocks.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub enum ClockMode {
-    /// Not clocked (or a clocked model stepped as a sampled unit without clocks).
-    #[default]
-    Off,
-    /// The master activates due clocks at events; the step only advances time.
-    Stepped,
-    /// The master activates one partition at a time (the Activation state).
-    Scheduled,
-}
-
-/// Clock bookkeeping, part of an FMU state.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct Clocks {
-    pub mode: ClockMode,
-    /// Activated at the current event and not yet run.
-    pub active: Vec<bool>,
-    /// Index k of each clock's next tick.
-    pub next: Vec<i64>,
-    /// Whether the interval of each clock was reported to the master already (its qualifier).
-    pub reported: Vec<bool>,
-    /// The held clocked outputs: (declaration index, value), clock by clock.
-    pub held: Vec<(usize, f64)>,
-    /// The instant whose outputs were computed before its partitions ran, and those outputs.
-    pub snap: Option<(f64, Vec<(usize, f64)>)>,
-}
 
 fn number(v: Value) -> f64 {
     match v {
@@ -182,7 +153,11 @@ impl Instance {
         self.check_due(i, t)?;
         let tick = self.tick_time(i, self.clocks.next[i])?;
         let (interval, _) = self.clock_timing(i)?;
-        let snap_here = self.clocks.snap.as_ref().is_some_and(|(s, _)| *s == tick);
+        // the same instant for two clocks may differ in the last bits (0.2 + 5·0.2 and 6·0.2)
+        let snap_here = match &self.clocks.snap {
+            Some((s, _)) => self.is_at(i, *s, tick)?,
+            None => false,
+        };
         if !snap_here {
             self.model.update_outputs(tick).map_err(|e| {
                 Fail::error(format!(

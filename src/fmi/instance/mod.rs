@@ -9,6 +9,7 @@ use std::ffi::{c_void, CString};
 
 use serde::{Deserialize, Serialize};
 
+mod clock_book;
 mod clocks;
 mod jacobian;
 mod logging;
@@ -18,7 +19,7 @@ mod values;
 pub use crate::fmi::fail::{CallResult, Fail, Reason};
 use crate::fmi::types::{Dialect, FsmState, PrintfLogFn, Status, TextLogFn, LOG_CATEGORIES};
 use crate::math::sample_grid;
-pub use clocks::{ClockMode, Clocks};
+pub use clock_book::{ClockMode, Clocks};
 
 /// The master's logger, by the shape of its callback.
 #[derive(Clone, Copy)]
