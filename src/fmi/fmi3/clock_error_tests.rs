@@ -281,3 +281,28 @@ fn scheduled_execution_calls_the_preemption_callbacks_around_each_activation() {
     }
     fmi3FreeInstance(c);
 }
+
+/// A clocked run starts on the sample grid k·T from t = 0 (where the units count their samples); an
+/// off-grid start is refused at fmi3ExitInitializationMode, naming the clock and the parameter.
+#[test]
+fn a_clocked_start_off_the_sample_grid_is_refused() {
+    let e = entry("StarTracker");
+    for (t0, ok) in [(0.4, true), (0.1, false)] {
+        let log = Log::default();
+        let c = instantiate(e, Master::Clocked, &log);
+        assert_eq!(fmi3EnterInitializationMode(c, 0, 0.0, t0, 0, 0.0), 0);
+        set(c, e, "sample_period", 0.2);
+        let status = fmi3ExitInitializationMode(c);
+        if ok {
+            assert_eq!(status, 0, "{}", last(&log));
+        } else {
+            assert_eq!(status, 3);
+            let msg = last(&log);
+            assert!(
+                msg.contains("sample_clock") && msg.contains("not a multiple of sample_period"),
+                "{msg}"
+            );
+        }
+        fmi3FreeInstance(c);
+    }
+}

@@ -101,6 +101,25 @@ impl Instance {
             .collect()
     }
 
+    /// Refuses a clocked run whose start time is off a clock's grid k·T from t = 0: the units count
+    /// their samples at k·T (most from t = 0), so a periodic clock from an off-grid start would tick
+    /// between the samples of the sampled run and could not repeat it.
+    pub fn check_clock_start(&self) -> CallResult {
+        let t0 = self.run.exp.start_time;
+        for (i, c) in self.clock_decls().iter().enumerate() {
+            let (interval, _) = self.clock_timing(i)?;
+            if sample_grid::on_grid(t0, interval, t0).map_err(Fail::error)?.is_none() {
+                return Err(Fail::error(format!(
+                    "clock {} of {}: the start time {t0} s is not a multiple of {} = {interval} s; a clocked run \
+                     needs a start time on the sample grid k·{} from t = 0 (where the unit counts its samples); \
+                     start there, or run the unit without event mode (it then samples inside the step)",
+                    c.name, self.entry.info.name, c.interval, c.interval
+                )));
+            }
+        }
+        Ok(())
+    }
+
     /// At the end of initialization: every clock's next tick is its first, nothing is active, and the
     /// held outputs are those of the start time (already computed).
     pub fn start_clocks(&mut self, mode: ClockMode) {

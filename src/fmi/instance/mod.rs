@@ -269,6 +269,9 @@ impl Instance {
                 None
             }
         };
+        if self.clocks.mode != ClockMode::Off {
+            self.check_clock_start()?;
+        }
         self.run.fsm = match (self.model_exchange, self.clocks.mode) {
             (true, _) | (false, ClockMode::Stepped) => FsmState::EventMode,
             (false, ClockMode::Scheduled) => FsmState::Activation,
