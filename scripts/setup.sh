@@ -47,9 +47,8 @@ for c in fmt:rustfmt clippy:clippy; do
         fi
     fi
 done
-# System tools the tests use: gcc (the hostile C master of tests/test_hardening.py), valgrind
-# (memcheck) and libxml2's link library (the packager's XSD test, src/package/tests/xsd). Installed with
-# apt-get where missing and we are root (CI, fresh machines).
+# System tools the tests use: gcc (the hostile C master of tests/test_hardening.py) and valgrind
+# (memcheck). Installed with apt-get where missing and we are root (CI, fresh machines).
 can_apt() { [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; }
 apt_updated=0
 apt_install() {
@@ -60,16 +59,13 @@ missing=()
 if [ "$test_tools" = 1 ]; then
     command -v gcc >/dev/null 2>&1 || missing+=(gcc libc6-dev)
     command -v valgrind >/dev/null 2>&1 || missing+=(valgrind)
-    if command -v dpkg-query >/dev/null 2>&1; then
-        dpkg-query -W -f='${Status}' libxml2-dev 2>/dev/null | grep -q "ok installed" || missing+=(libxml2-dev)
-    fi
 fi
 if [ ${#missing[@]} -gt 0 ]; then
     if can_apt; then
         echo "setup: installing ${missing[*]}"
         apt_install "${missing[@]}"
     else
-        echo "setup: please install ${missing[*]} (needed by the tests)" >&2
+        echo "setup: please install ${missing[*]} (needed by tests/test_hardening.py)" >&2
     fi
 fi
 # Windows x86-64 binaries (scripts/build_win64.sh) and their smoke test (tests/test_win64.py): Debian's

@@ -395,12 +395,13 @@ fn fmi_rs_validates_every_committed_fmi3_description() {
             .unwrap_or_else(|err| panic!("{}: fmi-rs cannot read {}: {err}", e.info.name, path.display()));
         let problems: Vec<String> = md.validate().into_iter().map(|p| format!("{p:?}")).collect();
         assert!(problems.is_empty(), "{}: {problems:?}", e.info.name);
-        // declared variables, time, and for Model Exchange each continuous state and its derivative
+        // declared variables, time, for Model Exchange each continuous state and its derivative, and
+        // each clock of a sampled unit
         let nx = e.state_decls().len();
         assert_eq!(
             md.modelVariables.len(),
-            e.decls.len() + 1 + 2 * nx,
-            "{}: declared variables + time + states + derivatives",
+            e.decls.len() + 1 + 2 * nx + e.clocks.len(),
+            "{}: declared variables + time + states + derivatives + clocks",
             e.info.name
         );
         assert_eq!(md.modelExchange.is_some(), e.model_exchange(), "{}", e.info.name);

@@ -65,7 +65,7 @@ def violations(found: dict, claimed: set[str]) -> list[str]:
 
 def test_ctypes_lives_where_contributing_says():
     claimed = claimed_ctypes_modules()
-    assert len(claimed) == 8, claimed  # the paragraph's list was read (a changed wording must not empty it)
+    assert len(claimed) == 9, claimed  # the paragraph's list was read (a changed wording must not empty it)
     assert violations(scan(ROOT), claimed) == []
 
 
@@ -151,7 +151,10 @@ def model_edit_problems(src: Path) -> list[str]:
     blind = []
     for entry in MODEL_BLIND:
         p = src.parent / entry
-        blind += [p] if p.is_file() else sorted(x for x in p.rglob("*.rs") if not (x.stem.endswith("_tests") or x.name == "tests.rs"))
+        # test code may use the project's models as data (a `tests/` folder, `*_tests.rs`, `tests.rs`)
+        blind += [p] if p.is_file() else sorted(
+            x for x in p.rglob("*.rs")
+            if not (x.stem.endswith("_tests") or x.name == "tests.rs" or "tests" in x.relative_to(p).parts[:-1]))
     for p in blind:
         code = _code(p.read_text())
         named = sorted(n for n in models if re.search(rf"\b{n}\b", code))

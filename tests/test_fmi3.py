@@ -81,6 +81,27 @@ def test_fmpy_validation_finds_no_problem(model):
     assert validate_fmu(fmu3(model)) == []
 
 
+def test_the_schema_check_is_not_blind_to_clocks(tmp_path):
+    """fmpy validates every description against the official FMI 3.0 XSD (test above); it refuses a
+    clocked description that breaks the schema: a <Clock> without its required intervalVariability, a
+    clocked output with an unknown variability."""
+    from fmpy.model_description import ValidationError
+
+    def read(xml: str):
+        path = tmp_path / "modelDescription.xml"
+        path.write_text(xml)
+        return read_model_description(str(path))
+
+    good = (ROOT / "modelDescription" / "fmi3" / "StarTracker.xml").read_text()
+    assert read(good).scheduledExecution is not None  # the committed one passes
+    broken = [good.replace(' intervalVariability="fixed"', "", 1),
+              good.replace('variability="discrete" clocks=', 'variability="sometimes" clocks=', 1)]
+    for xml in broken:
+        assert xml != good
+        with pytest.raises(ValidationError):
+            read(xml)
+
+
 @pytest.mark.parametrize("model", MODELS)
 def test_archive_layout_and_description(model):
     with zipfile.ZipFile(fmu3(model)) as z:
