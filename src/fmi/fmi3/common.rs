@@ -87,8 +87,15 @@ pub mod mask3 {
         ContinuousTimeMode,
         Activation,
     ]);
-    pub const DIRECTIONAL_DERIVATIVE: u16 =
-        m(&[InitializationMode, StepMode, Terminated, EventMode, ContinuousTimeMode]);
+    /// Clock Activation Mode included: the Scheduled Execution API allows it there.
+    pub const DIRECTIONAL_DERIVATIVE: u16 = m(&[
+        InitializationMode,
+        StepMode,
+        Terminated,
+        EventMode,
+        ContinuousTimeMode,
+        Activation,
+    ]);
     pub const DO_STEP: u16 = m(&[StepMode]);
     pub const OUTPUT_DERIVATIVES: u16 = m(&[StepMode, Terminated]);
 }
