@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::shared::{law_params, sampled_output, sampled_step, SampleCounter};
+use super::shared::{LAW_CLOCKS, law_params, sampled_output, sampled_step, SampleCounter};
 use crate::declare_variables;
 use super::shared::laws::PidLaw;
 use crate::model::{ClockDecl, Experiment, Feedthrough, Model, ModelInfo, ModelResult, SWITCH};
@@ -34,16 +34,7 @@ pub struct PidController {
 
 impl Model for PidController {
     type Vars = PidControllerVars;
-    const CLOCKS: &'static [ClockDecl] = &[
-        ClockDecl {
-            name: "sample_clock",
-            description: "Sample clock of the law: at each tick u is computed from the inputs and held; the error is appended to the history",
-            interval: "step",
-            shift: "",
-            steps: true,
-            outputs: &["u"],
-        },
-    ];
+    const CLOCKS: &'static [ClockDecl] = LAW_CLOCKS;
     fn time_grid(v: &PidControllerVars) -> Option<f64> {
         Some(v.step)
     }

@@ -7,6 +7,16 @@ use laws::{FopidLaw, FopidParams, PidLaw};
 
 pub use crate::math::sample_grid::SampleCounter;
 
+/// The one FMI 3.0 clock of the discrete PID and PI^lambda D^mu laws (their sample time `step`).
+pub const LAW_CLOCKS: &[crate::model::ClockDecl] = &[crate::model::ClockDecl {
+    name: "sample_clock",
+    description: "Sample clock of the law: at each tick u is computed from the inputs and held; the error is appended to the history",
+    interval: "step",
+    shift: "",
+    steps: true,
+    outputs: &["u"],
+}];
+
 /// Law parameters from the declared variables (the bounds were checked by the FMI layer).
 #[allow(clippy::too_many_arguments)]
 pub fn law_params(
